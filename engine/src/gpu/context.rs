@@ -1,0 +1,178 @@
+use anyhow::{Context, Result, anyhow};
+
+/// What to tell a user whose machine offers no adapter.
+pub const NO_ADAPTER_HELP: &str = "no GPU adapter found. Hush needs a Vulkan, Metal, DX12 or GL \
+driver; on a machine without a GPU install the software Vulkan driver (on Debian/Ubuntu: \
+`apt-get install mesa-vulkan-drivers`). WGPU_BACKEND (vulkan, metal, dx12, gl) and \
+WGPU_ADAPTER_NAME (a substring of the adapter's name) choose among several.";
+
+/// Features and limits a scene and its passes need. The device is created with exactly these,
+/// so a pass that would exceed them fails validation on every machine, not only on small GPUs.
+#[derive(Clone, Debug)]
+pub struct GpuRequirements {
+    pub features: wgpu::Features,
+    /// Largest storage buffer the scene binds, in bytes.
+    pub max_storage_buffer_binding_size: u64,
+    /// Storage buffers bound at once by the busiest compute stage.
+    pub max_storage_buffers_per_shader_stage: u32,
+}
+
+impl Default for GpuRequirements {
+    fn default() -> Self {
+        let d = wgpu::Limits::default();
+        Self {
+            features: wgpu::Features::empty(),
+            max_storage_buffer_binding_size: d.max_storage_buffer_binding_size as u64,
+            max_storage_buffers_per_shader_stage: d.max_storage_buffers_per_shader_stage,
+        }
+    }
+}
+
+impl GpuRequirements {
+    /// Raise to cover `other` too.
+    pub fn merge(&mut self, other: &GpuRequirements) {
+        self.features |= other.features;
+        self.max_storage_buffer_binding_size =
+            self.max_storage_buffer_binding_size.max(other.max_storage_buffer_binding_size);
+        self.max_storage_buffers_per_shader_stage = self
+            .max_storage_buffers_per_shader_stage
+            .max(other.max_storage_buffers_per_shader_stage);
+    }
+}
+
+/// A wgpu device and queue with the adapter they came from.
+pub struct Gpu {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    /// Whether timestamp queries were granted (used by benchmarks when the adapter has them).
+    pub timestamps: bool,
+}
+
+impl Gpu {
+    /// A device with no window: tests, the CLI, benchmarks.
+    pub fn headless(req: &GpuRequirements) -> Result<Gpu> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(choose_adapter(&instance, None))?;
+        Self::from_adapter(instance, adapter, req)
+    }
+
+    /// A device that can present to `surface` (created from `instance`).
+    pub fn for_surface(
+        instance: wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+        req: &GpuRequirements,
+    ) -> Result<Gpu> {
+        let adapter = pollster::block_on(choose_adapter(&instance, Some(surface)))?;
+        Self::from_adapter(instance, adapter, req)
+    }
+
+    fn from_adapter(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        req: &GpuRequirements,
+    ) -> Result<Gpu> {
+        let info = adapter.get_info();
+        let have = adapter.limits();
+        let mut limits = wgpu::Limits::default().using_resolution(have.clone());
+        limits.max_storage_buffer_binding_size =
+            limits.max_storage_buffer_binding_size.max(req.max_storage_buffer_binding_size);
+        limits.max_buffer_size = limits.max_buffer_size.max(req.max_storage_buffer_binding_size);
+        limits.max_storage_buffers_per_shader_stage = limits
+            .max_storage_buffers_per_shader_stage
+            .max(req.max_storage_buffers_per_shader_stage);
+        if limits.max_storage_buffer_binding_size > have.max_storage_buffer_binding_size
+            || limits.max_storage_buffers_per_shader_stage > have.max_storage_buffers_per_shader_stage
+        {
+            return Err(anyhow!(
+                "adapter {:?} cannot hold this scene: it needs storage buffers of {} bytes \
+                 ({} bound at once); the adapter allows {} bytes ({} at once). Try a smaller \
+                 scene or a smaller texture budget (--max-texture-size)",
+                info.name,
+                req.max_storage_buffer_binding_size,
+                req.max_storage_buffers_per_shader_stage,
+                have.max_storage_buffer_binding_size,
+                have.max_storage_buffers_per_shader_stage
+            ));
+        }
+        let mut features = req.features;
+        // Timestamps are optional: benchmarks use them where the adapter has them.
+        let ts = wgpu::Features::TIMESTAMP_QUERY;
+        let timestamps = adapter.features().contains(ts);
+        if timestamps {
+            features |= ts;
+        }
+        let missing = features - adapter.features();
+        if !missing.is_empty() {
+            return Err(anyhow!("adapter {:?} lacks the features {missing:?}", info.name));
+        }
+        log::info!(
+            "adapter: {} ({:?}, {:?}); features requested: {:?}; limits raised above the WebGPU \
+             defaults: max_storage_buffer_binding_size={} max_buffer_size={} \
+             max_storage_buffers_per_shader_stage={}",
+            info.name,
+            info.device_type,
+            info.backend,
+            features,
+            limits.max_storage_buffer_binding_size,
+            limits.max_buffer_size,
+            limits.max_storage_buffers_per_shader_stage
+        );
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("hush"),
+            required_features: features,
+            required_limits: limits,
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .with_context(|| format!("requesting a device from adapter {:?}", info.name))?;
+        device.on_uncaptured_error(std::sync::Arc::new(|e| {
+            log::error!("wgpu: {e}");
+        }));
+        Ok(Gpu { instance, adapter, device, queue, info, timestamps })
+    }
+
+    /// Block until all submitted work has finished.
+    pub fn wait(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| anyhow!("waiting for the GPU: {e}"))
+    }
+}
+
+/// Honour `WGPU_ADAPTER_NAME` (a case-insensitive substring) and `WGPU_POWER_PREF`, as wgpu's
+/// own tools do, without panicking when the name matches nothing.
+async fn choose_adapter(
+    instance: &wgpu::Instance,
+    surface: Option<&wgpu::Surface<'_>>,
+) -> Result<wgpu::Adapter> {
+    if let Ok(name) = std::env::var("WGPU_ADAPTER_NAME") {
+        let want = name.to_lowercase();
+        let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+        let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+        for a in adapters {
+            let ok = a.get_info().name.to_lowercase().contains(&want)
+                && surface.is_none_or(|s| a.is_surface_supported(s));
+            if ok {
+                return Ok(a);
+            }
+        }
+        return Err(anyhow!(
+            "WGPU_ADAPTER_NAME={name:?} matches none of the adapters {names:?}; {NO_ADAPTER_HELP}"
+        ));
+    }
+    instance
+        .request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::from_env().unwrap_or_default(),
+            compatible_surface: surface,
+            force_fallback_adapter: false,
+            ..Default::default()
+        })
+        .await
+        .map_err(|e| anyhow!("{NO_ADAPTER_HELP} ({e})"))
+}

@@ -1,0 +1,365 @@
+//! The CPU half of uploading a scene: flatten objects into world-space triangles rebased around
+//! the scene's centre, build the BVH, pack materials, lights, emitters, the environment and
+//! textures into the layouts the shaders read (`shaders/common/*.wgsl`).
+
+use crate::accel::{self, Accel, BvhKind};
+use crate::scene::{AlphaMode, Environment, Light, Scene, Wrap};
+use anyhow::{Result, bail};
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat3, DVec3, Vec3, Vec3A, Vec4};
+use obvhs::triangle::Triangle;
+
+/// Which optional parts of the renderer a scene needs. Each one missing removes its bindings,
+/// its buffers and its code from the programs (`*_none.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneFeatures {
+    pub punctual_lights: bool,
+    pub emitters: bool,
+    pub env: EnvKind,
+    pub textures: bool,
+    pub normal_maps: bool,
+    pub alpha_mask: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvKind {
+    None,
+    Constant,
+    Map,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub base_color: [f32; 4],
+    pub emission: [f32; 3],
+    pub metallic: f32,
+    pub specular_color: [f32; 3],
+    pub roughness: f32,
+    pub specular_factor: f32,
+    pub alpha_cutoff: f32,
+    pub normal_scale: f32,
+    pub flags: u32,
+    pub tex: [i32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLight {
+    pub pos: [f32; 3],
+    pub kind: u32,
+    pub dir: [f32; 3],
+    pub cos_outer: f32,
+    pub intensity: [f32; 3],
+    pub cos_inner: f32,
+}
+
+pub const MAT_DOUBLE_SIDED: u32 = 1;
+pub const MAT_ALPHA_MASK: u32 = 2;
+
+/// Everything ready for upload, with no GPU involved (so limits can be computed before a device
+/// is requested, and so tests can inspect it).
+pub struct PreparedScene {
+    pub features: SceneFeatures,
+    pub accel: Accel,
+    /// World position the GPU scene is relative to.
+    pub origin: DVec3,
+    /// Length of the bounds' diagonal (scene units).
+    pub extent: f64,
+    pub tris: Vec<Vec4>,
+    pub shading: Vec<Vec4>,
+    pub tangents: Vec<Vec4>,
+    pub materials: Vec<GpuMaterial>,
+    pub lights: Vec<GpuLight>,
+    /// (cumulative probability bits, triangle slot).
+    pub emitters: Vec<[u32; 2]>,
+    /// 1 / sum(area x luminance(emission)).
+    pub emit_inv_total: f32,
+    pub env_data: Vec<f32>,
+    pub env_radiance: Vec3,
+    /// width, height, marginal offset, conditional offset.
+    pub env_size: [u32; 4],
+    pub env_rotation_y_degrees: f32,
+    /// W H / (sum(luminance x sin theta) 2 pi^2).
+    pub env_pdf_norm: f32,
+    pub tex_data: Vec<u32>,
+    /// Input triangles dropped: non-finite vertices or zero area.
+    pub dropped_triangles: usize,
+}
+
+/// Triangle slots and node indices share 24 bits in the BVH2 traversal stack.
+pub const MAX_TRIANGLES: usize = 1 << 24;
+
+impl PreparedScene {
+    pub fn new(scene: &Scene, kind: BvhKind) -> Result<PreparedScene> {
+        let origin = scene.origin();
+        let extent = scene.bounds().map(|(lo, hi)| (hi - lo).length()).filter(|e| *e > 0.0).unwrap_or(1.0);
+        let mut tris_in: Vec<Triangle> = vec![];
+        let mut attrs: Vec<[Vec4; 4]> = vec![];
+        let mut tans: Vec<[Vec4; 3]> = vec![];
+        let mut mats: Vec<u32> = vec![];
+        let mut dropped = 0usize;
+        let normal_maps = scene.materials.iter().any(|m| m.normal_texture.is_some());
+        for o in &scene.objects {
+            let mesh = &scene.meshes[o.mesh];
+            let m3 = DMat3::from_mat4(o.transform);
+            let flip = m3.determinant() < 0.0;
+            let nmat = m3.inverse().transpose();
+            let mat = if (mesh.material as usize) < scene.materials.len() { mesh.material } else { 0 };
+            for t in mesh.indices.chunks_exact(3) {
+                // A mirroring transform reverses the winding; swap to keep the front face CCW.
+                let idx = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
+                let p = idx.map(|i| (o.transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin).as_vec3());
+                let area2 = (p[1] - p[0]).cross(p[2] - p[0]).length();
+                if !p.iter().all(|v| v.is_finite()) || !(area2 > 0.0) || !area2.is_finite() {
+                    dropped += 1;
+                    continue;
+                }
+                tris_in.push(Triangle { v0: p[0].into(), v1: p[1].into(), v2: p[2].into() });
+                let n = idx.map(|i| {
+                    let n = mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+                    let n = (nmat * n.as_dvec3()).normalize_or_zero().as_vec3();
+                    if n.is_finite() { n } else { Vec3::ZERO }
+                });
+                let uv = idx.map(|i| {
+                    let uv = mesh.uvs.get(i as usize).copied().unwrap_or_default();
+                    if uv.is_finite() { uv } else { glam::Vec2::ZERO }
+                });
+                attrs.push([
+                    n[0].extend(uv[0].x),
+                    n[1].extend(uv[1].x),
+                    n[2].extend(uv[2].x),
+                    Vec4::new(uv[0].y, uv[1].y, uv[2].y, 0.0),
+                ]);
+                if normal_maps {
+                    tans.push(idx.map(|i| {
+                        let t = mesh.tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
+                        let xyz = (m3 * t.truncate().as_dvec3()).normalize_or_zero().as_vec3();
+                        let w = if flip { -t.w } else { t.w };
+                        if xyz.is_finite() { xyz.extend(w) } else { Vec4::new(1.0, 0.0, 0.0, 1.0) }
+                    }));
+                }
+                mats.push(mat);
+            }
+        }
+        if tris_in.len() >= MAX_TRIANGLES {
+            bail!("{} triangles: Hush handles at most {} per scene", tris_in.len(), MAX_TRIANGLES - 1);
+        }
+        if dropped > 0 {
+            log::warn!("dropped {dropped} triangles with non-finite vertices or zero area");
+        }
+        let accel = accel::build(&tris_in, kind);
+        let mut tris = Vec::with_capacity(tris_in.len() * 3);
+        let mut shading = Vec::with_capacity(tris_in.len() * 4);
+        let mut tangents = vec![];
+        for &orig in &accel.order {
+            let (t, i) = (&tris_in[orig as usize], orig as usize);
+            let v = |a: Vec3A| Vec3::from(a);
+            tris.push(v(t.v0).extend(f32::from_bits(mats[i])));
+            tris.push(v(t.v1).extend(f32::from_bits(orig)));
+            tris.push(v(t.v2).extend(0.0));
+            shading.extend_from_slice(&attrs[i]);
+            if normal_maps {
+                tangents.extend_from_slice(&tans[i]);
+            }
+        }
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| {
+                let t = |r: Option<crate::scene::TextureRef>| r.map(|r| r.index as i32).unwrap_or(-1);
+                let (mask, cutoff) = match m.alpha_mode {
+                    AlphaMode::Opaque => (0, 0.0),
+                    AlphaMode::Mask(c) => (MAT_ALPHA_MASK, c),
+                };
+                GpuMaterial {
+                    base_color: m.base_color.to_array(),
+                    emission: m.emission.to_array(),
+                    metallic: m.metallic,
+                    specular_color: m.specular_color.to_array(),
+                    roughness: m.roughness,
+                    specular_factor: m.specular_factor,
+                    alpha_cutoff: cutoff,
+                    normal_scale: m.normal_scale,
+                    flags: mask | if m.double_sided { MAT_DOUBLE_SIDED } else { 0 },
+                    tex: [t(m.base_color_texture), t(m.metallic_roughness_texture), t(m.normal_texture), t(m.emissive_texture)],
+                }
+            })
+            .collect();
+        let lights: Vec<GpuLight> = scene.lights.iter().map(|l| pack_light(l, origin)).collect();
+
+        // Emissive triangles by area x luminance (one-sided power up to a constant pi).
+        let mut emitters = vec![];
+        let mut weights = vec![];
+        for (slot, &orig) in accel.order.iter().enumerate() {
+            let m = &scene.materials[mats[orig as usize] as usize];
+            let lum = crate::quality::luminance(m.emission);
+            if lum > 0.0 {
+                let t = &tris_in[orig as usize];
+                let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
+                weights.push(area * lum as f64);
+                emitters.push([0u32, slot as u32]);
+            }
+        }
+        let total: f64 = weights.iter().sum();
+        let mut acc = 0.0;
+        for (e, w) in emitters.iter_mut().zip(&weights) {
+            acc += w;
+            e[0] = ((acc / total) as f32).to_bits();
+        }
+        if let Some(last) = emitters.last_mut() {
+            last[0] = 1.0f32.to_bits();
+        }
+        let emit_inv_total = if total > 0.0 { (1.0 / total) as f32 } else { 0.0 };
+
+        let mut env = EnvPack::default();
+        let env_kind = match &scene.environment {
+            Environment::None => EnvKind::None,
+            Environment::Constant(c) if c.max_element() > 0.0 => {
+                env.radiance = *c;
+                EnvKind::Constant
+            }
+            Environment::Constant(_) => EnvKind::None,
+            Environment::Map(map) => {
+                if env.pack_map(map) { EnvKind::Map } else { EnvKind::None }
+            }
+        };
+        let tex_data = pack_textures(scene);
+        let alpha_mask = scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_)));
+        let features = SceneFeatures {
+            punctual_lights: !lights.is_empty(),
+            emitters: !emitters.is_empty(),
+            env: env_kind,
+            textures: !scene.textures.is_empty(),
+            normal_maps,
+            alpha_mask,
+        };
+        Ok(PreparedScene {
+            features,
+            accel,
+            origin,
+            extent,
+            tris,
+            shading,
+            tangents,
+            materials,
+            lights,
+            emitters,
+            emit_inv_total,
+            env_data: env.data,
+            env_radiance: env.radiance,
+            env_size: env.size,
+            env_rotation_y_degrees: env.rotation,
+            env_pdf_norm: env.pdf_norm,
+            tex_data,
+            dropped_triangles: dropped,
+        })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.tris.len() / 3
+    }
+
+    /// The ray-offset epsilon of `offset_ray` in `shaders/common/math.wgsl`: 2^-17 of the extent.
+    pub fn ray_epsilon(&self) -> f32 {
+        (self.extent * 2f64.powi(-17)) as f32
+    }
+}
+
+fn pack_light(l: &Light, origin: DVec3) -> GpuLight {
+    match *l {
+        Light::Directional { direction, irradiance } => GpuLight {
+            pos: [0.0; 3],
+            kind: 0,
+            dir: direction.normalize_or(Vec3::NEG_Y).to_array(),
+            cos_outer: 0.0,
+            intensity: irradiance.to_array(),
+            cos_inner: 0.0,
+        },
+        Light::Point { position, intensity } => GpuLight {
+            pos: (position - origin).as_vec3().to_array(),
+            kind: 1,
+            dir: [0.0, 0.0, -1.0],
+            cos_outer: 0.0,
+            intensity: intensity.to_array(),
+            cos_inner: 0.0,
+        },
+        Light::Spot { position, direction, intensity, inner_cone, outer_cone } => GpuLight {
+            pos: (position - origin).as_vec3().to_array(),
+            kind: 2,
+            dir: direction.normalize_or(Vec3::NEG_Z).to_array(),
+            cos_outer: outer_cone.cos(),
+            intensity: intensity.to_array(),
+            cos_inner: inner_cone.cos(),
+        },
+    }
+}
+
+#[derive(Default)]
+struct EnvPack {
+    data: Vec<f32>,
+    radiance: Vec3,
+    size: [u32; 4],
+    rotation: f32,
+    pdf_norm: f32,
+}
+
+impl EnvPack {
+    /// Texels, marginal CDF over rows, conditional CDFs over columns of luminance x sin(theta).
+    /// Returns false for a map with no energy (rendered as no environment).
+    fn pack_map(&mut self, map: &crate::scene::EnvMap) -> bool {
+        let (w, h) = (map.width as usize, map.height as usize);
+        let mut data: Vec<f32> = map.rgb.iter().flat_map(|c| c.to_array()).collect();
+        let moff = data.len();
+        let coff = moff + h + 1;
+        let mut rows = vec![0f64; h];
+        let mut cond = vec![0f32; h * (w + 1)];
+        for r in 0..h {
+            let s = (std::f64::consts::PI * (r as f64 + 0.5) / h as f64).sin();
+            let mut acc = 0f64;
+            let f: Vec<f64> = (0..w).map(|c| crate::quality::luminance(map.rgb[r * w + c]) as f64 * s).collect();
+            let sum: f64 = f.iter().sum();
+            for c in 0..w {
+                acc += f[c];
+                cond[r * (w + 1) + c + 1] = if sum > 0.0 { (acc / sum) as f32 } else { (c + 1) as f32 / w as f32 };
+            }
+            cond[r * (w + 1) + w] = 1.0;
+            rows[r] = sum;
+        }
+        let total: f64 = rows.iter().sum();
+        if !(total > 0.0) || !total.is_finite() {
+            log::warn!("environment map carries no light; rendering without it");
+            return false;
+        }
+        data.push(0.0);
+        let mut acc = 0f64;
+        for r in 0..h {
+            acc += rows[r];
+            data.push(if r + 1 == h { 1.0 } else { (acc / total) as f32 });
+        }
+        data.extend_from_slice(&cond);
+        self.data = data;
+        self.size = [w as u32, h as u32, moff as u32, coff as u32];
+        self.rotation = map.rotation_y_degrees;
+        self.pdf_norm = ((w * h) as f64 / (total * 2.0 * std::f64::consts::PI.powi(2))) as f32;
+        true
+    }
+}
+
+fn pack_textures(scene: &Scene) -> Vec<u32> {
+    let n = scene.textures.len();
+    let mut data = vec![0u32; n * 4];
+    for (i, t) in scene.textures.iter().enumerate() {
+        let wrap = |w: Wrap| match w {
+            Wrap::Repeat => 0u32,
+            Wrap::Clamp => 1,
+            Wrap::Mirror => 2,
+        };
+        data[i * 4] = data.len() as u32;
+        data[i * 4 + 1] = t.width;
+        data[i * 4 + 2] = t.height;
+        data[i * 4 + 3] = (t.srgb as u32) | (wrap(t.wrap_s) << 1) | (wrap(t.wrap_t) << 3);
+        data.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
+    }
+    data
+}

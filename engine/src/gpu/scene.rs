@@ -1,0 +1,180 @@
+//! A scene on the GPU: the buffers of a [`PreparedScene`] and what they cost.
+
+use super::prepare::{EnvKind, PreparedScene, SceneFeatures};
+use super::{Gpu, GpuMemory, GpuRequirements};
+use crate::accel::BvhKind;
+
+pub struct GpuScene {
+    pub features: SceneFeatures,
+    pub bvh_kind: BvhKind,
+    pub nodes: wgpu::Buffer,
+    pub tris: wgpu::Buffer,
+    pub shading: wgpu::Buffer,
+    pub materials: wgpu::Buffer,
+    pub lights: Option<wgpu::Buffer>,
+    pub emitters: Option<wgpu::Buffer>,
+    pub env: Option<wgpu::Buffer>,
+    pub textures: Option<wgpu::Buffer>,
+    pub tangents: Option<wgpu::Buffer>,
+    pub memory: GpuMemory,
+}
+
+/// Binding numbers shared by every program that reads the scene (`shaders/common`).
+pub mod binding {
+    pub const PARAMS: u32 = 0;
+    pub const NODES: u32 = 1;
+    pub const TRIS: u32 = 2;
+    pub const SHADING: u32 = 3;
+    pub const MATERIALS: u32 = 4;
+    pub const LIGHTS: u32 = 6;
+    pub const EMITTERS: u32 = 7;
+    pub const ENV: u32 = 8;
+    pub const TEXTURES: u32 = 9;
+    pub const TANGENTS: u32 = 10;
+}
+
+impl PreparedScene {
+    /// Storage buffers the reference tracer binds, and the largest of them (plus `extra` bytes of
+    /// per-pixel output), for [`Gpu::headless`].
+    pub fn requirements(&self, output_bytes: u64) -> GpuRequirements {
+        let f = &self.features;
+        let sizes = [
+            self.accel.nodes.len() as u64,
+            (self.tris.len() * 16) as u64,
+            (self.shading.len() * 16) as u64,
+            (self.tangents.len() * 16) as u64,
+            (self.env_data.len() * 4) as u64,
+            (self.tex_data.len() * 4) as u64,
+            output_bytes,
+        ];
+        let count = 5
+            + f.punctual_lights as u32
+            + f.emitters as u32
+            + (f.env == EnvKind::Map) as u32
+            + f.textures as u32
+            + f.normal_maps as u32;
+        let d = GpuRequirements::default();
+        GpuRequirements {
+            features: wgpu::Features::empty(),
+            max_storage_buffer_binding_size: sizes.into_iter().max().unwrap_or(0).max(d.max_storage_buffer_binding_size),
+            max_storage_buffers_per_shader_stage: count.max(d.max_storage_buffers_per_shader_stage),
+        }
+    }
+
+    pub fn upload(&self, gpu: &Gpu) -> GpuScene {
+        let mut mem = GpuMemory::default();
+        let s = wgpu::BufferUsages::STORAGE;
+        let d = &gpu.device;
+        fn b<T: bytemuck::Pod>(v: &[T]) -> &[u8] {
+            bytemuck::cast_slice(v)
+        }
+        let f = self.features;
+        let nodes = mem.buffer_init(d, "scene/bvh nodes", &self.accel.nodes, s);
+        let tris = mem.buffer_init(d, "scene/triangles", b(&self.tris), s);
+        let shading = mem.buffer_init(d, "scene/shading", b(&self.shading), s);
+        let materials = mem.buffer_init(d, "scene/materials", b(&self.materials), s);
+        let lights = f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), s));
+        let emitters = f.emitters.then(|| mem.buffer_init(d, "scene/emitters", b(&self.emitters), s));
+        let env = (f.env == EnvKind::Map).then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), s));
+        let textures = f.textures.then(|| mem.buffer_init(d, "scene/textures", b(&self.tex_data), s));
+        let tangents = f.normal_maps.then(|| mem.buffer_init(d, "scene/tangents", b(&self.tangents), s));
+        log::info!(
+            "scene on the GPU: {} triangles, {} BVH nodes ({}), features {:?}, {} bytes: {}",
+            self.triangle_count(),
+            self.accel.node_count,
+            self.accel.kind.name(),
+            f,
+            mem.total_bytes(),
+            mem.allocations.iter().map(|(l, b)| format!("{l}={b}")).collect::<Vec<_>>().join(" ")
+        );
+        GpuScene {
+            features: f,
+            bvh_kind: self.accel.kind,
+            nodes,
+            tris,
+            shading,
+            materials,
+            lights,
+            emitters,
+            env,
+            textures,
+            tangents,
+            memory: mem,
+        }
+    }
+}
+
+pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl GpuScene {
+    /// (binding, buffer) of the whole scene, for programs that shade (the tracer).
+    pub fn shading_bindings(&self) -> Vec<(u32, &wgpu::Buffer)> {
+        use binding::*;
+        let mut v = vec![(NODES, &self.nodes), (TRIS, &self.tris), (SHADING, &self.shading), (MATERIALS, &self.materials)];
+        let opt = [(LIGHTS, &self.lights), (EMITTERS, &self.emitters), (ENV, &self.env), (TEXTURES, &self.textures), (TANGENTS, &self.tangents)];
+        for (b, buf) in opt {
+            if let Some(buf) = buf {
+                v.push((b, buf));
+            }
+        }
+        v
+    }
+
+    /// Program modules that match this scene's features, for a program that shades.
+    pub fn shading_modules(&self) -> Vec<&'static str> {
+        let f = &self.features;
+        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl"];
+        m.push(if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" });
+        m.push(if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" });
+        m.push(if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" });
+        m.push(if f.punctual_lights { "common/lights.wgsl" } else { "common/lights_none.wgsl" });
+        m.push(if f.emitters { "common/emitters.wgsl" } else { "common/emitters_none.wgsl" });
+        m.push(match f.env {
+            EnvKind::None => "common/env_none.wgsl",
+            EnvKind::Constant => "common/env_constant.wgsl",
+            EnvKind::Map => "common/env_map.wgsl",
+        });
+        m
+    }
+
+    pub fn traversal_module(&self) -> &'static str {
+        match self.bvh_kind {
+            BvhKind::Bvh2 => "common/bvh2.wgsl",
+            BvhKind::Cwbvh => "common/cwbvh.wgsl",
+        }
+    }
+
+    /// `const` flags the shading modules branch on.
+    pub fn prelude(&self) -> String {
+        let f = &self.features;
+        format!(
+            "const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n",
+            f.emitters,
+            f.env != EnvKind::None
+        )
+    }
+}

@@ -1,0 +1,15 @@
+//! Hush: a real-time path-tracing renderer. This crate holds everything that renders; windows and
+//! UI live in the `hush` viewer, command-line tools in `hush-cli`.
+//!
+//! Data flows one way: file -> [`scene`] (CPU) -> GPU scene ([`accel`], [`passes`]) -> image
+//! ([`quality`] for metrics and files).
+
+pub mod accel;
+pub mod gpu;
+pub mod passes;
+pub mod quality;
+pub mod scene;
+pub mod settings;
+pub mod shader;
+
+pub use settings::Settings;

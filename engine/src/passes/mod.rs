@@ -1,0 +1,7 @@
+//! Passes: each owns its pipelines and outputs and records itself.
+
+pub mod raycast;
+pub mod reference;
+
+pub use raycast::{RayHit, Raycaster};
+pub use reference::{Accumulation, ReferenceTracer, TraceView};

@@ -1,0 +1,211 @@
+//! `reference/trace`: the progressive reference path tracer (shaders/reference/trace.wgsl).
+
+use crate::gpu::scene::{storage_entry, uniform_entry};
+use crate::gpu::{Gpu, GpuMemory, GpuScene, PreparedScene, readback_buffer};
+use crate::quality::Image;
+use crate::scene::Camera;
+use anyhow::{Result, bail};
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Vec3};
+
+pub const LABEL: &str = "reference/trace";
+
+/// Mirror of `Params` in shaders/reference/params.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TraceParams {
+    pub width: u32,
+    pub height: u32,
+    pub sample_index: u32,
+    pub seed: u32,
+    pub max_depth: i32,
+    pub rr_depth: i32,
+    pub num_lights: u32,
+    pub num_emitters: u32,
+    pub cam_pos: [f32; 4],
+    pub cam_right: [f32; 4],
+    pub cam_up: [f32; 4],
+    pub cam_fwd: [f32; 4],
+    pub env_radiance: [f32; 4],
+    pub env_rot: [f32; 4],
+    pub env_size: [u32; 4],
+    pub emit: [f32; 4],
+}
+
+/// What to render: the camera, image size and path settings.
+#[derive(Clone, Copy, Debug)]
+pub struct TraceView {
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+    /// Mitsuba's max_depth (-1 = unbounded).
+    pub max_depth: i32,
+    pub seed: u32,
+}
+
+/// Russian roulette starts after this many segments (Mitsuba's rr_depth).
+pub const RR_DEPTH: i32 = 5;
+
+/// The mean image and what is known of its noise.
+pub struct Accumulation {
+    pub samples: u32,
+    pub mean: Image,
+    /// Per-pixel variance of the mean (sample variance / N), per channel.
+    pub variance_of_mean: Image,
+    /// Samples that came out NaN or Inf and were dropped (should be 0).
+    pub nonfinite_samples: u64,
+}
+
+pub struct ReferenceTracer {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    params_buf: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    params: TraceParams,
+    pub samples: u32,
+    pub memory: GpuMemory,
+}
+
+/// Largest image side the tracer accepts (one dispatch covers it).
+pub const MAX_SIDE: u32 = 16384;
+
+impl ReferenceTracer {
+    pub fn new(gpu: &Gpu, prepared: &PreparedScene, scene: &GpuScene, view: &TraceView) -> Result<ReferenceTracer> {
+        let (w, h) = (view.width, view.height);
+        if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+            bail!("image size {w}x{h} is out of range (1..={MAX_SIDE} per side)");
+        }
+        let mut modules = scene.shading_modules();
+        modules.extend(["reference/params.wgsl", "reference/trace.wgsl"]);
+        let program = crate::shader::compose(LABEL, &scene.prelude(), &modules)?;
+        let module = program.create(&gpu.device)?;
+        let mut memory = GpuMemory::default();
+        let accum = memory.buffer(
+            &gpu.device,
+            "reference/accumulation",
+            w as u64 * h as u64 * 32,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        );
+        let params_buf = memory.buffer(
+            &gpu.device,
+            "reference/params",
+            std::mem::size_of::<TraceParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let scene_bindings = scene.shading_bindings();
+        let mut entries = vec![uniform_entry(0), storage_entry(5, false)];
+        entries.extend(scene_bindings.iter().map(|(b, _)| storage_entry(*b, true)));
+        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(LABEL), entries: &entries });
+        let mut bg = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: params_buf.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 5, resource: accum.as_entire_binding() },
+        ];
+        bg.extend(scene_bindings.iter().map(|(b, buf)| wgpu::BindGroupEntry { binding: *b, resource: buf.as_entire_binding() }));
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(LABEL), layout: &layout, entries: &bg });
+        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(LABEL),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(LABEL),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let params = make_params(prepared, view);
+        Ok(ReferenceTracer { pipeline, bind_group, params_buf, accum, params, samples: 0, memory })
+    }
+
+    /// Start over (new camera or settings).
+    pub fn reset(&mut self, gpu: &Gpu, prepared: &PreparedScene, view: &TraceView) {
+        let (w, h) = (self.params.width, self.params.height);
+        self.params = make_params(prepared, view);
+        self.params.width = w;
+        self.params.height = h;
+        self.samples = 0;
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.accum, 0, None);
+        gpu.queue.submit([enc.finish()]);
+    }
+
+    /// Record `count` one-sample-per-pixel dispatches; returns after submitting them.
+    pub fn dispatch(&mut self, gpu: &Gpu, count: u32) {
+        for _ in 0..count {
+            self.params.sample_index = self.samples;
+            gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
+            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: None });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.bind_group, &[]);
+                pass.dispatch_workgroups(self.params.width.div_ceil(8), self.params.height.div_ceil(8), 1);
+            }
+            gpu.queue.submit([enc.finish()]);
+            self.samples += 1;
+        }
+    }
+
+    /// The accumulation buffer (two vec4 per pixel: sum, sum of squares + dropped count).
+    pub fn accumulation_buffer(&self) -> &wgpu::Buffer {
+        &self.accum
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.params.width, self.params.height)
+    }
+
+    pub fn readback(&self, gpu: &Gpu) -> Result<Accumulation> {
+        let (w, h) = self.size();
+        let bytes = readback_buffer(&gpu.device, &gpu.queue, &self.accum, w as u64 * h as u64 * 32)?;
+        let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let n = self.samples.max(1) as f32;
+        let mut mean = Image::new(w, h);
+        let mut var = Image::new(w, h);
+        let mut bad = 0u64;
+        for i in 0..(w * h) as usize {
+            let s = Vec3::from_slice(&v[i * 2]);
+            let s2 = Vec3::from_slice(&v[i * 2 + 1]);
+            let m = s / n;
+            mean.data[i] = m;
+            let sample_var = ((s2 / n - m * m) * (n / (n - 1.0).max(1.0))).max(Vec3::ZERO);
+            var.data[i] = sample_var / n;
+            bad += v[i * 2 + 1][3] as u64;
+        }
+        Ok(Accumulation { samples: self.samples, mean, variance_of_mean: var, nonfinite_samples: bad })
+    }
+}
+
+fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
+    let cam = &view.camera;
+    let m = cam.world;
+    let pos = (m.transform_point3(DVec3::ZERO) - p.origin).as_vec3();
+    let x = m.transform_vector3(DVec3::X).normalize_or_zero().as_vec3();
+    let y = m.transform_vector3(DVec3::Y).normalize_or_zero().as_vec3();
+    let z = m.transform_vector3(DVec3::Z).normalize_or_zero().as_vec3();
+    let fov = if cam.yfov.is_finite() { cam.yfov.clamp(1e-4, 3.1) } else { 0.8 };
+    let th = (fov * 0.5).tan();
+    let aspect = view.width as f32 / view.height as f32;
+    let rot = p.env_rotation_y_degrees.to_radians();
+    let f = &p.features;
+    TraceParams {
+        width: view.width,
+        height: view.height,
+        sample_index: 0,
+        seed: view.seed,
+        max_depth: view.max_depth,
+        rr_depth: RR_DEPTH,
+        num_lights: p.lights.len() as u32,
+        num_emitters: p.emitters.len() as u32,
+        cam_pos: pos.extend(p.ray_epsilon()).to_array(),
+        cam_right: (x * th * aspect).extend(0.0).to_array(),
+        cam_up: (y * th).extend(0.0).to_array(),
+        cam_fwd: (-z).extend(0.0).to_array(),
+        env_radiance: p.env_radiance.extend(0.0).to_array(),
+        env_rot: [rot.cos(), rot.sin(), p.env_pdf_norm, 0.0],
+        env_size: p.env_size,
+        emit: [if f.emitters { p.emit_inv_total } else { 0.0 }, 0.0, 0.0, 0.0],
+    }
+}

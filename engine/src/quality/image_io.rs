@@ -1,0 +1,130 @@
+use anyhow::{Context, Result, anyhow, bail};
+use glam::Vec3;
+use std::path::Path;
+
+/// A linear HDR RGB image, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub data: Vec<Vec3>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Image {
+        Image { width, height, data: vec![Vec3::ZERO; (width * height) as usize] }
+    }
+
+    pub fn at(&self, x: u32, y: u32) -> Vec3 {
+        self.data[(y * self.width + x) as usize]
+    }
+
+    pub fn load(path: &Path) -> Result<Image> {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_lowercase();
+        if ext == "exr" {
+            let (width, height, data) = read_exr(path)?;
+            return Ok(Image { width, height, data });
+        }
+        let img = image::open(path).with_context(|| format!("reading {}", path.display()))?.to_rgb32f();
+        // 8-bit files hold display values: undo the sRGB curve so metrics compare radiance.
+        let data = img
+            .pixels()
+            .map(|p| Vec3::new(srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2])))
+            .collect();
+        Ok(Image { width: img.width(), height: img.height(), data })
+    }
+
+    pub fn save(&self, path: &Path) -> Result<()> {
+        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_lowercase()).as_deref() {
+            Some("exr") => write_exr(path, self),
+            Some("png") => write_png(path, self),
+            _ => bail!("{}: output must end in .exr or .png", path.display()),
+        }
+    }
+
+    /// Mean of `factor` x `factor` blocks (a box filter): how a low-resolution render of the same
+    /// view relates to a high-resolution reference.
+    pub fn box_downsample(&self, factor: u32) -> Result<Image> {
+        if factor == 0 || self.width % factor != 0 || self.height % factor != 0 {
+            bail!("cannot box-downsample {}x{} by {factor}", self.width, self.height);
+        }
+        let (w, h) = (self.width / factor, self.height / factor);
+        let mut out = Image::new(w, h);
+        let inv = 1.0 / (factor * factor) as f32;
+        for y in 0..h {
+            for x in 0..w {
+                let mut s = Vec3::ZERO;
+                for j in 0..factor {
+                    for i in 0..factor {
+                        s += self.at(x * factor + i, y * factor + j);
+                    }
+                }
+                out.data[(y * w + x) as usize] = s * inv;
+            }
+        }
+        Ok(out)
+    }
+
+    pub fn nonfinite_pixels(&self) -> usize {
+        self.data.iter().filter(|p| !p.is_finite()).count()
+    }
+
+    pub fn mean(&self) -> Vec3 {
+        let s: glam::DVec3 = self.data.iter().map(|p| p.as_dvec3()).sum();
+        (s / self.data.len().max(1) as f64).as_vec3()
+    }
+}
+
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
+    use exr::prelude::*;
+    let img = read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+        |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
+        },
+    )
+    .map_err(|e| anyhow!("reading EXR {}: {e}", path.display()))?;
+    let size = img.layer_data.size;
+    let (_, data) = img.layer_data.channel_data.pixels;
+    Ok((size.width() as u32, size.height() as u32, data))
+}
+
+/// Linear HDR RGB, 32-bit float.
+pub fn write_exr(path: &Path, img: &Image) -> Result<()> {
+    let w = img.width as usize;
+    exr::prelude::write_rgb_file(path, w, img.height as usize, |x, y| {
+        let p = img.data[y * w + x];
+        (p.x, p.y, p.z)
+    })
+    .map_err(|e| anyhow!("writing EXR {}: {e}", path.display()))
+}
+
+/// Tone-mapped sRGB PNG (see [`tonemap_srgb8`]).
+pub fn write_png(path: &Path, img: &Image) -> Result<()> {
+    let buf = image::RgbImage::from_raw(img.width, img.height, tonemap_srgb8(img))
+        .ok_or_else(|| anyhow!("image size mismatch"))?;
+    buf.save(path).with_context(|| format!("writing PNG {}", path.display()))
+}
+
+/// ACES filmic curve (Narkowicz 2015 fit) then the sRGB transfer function. Non-finite pixels
+/// become black.
+pub fn tonemap_srgb8(img: &Image) -> Vec<u8> {
+    let aces = |x: f32| {
+        let x = if x.is_finite() { x.max(0.0) } else { 0.0 };
+        ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+    };
+    img.data
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .map(|c| (linear_to_srgb(aces(c)) * 255.0 + 0.5) as u8)
+        .collect()
+}
+
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}

@@ -1,0 +1,224 @@
+//! Scenes on the CPU: what a glTF file (or the built-in default scene) describes, in the units and
+//! conventions of `README.md` ("Scene conventions").
+
+mod default_scene;
+mod environment;
+mod gltf_import;
+mod paths;
+mod sky;
+mod texture;
+
+pub use default_scene::default_scene;
+pub use environment::{EnvMap, Environment};
+pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with};
+pub use texture::{Texture, TextureRef, Wrap};
+
+use anyhow::Result;
+use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
+use std::path::Path;
+
+/// One triangle mesh (one glTF primitive) in its object's local space.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals; flat normals are generated where the file has none.
+    pub normals: Vec<Vec3>,
+    /// TEXCOORD_0, or zeros.
+    pub uvs: Vec<Vec2>,
+    /// xyz tangent, w handedness; only filled when the material has a normal map.
+    pub tangents: Vec<Vec4>,
+    pub indices: Vec<u32>,
+    pub material: u32,
+}
+
+/// A placed mesh. Transforms are kept in f64 so that a scene far from the origin keeps its
+/// precision until it is rebased around its own centre (see [`Scene::origin`]).
+#[derive(Clone, Debug)]
+pub struct Object {
+    pub name: String,
+    pub mesh: usize,
+    pub transform: DMat4,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    Opaque,
+    /// Cut out where base colour alpha < cutoff.
+    Mask(f32),
+}
+
+/// glTF metallic-roughness material (+ KHR_materials_specular, KHR_materials_emissive_strength).
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    pub base_color: Vec4,
+    pub base_color_texture: Option<TextureRef>,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Roughness in G, metallic in B (glTF).
+    pub metallic_roughness_texture: Option<TextureRef>,
+    pub normal_texture: Option<TextureRef>,
+    pub normal_scale: f32,
+    /// emissiveFactor x emissiveStrength: radiance in W/m^2/sr, front face only.
+    pub emission: Vec3,
+    pub emissive_texture: Option<TextureRef>,
+    /// KHR_materials_specular: 0 makes a dielectric purely Lambertian.
+    pub specular_factor: f32,
+    pub specular_color: Vec3,
+    pub alpha_mode: AlphaMode,
+    pub double_sided: bool,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        // glTF's default material.
+        Self {
+            name: "default".into(),
+            base_color: Vec4::ONE,
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            emission: Vec3::ZERO,
+            emissive_texture: None,
+            specular_factor: 1.0,
+            specular_color: Vec3::ONE,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: false,
+        }
+    }
+}
+
+impl Material {
+    pub fn is_emissive(&self) -> bool {
+        self.emission.max_element() > 0.0
+    }
+    /// Whether any light reaches the glossy lobe (metals, or dielectrics with a specular layer).
+    pub fn has_glossy(&self) -> bool {
+        self.metallic > 0.0 || self.specular_factor > 0.0
+    }
+}
+
+/// KHR_lights_punctual, in the radiometric reading of the conventions.
+#[derive(Clone, Copy, Debug)]
+pub enum Light {
+    /// `direction` is where the light travels (the node's -Z); `irradiance` in W/m^2.
+    Directional { direction: Vec3, irradiance: Vec3 },
+    /// Radiant intensity in W/sr.
+    Point { position: DVec3, intensity: Vec3 },
+    Spot { position: DVec3, direction: Vec3, intensity: Vec3, inner_cone: f32, outer_cone: f32 },
+}
+
+/// A pinhole camera: looks down its local -Z, +Y up, +X right.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    pub world: DMat4,
+    /// Full vertical field of view, radians.
+    pub yfov: f32,
+}
+
+impl Camera {
+    pub fn look_at(eye: DVec3, target: DVec3, yfov_degrees: f32) -> Camera {
+        // The camera's +Z points away from what it looks at (glTF cameras look down -Z).
+        let z = (eye - target).normalize_or(DVec3::Z);
+        let x = DVec3::Y.cross(z).normalize_or(DVec3::X);
+        let y = z.cross(x);
+        let world = DMat4::from_cols(x.extend(0.0), y.extend(0.0), z.extend(0.0), eye.extend(1.0));
+        Camera { world, yfov: yfov_degrees.to_radians() }
+    }
+    pub fn eye(&self) -> DVec3 {
+        self.world.w_axis.truncate()
+    }
+}
+
+/// Everything the renderer needs from a file.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub objects: Vec<Object>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub lights: Vec<Light>,
+    pub camera: Option<Camera>,
+    pub environment: Environment,
+    /// `scenes[0].extras.resolution`.
+    pub resolution: Option<(u32, u32)>,
+    /// Path length as Mitsuba counts it (2 = direct light only); -1 = unbounded.
+    pub max_depth: i32,
+    /// Non-fatal problems met while loading (missing textures, unsupported optional extensions).
+    pub warnings: Vec<String>,
+}
+
+/// Mitsuba's default path length, also the conventions' default.
+pub const DEFAULT_MAX_DEPTH: i32 = 6;
+
+impl Scene {
+    /// Load a `.gltf`/`.glb` file, or `default` for the built-in scene.
+    pub fn load(path_or_default: &str) -> Result<Scene> {
+        if path_or_default == "default" {
+            return Ok(default_scene());
+        }
+        load_gltf(Path::new(path_or_default))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| self.meshes[o.mesh].indices.len() / 3).sum()
+    }
+
+    /// World-space bounds of all geometry (f64), or None for an empty scene.
+    pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for o in &self.objects {
+            for p in &self.meshes[o.mesh].positions {
+                let w = o.transform.transform_point3(p.as_dvec3());
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// The point the GPU scene is rebased around: the centre of the geometry. Rendering relative
+    /// to it keeps f32 precision for scenes far from the world origin.
+    pub fn origin(&self) -> DVec3 {
+        self.bounds().map(|(lo, hi)| (lo + hi) * 0.5).unwrap_or(DVec3::ZERO)
+    }
+
+    /// The camera to render from: the file's, or one framing the geometry.
+    pub fn camera_or_default(&self) -> Camera {
+        if let Some(c) = self.camera {
+            return c;
+        }
+        let (lo, hi) = self.bounds().unwrap_or((DVec3::splat(-1.0), DVec3::splat(1.0)));
+        let c = (lo + hi) * 0.5;
+        let r = ((hi - lo).length() * 0.5).max(1e-6);
+        let fov = 45.0f32;
+        let dist = r / (fov.to_radians() as f64 * 0.5).tan();
+        Camera::look_at(c + DVec3::new(0.0, r * 0.25, dist), c, fov)
+    }
+
+    /// Whether the scene has any light source at all (punctual, emissive or environment).
+    pub fn has_any_light(&self) -> bool {
+        !self.lights.is_empty()
+            || !matches!(self.environment, Environment::None)
+            || self.objects.iter().any(|o| {
+                let m = self.meshes[o.mesh].material as usize;
+                self.materials.get(m).is_some_and(|m| m.is_emissive())
+            })
+    }
+
+    /// The conventions' rule: a scene with no lights and no emitters gets a sun and a sky.
+    pub fn add_sun_and_sky_if_unlit(&mut self) {
+        if self.has_any_light() {
+            return;
+        }
+        log::info!("scene {:?} has no light: adding the sun + sky preset", self.name);
+        let (sun, sky) = sky::sun_and_sky(Vec3::new(-0.4, -0.8, -0.45).normalize());
+        self.lights.push(sun);
+        self.environment = Environment::Map(sky);
+    }
+}

@@ -1,0 +1,49 @@
+use anyhow::{Context, Result};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Repeat,
+    Clamp,
+    Mirror,
+}
+
+/// An 8-bit RGBA image as the GPU samples it.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+    /// Colour data stored in sRGB (base colour, emissive); linear data otherwise.
+    pub srgb: bool,
+    pub wrap_s: Wrap,
+    pub wrap_t: Wrap,
+}
+
+/// A material's use of a texture. Only TEXCOORD_0 is supported.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TextureRef {
+    pub index: u32,
+}
+
+impl Texture {
+    /// Decode a PNG/JPEG, shrinking it (by halving) until neither side exceeds `max_size`, so
+    /// scenes with many 4K textures fit a GPU's storage-buffer limits.
+    pub fn decode(name: &str, bytes: &[u8], srgb: bool, max_size: u32) -> Result<Texture> {
+        let img = image::load_from_memory(bytes).with_context(|| format!("decoding image {name}"))?;
+        let mut img = img.to_rgba8();
+        while img.width().max(img.height()) > max_size.max(1) {
+            let (w, h) = ((img.width() / 2).max(1), (img.height() / 2).max(1));
+            img = image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle);
+        }
+        Ok(Texture {
+            name: name.to_string(),
+            width: img.width(),
+            height: img.height(),
+            rgba8: img.into_raw(),
+            srgb,
+            wrap_s: Wrap::Repeat,
+            wrap_t: Wrap::Repeat,
+        })
+    }
+}

@@ -1,0 +1,81 @@
+// Traversal of the binary BVH whose nodes hold both children's boxes (engine/src/accel).
+
+struct Bvh2Node {
+    lmin: vec3f,
+    l_index: u32,
+    lmax: vec3f,
+    l_count: u32,
+    rmin: vec3f,
+    r_index: u32,
+    rmax: vec3f,
+    r_count: u32,
+}
+
+@group(0) @binding(1) var<storage, read> bvh_nodes: array<Bvh2Node>;
+
+const BVH_STACK: u32 = 64u;
+
+// Closest accepted hit along o + t d, t in (0, tmax). With `any_hit`, the first accepted hit.
+fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
+    var hit = miss();
+    var tmax = tmax_in;
+    let inv_d = safe_inverse(d);
+    var stack: array<u32, 64>;
+    var sp = 0u;
+    // Items are (index, count) pairs packed: leaves have their count in the high 8 bits.
+    var item = 0u;
+    var is_leaf = false;
+    var count = 0u;
+    loop {
+        if is_leaf {
+            for (var i = 0u; i < count; i++) {
+                let slot = item + i;
+                let r = intersect_triangle(o, d, slot, tmax);
+                if r.x < tmax && alpha_accept(slot, r.yz) {
+                    tmax = r.x;
+                    hit = Hit(r.x, slot, r.yz);
+                    if any_hit {
+                        return hit;
+                    }
+                }
+            }
+            is_leaf = false;
+        } else {
+            let n = bvh_nodes[item];
+            let tl = intersect_box(o, inv_d, n.lmin, n.lmax, tmax);
+            let tr = intersect_box(o, inv_d, n.rmin, n.rmax, tmax);
+            let hl = tl < INF;
+            let hr = tr < INF;
+            if hl || hr {
+                // Visit the nearer child first; push the other.
+                var first_i = n.l_index;
+                var first_c = n.l_count;
+                var second_i = n.r_index;
+                var second_c = n.r_count;
+                if !hl || (hr && tr < tl) {
+                    first_i = n.r_index;
+                    first_c = n.r_count;
+                    second_i = n.l_index;
+                    second_c = n.l_count;
+                }
+                if hl && hr && sp < BVH_STACK {
+                    stack[sp] = second_i | (min(second_c, 255u) << 24u);
+                    sp += 1u;
+                }
+                item = first_i;
+                count = first_c;
+                is_leaf = first_c > 0u;
+                continue;
+            }
+        }
+        if sp == 0u {
+            break;
+        }
+        sp -= 1u;
+        let e = stack[sp];
+        item = e & 0xffffffu;
+        count = e >> 24u;
+        is_leaf = count > 0u;
+    }
+    return hit;
+}

@@ -1,0 +1,61 @@
+// Triangles in BVH leaf order: three vec4 per triangle, xyz = vertex; v0.w = material index,
+// v1.w = index of the triangle in the scene's input order (both as bits).
+@group(0) @binding(2) var<storage, read> tris: array<vec4f>;
+
+struct Hit {
+    t: f32,
+    // GPU triangle slot, or NO_HIT.
+    tri: u32,
+    // Barycentrics of v1 and v2.
+    b: vec2f,
+}
+
+const NO_HIT: u32 = 0xffffffffu;
+
+fn miss() -> Hit {
+    return Hit(INF, NO_HIT, vec2f(0.0));
+}
+
+fn tri_material(slot: u32) -> u32 {
+    return bitcast<u32>(tris[slot * 3u].w);
+}
+
+// Möller-Trumbore, both faces (sidedness is decided by the shader that shades the hit).
+// Returns (t, b1, b2) with t = INF on a miss.
+fn intersect_triangle(o: vec3f, d: vec3f, slot: u32, tmax: f32) -> vec3f {
+    let v0 = tris[slot * 3u].xyz;
+    let e1 = tris[slot * 3u + 1u].xyz - v0;
+    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    let pv = cross(d, e2);
+    let det = dot(e1, pv);
+    if abs(det) < 1e-30 {
+        return vec3f(INF, 0.0, 0.0);
+    }
+    let inv = 1.0 / det;
+    let tv = o - v0;
+    let b1 = dot(tv, pv) * inv;
+    let qv = cross(tv, e1);
+    let b2 = dot(d, qv) * inv;
+    let t = dot(e2, qv) * inv;
+    if b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || t <= 0.0 || t >= tmax {
+        return vec3f(INF, 0.0, 0.0);
+    }
+    return vec3f(t, b1, b2);
+}
+
+fn safe_inverse(d: vec3f) -> vec3f {
+    let tiny = 1e-30;
+    return 1.0 / select(d, select(vec3f(tiny), vec3f(-tiny), d < vec3f(0.0)), abs(d) < vec3f(tiny));
+}
+
+// Slab test; returns the entry distance or INF.
+fn intersect_box(o: vec3f, inv_d: vec3f, lo: vec3f, hi: vec3f, tmax: f32) -> f32 {
+    let t0 = (lo - o) * inv_d;
+    let t1 = (hi - o) * inv_d;
+    let tn = max3(min(t0, t1));
+    let tf = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    if tn <= tf && tf >= 0.0 && tn < tmax {
+        return max(tn, 0.0);
+    }
+    return INF;
+}

@@ -1,0 +1,72 @@
+// Shading data and materials (engine/src/gpu/scene.rs mirrors these layouts).
+
+// Four vec4 per triangle: (n0, uv0.x), (n1, uv1.x), (n2, uv2.x), (uv0.y, uv1.y, uv2.y, 0).
+@group(0) @binding(3) var<storage, read> shading: array<vec4f>;
+
+struct Material {
+    base_color: vec4f,
+    emission: vec3f,
+    metallic: f32,
+    specular_color: vec3f,
+    roughness: f32,
+    specular_factor: f32,
+    alpha_cutoff: f32,
+    normal_scale: f32,
+    flags: u32,
+    // Texture indices: base colour, metallic-roughness, normal, emissive (-1: none).
+    tex: vec4i,
+}
+
+const MAT_DOUBLE_SIDED: u32 = 1u;
+const MAT_ALPHA_MASK: u32 = 2u;
+
+@group(0) @binding(4) var<storage, read> materials: array<Material>;
+
+fn tri_uv(slot: u32, b: vec2f) -> vec2f {
+    let s0 = shading[slot * 4u];
+    let s1 = shading[slot * 4u + 1u];
+    let s2 = shading[slot * 4u + 2u];
+    let s3 = shading[slot * 4u + 3u];
+    let w = vec3f(1.0 - b.x - b.y, b.x, b.y);
+    return vec2f(dot(w, vec3f(s0.w, s1.w, s2.w)), dot(w, s3.xyz));
+}
+
+fn tri_normal(slot: u32, b: vec2f) -> vec3f {
+    let w = vec3f(1.0 - b.x - b.y, b.x, b.y);
+    return w.x * shading[slot * 4u].xyz + w.y * shading[slot * 4u + 1u].xyz + w.z * shading[slot * 4u + 2u].xyz;
+}
+
+// What a path needs at a hit.
+struct Surface {
+    p: vec3f,
+    // Geometric and shading normals, both turned to the side the ray came from.
+    ng: vec3f,
+    ns: vec3f,
+    uv: vec2f,
+    // The ray hit the counter-clockwise (front) side.
+    front: bool,
+    material: u32,
+}
+
+fn surface_at(hit: Hit, rd: vec3f) -> Surface {
+    let slot = hit.tri;
+    let v0 = tris[slot * 3u].xyz;
+    let e1 = tris[slot * 3u + 1u].xyz - v0;
+    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    var s: Surface;
+    s.material = tri_material(slot);
+    s.p = v0 + hit.b.x * e1 + hit.b.y * e2;
+    var ng = normalize(cross(e1, e2));
+    s.front = dot(ng, rd) < 0.0;
+    var ns = tri_normal(slot, hit.b);
+    let len = length(ns);
+    ns = select(ng, ns / len, len > 1e-12 && len < 1e30);
+    if !s.front {
+        ng = -ng;
+        ns = -ns;
+    }
+    s.uv = tri_uv(slot, hit.b);
+    s.ng = ng;
+    s.ns = apply_normal_map(slot, hit.b, ns, s.uv, materials[s.material]);
+    return s;
+}

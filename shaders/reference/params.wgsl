@@ -1,0 +1,27 @@
+// Per-dispatch parameters of the reference tracer (engine/src/passes/reference.rs: TraceParams).
+struct Params {
+    width: u32,
+    height: u32,
+    sample_index: u32,
+    seed: u32,
+    max_depth: i32,
+    rr_depth: i32,
+    num_lights: u32,
+    num_emitters: u32,
+    // xyz: camera position (scene-relative); w: the scene's ray-offset epsilon.
+    cam_pos: vec4f,
+    // Camera axes scaled so that a pixel's direction is fwd + x right + y up for x, y in [-1, 1].
+    cam_right: vec4f,
+    cam_up: vec4f,
+    cam_fwd: vec4f,
+    // rgb: constant environment radiance.
+    env_radiance: vec4f,
+    // cos a, sin a, pdf normaliser, unused.
+    env_rot: vec4f,
+    // width, height, marginal CDF offset, conditional CDF offset.
+    env_size: vec4u,
+    // x: 1 / sum(area x luminance) over emissive triangles.
+    emit: vec4f,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;

@@ -1,0 +1,153 @@
+use crate::render::load_scene;
+use anyhow::{Context, Result};
+use clap::Args;
+use hush_engine::accel::BvhKind;
+use hush_engine::gpu::{Gpu, PreparedScene};
+use hush_engine::passes::{Raycaster, ReferenceTracer, TraceView};
+use serde::Serialize;
+use std::time::Instant;
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// A .gltf/.glb file, or `default`.
+    pub scene: String,
+    /// BVH layout to measure (bvh2, cwbvh); both when omitted.
+    #[arg(long)]
+    pub bvh: Option<String>,
+    /// Image size of the tracer benchmark.
+    #[arg(long, default_value_t = 128)]
+    pub width: u32,
+    #[arg(long, default_value_t = 128)]
+    pub height: u32,
+    /// Samples per pixel of the tracer benchmark.
+    #[arg(long, default_value_t = 16)]
+    pub spp: u32,
+    /// Random rays for the traversal benchmark.
+    #[arg(long, default_value_t = 262_144)]
+    pub rays: u32,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize)]
+struct LayoutResult {
+    bvh: &'static str,
+    bvh_build_seconds: f64,
+    bvh_nodes: usize,
+    /// Incoherent closest-hit rays per second (random origins in the bounds, random directions).
+    rays_per_second: f64,
+    /// Reference-tracer paths (camera samples) per second.
+    samples_per_second: f64,
+    /// Scene + tracer buffers allocated on the GPU.
+    gpu_bytes: u64,
+}
+
+#[derive(Serialize)]
+struct BenchResult {
+    scene: String,
+    adapter: String,
+    triangles: usize,
+    width: u32,
+    height: u32,
+    spp: u32,
+    layouts: Vec<LayoutResult>,
+    /// From the oracle's render_info.json beside the scene, when there is one.
+    mitsuba_samples_per_second: Option<f64>,
+}
+
+/// Mitsuba's samples per second from `render_info.json` next to an oracle scene.
+fn mitsuba_rate(scene: &str) -> Option<f64> {
+    let dir = std::path::Path::new(scene).parent()?;
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("render_info.json")).ok()?).ok()?;
+    let r = v.get("reference.exr")?;
+    let res = r.get("resolution")?.as_array()?;
+    let px = res[0].as_f64()? * res[1].as_f64()?;
+    Some(px * r.get("spp")?.as_f64()? / r.get("seconds")?.as_f64()?)
+}
+
+pub fn run(a: BenchArgs) -> Result<()> {
+    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let kinds = match &a.bvh {
+        Some(s) => vec![BvhKind::parse(s).with_context(|| format!("--bvh {s:?}"))?],
+        None => vec![BvhKind::Bvh2, BvhKind::Cwbvh],
+    };
+    let mut layouts = vec![];
+    let mut adapter = String::new();
+    let mut triangles = 0;
+    for kind in kinds {
+        let prepared = PreparedScene::new(&scene, kind)?;
+        triangles = prepared.triangle_count();
+        let gpu = Gpu::headless(&prepared.requirements(a.width as u64 * a.height as u64 * 32))?;
+        adapter = gpu.info.name.clone();
+        let gscene = prepared.upload(&gpu);
+        // Traversal: random rays from inside the bounds in uniformly random directions.
+        let caster = Raycaster::new(&gpu, &gscene)?;
+        let half = (scene.bounds().map(|(lo, hi)| (hi - lo) * 0.5).unwrap_or(glam::DVec3::ONE)).as_vec3();
+        let mut rng = 0x9e3779b9u32;
+        let mut r = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            rng as f32 / u32::MAX as f32
+        };
+        let rays: Vec<_> = (0..a.rays)
+            .map(|_| {
+                let o = glam::Vec3::new(r() * 2.0 - 1.0, r() * 2.0 - 1.0, r() * 2.0 - 1.0) * half;
+                let z = r() * 2.0 - 1.0;
+                let phi = r() * std::f32::consts::TAU;
+                let s = (1.0 - z * z).max(0.0).sqrt();
+                (o, glam::Vec3::new(s * phi.cos(), s * phi.sin(), z), f32::MAX)
+            })
+            .collect();
+        caster.cast(&gpu, &gscene, &rays[..rays.len().min(4096)], false)?; // warm-up (pipeline compile)
+        let (_, t) = caster.cast(&gpu, &gscene, &rays, false)?;
+        let rays_per_second = a.rays as f64 / t.as_secs_f64();
+        let view = TraceView {
+            camera: scene.camera_or_default(),
+            width: a.width,
+            height: a.height,
+            max_depth: scene.max_depth,
+            seed: 0,
+        };
+        let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
+        tracer.dispatch(&gpu, 1);
+        gpu.wait()?;
+        let start = Instant::now();
+        tracer.dispatch(&gpu, a.spp);
+        gpu.wait()?;
+        let secs = start.elapsed().as_secs_f64();
+        layouts.push(LayoutResult {
+            bvh: kind.name(),
+            bvh_build_seconds: prepared.accel.build_time.as_secs_f64(),
+            bvh_nodes: prepared.accel.node_count,
+            rays_per_second,
+            samples_per_second: (a.width * a.height * a.spp) as f64 / secs,
+            gpu_bytes: gscene.memory.total_bytes() + tracer.memory.total_bytes(),
+        });
+    }
+    let res = BenchResult {
+        scene: a.scene.clone(),
+        adapter,
+        triangles,
+        width: a.width,
+        height: a.height,
+        spp: a.spp,
+        layouts,
+        mitsuba_samples_per_second: mitsuba_rate(&a.scene),
+    };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&res)?);
+    } else {
+        println!("{} ({} triangles) on {}", res.scene, res.triangles, res.adapter);
+        for l in &res.layouts {
+            println!(
+                "  {:6} build {:.3} s, {} nodes, {:.2} M rays/s, {:.3} M samples/s, {:.1} MiB",
+                l.bvh, l.bvh_build_seconds, l.bvh_nodes, l.rays_per_second / 1e6, l.samples_per_second / 1e6, l.gpu_bytes as f64 / 1048576.0
+            );
+        }
+        if let Some(m) = res.mitsuba_samples_per_second {
+            println!("  Mitsuba 3 (scalar_rgb, CPU): {:.3} M samples/s", m / 1e6);
+        }
+    }
+    Ok(())
+}

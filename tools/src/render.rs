@@ -1,0 +1,147 @@
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use hush_engine::accel::BvhKind;
+use hush_engine::gpu::{Gpu, PreparedScene};
+use hush_engine::passes::{ReferenceTracer, TraceView};
+use hush_engine::scene::{Camera, Scene};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// A .gltf/.glb file, or `default` for the built-in scene.
+    pub scene: String,
+    /// Only `reference` (progressive path tracing) exists so far.
+    #[arg(long, default_value = "reference")]
+    pub mode: String,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    #[arg(long)]
+    pub width: Option<u32>,
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded).
+    #[arg(long, allow_negative_numbers = true)]
+    pub max_depth: Option<i32>,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// "eye=x,y,z;target=x,y,z;fov=deg" (fov is vertical, in degrees).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// BVH layout: bvh2 or cwbvh.
+    #[arg(long)]
+    pub bvh: Option<String>,
+    /// Largest texture side kept on load.
+    #[arg(long, default_value_t = hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)]
+    pub max_texture_size: u32,
+    /// Output: .exr (linear HDR RGB float) or .png (tone-mapped sRGB).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+pub fn parse_camera(s: &str) -> Result<Camera> {
+    let mut eye = None;
+    let mut target = None;
+    let mut fov = 45.0f32;
+    for part in s.split(';').map(str::trim).filter(|p| !p.is_empty()) {
+        let (k, v) = part.split_once('=').with_context(|| format!("camera part {part:?} is not key=value"))?;
+        let nums = || -> Result<glam::DVec3> {
+            let n: Vec<f64> = v.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>()
+                .with_context(|| format!("camera {k}={v:?}: expected x,y,z"))?;
+            if n.len() != 3 || n.iter().any(|x| !x.is_finite()) {
+                bail!("camera {k}={v:?}: expected three finite numbers");
+            }
+            Ok(glam::DVec3::new(n[0], n[1], n[2]))
+        };
+        match k.trim() {
+            "eye" => eye = Some(nums()?),
+            "target" => target = Some(nums()?),
+            "fov" => {
+                fov = v.trim().parse().with_context(|| format!("camera fov={v:?}"))?;
+                if !(fov > 0.0 && fov < 180.0) {
+                    bail!("camera fov must be in (0, 180) degrees, got {fov}");
+                }
+            }
+            other => bail!("unknown camera key {other:?} (use eye, target, fov)"),
+        }
+    }
+    let (eye, target) = (eye.context("camera needs eye=x,y,z")?, target.context("camera needs target=x,y,z")?);
+    if (eye - target).length() == 0.0 {
+        bail!("camera eye and target coincide");
+    }
+    Ok(Camera::look_at(eye, target, fov))
+}
+
+pub fn load_scene(path: &str, max_texture_size: u32) -> Result<Scene> {
+    let mut scene = if path == "default" {
+        hush_engine::scene::default_scene()
+    } else {
+        hush_engine::scene::load_gltf_with(std::path::Path::new(path), max_texture_size)?
+    };
+    scene.add_sun_and_sky_if_unlit();
+    Ok(scene)
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    if a.mode != "reference" {
+        bail!("--mode {:?} is not available; use --mode reference", a.mode);
+    }
+    if a.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    let kind = match &a.bvh {
+        Some(s) => BvhKind::parse(s).with_context(|| format!("--bvh {s:?}: use bvh2 or cwbvh"))?,
+        None => BvhKind::DEFAULT,
+    };
+    let scene = load_scene(&a.scene, a.max_texture_size)?;
+    let (dw, dh) = scene.resolution.unwrap_or((640, 360));
+    let (w, h) = match (a.width, a.height) {
+        (Some(w), Some(h)) => (w, h),
+        // One side given: keep the scene's aspect ratio.
+        (Some(w), None) => (w, ((w as f64 * dh as f64 / dw as f64).round() as u32).max(1)),
+        (None, Some(h)) => (((h as f64 * dw as f64 / dh as f64).round() as u32).max(1), h),
+        (None, None) => (dw, dh),
+    };
+    let camera = match &a.camera {
+        Some(c) => parse_camera(c)?,
+        None => scene.camera_or_default(),
+    };
+    let view = TraceView { camera, width: w, height: h, max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed };
+    let prepared = PreparedScene::new(&scene, kind)?;
+    let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64 * 32))?;
+    let gscene = prepared.upload(&gpu);
+    let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
+    let bar = if std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(a.spp as u64);
+        b.set_style(indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} spp {per_sec} eta {eta}")?.progress_chars("=> "));
+        Some(b)
+    } else {
+        None
+    };
+    let start = std::time::Instant::now();
+    let mut done = 0;
+    while done < a.spp {
+        let n = (a.spp - done).min(4);
+        tracer.dispatch(&gpu, n);
+        gpu.wait()?;
+        done += n;
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let acc = tracer.readback(&gpu)?;
+    let secs = start.elapsed().as_secs_f64();
+    if acc.nonfinite_samples > 0 {
+        log::warn!("{} NaN/Inf samples were dropped", acc.nonfinite_samples);
+    }
+    acc.mean.save(&a.out)?;
+    eprintln!(
+        "{}: {}x{} {} spp in {:.2} s ({:.3} M samples/s) on {} -> {}",
+        scene.name, w, h, a.spp, secs, (w as f64 * h as f64 * a.spp as f64) / secs / 1e6, gpu.info.name, a.out.display()
+    );
+    Ok(())
+}
