@@ -18,7 +18,7 @@ const BVH_STACK: u32 = 64u;
 // Closest accepted hit along o + t d, t in (0, tmax). With `any_hit`, the first accepted hit.
 fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
-    var tmax = tmax_in;
+    var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
     var stack: array<u32, 64>;
     var sp = 0u;

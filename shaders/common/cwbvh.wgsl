@@ -28,8 +28,8 @@ fn cw_intersect(node: u32, o: vec3f, inv_d: vec3f, oct_inv4: u32, tmax: f32) -> 
     let neg = inv_d < vec3f(0.0);
     var mask = 0u;
     for (var c = 0u; c < 8u; c++) {
-        let meta = cw_byte(n1.z, n1.w, c);
-        if meta == 0u {
+        let cmeta = cw_byte(n1.z, n1.w, c);
+        if cmeta == 0u {
             continue;
         }
         let qlo = vec3f(f32(cw_byte(nx.x, nx.y, c)), f32(cw_byte(ny.x, ny.y, c)), f32(cw_byte(nz.x, nz.y, c)));
@@ -39,9 +39,9 @@ fn cw_intersect(node: u32, o: vec3f, inv_d: vec3f, oct_inv4: u32, tmax: f32) -> 
         let tn = max(max3(t0), 0.0);
         let tf = min(min(min(t1.x, t1.y), t1.z), tmax);
         if tn <= tf {
-            let is_inner = (meta & (meta << 1u) & 0x10u) != 0u;
-            let bits = (meta >> 5u) & 7u;
-            let index = select(meta & 0x1fu, (meta ^ (oct_inv4 & 0xffu)) & 0x1fu, is_inner);
+            let is_inner = (cmeta & (cmeta << 1u) & 0x10u) != 0u;
+            let bits = (cmeta >> 5u) & 7u;
+            let index = select(cmeta & 0x1fu, (cmeta ^ (oct_inv4 & 0xffu)) & 0x1fu, is_inner);
             mask |= bits << index;
         }
     }
@@ -52,7 +52,7 @@ const CW_STACK: u32 = 32u;
 
 fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
-    var tmax = tmax_in;
+    var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
     let oct_inv4 = select(0x04040404u, 0u, d.x < 0.0) | select(0x02020202u, 0u, d.y < 0.0)
         | select(0x01010101u, 0u, d.z < 0.0);

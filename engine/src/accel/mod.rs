@@ -17,7 +17,7 @@ pub enum BvhKind {
 
 impl BvhKind {
     /// Measured on llvmpipe (see README, "BVH layouts").
-    pub const DEFAULT: BvhKind = BvhKind::Bvh2;
+    pub const DEFAULT: BvhKind = BvhKind::Cwbvh;
 
     pub fn name(self) -> &'static str {
         match self {

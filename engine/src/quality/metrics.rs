@@ -98,7 +98,7 @@ pub fn compare(test: &Image, reference: &Image) -> Result<Metrics> {
 mod tests {
     use super::*;
 
-    fn img(w: u32, h: u32, f: impl Fn(u32, u32) -> Vec3) -> Image {
+    fn img(w: u32, h: u32, mut f: impl FnMut(u32, u32) -> Vec3) -> Image {
         let mut i = Image::new(w, h);
         for y in 0..h {
             for x in 0..w {

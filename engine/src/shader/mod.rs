@@ -89,7 +89,7 @@ impl Program {
     /// Parse and validate with naga; errors name the source file and line.
     pub fn validate(&self) -> Result<naga::Module> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
-            let at = e.location(&self.text).map(|l| self.locate(l.line_number as usize));
+            let at = e.location(&self.text).filter(|l| l.length > 0).map(|l| self.locate(l.line_number as usize));
             anyhow!("{}: WGSL parse error at {:?}: {}", self.label, at, e.message())
         })?;
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
@@ -108,5 +108,112 @@ impl Program {
             label: Some(&self.label),
             source: wgpu::ShaderSource::Wgsl(self.text.as_str().into()),
         }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FEATURE_SETS: &[[&str; 6]] = &[
+        ["common/alpha_none.wgsl", "common/textures_none.wgsl", "common/tangents_none.wgsl", "common/lights_none.wgsl", "common/emitters_none.wgsl", "common/env_none.wgsl"],
+        ["common/alpha_mask.wgsl", "common/textures.wgsl", "common/tangents.wgsl", "common/lights.wgsl", "common/emitters.wgsl", "common/env_map.wgsl"],
+        ["common/alpha_none.wgsl", "common/textures.wgsl", "common/tangents_none.wgsl", "common/lights.wgsl", "common/emitters_none.wgsl", "common/env_constant.wgsl"],
+        ["common/alpha_mask.wgsl", "common/textures.wgsl", "common/tangents.wgsl", "common/lights_none.wgsl", "common/emitters.wgsl", "common/env_none.wgsl"],
+    ];
+
+    /// Every program Hush can compose, over both BVH layouts and the feature alternatives.
+    fn all_programs() -> Vec<Program> {
+        let mut v = vec![];
+        for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
+            v.push(compose("raycast", "", &["common/math.wgsl", "common/geometry.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
+            for (i, set) in FEATURE_SETS.iter().enumerate() {
+                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", bvh, "common/scene.wgsl", "common/bsdf.wgsl"];
+                m.extend(set.iter());
+                m.extend(["reference/params.wgsl", "reference/trace.wgsl"]);
+                let prelude = format!("const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n", i % 2 == 1, i != 0);
+                v.push(compose(&format!("trace {bvh} {i}"), &prelude, &m).unwrap());
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn every_program_validates_with_naga() {
+        for p in all_programs() {
+            if let Err(e) = p.validate() {
+                panic!("{e:#}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_wgsl_file_is_embedded_and_used() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+        let mut files = vec![];
+        let mut stack = vec![dir.clone()];
+        while let Some(d) = stack.pop() {
+            for e in std::fs::read_dir(&d).unwrap() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if p.extension().is_some_and(|e| e == "wgsl") {
+                    files.push(p.strip_prefix(&dir).unwrap().to_string_lossy().replace('\\', "/"));
+                }
+            }
+        }
+        let programs = all_programs();
+        for f in &files {
+            assert!(SOURCES.iter().any(|(p, _)| p == f), "{f} is not embedded in shader::SOURCES");
+            assert!(programs.iter().any(|p| p.modules.contains(&f.as_str())), "{f} is in no validated program");
+        }
+        assert_eq!(files.len(), SOURCES.len(), "SOURCES lists a file that does not exist");
+    }
+
+    #[test]
+    fn errors_name_the_file_and_line() {
+        let p = Program { label: "t".into(), modules: vec![], text: "// ---- a.wgsl\nfn f() {}\n// ---- b.wgsl\nfn g() -> u32 {\n  return 1u +;\n}\n".into() };
+        let e = format!("{:#}", p.validate().unwrap_err());
+        assert!(e.contains("b.wgsl") && e.contains(", 2)"), "{e}");
+    }
+
+    /// Size and member offsets of a WGSL struct as naga lays it out for storage/uniform use.
+    fn wgsl_layout(p: &Program, name: &str) -> (u32, Vec<u32>) {
+        let m = p.validate().unwrap();
+        for (_, t) in m.types.iter() {
+            if t.name.as_deref() == Some(name) {
+                if let naga::TypeInner::Struct { members, span } = &t.inner {
+                    return (*span, members.iter().map(|m| m.offset).collect());
+                }
+            }
+        }
+        panic!("no struct {name}");
+    }
+
+    #[test]
+    fn gpu_structs_match_their_wgsl_mirrors() {
+        use crate::accel::Bvh2GpuNode;
+        use crate::gpu::prepare::{GpuLight, GpuMaterial};
+        use crate::passes::reference::TraceParams;
+        use std::mem::{offset_of, size_of};
+        let p = &all_programs()[2]; // trace, bvh2, every feature
+        assert_eq!(wgsl_layout(p, "Material"), (size_of::<GpuMaterial>() as u32, vec![
+            offset_of!(GpuMaterial, base_color), offset_of!(GpuMaterial, emission), offset_of!(GpuMaterial, metallic),
+            offset_of!(GpuMaterial, specular_color), offset_of!(GpuMaterial, roughness), offset_of!(GpuMaterial, specular_factor),
+            offset_of!(GpuMaterial, alpha_cutoff), offset_of!(GpuMaterial, normal_scale), offset_of!(GpuMaterial, flags),
+            offset_of!(GpuMaterial, tex)].into_iter().map(|o| o as u32).collect()));
+        assert_eq!(wgsl_layout(p, "Light"), (size_of::<GpuLight>() as u32, vec![
+            offset_of!(GpuLight, pos), offset_of!(GpuLight, kind), offset_of!(GpuLight, dir), offset_of!(GpuLight, cos_outer),
+            offset_of!(GpuLight, intensity), offset_of!(GpuLight, cos_inner)].into_iter().map(|o| o as u32).collect()));
+        assert_eq!(wgsl_layout(p, "Bvh2Node"), (size_of::<Bvh2GpuNode>() as u32, vec![
+            offset_of!(Bvh2GpuNode, lmin), offset_of!(Bvh2GpuNode, l_index), offset_of!(Bvh2GpuNode, lmax), offset_of!(Bvh2GpuNode, l_count),
+            offset_of!(Bvh2GpuNode, rmin), offset_of!(Bvh2GpuNode, r_index), offset_of!(Bvh2GpuNode, rmax), offset_of!(Bvh2GpuNode, r_count)]
+            .into_iter().map(|o| o as u32).collect()));
+        let (size, offs) = wgsl_layout(p, "Params");
+        assert_eq!(size as usize, size_of::<TraceParams>());
+        assert_eq!(offs[8] as usize, offset_of!(TraceParams, cam_pos));
+        assert_eq!(offs[15] as usize, offset_of!(TraceParams, emit));
+        // obvhs's CWBVH node is read as five vec4u.
+        assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
     }
 }
