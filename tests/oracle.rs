@@ -1,1 +1,147 @@
+//! Mitsuba parity: the reference mode against Mitsuba 3 renders of the same scenes
+//! (`../shared/oracle`), at a box-downsampled resolution small enough for CI.
+//!
+//! Thresholds come from the noise of both images rather than from a guess:
+//! - relMSE: its expectation for two unbiased estimators is the sum of their per-pixel variances
+//!   over (y² + 0.01). Hush's variance of the mean is measured from its own samples; Mitsuba's is
+//!   taken as the same per-sample variance over its larger sample count (ref spp x factor²
+//!   samples per downsampled pixel). A bias would add to this; the test allows `RELMSE_SLACK`
+//!   times the expectation because the variance estimate itself is noisy where caustics and tiny
+//!   highlights make the per-sample distribution heavy-tailed.
+//! - mean bias per channel, after leaving out the 0.1% of pixels with the largest difference
+//!   (caustic and highlight pixels whose means are dominated by a few rare samples in either
+//!   image): within 5 standard errors of the trimmed mean, or within the worst channel mean bias
+//!   the oracle measured between two independent Mitsuba renders at 256 spp (its README), as the
+//!   README asks: never tighter than the references' own noise.
 
+use hush_engine::quality::{Image, compare, luminance};
+use hush_engine::scene::load_gltf;
+use hush_tests::{oracle, render};
+
+const RELMSE_SLACK: f64 = 3.0;
+
+struct Case {
+    name: &'static str,
+    factor: u32,
+    spp: u32,
+    ref_spp: u32,
+    /// Worst channel mean bias of an independent 256-spp Mitsuba render (oracle README table).
+    mitsuba_bias_256: f64,
+}
+
+fn parity(c: Case) {
+    let dir = oracle(c.name);
+    let scene = load_gltf(&dir.join(format!("{}.gltf", c.name))).unwrap();
+    let reference = Image::load(&dir.join("reference.exr")).unwrap().box_downsample(c.factor).unwrap();
+    let (w, h) = (reference.width, reference.height);
+    let acc = render(&scene, w, h, c.spp, 7).unwrap();
+    assert_eq!(acc.nonfinite_samples, 0, "{}: NaN/Inf samples", c.name);
+    let m = compare(&acc.mean, &reference).unwrap();
+    assert_eq!(m.nonfinite_pixels, 0);
+
+    // Expected relMSE from the two images' noise.
+    let ref_share = c.spp as f64 / (c.ref_spp as f64 * (c.factor * c.factor) as f64);
+    let mut expected = 0.0;
+    for (v, y) in acc.variance_of_mean.data.iter().zip(&reference.data) {
+        for k in 0..3 {
+            expected += v[k] as f64 * (1.0 + ref_share) / (y[k] as f64 * y[k] as f64 + 0.01);
+        }
+    }
+    expected /= (3 * reference.data.len()) as f64;
+
+    // Trimmed per-channel bias and its standard error.
+    let n = reference.data.len();
+    let mut diffs: Vec<(f32, usize)> = (0..n).map(|i| ((luminance(acc.mean.data[i]) - luminance(reference.data[i])).abs(), i)).collect();
+    diffs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let keep: Vec<usize> = diffs[..n - n / 1000 - 1].iter().map(|d| d.1).collect();
+    let mut bias = [0f64; 3];
+    let mut allowed = [0f64; 3];
+    for k in 0..3 {
+        let (mut sx, mut sy, mut var) = (0f64, 0f64, 0f64);
+        for &i in &keep {
+            sx += acc.mean.data[i][k] as f64;
+            sy += reference.data[i][k] as f64;
+            var += acc.variance_of_mean.data[i][k] as f64 * (1.0 + ref_share);
+        }
+        bias[k] = (sx - sy) / sy;
+        allowed[k] = (5.0 * var.sqrt() / sy).max(c.mitsuba_bias_256);
+    }
+    println!(
+        "{}: {}x{} {} spp (reference {} spp, box /{}): relMSE {:.5} (noise predicts {:.5}), FLIP {:.4}, SSIM {:.4}, \
+         RMSE {:.4}, mean bias {:+.4} {:+.4} {:+.4}, trimmed bias {:+.4} {:+.4} {:+.4} (allowed {:.4} {:.4} {:.4})",
+        c.name, w, h, c.spp, c.ref_spp, c.factor, m.relmse, expected, m.flip, m.ssim, m.rmse,
+        m.mean_rel_bias[0], m.mean_rel_bias[1], m.mean_rel_bias[2], bias[0], bias[1], bias[2], allowed[0], allowed[1], allowed[2]
+    );
+    assert!(m.relmse <= RELMSE_SLACK * expected, "{}: relMSE {} > {} x predicted {}", c.name, m.relmse, RELMSE_SLACK, expected);
+    for k in 0..3 {
+        assert!(bias[k].abs() <= allowed[k], "{}: channel {k} biased by {:+.4} (allowed {:.4})", c.name, bias[k], allowed[k]);
+    }
+}
+
+#[test]
+fn cornell_diffuse_matches_mitsuba() {
+    parity(Case { name: "cornell_diffuse", factor: 4, spp: 256, ref_spp: 1024, mitsuba_bias_256: 0.0 });
+}
+
+#[test]
+fn cornell_mirror_matches_mitsuba() {
+    parity(Case { name: "cornell_mirror", factor: 4, spp: 512, ref_spp: 4096, mitsuba_bias_256: 0.001 });
+}
+
+#[test]
+fn point_glossy_matches_mitsuba() {
+    parity(Case { name: "point_glossy", factor: 2, spp: 256, ref_spp: 4096, mitsuba_bias_256: 0.015 });
+}
+
+#[test]
+fn furnace_matches_mitsuba() {
+    parity(Case { name: "furnace", factor: 4, spp: 64, ref_spp: 1024, mitsuba_bias_256: 0.0 });
+}
+
+/// White furnace: a Lambertian sphere of albedo 1 under uniform radiance 1 reflects exactly 1.
+/// Full resolution (256²) so the sphere mask from the oracle's normal image applies pixel for pixel.
+#[test]
+fn white_furnace_is_one() {
+    let dir = oracle("furnace");
+    let scene = load_gltf(&dir.join("furnace.gltf")).unwrap();
+    let normals = Image::load(&dir.join("normal.exr")).unwrap();
+    let spp = 32;
+    let acc = render(&scene, normals.width, normals.height, spp, 3).unwrap();
+    assert_eq!(acc.nonfinite_samples, 0);
+    // Sphere pixels: every pixel whose first-hit normal is set, less a 1-pixel rim whose
+    // footprint straddles the silhouette (those mix sphere and sky, both 1 anyway).
+    let (w, hgt) = (normals.width as i32, normals.height as i32);
+    let on = |x: i32, y: i32| x >= 0 && y >= 0 && x < w && y < hgt && normals.at(x as u32, y as u32).length() > 0.5;
+    let mut sum = 0f64;
+    let mut count = 0usize;
+    let mut worst_z = 0f64;
+    let mut worst_dev = 0f64;
+    for y in 0..hgt {
+        for x in 0..w {
+            if !(on(x, y) && on(x - 1, y) && on(x + 1, y) && on(x, y - 1) && on(x, y + 1)) {
+                continue;
+            }
+            let i = (y * w + x) as usize;
+            let v = acc.mean.data[i];
+            let s = acc.variance_of_mean.data[i];
+            sum += (v.x + v.y + v.z) as f64 / 3.0;
+            count += 1;
+            for k in 0..3 {
+                let dev = (v[k] as f64 - 1.0).abs();
+                worst_dev = worst_dev.max(dev);
+                // A pixel whose samples all came out identical has no measurable variance; its
+                // deviation must then be at f32 rounding level.
+                let se = (s[k] as f64).sqrt().max(1e-4);
+                worst_z = worst_z.max(dev / se);
+            }
+        }
+    }
+    let mean = sum / count as f64;
+    println!("furnace: {count} sphere pixels at {spp} spp, mean {mean:.5}, worst pixel |x-1| {worst_dev:.4} = {worst_z:.2} standard errors");
+    assert!(count > 20_000, "sphere mask too small: {count}");
+    // Mitsuba measured 0.99967 (the tessellated sphere loses 0.03%); the issue's bound is 0.5%.
+    assert!((mean - 1.0).abs() < 0.005, "furnace sphere mean {mean}");
+    // With ~30k pixels x 3 channels, a Gaussian deviation beyond 6 standard errors has a chance
+    // of about 2e-4 in the whole image; anything beyond is a real error, not noise.
+    assert!(worst_z < 6.0, "a furnace pixel is {worst_z:.2} standard errors from 1");
+}

@@ -109,9 +109,14 @@ impl PreparedScene {
             for t in mesh.indices.chunks_exact(3) {
                 // A mirroring transform reverses the winding; swap to keep the front face CCW.
                 let idx = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
-                let p = idx.map(|i| (o.transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin).as_vec3());
-                let area2 = (p[1] - p[0]).cross(p[2] - p[0]).length();
-                if !p.iter().all(|v| v.is_finite()) || !(area2 > 0.0) || !area2.is_finite() {
+                let p64 = idx.map(|i| o.transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin);
+                let p = p64.map(|v| v.as_vec3());
+                // Degenerate: zero area, or so thin (area below 1e-12 of the longest edge squared)
+                // that f32 arithmetic cannot resolve it; such a triangle cannot be hit reliably.
+                let area2 = (p64[1] - p64[0]).cross(p64[2] - p64[0]).length();
+                let edge2 = (p64[1] - p64[0]).length_squared().max((p64[2] - p64[1]).length_squared()).max((p64[0] - p64[2]).length_squared());
+                let area2_f32 = (p[1] - p[0]).cross(p[2] - p[0]).length();
+                if !p.iter().all(|v| v.is_finite()) || !(area2 > 1e-12 * edge2) || !(area2_f32 > 0.0) || !area2_f32.is_finite() {
                     dropped += 1;
                     continue;
                 }

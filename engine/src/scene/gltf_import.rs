@@ -28,28 +28,22 @@ pub fn load_gltf(path: &Path) -> Result<Scene> {
 pub fn load_gltf_with(path: &Path, max_texture_size: u32) -> Result<Scene> {
     let ctx = || format!("loading glTF scene {}", path.display());
     let bytes = std::fs::read(path).with_context(ctx)?;
-    check_required_extensions(&bytes).with_context(ctx)?;
-    let gltf = gltf::Gltf::from_slice(&bytes).with_context(ctx)?;
+    let (document, blob) = parse(&bytes).with_context(ctx)?;
     let base = path.parent().unwrap_or(Path::new("."));
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    Importer { base, warnings: vec![], max_texture_size }.import(gltf, name).with_context(ctx)
+    Importer { base, warnings: vec![], max_texture_size }.import(&document, blob.as_deref(), name).with_context(ctx)
 }
 
-/// Refuse unsupported required extensions with a message that names them (the `gltf` crate's
-/// own validation error only says "Unsupported").
-fn check_required_extensions(bytes: &[u8]) -> Result<()> {
-    let json: &[u8] = if bytes.starts_with(b"glTF") {
+/// JSON (from a .gltf or a .glb's JSON chunk) -> validated document, refusing unsupported
+/// required extensions by name (the `gltf` crate's own error only says "Unsupported").
+fn parse(bytes: &[u8]) -> Result<(gltf::Document, Option<Vec<u8>>)> {
+    let (json, blob) = if bytes.starts_with(b"glTF") {
         let glb = gltf::Glb::from_slice(bytes).map_err(|e| anyhow!("reading GLB container: {e}"))?;
-        return check_required_in_json(&glb.json);
+        (glb.json.to_vec(), glb.bin.map(|b| b.to_vec()))
     } else {
-        bytes
+        (bytes.to_vec(), None)
     };
-    check_required_in_json(json)
-}
-
-fn check_required_in_json(json: &[u8]) -> Result<()> {
-    let v: serde_json::Value =
-        serde_json::from_slice(json).map_err(|e| anyhow!("parsing glTF JSON: {e}"))?;
+    let mut v: serde_json::Value = serde_json::from_slice(&json).map_err(|e| anyhow!("parsing glTF JSON: {e}"))?;
     let mut unsupported = vec![];
     if let Some(req) = v.get("extensionsRequired").and_then(|r| r.as_array()) {
         for e in req.iter().filter_map(|e| e.as_str()) {
@@ -65,7 +59,15 @@ fn check_required_in_json(json: &[u8]) -> Result<()> {
             SUPPORTED_EXTENSIONS.join(", ")
         );
     }
-    Ok(())
+    // `scene.nodes` is optional in glTF 2.0, but the `gltf` crate's schema requires it.
+    if let Some(scenes) = v.get_mut("scenes").and_then(|s| s.as_array_mut()) {
+        for s in scenes.iter_mut().filter_map(|s| s.as_object_mut()) {
+            s.entry("nodes").or_insert_with(|| serde_json::json!([]));
+        }
+    }
+    let root: gltf::json::Root = serde_json::from_value(v).map_err(|e| anyhow!("reading glTF JSON: {e}"))?;
+    let document = gltf::Document::from_json(root).map_err(|e| anyhow!("invalid glTF: {e}"))?;
+    Ok((document, blob))
 }
 
 struct Importer<'a> {
@@ -80,14 +82,13 @@ impl Importer<'_> {
         self.warnings.push(msg);
     }
 
-    fn import(mut self, gltf: gltf::Gltf, name: String) -> Result<Scene> {
-        let doc = &gltf.document;
+    fn import(mut self, doc: &gltf::Document, blob: Option<&[u8]>, name: String) -> Result<Scene> {
         for ext in doc.extensions_used() {
             if !SUPPORTED_EXTENSIONS.contains(&ext) {
                 self.warn(format!("optional glTF extension {ext} is not supported; ignored"));
             }
         }
-        let buffers = self.load_buffers(doc, gltf.blob.as_deref())?;
+        let buffers = self.load_buffers(doc, blob)?;
         let (textures, tex_map) = self.load_textures(doc, &buffers);
         let materials: Vec<Material> =
             doc.materials().map(|m| self.material(&m, &tex_map)).collect();
