@@ -42,6 +42,7 @@ embed!(
     "reference/params.wgsl",
     "reference/trace.wgsl",
     "accel/raycast.wgsl",
+    "view/display.wgsl",
 );
 
 pub fn source(path: &str) -> Result<&'static str> {
@@ -124,7 +125,7 @@ mod tests {
 
     /// Every program Hush can compose, over both BVH layouts and the feature alternatives.
     fn all_programs() -> Vec<Program> {
-        let mut v = vec![];
+        let mut v = vec![compose("display", "", &["view/display.wgsl"]).unwrap()];
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             v.push(compose("raycast", "", &["common/math.wgsl", "common/geometry.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
             for (i, set) in FEATURE_SETS.iter().enumerate() {
@@ -196,7 +197,8 @@ mod tests {
         use crate::gpu::prepare::{GpuLight, GpuMaterial};
         use crate::passes::reference::TraceParams;
         use std::mem::{offset_of, size_of};
-        let p = &all_programs()[2]; // trace, bvh2, every feature
+        let programs = all_programs();
+        let p = programs.iter().find(|p| p.label == "trace common/bvh2.wgsl 1").unwrap(); // every feature
         assert_eq!(wgsl_layout(p, "Material"), (size_of::<GpuMaterial>() as u32, vec![
             offset_of!(GpuMaterial, base_color), offset_of!(GpuMaterial, emission), offset_of!(GpuMaterial, metallic),
             offset_of!(GpuMaterial, specular_color), offset_of!(GpuMaterial, roughness), offset_of!(GpuMaterial, specular_factor),
