@@ -73,7 +73,13 @@ fn uv_sphere(center: Vec3, r: f32, material: u32, seg: u32, rings: u32) -> Mesh 
         for i in 0..seg {
             let a = j * (seg + 1) + i;
             let b = a + seg + 1;
-            m.indices.extend([a, b, a + 1, a + 1, b, b + 1]);
+            // The rings at the poles collapse to a point: one triangle per quad there.
+            if j > 0 {
+                m.indices.extend([a, b, a + 1]);
+            }
+            if j + 1 < rings {
+                m.indices.extend([a + 1, b, b + 1]);
+            }
         }
     }
     m
