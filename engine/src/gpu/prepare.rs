@@ -351,10 +351,27 @@ impl EnvPack {
     }
 }
 
+/// All textures share one storage buffer; it must fit the 128 MiB binding every WebGPU adapter
+/// offers. Over that budget the largest textures are halved until the set fits.
+pub const TEXTURE_BUDGET_BYTES: usize = 128 << 20;
+
 fn pack_textures(scene: &Scene) -> Vec<u32> {
     let n = scene.textures.len();
+    let mut textures: Vec<std::borrow::Cow<crate::scene::Texture>> = scene.textures.iter().map(std::borrow::Cow::Borrowed).collect();
+    let bytes = |t: &[std::borrow::Cow<crate::scene::Texture>]| n * 16 + t.iter().map(|t| t.rgba8.len()).sum::<usize>();
+    let before = bytes(&textures);
+    while bytes(&textures) > TEXTURE_BUDGET_BYTES {
+        let largest = (0..n).max_by_key(|&i| textures[i].rgba8.len()).unwrap_or(0);
+        if textures[largest].width <= 1 && textures[largest].height <= 1 {
+            break;
+        }
+        textures[largest] = std::borrow::Cow::Owned(textures[largest].halved());
+    }
+    if bytes(&textures) != before {
+        log::warn!("textures need {} MiB; halved the largest to fit {} MiB", before >> 20, TEXTURE_BUDGET_BYTES >> 20);
+    }
     let mut data = vec![0u32; n * 4];
-    for (i, t) in scene.textures.iter().enumerate() {
+    for (i, t) in textures.iter().enumerate() {
         let wrap = |w: Wrap| match w {
             Wrap::Repeat => 0u32,
             Wrap::Clamp => 1,
@@ -367,4 +384,25 @@ fn pack_textures(scene: &Scene) -> Vec<u32> {
         data.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
     }
     data
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Texture, Wrap};
+
+    #[test]
+    fn textures_over_the_binding_budget_are_halved_to_fit() {
+        let side = 5800u32; // 5800² x 4 bytes = 134.6 MB > 128 MiB
+        let big = Texture { name: "big".into(), width: side, height: side, rgba8: vec![128; (side * side * 4) as usize], srgb: true, wrap_s: Wrap::Repeat, wrap_t: Wrap::Repeat };
+        let small = Texture { name: "small".into(), width: 4, height: 2, rgba8: vec![7; 32], ..big.clone() };
+        let scene = Scene { textures: vec![big, small], ..Default::default() };
+        let data = pack_textures(&scene);
+        assert!(data.len() * 4 <= TEXTURE_BUDGET_BYTES, "{} bytes", data.len() * 4);
+        // The large one was halved, the small one kept; headers point at the texels.
+        assert_eq!((data[1], data[2]), (side / 2, side / 2));
+        assert_eq!((data[5], data[6]), (4, 2));
+        assert_eq!(data[4] as usize, 8 + (side / 2 * side / 2) as usize);
+        assert_eq!(data[data[4] as usize], u32::from_le_bytes([7; 4]));
+    }
 }

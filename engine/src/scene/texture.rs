@@ -27,6 +27,14 @@ pub struct TextureRef {
 }
 
 impl Texture {
+    /// Half the resolution in each direction (a box-filtered mip level).
+    pub fn halved(&self) -> Texture {
+        let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8.clone()).expect("texture size");
+        let (w, h) = ((self.width / 2).max(1), (self.height / 2).max(1));
+        let img = image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle);
+        Texture { width: w, height: h, rgba8: img.into_raw(), name: self.name.clone(), ..*self }
+    }
+
     /// Decode a PNG/JPEG, shrinking it (by halving) until neither side exceeds `max_size`, so
     /// scenes with many 4K textures fit a GPU's storage-buffer limits.
     pub fn decode(name: &str, bytes: &[u8], srgb: bool, max_size: u32) -> Result<Texture> {
