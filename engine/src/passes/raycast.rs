@@ -1,7 +1,7 @@
 //! `accel/raycast`: closest (or any) hits for a batch of rays; checks the GPU BVH against the
 //! CPU and measures rays per second.
 
-use crate::gpu::scene::{binding, storage_entry, uniform_entry};
+use crate::gpu::scene::{binding, compute_pipeline, storage_entry, uniform_entry};
 use crate::gpu::{Gpu, GpuMemory, GpuScene, readback_buffer};
 use anyhow::Result;
 use glam::Vec3;
@@ -42,19 +42,7 @@ impl Raycaster {
             storage_entry(4, false),
         ];
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(LABEL), entries: &entries });
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(LABEL),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(LABEL),
-            layout: Some(&pl),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = compute_pipeline(&gpu.device, LABEL, &module, &layout);
         Ok(Raycaster { pipeline, layout })
     }
 

@@ -1,6 +1,6 @@
 //! `reference/trace`: the progressive reference path tracer (shaders/reference/trace.wgsl).
 
-use crate::gpu::scene::{storage_entry, uniform_entry};
+use crate::gpu::scene::{compute_pipeline, storage_entry, uniform_entry};
 use crate::gpu::{Gpu, GpuMemory, GpuScene, PreparedScene, readback_buffer};
 use crate::quality::Image;
 use crate::scene::Camera;
@@ -102,19 +102,7 @@ impl ReferenceTracer {
         ];
         bg.extend(scene_bindings.iter().map(|(b, buf)| wgpu::BindGroupEntry { binding: *b, resource: buf.as_entire_binding() }));
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(LABEL), layout: &layout, entries: &bg });
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(LABEL),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(LABEL),
-            layout: Some(&pl),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = compute_pipeline(&gpu.device, LABEL, &module, &layout);
         let params = make_params(prepared, view);
         Ok(ReferenceTracer { pipeline, bind_group, params_buf, accum, params, samples: 0, memory })
     }
