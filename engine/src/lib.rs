@@ -9,7 +9,4 @@ pub mod gpu;
 pub mod passes;
 pub mod quality;
 pub mod scene;
-pub mod settings;
 pub mod shader;
-
-pub use settings::Settings;
