@@ -28,18 +28,6 @@ impl Default for GpuRequirements {
     }
 }
 
-impl GpuRequirements {
-    /// Raise to cover `other` too.
-    pub fn merge(&mut self, other: &GpuRequirements) {
-        self.features |= other.features;
-        self.max_storage_buffer_binding_size =
-            self.max_storage_buffer_binding_size.max(other.max_storage_buffer_binding_size);
-        self.max_storage_buffers_per_shader_stage = self
-            .max_storage_buffers_per_shader_stage
-            .max(other.max_storage_buffers_per_shader_stage);
-    }
-}
-
 /// A wgpu device and queue with the adapter they came from.
 pub struct Gpu {
     pub instance: wgpu::Instance,

@@ -95,10 +95,6 @@ impl Material {
     pub fn is_emissive(&self) -> bool {
         self.emission.max_element() > 0.0
     }
-    /// Whether any light reaches the glossy lobe (metals, or dielectrics with a specular layer).
-    pub fn has_glossy(&self) -> bool {
-        self.metallic > 0.0 || self.specular_factor > 0.0
-    }
 }
 
 /// KHR_lights_punctual, in the radiometric reading of the conventions.
