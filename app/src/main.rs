@@ -44,7 +44,10 @@ impl Viewer {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let surface = instance.create_surface(window.clone()).context("creating the window surface")?;
         let size = window.inner_size();
-        let gpu = Gpu::for_surface(instance, &surface, &self.prepared.requirements(size.width.max(1) as u64 * size.height.max(1) as u64 * 32 * 4))?;
+        // The accumulation buffer is 32 bytes per pixel; allow the window to grow to four times
+        // its first area before the device's binding limit would need raising.
+        let accum_bytes = size.width.max(1) as u64 * size.height.max(1) as u64 * 32 * 4;
+        let gpu = Gpu::for_surface(instance, &surface, &self.prepared.requirements(accum_bytes))?;
         let caps = surface.get_capabilities(&gpu.adapter);
         let format = caps.formats.first().copied().context("the surface offers no format")?;
         let config = wgpu::SurfaceConfiguration {

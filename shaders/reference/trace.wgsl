@@ -135,7 +135,7 @@ fn path_radiance(ro_in: vec3f, rd_in: vec3f, rng: ptr<function, u32>) -> vec3f {
         beta *= bs.weight;
         prev_pdf = bs.pdf;
         prev_delta = bs.delta;
-        ro = offset_ray(s.p, s.ng, eps);
+        ro = origin;
         rd = normalize(wi);
         segments += 1;
         // Russian roulette from the fifth segment on, as Mitsuba (unbiased).
