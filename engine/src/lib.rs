@@ -5,8 +5,10 @@
 //! ([`quality`] for metrics and files).
 
 pub mod accel;
+pub mod frame;
 pub mod gpu;
 pub mod passes;
 pub mod quality;
 pub mod scene;
+pub mod settings;
 pub mod shader;

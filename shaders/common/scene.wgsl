@@ -70,3 +70,36 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     s.ns = apply_normal_map(slot, hit.b, ns, s.uv, materials[s.material]);
     return s;
 }
+
+// A material's parameters at a surface point, with its textures applied (glTF metallic-roughness:
+// roughness in G, metallic in B).
+struct MaterialSample {
+    base: vec4f,
+    metallic: f32,
+    roughness: f32,
+    emission: vec3f,
+}
+
+fn material_at(m: Material, uv: vec2f) -> MaterialSample {
+    var r: MaterialSample;
+    r.base = m.base_color;
+    r.metallic = m.metallic;
+    r.roughness = m.roughness;
+    r.emission = m.emission;
+    if m.tex.x >= 0 {
+        r.base *= tex_sample(u32(m.tex.x), uv);
+    }
+    if m.tex.y >= 0 {
+        let mr = tex_sample(u32(m.tex.y), uv);
+        r.roughness *= mr.g;
+        r.metallic *= mr.b;
+    }
+    if m.tex.w >= 0 {
+        r.emission *= tex_sample(u32(m.tex.w), uv).rgb;
+    }
+    return r;
+}
+
+fn material_bsdf(m: Material, ms: MaterialSample) -> Bsdf {
+    return make_bsdf(ms.base.rgb, ms.metallic, ms.roughness, m.specular_factor, m.specular_color);
+}

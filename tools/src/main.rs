@@ -2,6 +2,7 @@
 
 mod bench;
 mod compare;
+mod realtime;
 mod render;
 
 use anyhow::Result;

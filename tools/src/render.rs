@@ -11,10 +11,28 @@ use std::path::PathBuf;
 pub struct RenderArgs {
     /// A .gltf/.glb file, or `default` for the built-in scene.
     pub scene: String,
-    /// Only `reference` (progressive path tracing) exists so far.
+    /// `reference` (progressive path tracing) or `realtime` (the hybrid frame).
     #[arg(long, default_value = "reference")]
     pub mode: String,
-    /// Samples per pixel.
+    /// Real-time mode: frames to render.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
+    /// Real-time mode: a camera path (JSON, as the viewer records); frame k uses key k.
+    #[arg(long)]
+    pub camera_path: Option<PathBuf>,
+    /// Real-time mode: the denoiser (only `none` so far).
+    #[arg(long, default_value = "none")]
+    pub denoiser: String,
+    /// Real-time mode: sum all frames with a still camera and write their mean.
+    #[arg(long)]
+    pub accumulate: bool,
+    /// Real-time mode: frames per second of the animation clock when no camera path gives times.
+    #[arg(long, default_value_t = 60.0)]
+    pub fps: f64,
+    /// Real-time mode: write every frame as linear HDR EXR into this folder (frame_00000.exr, ...).
+    #[arg(long)]
+    pub out_dir: Option<PathBuf>,
+    /// Reference mode: samples per pixel.
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
     #[arg(long)]
@@ -35,9 +53,10 @@ pub struct RenderArgs {
     /// Largest texture side kept on load.
     #[arg(long, default_value_t = hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)]
     pub max_texture_size: u32,
-    /// Output: .exr (linear HDR RGB float) or .png (tone-mapped sRGB).
+    /// Output: .exr (linear HDR RGB float) or .png (tone-mapped sRGB). In real-time mode, the
+    /// last frame.
     #[arg(long)]
-    pub out: PathBuf,
+    pub out: Option<PathBuf>,
 }
 
 pub fn parse_camera(s: &str) -> Result<Camera> {
@@ -83,26 +102,37 @@ pub fn load_scene(path: &str, max_texture_size: u32) -> Result<Scene> {
     Ok(scene)
 }
 
-pub fn run(a: RenderArgs) -> Result<()> {
-    if a.mode != "reference" {
-        bail!("--mode {:?} is not available; use --mode reference", a.mode);
-    }
-    if a.spp == 0 {
-        bail!("--spp must be at least 1");
-    }
-    let kind = match &a.bvh {
-        Some(s) => BvhKind::parse(s).with_context(|| format!("--bvh {s:?}: use bvh2 or cwbvh"))?,
-        None => BvhKind::DEFAULT,
-    };
-    let scene = load_scene(&a.scene, a.max_texture_size)?;
+/// Width and height from the flags, keeping the scene's aspect ratio when one side is given.
+pub fn image_size(scene: &Scene, width: Option<u32>, height: Option<u32>) -> (u32, u32) {
     let (dw, dh) = scene.resolution.unwrap_or((640, 360));
-    let (w, h) = match (a.width, a.height) {
+    match (width, height) {
         (Some(w), Some(h)) => (w, h),
-        // One side given: keep the scene's aspect ratio.
         (Some(w), None) => (w, ((w as f64 * dh as f64 / dw as f64).round() as u32).max(1)),
         (None, Some(h)) => (((h as f64 * dw as f64 / dh as f64).round() as u32).max(1), h),
         (None, None) => (dw, dh),
-    };
+    }
+}
+
+pub fn bvh_kind(s: &Option<String>) -> Result<BvhKind> {
+    match s {
+        Some(s) => BvhKind::parse(s).with_context(|| format!("--bvh {s:?}: use bvh2 or cwbvh")),
+        None => Ok(BvhKind::DEFAULT),
+    }
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    match a.mode.as_str() {
+        "reference" => {}
+        "realtime" => return crate::realtime::run(a),
+        m => bail!("--mode {m:?} is not available; use reference or realtime"),
+    }
+    let out = a.out.clone().context("--out is required in reference mode")?;
+    if a.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    let kind = bvh_kind(&a.bvh)?;
+    let scene = load_scene(&a.scene, a.max_texture_size)?;
+    let (w, h) = image_size(&scene, a.width, a.height);
     let camera = match &a.camera {
         Some(c) => parse_camera(c)?,
         None => scene.camera_or_default(),
@@ -138,10 +168,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if acc.nonfinite_samples > 0 {
         log::warn!("{} NaN/Inf samples were dropped", acc.nonfinite_samples);
     }
-    acc.mean.save(&a.out)?;
+    acc.mean.save(&out)?;
     eprintln!(
         "{}: {}x{} {} spp in {:.2} s ({:.3} M samples/s) on {} -> {}",
-        scene.name, w, h, a.spp, secs, (w as f64 * h as f64 * a.spp as f64) / secs / 1e6, gpu.info.name, a.out.display()
+        scene.name, w, h, a.spp, secs, (w as f64 * h as f64 * a.spp as f64) / secs / 1e6, gpu.info.name, out.display()
     );
     Ok(())
 }

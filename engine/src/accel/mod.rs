@@ -64,6 +64,13 @@ pub struct Accel {
     pub build_time: Duration,
 }
 
+impl Accel {
+    /// Placeholder before the first build (no nodes).
+    pub fn empty(kind: BvhKind) -> Accel {
+        Accel { kind, nodes: vec![], node_count: 0, order: vec![], build_time: Duration::ZERO }
+    }
+}
+
 fn params() -> BvhBuildParams {
     // No spatial pre-splits: every triangle then sits in exactly one leaf, and the GPU can store
     // triangles in leaf order.

@@ -15,6 +15,10 @@ pub struct GpuRequirements {
     pub max_storage_buffer_binding_size: u64,
     /// Storage buffers bound at once by the busiest compute stage.
     pub max_storage_buffers_per_shader_stage: u32,
+    /// Storage textures written at once by the busiest compute stage.
+    pub max_storage_textures_per_shader_stage: u32,
+    /// Render-target bytes per sample of the widest render pass (WebGPU's accounting).
+    pub max_color_attachment_bytes_per_sample: u32,
 }
 
 impl Default for GpuRequirements {
@@ -24,6 +28,8 @@ impl Default for GpuRequirements {
             features: wgpu::Features::empty(),
             max_storage_buffer_binding_size: d.max_storage_buffer_binding_size as u64,
             max_storage_buffers_per_shader_stage: d.max_storage_buffers_per_shader_stage,
+            max_storage_textures_per_shader_stage: d.max_storage_textures_per_shader_stage,
+            max_color_attachment_bytes_per_sample: d.max_color_attachment_bytes_per_sample,
         }
     }
 }
@@ -72,6 +78,21 @@ impl Gpu {
         limits.max_storage_buffers_per_shader_stage = limits
             .max_storage_buffers_per_shader_stage
             .max(req.max_storage_buffers_per_shader_stage);
+        limits.max_storage_textures_per_shader_stage = limits.max_storage_textures_per_shader_stage.max(req.max_storage_textures_per_shader_stage);
+        limits.max_color_attachment_bytes_per_sample = limits.max_color_attachment_bytes_per_sample.max(req.max_color_attachment_bytes_per_sample);
+        if limits.max_storage_textures_per_shader_stage > have.max_storage_textures_per_shader_stage
+            || limits.max_color_attachment_bytes_per_sample > have.max_color_attachment_bytes_per_sample
+        {
+            return Err(anyhow!(
+                "adapter {:?} is too small for the real-time frame: it needs {} storage textures per \
+                 stage and {} render-target bytes per sample; it allows {} and {}",
+                info.name,
+                req.max_storage_textures_per_shader_stage,
+                req.max_color_attachment_bytes_per_sample,
+                have.max_storage_textures_per_shader_stage,
+                have.max_color_attachment_bytes_per_sample
+            ));
+        }
         if limits.max_storage_buffer_binding_size > have.max_storage_buffer_binding_size
             || limits.max_storage_buffers_per_shader_stage > have.max_storage_buffers_per_shader_stage
         {
@@ -122,6 +143,19 @@ impl Gpu {
             log::error!("wgpu: {e}");
         }));
         Ok(Gpu { instance, adapter, device, queue, info, timestamps })
+    }
+
+    /// Run `f` inside a validation error scope: what wgpu would only log becomes an error with
+    /// `what` as its context.
+    pub fn validated<T>(&self, what: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let r = f();
+        let e = pollster::block_on(scope.pop());
+        let v = r?;
+        match e {
+            Some(e) => Err(anyhow!("{what}: {e}")),
+            None => Ok(v),
+        }
     }
 
     /// Block until all submitted work has finished.

@@ -32,6 +32,31 @@ impl GpuMemory {
         })
     }
 
+    /// A 2D texture and its default view; its bytes are width x height x the format's block size.
+    pub fn texture(
+        &mut self,
+        device: &wgpu::Device,
+        label: &str,
+        (width, height): (u32, u32),
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> (wgpu::Texture, wgpu::TextureView) {
+        let bytes = format.block_copy_size(Some(wgpu::TextureAspect::All)).unwrap_or(4) as u64;
+        self.allocations.push((label.to_string(), width as u64 * height as u64 * bytes));
+        let t = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        });
+        let v = t.create_view(&Default::default());
+        (t, v)
+    }
+
     pub fn buffer(
         &mut self,
         device: &wgpu::Device,
@@ -85,4 +110,31 @@ pub fn readback_buffer(
         .to_vec();
     staging.unmap();
     Ok(data)
+}
+
+/// Copy a 2D texture (COPY_SRC) into memory, rows tightly packed.
+pub fn readback_texture(gpu: &super::Gpu, tex: &wgpu::Texture) -> Result<Vec<u8>> {
+    let (w, h) = (tex.width(), tex.height());
+    let bpp = tex.format().block_copy_size(Some(wgpu::TextureAspect::All)).ok_or_else(|| anyhow!("texture format {:?} cannot be copied", tex.format()))?;
+    let row = w * bpp;
+    let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture readback"),
+        size: padded as u64 * h as u64,
+        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        tex.as_image_copy(),
+        wgpu::TexelCopyBufferInfo { buffer: &staging, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) } },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+    );
+    gpu.queue.submit([enc.finish()]);
+    let bytes = readback_buffer(&gpu.device, &gpu.queue, &staging, padded as u64 * h as u64)?;
+    let mut out = Vec::with_capacity((row * h) as usize);
+    for y in 0..h as usize {
+        out.extend_from_slice(&bytes[y * padded as usize..y * padded as usize + row as usize]);
+    }
+    Ok(out)
 }

@@ -1,12 +1,16 @@
 //! The GPU context (headless or with a surface), tracked buffer allocation, readback, and the
 //! scene's GPU form.
 
+pub mod binding;
 mod context;
 mod memory;
 pub mod prepare;
 pub mod scene;
+mod timestamps;
 
 pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP};
-pub use memory::{GpuMemory, readback_buffer};
+pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use prepare::{EnvKind, PreparedScene, SceneFeatures};
 pub use scene::GpuScene;
+pub use timestamps::GpuTimer;
+pub use binding::Bindings;

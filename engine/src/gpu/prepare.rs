@@ -6,7 +6,7 @@ use crate::accel::{self, Accel, BvhKind};
 use crate::scene::{AlphaMode, Environment, Light, Scene, Wrap};
 use anyhow::{Result, bail};
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat3, DVec3, Vec3, Vec3A, Vec4};
+use glam::{DMat3, DMat4, DVec3, Vec3, Vec3A, Vec4};
 use obvhs::triangle::Triangle;
 
 /// Which optional parts of the renderer a scene needs. Each one missing removes its bindings,
@@ -19,6 +19,10 @@ pub struct SceneFeatures {
     pub textures: bool,
     pub normal_maps: bool,
     pub alpha_mask: bool,
+    /// Some material has a specular (GGX) lobe: the glossy path, its buffers and chain exist.
+    pub glossy: bool,
+    /// Some object moves: the BVH is rebuilt each frame and object motion enters the motion vectors.
+    pub animated: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,6 +58,28 @@ pub struct GpuLight {
     pub cos_inner: f32,
 }
 
+impl From<&crate::scene::Material> for GpuMaterial {
+    fn from(m: &crate::scene::Material) -> GpuMaterial {
+        let t = |r: Option<crate::scene::TextureRef>| r.map(|r| r.index as i32).unwrap_or(-1);
+        let (mask, cutoff) = match m.alpha_mode {
+            AlphaMode::Opaque => (0, 0.0),
+            AlphaMode::Mask(c) => (MAT_ALPHA_MASK, c),
+        };
+        GpuMaterial {
+            base_color: m.base_color.to_array(),
+            emission: m.emission.to_array(),
+            metallic: m.metallic,
+            specular_color: m.specular_color.to_array(),
+            roughness: m.roughness,
+            specular_factor: m.specular_factor,
+            alpha_cutoff: cutoff,
+            normal_scale: m.normal_scale,
+            flags: mask | if m.double_sided { MAT_DOUBLE_SIDED } else { 0 },
+            tex: [t(m.base_color_texture), t(m.metallic_roughness_texture), t(m.normal_texture), t(m.emissive_texture)],
+        }
+    }
+}
+
 pub const MAT_DOUBLE_SIDED: u32 = 1;
 pub const MAT_ALPHA_MASK: u32 = 2;
 
@@ -85,137 +111,103 @@ pub struct PreparedScene {
     pub tex_data: Vec<u32>,
     /// Input triangles dropped: non-finite vertices or zero area.
     pub dropped_triangles: usize,
+    /// Per material: emits light.
+    emissive_materials: Vec<bool>,
+    /// Per object: its world transform at `time`, and the rebased transform taking a point on
+    /// it now to where it was at the previous `animate` call.
+    world: Vec<DMat4>,
+    pub prev_from_current: Vec<glam::Mat4>,
+    flat: Vec<Flat>,
+    pub time: f64,
 }
 
 /// Triangle slots and node indices share 24 bits in the BVH2 traversal stack.
 pub const MAX_TRIANGLES: usize = 1 << 24;
 
+/// One object's triangles in rebased world space, before the BVH orders them.
+#[derive(Clone, Default)]
+struct Flat {
+    tris: Vec<Triangle>,
+    attrs: Vec<[Vec4; 4]>,
+    tans: Vec<[Vec4; 3]>,
+    mats: Vec<u32>,
+    dropped: usize,
+}
+
+fn flatten(scene: &Scene, object: usize, transform: DMat4, origin: DVec3, normal_maps: bool) -> Flat {
+    let o = &scene.objects[object];
+    let mesh = &scene.meshes[o.mesh];
+    let m3 = DMat3::from_mat4(transform);
+    let flip = m3.determinant() < 0.0;
+    let nmat = m3.inverse().transpose();
+    let mat = if (mesh.material as usize) < scene.materials.len() { mesh.material } else { 0 };
+    let mut f = Flat::default();
+    for t in mesh.indices.chunks_exact(3) {
+        // A mirroring transform reverses the winding; swap to keep the front face CCW.
+        let idx = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
+        let p64 = idx.map(|i| transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin);
+        let p = p64.map(|v| v.as_vec3());
+        // Degenerate: zero area, or so thin (area below 1e-12 of the longest edge squared)
+        // that f32 arithmetic cannot resolve it; such a triangle cannot be hit reliably.
+        let area2 = (p64[1] - p64[0]).cross(p64[2] - p64[0]).length();
+        let edge2 = (p64[1] - p64[0]).length_squared().max((p64[2] - p64[1]).length_squared()).max((p64[0] - p64[2]).length_squared());
+        let area2_f32 = (p[1] - p[0]).cross(p[2] - p[0]).length();
+        if !p.iter().all(|v| v.is_finite()) || !(area2 > 1e-12 * edge2) || !(area2_f32 > 0.0) || !area2_f32.is_finite() {
+            f.dropped += 1;
+            continue;
+        }
+        f.tris.push(Triangle { v0: p[0].into(), v1: p[1].into(), v2: p[2].into() });
+        let n = idx.map(|i| {
+            let n = mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+            let n = (nmat * n.as_dvec3()).normalize_or_zero().as_vec3();
+            if n.is_finite() { n } else { Vec3::ZERO }
+        });
+        let uv = idx.map(|i| {
+            let uv = mesh.uvs.get(i as usize).copied().unwrap_or_default();
+            if uv.is_finite() { uv } else { glam::Vec2::ZERO }
+        });
+        // The fourth vec4's w carries the object index (as bits) for motion vectors.
+        f.attrs.push([
+            n[0].extend(uv[0].x),
+            n[1].extend(uv[1].x),
+            n[2].extend(uv[2].x),
+            Vec4::new(uv[0].y, uv[1].y, uv[2].y, f32::from_bits(object as u32)),
+        ]);
+        if normal_maps {
+            f.tans.push(idx.map(|i| {
+                let t = mesh.tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
+                let xyz = (m3 * t.truncate().as_dvec3()).normalize_or_zero().as_vec3();
+                let w = if flip { -t.w } else { t.w };
+                if xyz.is_finite() { xyz.extend(w) } else { Vec4::new(1.0, 0.0, 0.0, 1.0) }
+            }));
+        }
+        f.mats.push(mat);
+    }
+    f
+}
+
+/// f32 matrix of a rebased world transform.
+fn rebased(m: DMat4, origin: DVec3) -> glam::Mat4 {
+    (DMat4::from_translation(-origin) * m).as_mat4()
+}
+
 impl PreparedScene {
     pub fn new(scene: &Scene, kind: BvhKind) -> Result<PreparedScene> {
         let origin = scene.origin();
         let extent = scene.bounds().map(|(lo, hi)| (hi - lo).length()).filter(|e| *e > 0.0).unwrap_or(1.0);
-        let mut tris_in: Vec<Triangle> = vec![];
-        let mut attrs: Vec<[Vec4; 4]> = vec![];
-        let mut tans: Vec<[Vec4; 3]> = vec![];
-        let mut mats: Vec<u32> = vec![];
-        let mut dropped = 0usize;
         let normal_maps = scene.materials.iter().any(|m| m.normal_texture.is_some());
-        for o in &scene.objects {
-            let mesh = &scene.meshes[o.mesh];
-            let m3 = DMat3::from_mat4(o.transform);
-            let flip = m3.determinant() < 0.0;
-            let nmat = m3.inverse().transpose();
-            let mat = if (mesh.material as usize) < scene.materials.len() { mesh.material } else { 0 };
-            for t in mesh.indices.chunks_exact(3) {
-                // A mirroring transform reverses the winding; swap to keep the front face CCW.
-                let idx = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
-                let p64 = idx.map(|i| o.transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin);
-                let p = p64.map(|v| v.as_vec3());
-                // Degenerate: zero area, or so thin (area below 1e-12 of the longest edge squared)
-                // that f32 arithmetic cannot resolve it; such a triangle cannot be hit reliably.
-                let area2 = (p64[1] - p64[0]).cross(p64[2] - p64[0]).length();
-                let edge2 = (p64[1] - p64[0]).length_squared().max((p64[2] - p64[1]).length_squared()).max((p64[0] - p64[2]).length_squared());
-                let area2_f32 = (p[1] - p[0]).cross(p[2] - p[0]).length();
-                if !p.iter().all(|v| v.is_finite()) || !(area2 > 1e-12 * edge2) || !(area2_f32 > 0.0) || !area2_f32.is_finite() {
-                    dropped += 1;
-                    continue;
-                }
-                tris_in.push(Triangle { v0: p[0].into(), v1: p[1].into(), v2: p[2].into() });
-                let n = idx.map(|i| {
-                    let n = mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-                    let n = (nmat * n.as_dvec3()).normalize_or_zero().as_vec3();
-                    if n.is_finite() { n } else { Vec3::ZERO }
-                });
-                let uv = idx.map(|i| {
-                    let uv = mesh.uvs.get(i as usize).copied().unwrap_or_default();
-                    if uv.is_finite() { uv } else { glam::Vec2::ZERO }
-                });
-                attrs.push([
-                    n[0].extend(uv[0].x),
-                    n[1].extend(uv[1].x),
-                    n[2].extend(uv[2].x),
-                    Vec4::new(uv[0].y, uv[1].y, uv[2].y, 0.0),
-                ]);
-                if normal_maps {
-                    tans.push(idx.map(|i| {
-                        let t = mesh.tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
-                        let xyz = (m3 * t.truncate().as_dvec3()).normalize_or_zero().as_vec3();
-                        let w = if flip { -t.w } else { t.w };
-                        if xyz.is_finite() { xyz.extend(w) } else { Vec4::new(1.0, 0.0, 0.0, 1.0) }
-                    }));
-                }
-                mats.push(mat);
-            }
-        }
-        if tris_in.len() >= MAX_TRIANGLES {
-            bail!("{} triangles: Hush handles at most {} per scene", tris_in.len(), MAX_TRIANGLES - 1);
-        }
+        let flat: Vec<Flat> = (0..scene.objects.len()).map(|i| flatten(scene, i, scene.objects[i].transform, origin, normal_maps)).collect();
+        let dropped: usize = flat.iter().map(|f| f.dropped).sum();
         if dropped > 0 {
             log::warn!("dropped {dropped} triangles with non-finite vertices or zero area");
         }
-        let accel = accel::build(&tris_in, kind);
-        let mut tris = Vec::with_capacity(tris_in.len() * 3);
-        let mut shading = Vec::with_capacity(tris_in.len() * 4);
-        let mut tangents = vec![];
-        for &orig in &accel.order {
-            let (t, i) = (&tris_in[orig as usize], orig as usize);
-            let v = |a: Vec3A| Vec3::from(a);
-            tris.push(v(t.v0).extend(f32::from_bits(mats[i])));
-            tris.push(v(t.v1).extend(f32::from_bits(orig)));
-            tris.push(v(t.v2).extend(0.0));
-            shading.extend_from_slice(&attrs[i]);
-            if normal_maps {
-                tangents.extend_from_slice(&tans[i]);
-            }
+        let count: usize = flat.iter().map(|f| f.tris.len()).sum();
+        if count >= MAX_TRIANGLES {
+            bail!("{} triangles: Hush handles at most {} per scene", count, MAX_TRIANGLES - 1);
         }
-        let materials: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .map(|m| {
-                let t = |r: Option<crate::scene::TextureRef>| r.map(|r| r.index as i32).unwrap_or(-1);
-                let (mask, cutoff) = match m.alpha_mode {
-                    AlphaMode::Opaque => (0, 0.0),
-                    AlphaMode::Mask(c) => (MAT_ALPHA_MASK, c),
-                };
-                GpuMaterial {
-                    base_color: m.base_color.to_array(),
-                    emission: m.emission.to_array(),
-                    metallic: m.metallic,
-                    specular_color: m.specular_color.to_array(),
-                    roughness: m.roughness,
-                    specular_factor: m.specular_factor,
-                    alpha_cutoff: cutoff,
-                    normal_scale: m.normal_scale,
-                    flags: mask | if m.double_sided { MAT_DOUBLE_SIDED } else { 0 },
-                    tex: [t(m.base_color_texture), t(m.metallic_roughness_texture), t(m.normal_texture), t(m.emissive_texture)],
-                }
-            })
-            .collect();
+        let world: Vec<DMat4> = scene.objects.iter().map(|o| o.transform).collect();
+        let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
         let lights: Vec<GpuLight> = scene.lights.iter().map(|l| pack_light(l, origin)).collect();
-
-        // Emissive triangles by area x luminance (one-sided power up to a constant pi).
-        let mut emitters = vec![];
-        let mut weights = vec![];
-        for (slot, &orig) in accel.order.iter().enumerate() {
-            let m = &scene.materials[mats[orig as usize] as usize];
-            let lum = crate::quality::luminance(m.emission);
-            if lum > 0.0 {
-                let t = &tris_in[orig as usize];
-                let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
-                weights.push(area * lum as f64);
-                emitters.push([0u32, slot as u32]);
-            }
-        }
-        let total: f64 = weights.iter().sum();
-        let mut acc = 0.0;
-        for (e, w) in emitters.iter_mut().zip(&weights) {
-            acc += w;
-            e[0] = ((acc / total) as f32).to_bits();
-        }
-        if let Some(last) = emitters.last_mut() {
-            last[0] = 1.0f32.to_bits();
-        }
-        let emit_inv_total = if total > 0.0 { (1.0 / total) as f32 } else { 0.0 };
 
         let mut env = EnvPack::default();
         let env_kind = match &scene.environment {
@@ -231,26 +223,33 @@ impl PreparedScene {
         };
         let tex_data = pack_textures(scene);
         let alpha_mask = scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_)));
-        let features = SceneFeatures {
-            punctual_lights: !lights.is_empty(),
-            emitters: !emitters.is_empty(),
-            env: env_kind,
-            textures: !scene.textures.is_empty(),
-            normal_maps,
-            alpha_mask,
-        };
-        Ok(PreparedScene {
-            features,
-            accel,
+        let emissive: Vec<bool> = scene.materials.iter().map(|m| crate::quality::luminance(m.emission) > 0.0).collect();
+        let glossy = scene.materials.iter().any(|m| {
+            let g = GpuMaterial::from(m);
+            g.metallic > 0.0 || (g.specular_factor > 0.0 && g.specular_color.iter().any(|c| *c > 0.0))
+        });
+        let mut p = PreparedScene {
+            features: SceneFeatures {
+                punctual_lights: !lights.is_empty(),
+                emitters: false,
+                env: env_kind,
+                textures: !scene.textures.is_empty(),
+                normal_maps,
+                alpha_mask,
+                glossy,
+                animated: scene.is_animated(),
+            },
+            accel: Accel::empty(kind),
             origin,
             extent,
-            tris,
-            shading,
-            tangents,
+            tris: vec![],
+            shading: vec![],
+            tangents: vec![],
             materials,
+            emissive_materials: emissive,
             lights,
-            emitters,
-            emit_inv_total,
+            emitters: vec![],
+            emit_inv_total: 0.0,
             env_data: env.data,
             env_radiance: env.radiance,
             env_size: env.size,
@@ -258,9 +257,99 @@ impl PreparedScene {
             env_pdf_norm: env.pdf_norm,
             tex_data,
             dropped_triangles: dropped,
-        })
+            prev_from_current: vec![glam::Mat4::IDENTITY; world.len()],
+            world,
+            flat,
+            time: 0.0,
+        };
+        p.assemble();
+        p.features.emitters = !p.emitters.is_empty();
+        Ok(p)
     }
 
+    /// Move animated objects to `time` seconds: re-flatten them, rebuild the BVH and the
+    /// per-object motion (`prev_from_current`) that the G-buffer's motion vectors read. Returns
+    /// false (and changes nothing) for a static scene.
+    pub fn animate(&mut self, scene: &Scene, time: f64) -> bool {
+        let mut moved = false;
+        for (i, o) in scene.objects.iter().enumerate().take(self.world.len()) {
+            let now = o.transform_at(time);
+            let before = self.world[i];
+            self.prev_from_current[i] = if o.animation.is_some() {
+                (rebased(before, self.origin) * rebased(now, self.origin).inverse()).into()
+            } else {
+                glam::Mat4::IDENTITY
+            };
+            if o.animation.is_some() && now != before {
+                self.flat[i] = flatten(scene, i, now, self.origin, self.features.normal_maps);
+                self.world[i] = now;
+                moved = true;
+            }
+        }
+        self.time = time;
+        if moved {
+            self.assemble();
+        }
+        moved
+    }
+
+    /// BVH over every object's triangles, then the buffers in BVH leaf order and the emitter CDF.
+    fn assemble(&mut self) {
+        let kind = self.accel.kind;
+        let mut tris_in: Vec<Triangle> = vec![];
+        let mut attrs: Vec<&[Vec4; 4]> = vec![];
+        let mut tans: Vec<&[Vec4; 3]> = vec![];
+        let mut mats: Vec<u32> = vec![];
+        for f in &self.flat {
+            tris_in.extend_from_slice(&f.tris);
+            attrs.extend(f.attrs.iter());
+            tans.extend(f.tans.iter());
+            mats.extend_from_slice(&f.mats);
+        }
+        let accel = accel::build(&tris_in, kind);
+        self.tris.clear();
+        self.shading.clear();
+        self.tangents.clear();
+        for &orig in &accel.order {
+            let (t, i) = (&tris_in[orig as usize], orig as usize);
+            let v = |a: Vec3A| Vec3::from(a);
+            self.tris.push(v(t.v0).extend(f32::from_bits(mats[i])));
+            self.tris.push(v(t.v1).extend(f32::from_bits(orig)));
+            self.tris.push(v(t.v2).extend(0.0));
+            self.shading.extend_from_slice(attrs[i]);
+            if self.features.normal_maps {
+                self.tangents.extend_from_slice(tans[i]);
+            }
+        }
+        // Emissive triangles by area x luminance (one-sided power up to a constant pi).
+        let mut emitters = vec![];
+        let mut weights = vec![];
+        for (slot, &orig) in accel.order.iter().enumerate() {
+            let m = mats[orig as usize] as usize;
+            if self.emissive_materials.get(m).copied().unwrap_or(false) {
+                let t = &tris_in[orig as usize];
+                let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
+                let lum = crate::quality::luminance(Vec3::from_slice(&self.materials[m].emission)) as f64;
+                weights.push(area * lum);
+                emitters.push([0u32, slot as u32]);
+            }
+        }
+        let total: f64 = weights.iter().sum();
+        let mut acc = 0.0;
+        for (e, w) in emitters.iter_mut().zip(&weights) {
+            acc += w;
+            e[0] = ((acc / total) as f32).to_bits();
+        }
+        if let Some(last) = emitters.last_mut() {
+            last[0] = 1.0f32.to_bits();
+        }
+        self.emit_inv_total = if total > 0.0 { (1.0 / total) as f32 } else { 0.0 };
+        self.emitters = emitters;
+        self.accel = accel;
+    }
+}
+
+impl PreparedScene {
     pub fn triangle_count(&self) -> usize {
         self.tris.len() / 3
     }

@@ -16,7 +16,12 @@ pub struct GpuScene {
     pub env: Option<wgpu::Buffer>,
     pub textures: Option<wgpu::Buffer>,
     pub tangents: Option<wgpu::Buffer>,
+    /// Per object: rebased previous-from-current transform (animated scenes only).
+    pub objects: Option<wgpu::Buffer>,
     pub memory: GpuMemory,
+    pub triangle_count: u32,
+    /// Bumped whenever a buffer is replaced, so passes know to rebuild their bind groups.
+    pub generation: u64,
 }
 
 /// Binding numbers shared by every program that reads the scene (`shaders/common`).
@@ -31,6 +36,7 @@ pub mod binding {
     pub const ENV: u32 = 8;
     pub const TEXTURES: u32 = 9;
     pub const TANGENTS: u32 = 10;
+    pub const OBJECTS: u32 = 17;
 }
 
 impl PreparedScene {
@@ -55,15 +61,16 @@ impl PreparedScene {
             + f.normal_maps as u32;
         let d = GpuRequirements::default();
         GpuRequirements {
-            features: wgpu::Features::empty(),
             max_storage_buffer_binding_size: sizes.into_iter().max().unwrap_or(0).max(d.max_storage_buffer_binding_size),
             max_storage_buffers_per_shader_stage: count.max(d.max_storage_buffers_per_shader_stage),
+            ..d
         }
     }
 
     pub fn upload(&self, gpu: &Gpu) -> GpuScene {
         let mut mem = GpuMemory::default();
-        let s = wgpu::BufferUsages::STORAGE;
+        // Animated scenes rewrite their geometry every frame.
+        let s = if self.features.animated { wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST } else { wgpu::BufferUsages::STORAGE };
         let d = &gpu.device;
         fn b<T: bytemuck::Pod>(v: &[T]) -> &[u8] {
             bytemuck::cast_slice(v)
@@ -78,6 +85,8 @@ impl PreparedScene {
         let env = (f.env == EnvKind::Map).then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), s));
         let textures = f.textures.then(|| mem.buffer_init(d, "scene/textures", b(&self.tex_data), s));
         let tangents = f.normal_maps.then(|| mem.buffer_init(d, "scene/tangents", b(&self.tangents), s));
+        let copy = s | wgpu::BufferUsages::COPY_DST;
+        let objects = f.animated.then(|| mem.buffer_init(d, "scene/object motion", b(&self.prev_from_current), copy));
         log::info!(
             "scene on the GPU: {} triangles, {} BVH nodes ({}), features {:?}, {} bytes: {}",
             self.triangle_count(),
@@ -99,7 +108,10 @@ impl PreparedScene {
             env,
             textures,
             tangents,
+            objects,
             memory: mem,
+            triangle_count: self.triangle_count() as u32,
+            generation: 0,
         }
     }
 }
@@ -131,6 +143,50 @@ pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl GpuScene {
+    /// After [`PreparedScene::animate`]: write the rebuilt geometry and object motion, replacing
+    /// a buffer (and bumping `generation`) only where the new data no longer fits.
+    pub fn update_geometry(&mut self, gpu: &Gpu, p: &PreparedScene, moved: bool) {
+        fn b<T: bytemuck::Pod>(v: &[T]) -> &[u8] {
+            bytemuck::cast_slice(v)
+        }
+        let mut replaced = false;
+        let mem = &mut self.memory;
+        let mut put = |buf: &mut wgpu::Buffer, label: &str, data: &[u8]| {
+            if data.is_empty() {
+                return;
+            }
+            if (data.len() as u64) <= buf.size() && buf.usage().contains(wgpu::BufferUsages::COPY_DST) {
+                gpu.queue.write_buffer(buf, 0, data);
+            } else {
+                mem.allocations.retain(|(l, _)| l != label);
+                let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+                // Headroom, so that a BVH a few nodes larger next frame does not reallocate again.
+                let size = (data.len() as u64 * 5 / 4).next_multiple_of(16);
+                *buf = mem.buffer(&gpu.device, label, size, usage);
+                gpu.queue.write_buffer(buf, 0, data);
+                replaced = true;
+            }
+        };
+        if moved {
+            put(&mut self.nodes, "scene/bvh nodes", &p.accel.nodes);
+            put(&mut self.tris, "scene/triangles", b(&p.tris));
+            put(&mut self.shading, "scene/shading", b(&p.shading));
+            if let Some(t) = self.tangents.as_mut() {
+                put(t, "scene/tangents", b(&p.tangents));
+            }
+            if let Some(e) = self.emitters.as_mut() {
+                put(e, "scene/emitters", b(&p.emitters));
+            }
+        }
+        if let Some(o) = self.objects.as_mut() {
+            put(o, "scene/object motion", b(&p.prev_from_current));
+        }
+        self.triangle_count = p.triangle_count() as u32;
+        if replaced {
+            self.generation += 1;
+        }
+    }
+
     /// (binding, buffer) of the whole scene, for programs that shade (the tracer).
     pub fn shading_bindings(&self) -> Vec<(u32, &wgpu::Buffer)> {
         use binding::*;
@@ -147,7 +203,7 @@ impl GpuScene {
     /// Program modules that match this scene's features, for a program that shades.
     pub fn shading_modules(&self) -> Vec<&'static str> {
         let f = &self.features;
-        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl"];
+        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
         m.push(if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" });
         m.push(if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" });
         m.push(if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" });

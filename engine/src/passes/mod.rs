@@ -5,3 +5,7 @@ pub mod reference;
 
 pub use raycast::{RayHit, Raycaster};
 pub use reference::{Accumulation, ReferenceTracer, TraceView};
+
+pub mod composite;
+pub mod gbuffer;
+pub mod trace;

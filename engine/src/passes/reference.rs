@@ -76,7 +76,7 @@ impl ReferenceTracer {
             bail!("image size {w}x{h} is out of range (1..={MAX_SIDE} per side)");
         }
         let mut modules = scene.shading_modules();
-        modules.extend(["reference/params.wgsl", "reference/trace.wgsl"]);
+        modules.push("reference/trace.wgsl");
         let program = crate::shader::compose(LABEL, &scene.prelude(), &modules)?;
         let module = program.create(&gpu.device)?;
         let mut memory = GpuMemory::default();
@@ -166,7 +166,7 @@ impl ReferenceTracer {
     }
 }
 
-fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
+pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
     let cam = &view.camera;
     let m = cam.world;
     let pos = (m.transform_point3(DVec3::ZERO) - p.origin).as_vec3();

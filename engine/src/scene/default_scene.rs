@@ -127,7 +127,7 @@ pub fn default_scene() -> Scene {
     // Sun from behind the room, through the window, onto the floor.
     let (sun, sky) = sky::sun_and_sky(Vec3::new(0.3, -0.55, 0.78).normalize());
     let objects = (0..meshes.len())
-        .map(|i| Object { name: format!("part{i}"), mesh: i, transform: DMat4::IDENTITY })
+        .map(|i| Object { name: format!("part{i}"), mesh: i, transform: DMat4::IDENTITY, animation: None })
         .collect();
     Scene {
         name: "default".into(),

@@ -2,7 +2,7 @@
 
 use super::paths::{read_uri, resolve};
 use super::{
-    AlphaMode, Camera, EnvMap, Environment, Light, Material, Mesh, Object, Scene, Texture,
+    Animation, Track, AlphaMode, Camera, EnvMap, Environment, Light, Material, Mesh, Object, Scene, Texture,
     TextureRef, Wrap, DEFAULT_MAX_DEPTH,
 };
 use anyhow::{Context, Result, anyhow, bail};
@@ -108,9 +108,18 @@ impl Importer<'_> {
             .ok_or_else(|| anyhow!("the file has no scene"))?;
         self.scene_extras(&gscene, &mut scene)?;
         let mut mesh_cache: HashMap<usize, Vec<usize>> = HashMap::new();
-        let mut stack: Vec<(gltf::Node, DMat4)> =
-            gscene.nodes().map(|n| (n, DMat4::IDENTITY)).collect();
-        while let Some((node, parent)) = stack.pop() {
+        let mut animated = self.animations(doc, &buffers);
+        // (node, parent world transform, whether an ancestor is animated)
+        let mut stack: Vec<(gltf::Node, DMat4, bool)> =
+            gscene.nodes().map(|n| (n, DMat4::IDENTITY, false)).collect();
+        while let Some((node, parent, moving_parent)) = stack.pop() {
+            let mut animation = animated.remove(&node.index());
+            if let Some(a) = animation.as_mut() {
+                if moving_parent {
+                    self.warn(format!("node {:?} is animated under an animated parent; only the parent's rest pose is used", node.name()));
+                }
+                a.parent = parent;
+            }
             let local = node.transform().matrix().map(|c| c.map(|x| x as f64));
             let world = parent * DMat4::from_cols_array_2d(&local);
             if !world.is_finite() {
@@ -132,6 +141,7 @@ impl Importer<'_> {
                         name: node.name().unwrap_or("").to_string(),
                         mesh: id,
                         transform: world,
+                        animation: animation.clone(),
                     });
                 }
             }
@@ -150,12 +160,75 @@ impl Importer<'_> {
                     }
                 }
             }
+            let moving = moving_parent || animation.is_some();
+            if animation.is_some() && node.children().next().is_some() {
+                self.warn(format!("children of animated node {:?} are placed at its rest pose", node.name()));
+            }
             for child in node.children() {
-                stack.push((child, world));
+                stack.push((child, world, moving));
             }
         }
         scene.warnings = self.warnings;
         Ok(scene)
+    }
+
+    /// Node index -> its animation (translation/rotation/scale channels of every glTF animation).
+    fn animations(&mut self, doc: &gltf::Document, buffers: &[Vec<u8>]) -> HashMap<usize, Animation> {
+        use gltf::animation::{Interpolation, Property, util::ReadOutputs};
+        let mut map: HashMap<usize, Animation> = HashMap::new();
+        for anim in doc.animations() {
+            for ch in anim.channels() {
+                let node = ch.target().node();
+                let reader = ch.reader(|b| buffers.get(b.index()).map(|v| v.as_slice()));
+                let Some(times) = reader.read_inputs() else { continue };
+                let times: Vec<f64> = times.map(|t| t as f64).collect();
+                let interp = ch.sampler().interpolation();
+                // CUBICSPLINE stores (in-tangent, value, out-tangent) per key: keep the values.
+                let pick = |i: usize| match interp {
+                    Interpolation::CubicSpline => i % 3 == 1,
+                    _ => true,
+                };
+                if interp == Interpolation::CubicSpline {
+                    self.warn(format!("animation on node {:?}: CUBICSPLINE is sampled linearly between keys", node.name()));
+                }
+                let sorted = times.windows(2).all(|w| w[0] <= w[1]) && times.iter().all(|t| t.is_finite());
+                if !sorted {
+                    self.warn(format!("animation on node {:?} has unsorted or non-finite key times; ignored", node.name()));
+                    continue;
+                }
+                let (t, r, s) = node.transform().decomposed();
+                let a = map.entry(node.index()).or_insert_with(|| Animation {
+                    parent: DMat4::IDENTITY,
+                    translation: glam::DVec3::from_array(t.map(|x| x as f64)),
+                    rotation: glam::DQuat::from_array(r.map(|x| x as f64)),
+                    scale: glam::DVec3::from_array(s.map(|x| x as f64)),
+                    translation_track: None,
+                    rotation_track: None,
+                    scale_track: None,
+                });
+                let step = interp == Interpolation::Step;
+                let v3 = |it: &mut dyn Iterator<Item = [f32; 3]>| -> Vec<glam::DVec3> {
+                    it.enumerate().filter(|(i, _)| pick(*i)).map(|(_, v)| glam::DVec3::from_array(v.map(|x| x as f64))).collect()
+                };
+                match (ch.target().property(), reader.read_outputs()) {
+                    (Property::Translation, Some(ReadOutputs::Translations(mut it))) => {
+                        a.translation_track = Some(Track { times: times.clone(), values: v3(&mut it), step });
+                    }
+                    (Property::Scale, Some(ReadOutputs::Scales(mut it))) => {
+                        a.scale_track = Some(Track { times: times.clone(), values: v3(&mut it), step });
+                    }
+                    (Property::Rotation, Some(ReadOutputs::Rotations(it))) => {
+                        let values = it.into_f32().enumerate().filter(|(i, _)| pick(*i))
+                            .map(|(_, q)| glam::DQuat::from_array(q.map(|x| x as f64)).normalize()).collect();
+                        a.rotation_track = Some(Track { times: times.clone(), values, step });
+                    }
+                    (Property::MorphTargetWeights, _) => self.warn("morph target animation is not supported; ignored".into()),
+                    _ => self.warn(format!("animation channel on node {:?} could not be read; ignored", node.name())),
+                }
+            }
+        }
+        map.retain(|_, a| a.duration() > 0.0 || a.translation_track.is_some() || a.rotation_track.is_some() || a.scale_track.is_some());
+        map
     }
 
     fn load_buffers(&mut self, doc: &gltf::Document, blob: Option<&[u8]>) -> Result<Vec<Vec<u8>>> {

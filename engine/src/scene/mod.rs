@@ -1,6 +1,8 @@
 //! Scenes on the CPU: what a glTF file (or the built-in default scene) describes, in the units and
 //! conventions of `README.md` ("Scene conventions").
 
+mod animation;
+mod camera_path;
 mod default_scene;
 mod environment;
 mod gltf_import;
@@ -8,6 +10,8 @@ mod paths;
 mod sky;
 mod texture;
 
+pub use animation::{Animation, Track};
+pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::default_scene;
 pub use environment::{EnvMap, Environment};
 pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with};
@@ -37,7 +41,17 @@ pub struct Mesh {
 pub struct Object {
     pub name: String,
     pub mesh: usize,
+    /// World transform at time 0 (the rest pose of an animated object).
     pub transform: DMat4,
+    /// Rigid motion over time, if the object moves.
+    pub animation: Option<Animation>,
+}
+
+impl Object {
+    /// World transform at `time` seconds.
+    pub fn transform_at(&self, time: f64) -> DMat4 {
+        self.animation.as_ref().map_or(self.transform, |a| a.world_at(time))
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,7 +122,7 @@ pub enum Light {
 }
 
 /// A pinhole camera: looks down its local -Z, +Y up, +X right.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     pub world: DMat4,
     /// Full vertical field of view, radians.
@@ -158,6 +172,10 @@ impl Scene {
             return Ok(default_scene());
         }
         load_gltf(Path::new(path_or_default))
+    }
+
+    pub fn is_animated(&self) -> bool {
+        self.objects.iter().any(|o| o.animation.is_some())
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -39,8 +39,21 @@ embed!(
     "common/env_none.wgsl",
     "common/env_constant.wgsl",
     "common/env_map.wgsl",
-    "reference/params.wgsl",
+    "common/params.wgsl",
+    "common/path.wgsl",
     "reference/trace.wgsl",
+    "realtime/frame.wgsl",
+    "realtime/motion_static.wgsl",
+    "realtime/motion_objects.wgsl",
+    "realtime/gbuffer.wgsl",
+    "realtime/trace.wgsl",
+    "realtime/trace_glossy.wgsl",
+    "realtime/trace_glossy_none.wgsl",
+    "realtime/gbuffer_in.wgsl",
+    "realtime/glossy_in.wgsl",
+    "realtime/glossy_in_none.wgsl",
+    "realtime/composite.wgsl",
+    "realtime/display.wgsl",
     "accel/raycast.wgsl",
     "view/display.wgsl",
 );
@@ -126,14 +139,30 @@ mod tests {
     /// Every program Hush can compose, over both BVH layouts and the feature alternatives.
     fn all_programs() -> Vec<Program> {
         let mut v = vec![compose("display", "", &["view/display.wgsl"]).unwrap()];
+        for set in FEATURE_SETS {
+            for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
+                let m = ["common/math.wgsl", "common/geometry.wgsl", "common/scene.wgsl", "common/bsdf.wgsl", set[1], set[2], set[0], "realtime/frame.wgsl", motion, "realtime/gbuffer.wgsl"];
+                v.push(compose("gbuffer", "", &m).unwrap());
+            }
+        }
+        for glossy in ["realtime/glossy_in.wgsl", "realtime/glossy_in_none.wgsl"] {
+            for last in ["realtime/composite.wgsl", "realtime/display.wgsl"] {
+                let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, last];
+                v.push(compose(last, "", &m).unwrap());
+            }
+        }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             v.push(compose("raycast", "", &["common/math.wgsl", "common/geometry.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
             for (i, set) in FEATURE_SETS.iter().enumerate() {
-                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", bvh, "common/scene.wgsl", "common/bsdf.wgsl"];
+                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", bvh, "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
                 m.extend(set.iter());
-                m.extend(["reference/params.wgsl", "reference/trace.wgsl"]);
                 let prelude = format!("const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n", i % 2 == 1, i != 0);
-                v.push(compose(&format!("trace {bvh} {i}"), &prelude, &m).unwrap());
+                let mut reference = m.clone();
+                reference.push("reference/trace.wgsl");
+                v.push(compose(&format!("trace {bvh} {i}"), &prelude, &reference).unwrap());
+                let glossy = if i % 2 == 0 { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" };
+                m.extend(["realtime/frame.wgsl", glossy, "realtime/trace.wgsl"]);
+                v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
             }
         }
         v
@@ -215,6 +244,12 @@ mod tests {
         assert_eq!(size as usize, size_of::<TraceParams>());
         assert_eq!(offs[8] as usize, offset_of!(TraceParams, cam_pos));
         assert_eq!(offs[15] as usize, offset_of!(TraceParams, emit));
+        let composite = programs.iter().find(|p| p.label == "realtime/composite.wgsl").unwrap();
+        let (size, offs) = wgsl_layout(composite, "Frame");
+        use crate::frame::FrameParams;
+        assert_eq!(size as usize, size_of::<FrameParams>());
+        assert_eq!(offs[7] as usize, offset_of!(FrameParams, jitter));
+        assert_eq!(offs[12] as usize, offset_of!(FrameParams, accumulated));
         // obvhs's CWBVH node is read as five vec4u.
         assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
     }

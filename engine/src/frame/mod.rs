@@ -1,0 +1,347 @@
+//! The real-time frame: G-buffer raster -> factored trace -> composite -> display, on one scene.
+//! Which passes, bindings and buffers exist follows the scene's features (no glossy lobe: no
+//! glossy path and no glossy buffers; no animation: no object motion buffer and no BVH rebuilds).
+
+mod params;
+mod views;
+
+pub use params::{CameraSetup, FrameParams, random_jitter};
+pub use views::View;
+
+use crate::accel::BvhKind;
+use crate::gpu::{Gpu, GpuMemory, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
+use crate::passes::composite::{CompositePass, DisplayPass, FrameBuffers};
+use crate::passes::gbuffer::{self, GBufferPass, GBufferTargets};
+use crate::passes::reference::{TraceParams, TraceView, make_params};
+use crate::passes::trace::{TracePass, TraceTargets};
+use crate::quality::Image;
+use crate::scene::{Camera, Scene};
+use crate::settings::FrameSettings;
+use anyhow::{Context, Result, bail};
+use glam::{Mat4, Vec2, Vec3};
+
+/// Largest image side of the real-time frame.
+pub const MAX_SIDE: u32 = 8192;
+
+/// Passes that can write timestamps in one frame.
+const TIMED_PASSES: u32 = 8;
+
+/// Where the camera is and what time it is in the scene's animation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameInput {
+    pub camera: Camera,
+    /// Seconds into the scene's animation.
+    pub time: f64,
+}
+
+/// Per-pixel targets of the frame, remade on resize.
+struct Targets {
+    size: (u32, u32),
+    gbuffer: GBufferTargets,
+    trace: TraceTargets,
+    hdr: wgpu::Buffer,
+    accumulation: Option<wgpu::Buffer>,
+    memory: GpuMemory,
+    generation: u64,
+}
+
+impl Targets {
+    fn new(gpu: &Gpu, size: (u32, u32), glossy: bool, generation: u64) -> Targets {
+        let mut memory = GpuMemory::default();
+        let gbuffer = GBufferTargets::new(gpu, &mut memory, size);
+        let trace = TraceTargets::new(gpu, &mut memory, size, glossy);
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let hdr = memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
+        Targets { size, gbuffer, trace, hdr, accumulation: None, memory, generation }
+    }
+}
+
+pub struct Renderer {
+    pub scene: Scene,
+    pub prepared: PreparedScene,
+    pub gpu_scene: GpuScene,
+    targets: Targets,
+    params_buf: wgpu::Buffer,
+    frame_buf: wgpu::Buffer,
+    display_buf: wgpu::Buffer,
+    /// Bound where accumulation is off, so the composite's layout stays the same.
+    no_accumulation: wgpu::Buffer,
+    gbuffer: GBufferPass,
+    trace: TracePass,
+    composite: CompositePass,
+    display: Option<DisplayPass>,
+    timer: Option<GpuTimer>,
+    prev_view_proj: Option<Mat4>,
+    frame_index: u32,
+    accumulated: u32,
+    accumulated_state: Option<(FrameInput, FrameSettings)>,
+    /// Uniform and small buffers of the frame (the per-pixel ones are in `targets`).
+    memory: GpuMemory,
+}
+
+impl PreparedScene {
+    /// Features and limits of the real-time frame on this scene.
+    pub fn realtime_requirements(&self, size: (u32, u32)) -> GpuRequirements {
+        let mut r = self.requirements(size.0 as u64 * size.1 as u64 * 16);
+        r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
+        // matte, direct, and with a glossy lobe glossy, reflection and mirror.
+        r.max_storage_textures_per_shader_stage = if self.features.glossy { 5 } else { 2 };
+        r
+    }
+}
+
+fn check_size((w, h): (u32, u32)) -> Result<()> {
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        bail!("frame size {w}x{h} is out of range (1..={MAX_SIDE} per side)");
+    }
+    Ok(())
+}
+
+impl Renderer {
+    /// Prepare `scene`, open a headless device that fits it, and build the frame.
+    pub fn headless(scene: Scene, kind: BvhKind, size: (u32, u32)) -> Result<(Gpu, Renderer)> {
+        check_size(size)?;
+        let prepared = PreparedScene::new(&scene, kind).with_context(|| format!("preparing scene {:?}", scene.name))?;
+        let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
+        let r = Renderer::new(&gpu, scene, prepared, size)?;
+        Ok((gpu, r))
+    }
+
+    pub fn new(gpu: &Gpu, scene: Scene, prepared: PreparedScene, size: (u32, u32)) -> Result<Renderer> {
+        check_size(size)?;
+        gpu.validated("creating the real-time frame", || Self::create(gpu, scene, prepared, size))
+    }
+
+    fn create(gpu: &Gpu, scene: Scene, prepared: PreparedScene, size: (u32, u32)) -> Result<Renderer> {
+        let gpu_scene = prepared.upload(gpu);
+        let glossy = prepared.features.glossy;
+        let targets = Targets::new(gpu, size, glossy, 0);
+        let mut memory = GpuMemory::default();
+        let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let d = &gpu.device;
+        let params_buf = memory.buffer(d, "frame/scene params", size_of::<TraceParams>() as u64, u);
+        let frame_buf = memory.buffer(d, "frame/params", size_of::<FrameParams>() as u64, u);
+        let display_buf = memory.buffer(d, "display/options", 32, u);
+        let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
+        let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
+        let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
+        let fb = FrameBuffers { frame: &frame_buf, hdr: &targets.hdr, accumulation: &no_accumulation, display: &display_buf };
+        let composite = CompositePass::new(gpu, &targets.gbuffer, &targets.trace, &fb).context("creating the composite pass")?;
+        let timer = GpuTimer::new(gpu, TIMED_PASSES);
+        let r = Renderer {
+            scene,
+            prepared,
+            gpu_scene,
+            targets,
+            params_buf,
+            frame_buf,
+            display_buf,
+            no_accumulation,
+            gbuffer,
+            trace,
+            composite,
+            display: None,
+            timer,
+            prev_view_proj: None,
+            frame_index: 0,
+            accumulated: 0,
+            accumulated_state: None,
+            memory,
+        };
+        log::info!("{}", r.report());
+        Ok(r)
+    }
+
+    /// What the frame enabled and allocated, for logs and the viewer.
+    pub fn report(&self) -> String {
+        let f = &self.prepared.features;
+        let (w, h) = self.targets.size;
+        let per_pixel = self.targets.memory.total_bytes() as f64 / (w as f64 * h as f64);
+        let buffers = self.targets.memory.allocations.iter().map(|(l, b)| format!("{l}={b}")).collect::<Vec<_>>().join(" ");
+        format!(
+            "real-time frame {w}x{h}: passes gbuffer, trace ({}), composite, display; animated: {}; scene {} bytes, per-pixel targets {} bytes ({per_pixel:.0} B/pixel): {buffers}",
+            if f.glossy { "matte + glossy" } else { "matte only" },
+            f.animated,
+            self.gpu_scene.memory.total_bytes(),
+            self.targets.memory.total_bytes(),
+        )
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        self.targets.size
+    }
+
+    /// Every buffer and texture of the frame and the scene, (label, bytes).
+    pub fn allocations(&self) -> Vec<(String, u64)> {
+        let mut v = self.gpu_scene.memory.allocations.clone();
+        v.extend(self.targets.memory.allocations.iter().cloned());
+        v.extend(self.memory.allocations.iter().cloned());
+        v
+    }
+
+    /// Bytes per pixel of the per-pixel targets.
+    pub fn bytes_per_pixel(&self) -> f64 {
+        let (w, h) = self.targets.size;
+        self.targets.memory.total_bytes() as f64 / (w as f64 * h as f64)
+    }
+
+    pub fn resize(&mut self, gpu: &Gpu, size: (u32, u32)) -> Result<()> {
+        check_size(size)?;
+        if size == self.targets.size {
+            return Ok(());
+        }
+        let g = self.targets.generation + 1;
+        self.targets = Targets::new(gpu, size, self.prepared.features.glossy, g);
+        self.prev_view_proj = None;
+        self.accumulated = 0;
+        self.accumulated_state = None;
+        Ok(())
+    }
+
+    /// Near plane: 2^-14 of the scene's extent (reversed Z keeps depth precise far beyond it).
+    fn near(&self) -> f32 {
+        (self.prepared.extent * 2f64.powi(-14)) as f32
+    }
+
+    /// The camera as the raster and the tracer see it at the current size.
+    pub fn camera_setup(&self, camera: &Camera) -> CameraSetup {
+        CameraSetup::new(camera, self.prepared.origin, self.targets.size, self.near())
+    }
+
+    /// Render one frame; with `target`, also tone-map (or show `settings.view`) into it.
+    pub fn render(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<()> {
+        gpu.validated("rendering a frame", || self.record_frame(gpu, input, settings, target))
+    }
+
+    fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<()> {
+        if self.prepared.features.animated {
+            let moved = self.prepared.animate(&self.scene, input.time);
+            self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
+        }
+        let size = self.targets.size;
+        let cam = self.camera_setup(&input.camera);
+
+        // Accumulation restarts whenever anything that changes the image changes.
+        if settings.accumulate {
+            let same = self.accumulated_state.as_ref().is_some_and(|(i, s)| i == input && s.max_depth == settings.max_depth && s.seed == settings.seed);
+            self.accumulated = if same { self.accumulated + 1 } else { 1 };
+            self.accumulated_state = Some((*input, settings.clone()));
+            if self.targets.accumulation.is_none() {
+                let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+                self.targets.accumulation = Some(self.targets.memory.buffer(&gpu.device, "composite/accumulation", size.0 as u64 * size.1 as u64 * 16, usage));
+                self.targets.generation += 1;
+            }
+        } else {
+            self.accumulated = 0;
+            self.accumulated_state = None;
+        }
+        let jitter = if settings.accumulate { random_jitter(self.frame_index, settings.seed) } else { Vec2::splat(0.5) };
+        let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
+        let fp = FrameParams {
+            view_proj: cam.jittered(jitter, size).to_cols_array_2d(),
+            unjittered_view_proj: cam.view_proj.to_cols_array_2d(),
+            prev_view_proj: prev.to_cols_array_2d(),
+            cam_pos: cam.pos.extend(self.prepared.ray_epsilon()).to_array(),
+            cam_right: cam.right.extend(0.0).to_array(),
+            cam_up: cam.up.extend(0.0).to_array(),
+            cam_fwd: cam.fwd.extend(0.0).to_array(),
+            jitter: jitter.to_array(),
+            size: [size.0, size.1],
+            index: self.frame_index,
+            view: settings.view as u32,
+            exposure: 2f32.powf(settings.exposure_ev.clamp(-30.0, 30.0)),
+            accumulated: self.accumulated,
+        };
+        let view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
+        let tp = make_params(&self.prepared, &view);
+        gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
+        gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
+
+        if let Some((_, format)) = target {
+            if self.display.as_ref().is_none_or(|d| d.format != format) {
+                let fb = self.frame_buffers();
+                self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, format).context("creating the display pass")?);
+            }
+            let srgb = !format.is_srgb() as u32;
+            gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, 0, 0, 0, 0, 0, 0]));
+        }
+
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        if let Some(t) = self.timer.as_mut() {
+            t.begin_frame();
+        }
+        let key = (self.gpu_scene.generation, self.targets.generation);
+        let t = &self.targets;
+        let fb = FrameBuffers { frame: &self.frame_buf, hdr: &t.hdr, accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation), display: &self.display_buf };
+        self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &t.gbuffer, self.timer.as_mut());
+        self.trace.record(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut());
+        self.composite.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut());
+        if let (Some((view, _)), Some(d)) = (target, self.display.as_mut()) {
+            d.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, view, self.timer.as_mut());
+        }
+        if let Some(timer) = &self.timer {
+            timer.resolve(&mut enc);
+        }
+        gpu.queue.submit([enc.finish()]);
+        self.prev_view_proj = Some(cam.view_proj);
+        self.frame_index = self.frame_index.wrapping_add(1);
+        Ok(())
+    }
+
+    fn frame_buffers(&self) -> FrameBuffers<'_> {
+        let t = &self.targets;
+        FrameBuffers { frame: &self.frame_buf, hdr: &t.hdr, accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation), display: &self.display_buf }
+    }
+
+    /// GPU milliseconds per pass of the last frame (blocks until it finished); empty without
+    /// timestamp queries.
+    pub fn pass_times(&self, gpu: &Gpu) -> Result<Vec<(&'static str, f64)>> {
+        match &self.timer {
+            Some(t) => t.read(gpu),
+            None => Ok(vec![]),
+        }
+    }
+
+    /// Frames summed in accumulate mode (0 when off).
+    pub fn accumulated(&self) -> u32 {
+        self.accumulated
+    }
+
+    /// The last frame's linear HDR image (after composite), or in accumulate mode the mean.
+    pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
+        let (w, h) = self.targets.size;
+        let n = w as u64 * h as u64 * 16;
+        let (buf, scale) = match (&self.targets.accumulation, self.accumulated) {
+            (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
+            _ => (&self.targets.hdr, 1.0),
+        };
+        let bytes = crate::gpu::readback_buffer(&gpu.device, &gpu.queue, buf, n)?;
+        let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let mut img = Image::new(w, h);
+        for (d, s) in img.data.iter_mut().zip(v) {
+            *d = Vec3::new(s[0], s[1], s[2]) * scale;
+        }
+        Ok(img)
+    }
+
+    /// Read a G-buffer or trace texture back as raw bytes, rows tightly packed.
+    pub fn read_texture(&self, gpu: &Gpu, name: &str) -> Result<(Vec<u8>, wgpu::TextureFormat)> {
+        let t = &self.targets;
+        let tex = match name {
+            "gbuffer/depth" => &t.gbuffer.depth.0,
+            "trace/matte" => &t.trace.matte.0,
+            "trace/direct" => &t.trace.direct.0,
+            n if n.starts_with("gbuffer/") => &t.gbuffer.color[gbuffer::COLOR_FORMATS.iter().position(|(l, _)| *l == n).with_context(|| format!("no texture {n}"))?].0,
+            n => {
+                let g = t.trace.glossy.as_ref().with_context(|| format!("no texture {n}: the scene has no glossy buffers"))?;
+                match n {
+                    "trace/glossy" => &g.light.0,
+                    "trace/reflection" => &g.reflection.0,
+                    "trace/mirror" => &g.mirror.0,
+                    _ => bail!("no texture {n}"),
+                }
+            }
+        };
+        Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
+    }
+}

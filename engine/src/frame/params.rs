@@ -1,0 +1,79 @@
+//! The per-frame uniform (mirror of `Frame` in shaders/realtime/frame.wgsl) and the camera
+//! matrices behind it.
+
+use crate::scene::Camera;
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameParams {
+    pub view_proj: [[f32; 4]; 4],
+    pub unjittered_view_proj: [[f32; 4]; 4],
+    pub prev_view_proj: [[f32; 4]; 4],
+    pub cam_pos: [f32; 4],
+    pub cam_right: [f32; 4],
+    pub cam_up: [f32; 4],
+    pub cam_fwd: [f32; 4],
+    pub jitter: [f32; 2],
+    pub size: [u32; 2],
+    pub index: u32,
+    pub view: u32,
+    pub exposure: f32,
+    pub accumulated: u32,
+}
+
+/// A camera in the GPU scene's rebased space, as both the raster and the tracer see it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSetup {
+    pub pos: Vec3,
+    pub right: Vec3,
+    pub up: Vec3,
+    pub fwd: Vec3,
+    /// World -> clip, reversed infinite Z, no jitter.
+    pub view_proj: Mat4,
+}
+
+impl CameraSetup {
+    /// `near`: the near plane in scene units (reversed Z keeps precision far beyond it).
+    pub fn new(camera: &Camera, origin: DVec3, size: (u32, u32), near: f32) -> CameraSetup {
+        let m = DMat4::from_translation(-origin) * camera.world;
+        let pos = m.w_axis.truncate().as_vec3();
+        let x = m.transform_vector3(DVec3::X).normalize_or(DVec3::X).as_vec3();
+        let y = m.transform_vector3(DVec3::Y).normalize_or(DVec3::Y).as_vec3();
+        let z = m.transform_vector3(DVec3::Z).normalize_or(DVec3::Z).as_vec3();
+        // The same field of view clamp as the reference tracer (passes/reference.rs).
+        let fov = if camera.yfov.is_finite() { camera.yfov.clamp(1e-4, 3.1) } else { 0.8 };
+        let th = (fov * 0.5).tan();
+        let aspect = size.0 as f32 / size.1 as f32;
+        let view = Mat4::from_cols(x.extend(0.0), y.extend(0.0), z.extend(0.0), pos.extend(1.0)).inverse();
+        // Right-handed, depth in [0, 1] reversed (1 at `near`, 0 at infinity): float depth then
+        // keeps its precision with distance.
+        let f = 1.0 / th;
+        let proj = Mat4::from_cols(
+            glam::Vec4::new(f / aspect, 0.0, 0.0, 0.0),
+            glam::Vec4::new(0.0, f, 0.0, 0.0),
+            glam::Vec4::new(0.0, 0.0, 0.0, -1.0),
+            glam::Vec4::new(0.0, 0.0, near, 0.0),
+        );
+        CameraSetup { pos, right: x * th * aspect, up: y * th, fwd: -z, view_proj: proj * view }
+    }
+
+    /// The projection shifted so that pixel centres sample `jitter` (in [0, 1)^2) of each pixel.
+    pub fn jittered(&self, jitter: Vec2, size: (u32, u32)) -> Mat4 {
+        let o = Vec2::new((0.5 - jitter.x) * 2.0 / size.0 as f32, -(0.5 - jitter.y) * 2.0 / size.1 as f32);
+        Mat4::from_translation(o.extend(0.0)) * self.view_proj
+    }
+}
+
+/// Uniform in [0, 1)^2 from (frame, seed): the accumulate mode's pixel sample positions.
+pub fn random_jitter(frame: u32, seed: u32) -> Vec2 {
+    let h = |v: u32| {
+        let s = v.wrapping_mul(747796405).wrapping_add(2891336453);
+        let w = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277803737);
+        (w >> 22) ^ w
+    };
+    let a = h(frame ^ h(seed ^ 0x9e3779b9));
+    let b = h(a);
+    Vec2::new((a >> 8) as f32 / 16777216.0, (b >> 8) as f32 / 16777216.0)
+}

@@ -1,0 +1,71 @@
+//! What the display shows: the image or one buffer of the frame (shaders/realtime/display.wgsl).
+
+/// Debug views, numbered as the display shader's `frame.view`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum View {
+    #[default]
+    Final = 0,
+    Depth = 1,
+    Normal = 2,
+    BaseColor = 3,
+    Metallic = 4,
+    Roughness = 5,
+    SpecularF0 = 6,
+    Emission = 7,
+    ObjectId = 8,
+    Motion = 9,
+    MatteLight = 10,
+    DirectLight = 11,
+    GlossyLight = 12,
+    GlossyHitDistance = 13,
+    VirtualPosition = 14,
+    MirrorDirection = 15,
+}
+
+impl View {
+    pub const ALL: [View; 16] = [
+        View::Final,
+        View::Depth,
+        View::Normal,
+        View::BaseColor,
+        View::Metallic,
+        View::Roughness,
+        View::SpecularF0,
+        View::Emission,
+        View::ObjectId,
+        View::Motion,
+        View::MatteLight,
+        View::DirectLight,
+        View::GlossyLight,
+        View::GlossyHitDistance,
+        View::VirtualPosition,
+        View::MirrorDirection,
+    ];
+
+    /// The pass output it shows, as named in labels and the profiler.
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Final => "final",
+            View::Depth => "gbuffer/depth",
+            View::Normal => "gbuffer/normal",
+            View::BaseColor => "gbuffer/base_color",
+            View::Metallic => "gbuffer/metallic",
+            View::Roughness => "gbuffer/roughness",
+            View::SpecularF0 => "gbuffer/specular F0",
+            View::Emission => "gbuffer/emission",
+            View::ObjectId => "gbuffer/object id",
+            View::Motion => "gbuffer/motion",
+            View::MatteLight => "trace/matte",
+            View::DirectLight => "trace/direct",
+            View::GlossyLight => "trace/glossy",
+            View::GlossyHitDistance => "trace/glossy hit distance",
+            View::VirtualPosition => "trace/virtual position",
+            View::MirrorDirection => "trace/mirror direction",
+        }
+    }
+
+    /// Views of buffers that exist only in scenes with a specular lobe.
+    pub fn needs_glossy(self) -> bool {
+        (self as u32) >= View::GlossyLight as u32
+    }
+}

@@ -1,0 +1,125 @@
+//! `composite` (remodulate the light buffers with the material, shaders/realtime/composite.wgsl)
+//! and `display` (exposure, ACES tone map, sRGB, debug views; shaders/realtime/display.wgsl).
+//! Both read the whole G-buffer and the trace outputs through the same bindings.
+
+use super::gbuffer::GBufferTargets;
+use super::trace::TraceTargets;
+use crate::gpu::scene::compute_pipeline;
+use crate::gpu::{Bindings, Gpu, GpuTimer};
+use anyhow::Result;
+
+pub const COMPOSITE: &str = "composite";
+pub const DISPLAY: &str = "display";
+
+/// The HDR image (and the accumulation sum) as storage buffers: one vec4 (16 bytes) per pixel.
+pub struct FrameBuffers<'a> {
+    pub frame: &'a wgpu::Buffer,
+    pub hdr: &'a wgpu::Buffer,
+    pub accumulation: &'a wgpu::Buffer,
+    pub display: &'a wgpu::Buffer,
+}
+
+fn inputs<'a>(stages: wgpu::ShaderStages, g: &'a GBufferTargets, t: &'a TraceTargets, b: &FrameBuffers<'a>, read_only: bool) -> Bindings<'a> {
+    let f = || wgpu::TextureSampleType::Float { filterable: false };
+    let mut s = Bindings::new(stages)
+        .uniform(11, b.frame)
+        .texture(20, &g.depth.1, wgpu::TextureSampleType::Depth)
+        .texture(21, g.view("normal"), f())
+        .texture(22, g.view("motion"), f())
+        .texture(23, g.view("base_color"), f())
+        .texture(24, g.view("specular"), f())
+        .texture(25, g.view("emission"), f())
+        .texture(26, g.view("ids"), wgpu::TextureSampleType::Uint)
+        .texture(27, &t.matte.1, f())
+        .texture(28, &t.direct.1, f());
+    if let Some(gl) = &t.glossy {
+        s = s.texture(29, &gl.light.1, f()).texture(30, &gl.reflection.1, f()).texture(31, &gl.mirror.1, wgpu::TextureSampleType::Uint);
+    }
+    s = s.storage(32, b.hdr, read_only).storage(33, b.accumulation, read_only);
+    if read_only {
+        s = s.uniform(34, b.display);
+    }
+    s
+}
+
+fn modules(glossy: bool, last: &'static str) -> Vec<&'static str> {
+    vec![
+        "common/math.wgsl",
+        "common/rng.wgsl",
+        "realtime/frame.wgsl",
+        "realtime/gbuffer_in.wgsl",
+        if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" },
+        last,
+    ]
+}
+
+pub struct CompositePass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    bind_group: Option<(u64, wgpu::BindGroup)>,
+}
+
+impl CompositePass {
+    pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers) -> Result<CompositePass> {
+        let module = crate::shader::compose(COMPOSITE, "", &modules(t.glossy.is_some(), "realtime/composite.wgsl"))?.create(&gpu.device)?;
+        let layout = inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_layout(&gpu.device, COMPOSITE);
+        let pipeline = compute_pipeline(&gpu.device, COMPOSITE, &module, &layout);
+        Ok(CompositePass { pipeline, layout, bind_group: None })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, size: (u32, u32), timer: Option<&mut GpuTimer>) {
+        if self.bind_group.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.bind_group = Some((key, inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_group(&gpu.device, COMPOSITE, &self.layout)));
+        }
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(COMPOSITE), timestamp_writes: timer.and_then(|t| t.compute(COMPOSITE)) });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+    }
+}
+
+pub struct DisplayPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    bind_group: Option<(u64, wgpu::BindGroup)>,
+    pub format: wgpu::TextureFormat,
+}
+
+impl DisplayPass {
+    pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
+        let module = crate::shader::compose(DISPLAY, "", &modules(t.glossy.is_some(), "realtime/display.wgsl"))?.create(&gpu.device)?;
+        let layout = inputs(wgpu::ShaderStages::FRAGMENT, g, t, b, true).create_layout(&gpu.device, DISPLAY);
+        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(DISPLAY), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(DISPLAY),
+            layout: Some(&pl),
+            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &[Some(format.into())] }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(DisplayPass { pipeline, layout, bind_group: None, format })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) {
+        if self.bind_group.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.bind_group = Some((key, inputs(wgpu::ShaderStages::FRAGMENT, g, t, b, true).create_group(&gpu.device, DISPLAY, &self.layout)));
+        }
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(DISPLAY),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: target, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store } })],
+            depth_stencil_attachment: None,
+            timestamp_writes: timer.and_then(|t| t.render(DISPLAY)),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

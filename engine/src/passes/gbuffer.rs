@@ -1,0 +1,146 @@
+//! `gbuffer`: the raster pass that draws the primary surfaces (shaders/realtime/gbuffer.wgsl).
+//!
+//! Channels and their cost per pixel (36 bytes in all):
+//! | channel | format | bytes | content |
+//! |---|---|---|---|
+//! | depth | Depth32Float | 4 | reversed infinite Z |
+//! | normal | Rg16Float | 4 | octahedral shading normal (world), facing the camera |
+//! | motion | Rg16Float | 4 | pixels to the surface's position in the previous frame |
+//! | base_color | Rgba8UnormSrgb | 4 | base colour, metallic in alpha |
+//! | specular | Rgba8Unorm | 4 | specular F0, roughness in alpha |
+//! | emission | Rgba16Float | 8 | emitted radiance, Fresnel f90 in alpha |
+//! | ids | Rg32Uint | 8 | object index, triangle slot (u32::MAX: no surface) |
+//! Eight bits per channel suffice for colours and F0 (sRGB-encoded base colour: < 0.5% error);
+//! normals need more than 8 bits per octahedral coordinate for bilateral weights, motion more than
+//! 8 bits for sub-pixel reprojection. The six colour targets cost 40 bytes per sample under
+//! WebGPU's render-target accounting (8-bit RGBA counts 8), over its default of 32: the device
+//! asks for 40, which every native backend grants.
+
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuScene, GpuTimer};
+use anyhow::Result;
+
+pub const LABEL: &str = "gbuffer";
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub const COLOR_FORMATS: [(&str, wgpu::TextureFormat); 6] = [
+    ("gbuffer/normal", wgpu::TextureFormat::Rg16Float),
+    ("gbuffer/motion", wgpu::TextureFormat::Rg16Float),
+    ("gbuffer/base_color", wgpu::TextureFormat::Rgba8UnormSrgb),
+    ("gbuffer/specular", wgpu::TextureFormat::Rgba8Unorm),
+    ("gbuffer/emission", wgpu::TextureFormat::Rgba16Float),
+    ("gbuffer/ids", wgpu::TextureFormat::Rg32Uint),
+];
+/// Render-target bytes per sample of the colour attachments (WebGPU's accounting).
+pub const COLOR_BYTES_PER_SAMPLE: u32 = 40;
+
+pub struct GBufferTargets {
+    pub depth: (wgpu::Texture, wgpu::TextureView),
+    /// In the order of [`COLOR_FORMATS`].
+    pub color: Vec<(wgpu::Texture, wgpu::TextureView)>,
+}
+
+impl GBufferTargets {
+    pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32)) -> GBufferTargets {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let depth = mem.texture(&gpu.device, "gbuffer/depth", size, DEPTH_FORMAT, usage);
+        let color = COLOR_FORMATS.iter().map(|(l, f)| mem.texture(&gpu.device, l, size, *f, usage)).collect();
+        GBufferTargets { depth, color }
+    }
+
+    pub fn view(&self, name: &str) -> &wgpu::TextureView {
+        let i = COLOR_FORMATS.iter().position(|(l, _)| l.strip_prefix("gbuffer/") == Some(name)).expect("G-buffer channel");
+        &self.color[i].1
+    }
+}
+
+pub struct GBufferPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    bind_group: Option<(u64, wgpu::BindGroup)>,
+}
+
+fn bindings<'a>(scene: &'a GpuScene, frame: &'a wgpu::Buffer) -> Bindings<'a> {
+    use crate::gpu::scene::binding::*;
+    let mut b = Bindings::new(wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT)
+        .storage(TRIS, &scene.tris, true)
+        .storage(SHADING, &scene.shading, true)
+        .storage(MATERIALS, &scene.materials, true)
+        .uniform(11, frame);
+    for (n, buf) in [(TEXTURES, &scene.textures), (TANGENTS, &scene.tangents), (OBJECTS, &scene.objects)] {
+        if let Some(buf) = buf {
+            b = b.storage(n, buf, true);
+        }
+    }
+    b
+}
+
+impl GBufferPass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &wgpu::Buffer) -> Result<GBufferPass> {
+        let f = &scene.features;
+        let modules = vec![
+            "common/math.wgsl",
+            "common/geometry.wgsl",
+            "common/scene.wgsl",
+            "common/bsdf.wgsl",
+            if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" },
+            if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" },
+            if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" },
+            "realtime/frame.wgsl",
+            if f.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" },
+            "realtime/gbuffer.wgsl",
+        ];
+        let module = crate::shader::compose(LABEL, "", &modules)?.create(&gpu.device)?;
+        let layout = bindings(scene, frame).create_layout(&gpu.device, LABEL);
+        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(LABEL), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
+        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(LABEL),
+            layout: Some(&pl),
+            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+            primitive: wgpu::PrimitiveState { cull_mode: None, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                // Reversed Z: larger is nearer.
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(GBufferPass { pipeline, layout, bind_group: None })
+    }
+
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &wgpu::Buffer, t: &GBufferTargets, timer: Option<&mut GpuTimer>) {
+        if self.bind_group.as_ref().is_none_or(|(g, _)| *g != scene.generation) {
+            self.bind_group = Some((scene.generation, bindings(scene, frame).create_group(&gpu.device, LABEL, &self.layout)));
+        }
+        let clear_ids = wgpu::Color { r: u32::MAX as f64, g: u32::MAX as f64, b: 0.0, a: 0.0 };
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = t
+            .color
+            .iter()
+            .enumerate()
+            .map(|(i, (_, v))| {
+                let clear = if i == COLOR_FORMATS.len() - 1 { clear_ids } else { wgpu::Color::TRANSPARENT };
+                Some(wgpu::RenderPassColorAttachment { view: v, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store } })
+            })
+            .collect();
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(LABEL),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &t.depth.1,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.and_then(|t| t.render(LABEL)),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.draw(0..scene.triangle_count * 3, 0..1);
+    }
+}

@@ -1,0 +1,90 @@
+//! `trace`: one factored sample per pixel at the G-buffer's surfaces (shaders/realtime/trace.wgsl).
+//!
+//! Outputs and their cost per pixel: matte light and direct light (Rgba16Float, 8 bytes each);
+//! in scenes with a specular lobe also the glossy light with its secondary hit distance
+//! (Rgba16Float, 8), the virtual position with that distance (Rgba32Float, 16: positions need
+//! f32) and the representative mirror direction (two snorm16 in R32Uint, 4).
+
+use super::gbuffer::GBufferTargets;
+use crate::gpu::scene::compute_pipeline;
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuScene, GpuTimer};
+use anyhow::Result;
+
+pub const LABEL: &str = "trace";
+pub const MATTE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const REFLECTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Octahedral direction packed as two snorm16 (Rg16 is not a storage format in core WebGPU).
+pub const MIRROR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+pub struct TraceTargets {
+    pub matte: (wgpu::Texture, wgpu::TextureView),
+    pub direct: (wgpu::Texture, wgpu::TextureView),
+    pub glossy: Option<GlossyTargets>,
+}
+
+pub struct GlossyTargets {
+    pub light: (wgpu::Texture, wgpu::TextureView),
+    pub reflection: (wgpu::Texture, wgpu::TextureView),
+    pub mirror: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl TraceTargets {
+    pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32), glossy: bool) -> TraceTargets {
+        let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let d = &gpu.device;
+        TraceTargets {
+            matte: mem.texture(d, "trace/matte", size, MATTE_FORMAT, usage),
+            direct: mem.texture(d, "trace/direct", size, MATTE_FORMAT, usage),
+            glossy: glossy.then(|| GlossyTargets {
+                light: mem.texture(d, "trace/glossy", size, MATTE_FORMAT, usage),
+                reflection: mem.texture(d, "trace/reflection", size, REFLECTION_FORMAT, usage),
+                mirror: mem.texture(d, "trace/mirror", size, MIRROR_FORMAT, usage),
+            }),
+        }
+    }
+}
+
+pub struct TracePass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    bind_group: Option<((u64, u64), wgpu::BindGroup)>,
+}
+
+fn bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::Buffer, g: &'a GBufferTargets, t: &'a TraceTargets) -> Bindings<'a> {
+    let mut b = Bindings::new(wgpu::ShaderStages::COMPUTE)
+        .uniform(0, params)
+        .storage_all(&scene.shading_bindings())
+        .uniform(11, frame)
+        .texture(12, g.view("ids"), wgpu::TextureSampleType::Uint)
+        .storage_texture(13, &t.matte.1, MATTE_FORMAT)
+        .storage_texture(14, &t.direct.1, MATTE_FORMAT);
+    if let Some(gl) = &t.glossy {
+        b = b.storage_texture(15, &gl.light.1, MATTE_FORMAT).storage_texture(16, &gl.reflection.1, REFLECTION_FORMAT).storage_texture(18, &gl.mirror.1, MIRROR_FORMAT);
+    }
+    b
+}
+
+impl TracePass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets) -> Result<TracePass> {
+        let mut modules = scene.shading_modules();
+        modules.push("realtime/frame.wgsl");
+        modules.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
+        modules.push("realtime/trace.wgsl");
+        let module = crate::shader::compose(LABEL, &scene.prelude(), &modules)?.create(&gpu.device)?;
+        let layout = bindings(scene, params, frame, g, t).create_layout(&gpu.device, LABEL);
+        let pipeline = compute_pipeline(&gpu.device, LABEL, &module, &layout);
+        Ok(TracePass { pipeline, layout, bind_group: None })
+    }
+
+    /// `key`: (scene generation, frame target generation); bind groups are rebuilt when it changes.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), timer: Option<&mut GpuTimer>) {
+        if self.bind_group.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.bind_group = Some((key, bindings(scene, params, frame, g, t).create_group(&gpu.device, LABEL, &self.layout)));
+        }
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+    }
+}

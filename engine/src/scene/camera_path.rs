@@ -1,0 +1,74 @@
+//! Camera paths: what the viewer records (one key per frame) and what `hush-cli render
+//! --camera-path` and the viewer play back. JSON:
+//! `{"keys": [{"time": 0.0, "eye": [x, y, z], "target": [x, y, z], "yfov_degrees": 45.0}, ...]}`
+//! with `time` in seconds (the scene's animation clock) and positions in scene units.
+
+use super::Camera;
+use anyhow::{Context, Result, bail};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CameraKey {
+    pub time: f64,
+    pub eye: [f64; 3],
+    pub target: [f64; 3],
+    pub yfov_degrees: f32,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CameraPath {
+    pub keys: Vec<CameraKey>,
+}
+
+impl CameraKey {
+    pub fn from_camera(camera: &Camera, time: f64) -> CameraKey {
+        let eye = camera.eye();
+        let fwd = -camera.world.z_axis.truncate().normalize_or(DVec3::NEG_Z);
+        CameraKey { time, eye: eye.to_array(), target: (eye + fwd).to_array(), yfov_degrees: camera.yfov.to_degrees() }
+    }
+
+    pub fn camera(&self) -> Camera {
+        Camera::look_at(DVec3::from_array(self.eye), DVec3::from_array(self.target), self.yfov_degrees)
+    }
+}
+
+impl CameraPath {
+    pub fn load(path: &Path) -> Result<CameraPath> {
+        let ctx = || format!("reading camera path {}", path.display());
+        let text = std::fs::read_to_string(path).with_context(ctx)?;
+        let p: CameraPath = serde_json::from_str(&text).with_context(ctx)?;
+        p.validate().with_context(ctx)?;
+        Ok(p)
+    }
+
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let text = serde_json::to_string_pretty(self)?;
+        std::fs::write(path, text).with_context(|| format!("writing camera path {}", path.display()))
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if self.keys.is_empty() {
+            bail!("the camera path has no keys");
+        }
+        for (i, k) in self.keys.iter().enumerate() {
+            let finite = k.time.is_finite() && k.eye.iter().chain(&k.target).all(|x| x.is_finite());
+            if !finite {
+                bail!("key {i}: non-finite time or position");
+            }
+            if k.eye == k.target {
+                bail!("key {i}: eye and target coincide");
+            }
+            if !(k.yfov_degrees > 0.0 && k.yfov_degrees < 180.0) {
+                bail!("key {i}: yfov_degrees must be in (0, 180), got {}", k.yfov_degrees);
+            }
+        }
+        Ok(())
+    }
+
+    /// The key for frame `i` (the last key holds once the path has ended).
+    pub fn frame(&self, i: usize) -> &CameraKey {
+        &self.keys[i.min(self.keys.len() - 1)]
+    }
+}

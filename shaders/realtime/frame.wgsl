@@ -1,0 +1,59 @@
+// Per-frame parameters of the real-time frame (engine/src/frame/params.rs: FrameParams).
+// Positions are in the GPU scene's rebased world space (see PreparedScene::origin).
+struct Frame {
+    // World -> clip with this frame's sub-pixel jitter (reversed, infinite Z).
+    view_proj: mat4x4f,
+    // The same without jitter, and the previous frame's (motion vectors compare these two).
+    unjittered_view_proj: mat4x4f,
+    prev_view_proj: mat4x4f,
+    // Camera rays as in common/params.wgsl: fwd + x right + y up, x, y in [-1, 1].
+    cam_pos: vec4f,
+    cam_right: vec4f,
+    cam_up: vec4f,
+    cam_fwd: vec4f,
+    // Where in the pixel this frame samples, in [0, 1)^2 (0.5, 0.5 = the centre).
+    jitter: vec2f,
+    size: vec2u,
+    index: u32,
+    // Debug view shown by realtime/display.wgsl (engine/src/frame/views.rs: View).
+    view: u32,
+    // Exposure multiplier 2^EV.
+    exposure: f32,
+    // Frames summed in the accumulation buffer (accumulate mode), 0 when off.
+    accumulated: u32,
+}
+
+@group(0) @binding(11) var<uniform> frame: Frame;
+
+// The camera ray through this frame's sample position in pixel px.
+fn camera_ray(px: vec2u) -> vec3f {
+    let ndc = vec2f(
+        (f32(px.x) + frame.jitter.x) / f32(frame.size.x) * 2.0 - 1.0,
+        1.0 - (f32(px.y) + frame.jitter.y) / f32(frame.size.y) * 2.0,
+    );
+    return normalize(frame.cam_fwd.xyz + ndc.x * frame.cam_right.xyz + ndc.y * frame.cam_up.xyz);
+}
+
+// Octahedral encoding of a unit vector into [-1, 1]^2 (Cigolle et al. 2014).
+fn oct_encode(n: vec3f) -> vec2f {
+    let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if n.z >= 0.0 {
+        return p;
+    }
+    return (1.0 - abs(p.yx)) * select(vec2f(-1.0), vec2f(1.0), p >= vec2f(0.0));
+}
+
+fn oct_decode(e: vec2f) -> vec3f {
+    var n = vec3f(e, 1.0 - abs(e.x) - abs(e.y));
+    if n.z < 0.0 {
+        let xy = (1.0 - abs(n.yx)) * select(vec2f(-1.0), vec2f(1.0), n.xy >= vec2f(0.0));
+        n = vec3f(xy, n.z);
+    }
+    return normalize(n);
+}
+
+// Largest finite half float is 65504: clamp below it and drop NaN/Inf so that nothing a pass
+// writes can poison a later one (or, in later chains, the history).
+fn half_safe(v: vec3f) -> vec3f {
+    return select(vec3f(0.0), clamp(v, vec3f(-65000.0), vec3f(65000.0)), v == v & abs(v) <= vec3f(3.0e38));
+}

@@ -1,0 +1,87 @@
+// Raster G-buffer: the primary surfaces, drawn from the same triangle buffers the tracer reads
+// (vertex pulling: vertex i is corner i % 3 of triangle slot i / 3), so raster and trace agree on
+// every triangle. Both faces are drawn: the back of a single-sided surface is a black absorber
+// (as in the tracer) and must still hide what is behind it.
+
+struct VsOut {
+    @builtin(position) clip: vec4f,
+    @location(0) bary: vec2f,
+    @location(1) @interpolate(flat) slot: u32,
+    // Unjittered current and previous clip positions, for motion vectors.
+    @location(2) cur: vec4f,
+    @location(3) prev: vec4f,
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+    let slot = vi / 3u;
+    let corner = vi % 3u;
+    let p = tris[slot * 3u + corner].xyz;
+    let object = bitcast<u32>(shading[slot * 4u + 3u].w);
+    var o: VsOut;
+    o.clip = frame.view_proj * vec4f(p, 1.0);
+    o.bary = select(vec2f(0.0), select(vec2f(0.0, 1.0), vec2f(1.0, 0.0), corner == 1u), corner > 0u);
+    o.slot = slot;
+    o.cur = frame.unjittered_view_proj * vec4f(p, 1.0);
+    o.prev = frame.prev_view_proj * vec4f(previous_position(object, p), 1.0);
+    return o;
+}
+
+struct GBufferOut {
+    // Octahedral shading normal (world), facing the camera.
+    @location(0) normal: vec2f,
+    // Pixels from this pixel to where its surface was in the previous frame.
+    @location(1) motion: vec2f,
+    // rgb: base colour; a: metallic.
+    @location(2) base_color: vec4f,
+    // rgb: specular F0; a: roughness.
+    @location(3) specular: vec4f,
+    // rgb: emitted radiance; a: Fresnel at grazing (f90).
+    @location(4) emission: vec4f,
+    // x: object index; y: triangle slot.
+    @location(5) ids: vec2u,
+}
+
+fn to_pixels(clip: vec4f) -> vec2f {
+    let ndc = clip.xy / clip.w;
+    return vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * vec2f(frame.size);
+}
+
+@fragment
+fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
+    let slot = v.slot;
+    let b = v.bary;
+    if !alpha_accept(slot, b) {
+        discard;
+    }
+    let m = materials[tri_material(slot)];
+    let uv = tri_uv(slot, b);
+    let v0 = tris[slot * 3u].xyz;
+    var ng = normalize(cross(tris[slot * 3u + 1u].xyz - v0, tris[slot * 3u + 2u].xyz - v0));
+    var ns = tri_normal(slot, b);
+    let len = length(ns);
+    ns = select(ng, ns / len, len > 1e-12 && len < 1e30);
+    if !front {
+        ns = -ns;
+    }
+    ns = apply_normal_map(slot, b, ns, uv, m);
+    let ms = material_at(m, uv);
+    let bsdf = material_bsdf(m, ms);
+    var o: GBufferOut;
+    o.normal = oct_encode(ns);
+    o.motion = to_pixels(v.prev) - to_pixels(v.cur);
+    o.ids = vec2u(bitcast<u32>(shading[slot * 4u + 3u].w), slot);
+    if !front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
+        // The tracer's black absorber: no material, no light.
+        o.base_color = vec4f(0.0);
+        o.specular = vec4f(0.0, 0.0, 0.0, 1.0);
+        o.emission = vec4f(0.0);
+        return o;
+    }
+    o.base_color = vec4f(clamp(ms.base.rgb, vec3f(0.0), vec3f(1.0)), clamp(ms.metallic, 0.0, 1.0));
+    o.specular = vec4f(clamp(bsdf.f0, vec3f(0.0), vec3f(1.0)), clamp(ms.roughness, 0.0, 1.0));
+    // Emitters emit from the front face only.
+    let e = select(vec3f(0.0), ms.emission, front);
+    o.emission = vec4f(half_safe(e), clamp(max3(bsdf.f90), 0.0, 1.0));
+    return o;
+}

@@ -1,0 +1,47 @@
+// The G-buffer as read by compute and display passes (written by realtime/gbuffer.wgsl).
+@group(0) @binding(20) var gb_depth: texture_depth_2d;
+@group(0) @binding(21) var gb_normal: texture_2d<f32>;
+@group(0) @binding(22) var gb_motion: texture_2d<f32>;
+@group(0) @binding(23) var gb_base_color: texture_2d<f32>;
+@group(0) @binding(24) var gb_specular: texture_2d<f32>;
+@group(0) @binding(25) var gb_emission: texture_2d<f32>;
+@group(0) @binding(26) var gb_object: texture_2d<u32>;
+// Trace outputs every scene has.
+@group(0) @binding(27) var tr_matte: texture_2d<f32>;
+@group(0) @binding(28) var tr_direct: texture_2d<f32>;
+
+const NO_SURFACE: u32 = 0xffffffffu;
+
+struct GSample {
+    hit: bool,
+    n: vec3f,
+    base: vec3f,
+    metallic: f32,
+    f0: vec3f,
+    roughness: f32,
+    emission: vec3f,
+    f90: f32,
+}
+
+fn gbuffer_at(p: vec2i) -> GSample {
+    var g: GSample;
+    g.hit = textureLoad(gb_object, p, 0).y != NO_SURFACE;
+    g.n = oct_decode(textureLoad(gb_normal, p, 0).xy);
+    let bc = textureLoad(gb_base_color, p, 0);
+    g.base = bc.rgb;
+    g.metallic = bc.a;
+    let sp = textureLoad(gb_specular, p, 0);
+    g.f0 = sp.rgb;
+    g.roughness = sp.a;
+    let e = textureLoad(gb_emission, p, 0);
+    g.emission = e.rgb;
+    g.f90 = e.a;
+    return g;
+}
+
+// Schlick's Fresnel at the mirror direction (Mara et al. eq. (4) with w_h = n).
+fn fresnel_mirror(g: GSample, cos_o: f32) -> vec3f {
+    let m = 1.0 - clamp(cos_o, 0.0, 1.0);
+    let m2 = m * m;
+    return g.f0 + (vec3f(g.f90) - g.f0) * (m2 * m2 * m);
+}

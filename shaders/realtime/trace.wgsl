@@ -1,0 +1,188 @@
+// Real-time trace: one sample per pixel at the G-buffer's surface, split by the factored BRDF of
+// Mara et al. 2017 (§3.2-3.3). Light buffers carry no material: the matte buffer holds
+// sum L_i / N of eq. (9) and the glossy buffer the sum of eq. (10) divided by F(w_s, w_o), so
+// that filters never blur texture and the composite multiplies the material back in.
+//
+// - Punctual lights are evaluated exhaustively with the full BRDF into `direct`: at one sample
+//   they carry no noise (their only randomness would be the choice of light), so they bypass
+//   the filters and keep their hard shadows.
+// - Emissive triangles and the environment are sampled once (next-event estimation) and split
+//   into a matte and a glossy part, each weighed by the power heuristic against the path that
+//   samples the same lobe, so the chains filter their noise with the indirect light.
+// - One matte path (cosine-sampled, eq. (6)) and one glossy path (GGX visible normals) continue
+//   with the reference tracer's loop (common/path.wgsl).
+//
+// The primary hit is re-derived from the triangle the raster stored and this frame's camera ray,
+// so it is exact (the same point the reference tracer would find for that ray).
+
+@group(0) @binding(12) var gb_ids: texture_2d<u32>;
+@group(0) @binding(13) var out_matte: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(14) var out_direct: texture_storage_2d<rgba16float, write>;
+
+fn area_groups() -> u32 {
+    return select(0u, 1u, HAS_EMITTERS) + select(0u, 1u, HAS_ENV);
+}
+
+// One sample of the non-delta lights (emitters or environment, chosen uniformly).
+fn sample_area_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
+    let n = area_groups();
+    let u = rand(rng);
+    var s: LightSample;
+    if HAS_EMITTERS && (!HAS_ENV || u < 0.5) {
+        s = sample_emitter(p, vec3f(rand(rng), rand(rng), rand(rng)));
+    } else {
+        s = sample_env(rand2(rng));
+    }
+    s.li *= f32(n);
+    s.pdf /= f32(n);
+    return s;
+}
+
+// The glossy lobe alone: F(h) D G / (4 cos_o) cos_i, and its visible-normal pdf.
+fn glossy_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
+    var r: BsdfEval;
+    r.f_cos = vec3f(0.0);
+    r.pdf = 0.0;
+    if wo.z <= 0.0 || wi.z <= 0.0 || b.delta {
+        return r;
+    }
+    let h = normalize(wi + wo);
+    let g = smith_g1(b.alpha, wo.z) * smith_g1(b.alpha, wi.z);
+    r.f_cos = fresnel(b, dot(wo, h)) * (ggx_d(b.alpha, h.z) * g / (4.0 * wo.z));
+    r.pdf = vndf_pdf(b.alpha, wo, h);
+    return r;
+}
+
+fn write_all(px: vec2u, matte: vec3f, direct: vec3f) {
+    textureStore(out_matte, px, vec4f(half_safe(matte), 1.0));
+    textureStore(out_direct, px, vec4f(half_safe(direct), 1.0));
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let px = gid.xy;
+    if px.x >= frame.size.x || px.y >= frame.size.y {
+        return;
+    }
+    var rng = rng_init(px.y * frame.size.x + px.x, frame.index, params.seed);
+    let eps = params.cam_pos.w;
+    let ro = frame.cam_pos.xyz;
+    let rd = camera_ray(px);
+    let slot = textureLoad(gb_ids, px, 0).y;
+    if slot == NO_HIT {
+        // Background: what the camera sees of the environment goes straight to the screen.
+        write_all(px, vec3f(0.0), env_radiance(rd));
+        write_glossy(px, vec3f(0.0), INF, rd, rd);
+        return;
+    }
+    // Exact barycentrics of this frame's camera ray on the rasterised triangle (no bounds test:
+    // at a silhouette the sample may sit a hair outside it).
+    let v0 = tris[slot * 3u].xyz;
+    let e1 = tris[slot * 3u + 1u].xyz - v0;
+    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    let pv = cross(rd, e2);
+    let inv = 1.0 / dot(e1, pv);
+    let tv = ro - v0;
+    let qv = cross(tv, e1);
+    let hit = Hit(dot(e2, qv) * inv, slot, vec2f(dot(tv, pv) * inv, dot(rd, qv) * inv));
+    let s = surface_at(hit, rd);
+    let m = materials[s.material];
+    if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
+        write_all(px, vec3f(0.0), vec3f(0.0));
+        write_glossy(px, vec3f(0.0), INF, rd, rd);
+        return;
+    }
+    let ms = material_at(m, s.uv);
+    let bsdf = material_bsdf(m, ms);
+    let basis = onb(s.ns);
+    let wo = to_local(basis, -rd);
+    let origin = offset_ray(s.p, s.ng, eps);
+    // F at the mirror direction w_s: the half vector is the normal, so F(w_s, w_o) = F(n . w_o).
+    let f_s = fresnel(bsdf, wo.z);
+    let has_matte = max3(bsdf.albedo) > 0.0;
+    let has_glossy = HAS_GLOSSY && max3(f_s) > 0.0;
+    let mirror = reflect(rd, s.ns);
+    var matte = vec3f(0.0);
+    var glossy = vec3f(0.0);
+    var direct = vec3f(0.0);
+    var glossy_t = INF;
+    if !depth_ok(2) || wo.z <= 0.0 {
+        write_all(px, matte, direct);
+        write_glossy(px, glossy, glossy_t, rd * hit.t, mirror);
+        return;
+    }
+
+    for (var i = 0u; i < params.num_lights; i++) {
+        let ls = sample_punctual(i, s.p);
+        let wi = to_local(basis, ls.wi);
+        if max3(ls.li) <= 0.0 || wi.z <= 0.0 || dot(ls.wi, s.ng) <= 0.0 {
+            continue;
+        }
+        let e = bsdf_eval(bsdf, wo, wi);
+        if max3(e.f_cos) <= 0.0 {
+            continue;
+        }
+        let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+        if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
+            direct += e.f_cos * ls.li;
+        }
+    }
+
+    let groups = area_groups();
+    let nee_select = 1.0 / f32(max(groups, 1u));
+    if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
+        let ls = sample_area_light(s.p, &rng);
+        let wi = to_local(basis, ls.wi);
+        if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
+            let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+            if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
+                if has_matte {
+                    // Eq. (9): the matte light is L_i cos / pi over the pdf; m (1 - F)^2 comes later.
+                    matte += ls.li * (wi.z * INV_PI) * power_heuristic(ls.pdf, wi.z * INV_PI);
+                }
+                if has_glossy {
+                    let g = glossy_eval(bsdf, wo, wi);
+                    glossy += ls.li * g.f_cos / f_s * power_heuristic(ls.pdf, g.pdf);
+                }
+            }
+        }
+    }
+
+    if has_matte {
+        // Cosine sampling cancels eq. (7)'s cos / pi: the path's throughput starts at 1.
+        let wl = cosine_hemisphere(rand2(&rng));
+        let wi = basis * wl;
+        if dot(wi, s.ng) > 0.0 {
+            let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select), &rng);
+            matte += r.radiance;
+        }
+    } else {
+        // Keep the random sequence of the glossy path independent of the material.
+        rand2(&rng);
+    }
+
+    if has_glossy {
+        var wl: vec3f;
+        var start: PathStart;
+        if bsdf.delta {
+            // A mirror: F(h) = F(w_s) exactly, so the demodulated weight is 1.
+            wl = vec3f(-wo.xy, wo.z);
+            start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select);
+        } else {
+            wl = reflect(-wo, sample_vndf(bsdf.alpha, wo, rand2(&rng)));
+            let g = glossy_eval(bsdf, wo, wl);
+            var weight = vec3f(0.0);
+            if g.pdf > 0.0 {
+                weight = g.f_cos / (g.pdf * f_s);
+            }
+            start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select);
+        }
+        if wl.z > 0.0 && dot(start.rd, s.ng) > 0.0 && max3(start.beta) > 0.0 {
+            let r = trace_path(start, &rng);
+            glossy += r.radiance;
+            glossy_t = r.first_t;
+        }
+    }
+    write_all(px, matte, direct);
+    write_glossy(px, glossy, glossy_t, rd * hit.t, mirror);
+}

@@ -1,0 +1,67 @@
+//! `hush-cli render --mode realtime`: the hybrid frame, headless and deterministic.
+
+use crate::render::{RenderArgs, bvh_kind, image_size, load_scene, parse_camera};
+use anyhow::{Context, Result, bail};
+use hush_engine::frame::{FrameInput, Renderer};
+use hush_engine::scene::CameraPath;
+use hush_engine::settings::FrameSettings;
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    if a.denoiser != "none" {
+        bail!("--denoiser {:?} is not available; use none", a.denoiser);
+    }
+    if a.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    if a.out.is_none() && a.out_dir.is_none() {
+        bail!("real-time mode needs --out FILE (last frame) or --out-dir DIR (every frame)");
+    }
+    if !(a.fps > 0.0 && a.fps.is_finite()) {
+        bail!("--fps must be a positive number");
+    }
+    let scene = load_scene(&a.scene, a.max_texture_size)?;
+    let size = image_size(&scene, a.width, a.height);
+    let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
+    let camera = match &a.camera {
+        Some(c) => parse_camera(c)?,
+        None => scene.camera_or_default(),
+    };
+    if a.accumulate && path.is_some() {
+        bail!("--accumulate needs a still camera; it cannot be combined with --camera-path");
+    }
+    let settings = FrameSettings { max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, accumulate: a.accumulate, ..Default::default() };
+    let name = scene.name.clone();
+    let start = std::time::Instant::now();
+    let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
+    if let Some(dir) = &a.out_dir {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    for k in 0..a.frames {
+        let input = match &path {
+            Some(p) => {
+                let key = p.frame(k as usize);
+                FrameInput { camera: key.camera(), time: key.time }
+            }
+            // Accumulation needs a frozen clock; otherwise time advances at --fps.
+            None => FrameInput { camera, time: if a.accumulate { 0.0 } else { k as f64 / a.fps } },
+        };
+        r.render(&gpu, &input, &settings, None)?;
+        if let Some(dir) = &a.out_dir {
+            r.read_hdr(&gpu)?.save(&dir.join(format!("frame_{k:05}.exr")))?;
+        }
+    }
+    let img = r.read_hdr(&gpu)?;
+    let secs = start.elapsed().as_secs_f64();
+    if let Some(out) = &a.out {
+        img.save(out)?;
+    }
+    eprintln!(
+        "{name}: {}x{} real-time, {} frames{} in {secs:.2} s on {}",
+        size.0,
+        size.1,
+        a.frames,
+        if a.accumulate { " accumulated" } else { "" },
+        gpu.info.name
+    );
+    Ok(())
+}
