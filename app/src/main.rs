@@ -1,28 +1,47 @@
-//! `hush`: the viewer. Opens a window on a scene (the built-in one without an argument) and
-//! shows the reference path tracer converging, one sample per pixel per frame.
+//! `hush`: the viewer. Opens a window on a scene (the default level without an argument) and
+//! shows the real-time frame, with a fly camera and a side panel of settings and debug views.
 
-mod display;
+mod fly;
+mod ui;
 
 use anyhow::{Context, Result};
 use hush_engine::accel::BvhKind;
-use hush_engine::gpu::{Gpu, GpuScene, PreparedScene};
-use hush_engine::passes::{ReferenceTracer, TraceView};
-use hush_engine::scene::Scene;
+use hush_engine::frame::{DisplayTarget, FrameInput, Renderer};
+use hush_engine::gpu::{Gpu, PreparedScene};
+use hush_engine::scene::{CameraKey, CameraPath, Scene};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::Instant;
 use winit::application::ApplicationHandler;
-use winit::event::{ElementState, KeyEvent, WindowEvent};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
-use winit::keyboard::{Key, NamedKey};
+use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 const NO_DISPLAY: &str = "hush needs a display (no X11 or Wayland display was found). To render \
-without a window use the command-line tool, e.g.\n    hush-cli render default --spp 64 --out image.png";
+without a window use the command-line tool, e.g.\n    hush-cli render level --mode realtime --frames 16 --out image.png";
 
-struct Viewer {
-    scene: Scene,
-    prepared: PreparedScene,
-    state: Option<Running>,
-    error: Option<anyhow::Error>,
+const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-path PATH.json]
+  no scene: the default level. Keys: WASD move, Q/E down/up, right-drag look, wheel speed,
+  shift run, F12 screenshot (PNG + EXR), R record a camera path, P play it, Esc quit.
+  Drop a .gltf/.glb on the window to load it.";
+
+struct Args {
+    scene: String,
+    camera_path: Option<PathBuf>,
+}
+
+fn load_scene(path: &str) -> Result<Scene> {
+    let mut scene = Scene::load(path)?;
+    for w in &scene.warnings {
+        log::warn!("{w}");
+    }
+    scene.add_sun_and_sky_if_unlit();
+    Ok(scene)
+}
+
+fn unix_seconds() -> u64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
 }
 
 struct Running {
@@ -30,31 +49,66 @@ struct Running {
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
     gpu: Gpu,
-    gscene: GpuScene,
-    tracer: ReferenceTracer,
-    display: display::Display,
+    renderer: Renderer,
+    fly: fly::FlyCamera,
+    panel: ui::Panel,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    last: Instant,
+    cursor: Option<(f64, f64)>,
+    recording: Option<CameraPath>,
+    path: Option<CameraPath>,
+    playback: Option<usize>,
+}
+
+struct Viewer {
+    args: Args,
+    state: Option<Running>,
+    error: Option<anyhow::Error>,
+}
+
+fn panel_for(r: &Renderer, message: String) -> ui::Panel {
+    ui::Panel {
+        settings: hush_engine::settings::FrameSettings { max_depth: r.scene.max_depth.max(2), ..Default::default() },
+        resolution_scale: 1.0,
+        sun: r.scene.sun_direction().map(ui::sun_angles),
+        paused: false,
+        time: 0.0,
+        glossy: r.prepared.features.glossy,
+        frame_ms: 0.0,
+        pass_ms: vec![],
+        report: r.report(),
+        message,
+        recording: false,
+        playing: false,
+    }
 }
 
 impl Viewer {
     fn start(&mut self, el: &ActiveEventLoop) -> Result<()> {
-        let attrs = Window::default_attributes()
-            .with_title(format!("Hush: {}", self.scene.name))
-            .with_inner_size(winit::dpi::LogicalSize::new(960.0, 540.0));
+        let t0 = Instant::now();
+        let scene = load_scene(&self.args.scene)?;
+        let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
+        let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let attrs = Window::default_attributes().with_title(format!("Hush: {}", scene.name)).with_inner_size(winit::dpi::LogicalSize::new(1280.0, 720.0));
         let window = Arc::new(el.create_window(attrs).context("creating the window")?);
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let surface = instance.create_surface(window.clone()).context("creating the window surface")?;
         let size = window.inner_size();
-        // The accumulation buffer is 32 bytes per pixel; allow the window to grow to four times
-        // its first area before the device's binding limit would need raising.
-        let accum_bytes = size.width.max(1) as u64 * size.height.max(1) as u64 * 32 * 4;
-        let gpu = Gpu::for_surface(instance, &surface, &self.prepared.requirements(accum_bytes))?;
+        let (w, h) = (size.width.max(1), size.height.max(1));
+        // The viewer asks for the adapter's own limits: scenes dropped on it later may be larger.
+        let mut req = prepared.realtime_requirements((w, h));
+        req.adapter_limits = true;
+        let gpu = Gpu::for_surface(instance, &surface, &req)?;
         let caps = surface.get_capabilities(&gpu.adapter);
-        let format = caps.formats.first().copied().context("the surface offers no format")?;
+        // egui blends in gamma space: prefer a non-sRGB surface (the display pass then encodes sRGB).
+        let format = caps.formats.iter().copied().find(|f| !f.is_srgb()).or(caps.formats.first().copied()).context("the surface offers no format")?;
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
             format,
-            width: size.width.max(1),
-            height: size.height.max(1),
+            width: w,
+            height: h,
             present_mode: wgpu::PresentMode::AutoVsync,
             alpha_mode: caps.alpha_modes[0],
             view_formats: vec![],
@@ -62,41 +116,129 @@ impl Viewer {
             color_space: Default::default(),
         };
         surface.configure(&gpu.device, &config);
-        let gscene = self.prepared.upload(&gpu);
-        let tracer = ReferenceTracer::new(&gpu, &self.prepared, &gscene, &self.view(config.width, config.height))?;
-        let display = display::Display::new(&gpu, format, &tracer)?;
-        self.state = Some(Running { window, surface, config, gpu, gscene, tracer, display });
+        let extent = prepared.extent;
+        let renderer = Renderer::new(&gpu, scene, prepared, (w, h))?;
+        let fly = fly::FlyCamera::from_camera(&renderer.scene.camera_or_default(), extent);
+        let panel = panel_for(&renderer, format!("loaded in {load_ms:.0} ms"));
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(egui_ctx.clone(), egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), None, Some(gpu.device.limits().max_texture_dimension_2d as usize));
+        let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        let path = self.args.camera_path.as_deref().map(CameraPath::load).transpose()?;
+        let playback = path.as_ref().map(|_| 0);
+        self.state = Some(Running { window, surface, config, gpu, renderer, fly, panel, egui_ctx, egui_state, egui_renderer, last: Instant::now(), cursor: None, recording: None, path, playback });
         Ok(())
     }
+}
 
-    fn view(&self, width: u32, height: u32) -> TraceView {
-        TraceView { camera: self.scene.camera_or_default(), width, height, max_depth: self.scene.max_depth, seed: 0 }
+impl Running {
+    fn frame_size(&self) -> (u32, u32) {
+        let s = self.panel.resolution_scale.clamp(0.25, 1.0);
+        (((self.config.width as f32 * s) as u32).max(1), ((self.config.height as f32 * s) as u32).max(1))
     }
 
-    fn resize(&mut self, w: u32, h: u32) -> Result<()> {
-        let view = self.view(w, h);
-        let Some(s) = &mut self.state else { return Ok(()) };
+    fn resize(&mut self, w: u32, h: u32) {
         if w == 0 || h == 0 {
-            return Ok(()); // minimized: keep everything, render nothing
+            return; // minimized: keep everything, render nothing
         }
-        s.config.width = w;
-        s.config.height = h;
-        s.surface.configure(&s.gpu.device, &s.config);
-        s.tracer = ReferenceTracer::new(&s.gpu, &self.prepared, &s.gscene, &view)?;
-        s.display = display::Display::new(&s.gpu, s.config.format, &s.tracer)?;
-        Ok(())
+        self.config.width = w;
+        self.config.height = h;
+        self.surface.configure(&self.gpu.device, &self.config);
+    }
+
+    fn load(&mut self, path: &Path) {
+        let r = load_scene(&path.to_string_lossy()).and_then(|scene| {
+            let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
+            let extent = prepared.extent;
+            let size = self.frame_size();
+            let r = Renderer::new(&self.gpu, scene, prepared, size)?;
+            Ok((r, extent))
+        });
+        match r {
+            Ok((r, extent)) => {
+                self.fly = fly::FlyCamera::from_camera(&r.scene.camera_or_default(), extent);
+                self.panel = panel_for(&r, format!("loaded {}", path.display()));
+                self.window.set_title(&format!("Hush: {}", r.scene.name));
+                self.renderer = r;
+            }
+            Err(e) => {
+                log::error!("{e:#}");
+                self.panel.message = format!("could not load {}: {e:#}", path.display());
+            }
+        }
+    }
+
+    fn screenshot(&mut self) {
+        let stem = format!("hush_{}", unix_seconds());
+        let r = (|| -> Result<String> {
+            let png = self.renderer.display_image(&self.gpu, &self.panel.settings)?;
+            png.save(format!("{stem}.png")).with_context(|| format!("writing {stem}.png"))?;
+            self.renderer.read_hdr(&self.gpu)?.save(Path::new(&format!("{stem}.exr")))?;
+            Ok(format!("wrote {stem}.png and {stem}.exr"))
+        })();
+        self.panel.message = r.unwrap_or_else(|e| format!("screenshot failed: {e:#}"));
+    }
+
+    fn toggle_record(&mut self) {
+        match self.recording.take() {
+            None => {
+                self.recording = Some(CameraPath::default());
+                self.panel.message = "recording the camera path".into();
+            }
+            Some(p) if !p.keys.is_empty() => {
+                let file = format!("camera_path_{}.json", unix_seconds());
+                self.panel.message = match p.save(Path::new(&file)) {
+                    Ok(()) => format!("wrote {file} ({} keys)", p.keys.len()),
+                    Err(e) => format!("{e:#}"),
+                };
+                self.path = Some(p);
+            }
+            Some(_) => self.panel.message = "nothing recorded".into(),
+        }
+        self.panel.recording = self.recording.is_some();
+    }
+
+    fn toggle_play(&mut self) {
+        self.playback = match (self.playback, &self.path) {
+            (None, Some(_)) => Some(0),
+            (None, None) => {
+                self.panel.message = "no camera path: record one with R or pass --camera-path".into();
+                None
+            }
+            (Some(_), _) => None,
+        };
+        self.panel.playing = self.playback.is_some();
     }
 
     fn frame(&mut self) -> Result<()> {
-        let Some(s) = &mut self.state else { return Ok(()) };
-        if s.config.width == 0 || s.config.height == 0 || s.window.is_minimized() == Some(true) {
+        if self.config.width == 0 || self.config.height == 0 || self.window.is_minimized() == Some(true) {
             return Ok(());
         }
-        s.tracer.dispatch(&s.gpu, 1);
-        let frame = match s.surface.get_current_texture() {
+        let now = Instant::now();
+        let dt = (now - self.last).as_secs_f64();
+        self.last = now;
+        self.panel.frame_ms = dt * 1e3;
+        self.fly.update(dt);
+        let accumulate = self.panel.settings.accumulate;
+        if !self.panel.paused && !accumulate {
+            self.panel.time += dt;
+        }
+        let mut input = FrameInput { camera: self.fly.camera(), time: self.panel.time };
+        if let (Some(i), Some(p)) = (self.playback, &self.path) {
+            let key = p.frame(i);
+            input = FrameInput { camera: key.camera(), time: key.time };
+            self.playback = if i + 1 < p.keys.len() { Some(i + 1) } else { None };
+            self.panel.playing = self.playback.is_some();
+        }
+        if let Some(rec) = &mut self.recording {
+            rec.keys.push(CameraKey::from_camera(&input.camera, input.time));
+        }
+        let size = self.frame_size();
+        self.renderer.resize(&self.gpu, size)?;
+
+        let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                s.surface.configure(&s.gpu.device, &s.config);
+                self.surface.configure(&self.gpu.device, &self.config);
                 return Ok(());
             }
             other => {
@@ -104,11 +246,112 @@ impl Viewer {
                 return Ok(());
             }
         };
-        s.display.draw(&s.gpu, &s.tracer, &frame.texture);
-        s.gpu.queue.present(frame);
-        s.window.set_title(&format!("Hush: {} - reference, {} spp", self.scene.name, s.tracer.samples));
-        s.window.request_redraw();
+        let view = frame.texture.create_view(&Default::default());
+        let target = DisplayTarget { view: &view, format: self.config.format, size: (self.config.width, self.config.height) };
+        self.renderer.render(&self.gpu, &input, &self.panel.settings, Some(&target))?;
+        self.panel.pass_ms = self.renderer.pass_times(&self.gpu).unwrap_or_default();
+        if accumulate {
+            self.panel.message = format!("accumulated {} frames", self.renderer.accumulated());
+        }
+
+        let raw = self.egui_state.take_egui_input(&self.window);
+        let mut actions = ui::Actions::default();
+        let panel = &mut self.panel;
+        let out = self.egui_ctx.run_ui(raw, |ui| {
+            egui::Panel::right("settings").show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| actions = panel.show(ui));
+            });
+        });
+        self.egui_state.handle_platform_output(&self.window, out.platform_output);
+        let jobs = self.egui_ctx.tessellate(out.shapes, out.pixels_per_point);
+        let mut textures = out.textures_delta;
+        let (d, q) = (&self.gpu.device, &self.gpu.queue);
+        for (id, deltas) in textures.set.drain() {
+            for delta in &deltas {
+                self.egui_renderer.update_texture(d, q, id, delta);
+            }
+        }
+        let sd = egui_wgpu::ScreenDescriptor { size_in_pixels: [self.config.width, self.config.height], pixels_per_point: out.pixels_per_point };
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("egui") });
+        let extra = self.egui_renderer.update_buffers(d, q, &mut enc, &jobs, &sd);
+        {
+            let mut pass = enc
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("egui"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: &view, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store } })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                })
+                .forget_lifetime();
+            self.egui_renderer.render(&mut pass, &jobs, &sd);
+        }
+        q.submit(extra.into_iter().chain([enc.finish()]));
+        for id in textures.free.drain() {
+            self.egui_renderer.free_texture(&id);
+        }
+        self.gpu.queue.present(frame);
+
+        if actions.sun_changed {
+            if let Some((az, el)) = self.panel.sun {
+                self.renderer.set_sun_direction(&self.gpu, ui::sun_dir(az, el));
+            }
+        }
+        if actions.screenshot {
+            self.screenshot();
+        }
+        if actions.toggle_record {
+            self.toggle_record();
+        }
+        if actions.toggle_play {
+            self.toggle_play();
+        }
+        self.window.request_redraw();
         Ok(())
+    }
+
+    /// Returns true when the viewer should quit.
+    fn event(&mut self, event: &WindowEvent) -> Result<bool> {
+        let consumed = self.egui_state.on_window_event(&self.window, event).consumed;
+        match event {
+            WindowEvent::CloseRequested => return Ok(true),
+            WindowEvent::Resized(s) => self.resize(s.width, s.height),
+            WindowEvent::RedrawRequested => self.frame()?,
+            WindowEvent::DroppedFile(p) => self.load(p),
+            WindowEvent::KeyboardInput { event, .. } if !consumed || event.state == ElementState::Released => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    let pressed = event.state == ElementState::Pressed;
+                    if pressed {
+                        self.fly.held.insert(code);
+                    } else {
+                        self.fly.held.remove(&code);
+                    }
+                    if pressed && !event.repeat {
+                        match code {
+                            KeyCode::Escape => return Ok(true),
+                            KeyCode::F12 => self.screenshot(),
+                            KeyCode::KeyR => self.toggle_record(),
+                            KeyCode::KeyP => self.toggle_play(),
+                            _ => {}
+                        }
+                    }
+                }
+            }
+            WindowEvent::MouseInput { state, button: MouseButton::Right, .. } => self.fly.looking = *state == ElementState::Pressed && !consumed,
+            WindowEvent::CursorMoved { position, .. } => {
+                if let (true, Some((x, y))) = (self.fly.looking, self.cursor) {
+                    self.fly.look(position.x - x, position.y - y);
+                }
+                self.cursor = Some((position.x, position.y));
+            }
+            WindowEvent::MouseWheel { delta, .. } if !consumed => match delta {
+                MouseScrollDelta::LineDelta(_, y) => self.fly.wheel(*y as f64),
+                MouseScrollDelta::PixelDelta(p) => self.fly.wheel(p.y / 40.0),
+            },
+            _ => {}
+        }
+        Ok(false)
     }
 }
 
@@ -118,27 +361,21 @@ impl ApplicationHandler for Viewer {
             if let Err(e) = self.start(el) {
                 self.error = Some(e);
                 el.exit();
+            } else if let Some(s) = &self.state {
+                s.window.request_redraw();
             }
         }
     }
 
     fn window_event(&mut self, el: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
-        let r = match event {
-            WindowEvent::CloseRequested => {
+        let Some(s) = &mut self.state else { return };
+        match s.event(&event) {
+            Ok(true) => el.exit(),
+            Ok(false) => {}
+            Err(e) => {
+                self.error = Some(e);
                 el.exit();
-                Ok(())
             }
-            WindowEvent::KeyboardInput { event: KeyEvent { logical_key: Key::Named(NamedKey::Escape), state: ElementState::Pressed, .. }, .. } => {
-                el.exit();
-                Ok(())
-            }
-            WindowEvent::Resized(size) => self.resize(size.width, size.height),
-            WindowEvent::RedrawRequested => self.frame(),
-            _ => Ok(()),
-        };
-        if let Err(e) = r {
-            self.error = Some(e);
-            el.exit();
         }
     }
 }
@@ -150,20 +387,31 @@ fn has_display() -> bool {
     true
 }
 
-fn run() -> Result<()> {
-    let arg = std::env::args().nth(1);
-    if matches!(arg.as_deref(), Some("-h" | "--help")) {
-        println!("usage: hush [SCENE.gltf|SCENE.glb]   (no argument: the built-in scene)");
-        return Ok(());
+fn parse_args() -> Result<Option<Args>> {
+    let mut scene = None;
+    let mut camera_path = None;
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "-h" | "--help" => return Ok(None),
+            "--camera-path" => camera_path = Some(PathBuf::from(it.next().context("--camera-path needs a file")?)),
+            s if s.starts_with('-') => anyhow::bail!("unknown option {s}\n{USAGE}"),
+            s => scene = Some(s.to_string()),
+        }
     }
+    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path }))
+}
+
+fn run() -> Result<()> {
+    let Some(args) = parse_args()? else {
+        println!("{USAGE}");
+        return Ok(());
+    };
     if !has_display() {
         anyhow::bail!(NO_DISPLAY);
     }
-    let mut scene = Scene::load(arg.as_deref().unwrap_or("default"))?;
-    scene.add_sun_and_sky_if_unlit();
-    let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY}\n({e})"))?;
-    let mut viewer = Viewer { scene, prepared, state: None, error: None };
+    let mut viewer = Viewer { args, state: None, error: None };
     event_loop.run_app(&mut viewer)?;
     match viewer.error {
         Some(e) => Err(e),

@@ -6,7 +6,9 @@
 
 struct DisplayOptions {
     encode_srgb: u32,
-    _pad: vec3u,
+    _pad: u32,
+    // Size of the render target: the frame is scaled to cover it (resolution scale).
+    target_size: vec2u,
 }
 
 @group(0) @binding(34) var<uniform> display: DisplayOptions;
@@ -83,7 +85,8 @@ fn debug_view(view: u32, p: vec2i) -> vec4f {
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
-    let px = vec2u(min(u32(pos.x), frame.size.x - 1u), min(u32(pos.y), frame.size.y - 1u));
+    let q = vec2u(pos.xy * vec2f(frame.size) / vec2f(max(display.target_size, vec2u(1u))));
+    let px = min(q, frame.size - 1u);
     let i = px.y * frame.size.x + px.x;
     var c: vec3f;
     if frame.view == 0u {

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// A .gltf/.glb file, or `default` for the built-in scene.
+    /// A .gltf/.glb file, `default` for the built-in room or `level` for the default level.
     pub scene: String,
     /// `reference` (progressive path tracing) or `realtime` (the hybrid frame).
     #[arg(long, default_value = "reference")]
@@ -95,6 +95,8 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
 pub fn load_scene(path: &str, max_texture_size: u32) -> Result<Scene> {
     let mut scene = if path == "default" {
         hush_engine::scene::default_scene()
+    } else if path == "level" {
+        hush_engine::scene::default_level()
     } else {
         hush_engine::scene::load_gltf_with(std::path::Path::new(path), max_texture_size)?
     };

@@ -34,6 +34,14 @@ pub struct FrameInput {
     pub time: f64,
 }
 
+/// Where the display pass draws: a surface texture or an offscreen image of any size (the frame
+/// is scaled to cover it).
+pub struct DisplayTarget<'a> {
+    pub view: &'a wgpu::TextureView,
+    pub format: wgpu::TextureFormat,
+    pub size: (u32, u32),
+}
+
 /// Per-pixel targets of the frame, remade on resize.
 struct Targets {
     size: (u32, u32),
@@ -121,7 +129,7 @@ impl Renderer {
         let d = &gpu.device;
         let params_buf = memory.buffer(d, "frame/scene params", size_of::<TraceParams>() as u64, u);
         let frame_buf = memory.buffer(d, "frame/params", size_of::<FrameParams>() as u64, u);
-        let display_buf = memory.buffer(d, "display/options", 32, u);
+        let display_buf = memory.buffer(d, "display/options", 16, u);
         let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
         let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
@@ -167,6 +175,17 @@ impl Renderer {
         )
     }
 
+    /// Move the sun (the first directional light); false if the scene has none.
+    pub fn set_sun_direction(&mut self, gpu: &Gpu, dir: Vec3) -> bool {
+        if !self.scene.set_sun_direction(dir) {
+            return false;
+        }
+        self.prepared.repack_lighting(&self.scene);
+        self.gpu_scene.update_lighting(gpu, &self.prepared);
+        self.accumulated_state = None;
+        true
+    }
+
     pub fn size(&self) -> (u32, u32) {
         self.targets.size
     }
@@ -209,11 +228,11 @@ impl Renderer {
     }
 
     /// Render one frame; with `target`, also tone-map (or show `settings.view`) into it.
-    pub fn render(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<()> {
+    pub fn render(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
         gpu.validated("rendering a frame", || self.record_frame(gpu, input, settings, target))
     }
 
-    fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<()> {
+    fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
         if self.prepared.features.animated {
             let moved = self.prepared.animate(&self.scene, input.time);
             self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
@@ -257,13 +276,13 @@ impl Renderer {
         gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
         gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
 
-        if let Some((_, format)) = target {
+        if let Some(&DisplayTarget { format, size: tsize, .. }) = target {
             if self.display.as_ref().is_none_or(|d| d.format != format) {
                 let fb = self.frame_buffers();
                 self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, format).context("creating the display pass")?);
             }
             let srgb = !format.is_srgb() as u32;
-            gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, 0, 0, 0, 0, 0, 0]));
+            gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, tsize.0, tsize.1]));
         }
 
         let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
@@ -276,8 +295,8 @@ impl Renderer {
         self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &t.gbuffer, self.timer.as_mut());
         self.trace.record(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut());
         self.composite.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut());
-        if let (Some((view, _)), Some(d)) = (target, self.display.as_mut()) {
-            d.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, view, self.timer.as_mut());
+        if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
+            d.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, target.view, self.timer.as_mut());
         }
         if let Some(timer) = &self.timer {
             timer.resolve(&mut enc);
@@ -286,6 +305,53 @@ impl Renderer {
         self.prev_view_proj = Some(cam.view_proj);
         self.frame_index = self.frame_index.wrapping_add(1);
         Ok(())
+    }
+
+    /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
+    pub fn redisplay(&mut self, gpu: &Gpu, settings: &FrameSettings, target: &DisplayTarget) -> Result<()> {
+        gpu.validated("displaying the frame", || {
+            if self.display.as_ref().is_none_or(|d| d.format != target.format) {
+                let fb = self.frame_buffers();
+                self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, target.format)?);
+            }
+            // Only the view and exposure change; the rest of the uniform is the last frame's.
+            let mut fp: FrameParams = bytemuck::Zeroable::zeroed();
+            fp.view = settings.view as u32;
+            fp.exposure = 2f32.powf(settings.exposure_ev.clamp(-30.0, 30.0));
+            let off = std::mem::offset_of!(FrameParams, view) as u64;
+            gpu.queue.write_buffer(&self.frame_buf, off, bytemuck::cast_slice(&[fp.view]));
+            gpu.queue.write_buffer(&self.frame_buf, off + 4, bytemuck::cast_slice(&[fp.exposure]));
+            let srgb = !target.format.is_srgb() as u32;
+            gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, target.size.0, target.size.1]));
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            let t = &self.targets;
+            let fb = FrameBuffers { frame: &self.frame_buf, hdr: &t.hdr, accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation), display: &self.display_buf };
+            if let Some(d) = self.display.as_mut() {
+                d.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, target.view, None);
+            }
+            gpu.queue.submit([enc.finish()]);
+            Ok(())
+        })
+    }
+
+    /// The display's image of the last frame (tone-mapped or the chosen debug view) as 8-bit sRGB.
+    pub fn display_image(&mut self, gpu: &Gpu, settings: &FrameSettings) -> Result<image::RgbaImage> {
+        let (w, h) = self.targets.size;
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("display image"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = tex.create_view(&Default::default());
+        self.redisplay(gpu, settings, &DisplayTarget { view: &view, format, size: (w, h) })?;
+        let bytes = crate::gpu::readback_texture(gpu, &tex)?;
+        image::RgbaImage::from_raw(w, h, bytes).context("display image has the wrong size")
     }
 
     fn frame_buffers(&self) -> FrameBuffers<'_> {

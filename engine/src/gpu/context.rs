@@ -19,6 +19,8 @@ pub struct GpuRequirements {
     pub max_storage_textures_per_shader_stage: u32,
     /// Render-target bytes per sample of the widest render pass (WebGPU's accounting).
     pub max_color_attachment_bytes_per_sample: u32,
+    /// Ask for everything the adapter offers (the viewer, which may load larger scenes later).
+    pub adapter_limits: bool,
 }
 
 impl Default for GpuRequirements {
@@ -30,6 +32,7 @@ impl Default for GpuRequirements {
             max_storage_buffers_per_shader_stage: d.max_storage_buffers_per_shader_stage,
             max_storage_textures_per_shader_stage: d.max_storage_textures_per_shader_stage,
             max_color_attachment_bytes_per_sample: d.max_color_attachment_bytes_per_sample,
+            adapter_limits: false,
         }
     }
 }
@@ -71,7 +74,7 @@ impl Gpu {
     ) -> Result<Gpu> {
         let info = adapter.get_info();
         let have = adapter.limits();
-        let mut limits = wgpu::Limits::default().using_resolution(have.clone());
+        let mut limits = if req.adapter_limits { have.clone() } else { wgpu::Limits::default().using_resolution(have.clone()) };
         limits.max_storage_buffer_binding_size =
             limits.max_storage_buffer_binding_size.max(req.max_storage_buffer_binding_size);
         limits.max_buffer_size = limits.max_buffer_size.max(req.max_storage_buffer_binding_size);

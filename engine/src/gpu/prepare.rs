@@ -224,7 +224,9 @@ impl PreparedScene {
         let tex_data = pack_textures(scene);
         let alpha_mask = scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_)));
         let emissive: Vec<bool> = scene.materials.iter().map(|m| crate::quality::luminance(m.emission) > 0.0).collect();
-        let glossy = scene.materials.iter().any(|m| {
+        // Only materials some object uses count (importers append an unused default material).
+        let used: std::collections::HashSet<usize> = scene.objects.iter().map(|o| scene.meshes[o.mesh].material as usize).collect();
+        let glossy = scene.materials.iter().enumerate().filter(|(i, _)| used.contains(i)).any(|(_, m)| {
             let g = GpuMaterial::from(m);
             g.metallic > 0.0 || (g.specular_factor > 0.0 && g.specular_color.iter().any(|c| *c > 0.0))
         });
@@ -350,6 +352,19 @@ impl PreparedScene {
 }
 
 impl PreparedScene {
+    /// Repack lights and a procedural environment after the scene's lighting changed (same
+    /// number of lights and the same environment kind and size; geometry untouched).
+    pub fn repack_lighting(&mut self, scene: &Scene) {
+        self.lights = scene.lights.iter().map(|l| pack_light(l, self.origin)).collect();
+        if let Environment::Map(map) = &scene.environment {
+            let mut env = EnvPack::default();
+            if env.pack_map(map) && env.data.len() == self.env_data.len() {
+                self.env_data = env.data;
+                self.env_pdf_norm = env.pdf_norm;
+            }
+        }
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.tris.len() / 3
     }

@@ -80,12 +80,13 @@ impl PreparedScene {
         let tris = mem.buffer_init(d, "scene/triangles", b(&self.tris), s);
         let shading = mem.buffer_init(d, "scene/shading", b(&self.shading), s);
         let materials = mem.buffer_init(d, "scene/materials", b(&self.materials), s);
-        let lights = f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), s));
+        let copy = s | wgpu::BufferUsages::COPY_DST;
+        // Lights and environment are rewritten when the user moves the sun.
+        let lights = f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), copy));
         let emitters = f.emitters.then(|| mem.buffer_init(d, "scene/emitters", b(&self.emitters), s));
-        let env = (f.env == EnvKind::Map).then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), s));
+        let env = (f.env == EnvKind::Map).then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), copy));
         let textures = f.textures.then(|| mem.buffer_init(d, "scene/textures", b(&self.tex_data), s));
         let tangents = f.normal_maps.then(|| mem.buffer_init(d, "scene/tangents", b(&self.tangents), s));
-        let copy = s | wgpu::BufferUsages::COPY_DST;
         let objects = f.animated.then(|| mem.buffer_init(d, "scene/object motion", b(&self.prev_from_current), copy));
         log::info!(
             "scene on the GPU: {} triangles, {} BVH nodes ({}), features {:?}, {} bytes: {}",
@@ -143,6 +144,18 @@ pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl GpuScene {
+    /// After [`PreparedScene::repack_lighting`].
+    pub fn update_lighting(&self, gpu: &Gpu, p: &PreparedScene) {
+        if let Some(l) = &self.lights {
+            gpu.queue.write_buffer(l, 0, bytemuck::cast_slice(&p.lights));
+        }
+        if let Some(e) = &self.env {
+            if e.size() >= (p.env_data.len() * 4) as u64 {
+                gpu.queue.write_buffer(e, 0, bytemuck::cast_slice(&p.env_data));
+            }
+        }
+    }
+
     /// After [`PreparedScene::animate`]: write the rebuilt geometry and object motion, replacing
     /// a buffer (and bumping `generation`) only where the new data no longer fits.
     pub fn update_geometry(&mut self, gpu: &Gpu, p: &PreparedScene, moved: bool) {

@@ -5,7 +5,7 @@
 use super::{Camera, Environment, Material, Mesh, Object, Scene, sky};
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 
-fn lambert(name: &str, c: Vec3) -> Material {
+pub(super) fn lambert(name: &str, c: Vec3) -> Material {
     Material {
         name: name.into(),
         base_color: c.extend(1.0),
@@ -16,12 +16,12 @@ fn lambert(name: &str, c: Vec3) -> Material {
     }
 }
 
-fn metal(name: &str, c: Vec3, roughness: f32) -> Material {
+pub(super) fn metal(name: &str, c: Vec3, roughness: f32) -> Material {
     Material { name: name.into(), base_color: c.extend(1.0), metallic: 1.0, roughness, ..Default::default() }
 }
 
 /// Axis-aligned quad with CCW winding seen from `normal`'s side.
-fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
+pub(super) fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
     let n = u.cross(v).normalize();
     let positions = vec![center - u - v, center + u - v, center + u + v, center - u + v];
     Mesh {
@@ -34,7 +34,7 @@ fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
     }
 }
 
-fn cuboid(center: Vec3, half: Vec3, material: u32) -> Mesh {
+pub(super) fn cuboid(center: Vec3, half: Vec3, material: u32) -> Mesh {
     let mut m = Mesh { material, ..Default::default() };
     let faces = [
         (Vec3::X, Vec3::Z, Vec3::Y),
@@ -57,7 +57,7 @@ fn cuboid(center: Vec3, half: Vec3, material: u32) -> Mesh {
     m
 }
 
-fn uv_sphere(center: Vec3, r: f32, material: u32, seg: u32, rings: u32) -> Mesh {
+pub(super) fn uv_sphere(center: Vec3, r: f32, material: u32, seg: u32, rings: u32) -> Mesh {
     let mut m = Mesh { material, ..Default::default() };
     for j in 0..=rings {
         let th = std::f32::consts::PI * j as f32 / rings as f32;
@@ -141,5 +141,6 @@ pub fn default_scene() -> Scene {
         resolution: Some((640, 360)),
         max_depth: super::DEFAULT_MAX_DEPTH,
         warnings: vec![],
+        procedural_sky: true,
     }
 }

@@ -4,6 +4,7 @@
 mod animation;
 mod camera_path;
 mod default_scene;
+mod level;
 mod environment;
 mod gltf_import;
 mod paths;
@@ -13,6 +14,7 @@ mod texture;
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::default_scene;
+pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use environment::{EnvMap, Environment};
 pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with};
 pub use texture::{Texture, TextureRef, Wrap};
@@ -160,16 +162,23 @@ pub struct Scene {
     pub max_depth: i32,
     /// Non-fatal problems met while loading (missing textures, unsupported optional extensions).
     pub warnings: Vec<String>,
+    /// The environment is the procedural sky of the first directional light (the sun + sky
+    /// preset or the default level): moving the sun regenerates it.
+    pub procedural_sky: bool,
 }
 
 /// Mitsuba's default path length, also the conventions' default.
 pub const DEFAULT_MAX_DEPTH: i32 = 6;
 
 impl Scene {
-    /// Load a `.gltf`/`.glb` file, or `default` for the built-in scene.
+    /// Load a `.gltf`/`.glb` file, `default` for the built-in room or `level` for the default
+    /// level.
     pub fn load(path_or_default: &str) -> Result<Scene> {
         if path_or_default == "default" {
             return Ok(default_scene());
+        }
+        if path_or_default == "level" {
+            return Ok(default_level());
         }
         load_gltf(Path::new(path_or_default))
     }
@@ -234,5 +243,27 @@ impl Scene {
         let (sun, sky) = sky::sun_and_sky(Vec3::new(-0.4, -0.8, -0.45).normalize());
         self.lights.push(sun);
         self.environment = Environment::Map(sky);
+        self.procedural_sky = true;
+    }
+
+    /// Point the first directional light along `dir` (regenerating a procedural sky with it).
+    /// Returns false when the scene has no directional light.
+    pub fn set_sun_direction(&mut self, dir: Vec3) -> bool {
+        let Some(Light::Directional { direction, .. }) = self.lights.iter_mut().find(|l| matches!(l, Light::Directional { .. })) else {
+            return false;
+        };
+        *direction = dir.normalize_or(Vec3::NEG_Y);
+        if self.procedural_sky {
+            let (_, sky) = sky::sun_and_sky(*direction);
+            self.environment = Environment::Map(sky);
+        }
+        true
+    }
+
+    pub fn sun_direction(&self) -> Option<Vec3> {
+        self.lights.iter().find_map(|l| match l {
+            Light::Directional { direction, .. } => Some(*direction),
+            _ => None,
+        })
     }
 }

@@ -55,7 +55,6 @@ embed!(
     "realtime/composite.wgsl",
     "realtime/display.wgsl",
     "accel/raycast.wgsl",
-    "view/display.wgsl",
 );
 
 pub fn source(path: &str) -> Result<&'static str> {
@@ -138,7 +137,7 @@ mod tests {
 
     /// Every program Hush can compose, over both BVH layouts and the feature alternatives.
     fn all_programs() -> Vec<Program> {
-        let mut v = vec![compose("display", "", &["view/display.wgsl"]).unwrap()];
+        let mut v = vec![];
         for set in FEATURE_SETS {
             for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
                 let m = ["common/math.wgsl", "common/geometry.wgsl", "common/scene.wgsl", "common/bsdf.wgsl", set[1], set[2], set[0], "realtime/frame.wgsl", motion, "realtime/gbuffer.wgsl"];

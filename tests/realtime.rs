@@ -1,0 +1,226 @@
+//! The real-time frame: converged accumulation against the reference mode, motion vectors,
+//! feature-driven allocation, the default level.
+
+use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
+use hush_engine::accel::BvhKind;
+use hush_engine::frame::{FrameInput, Renderer, View};
+use hush_engine::quality::Image;
+use hush_engine::scene::{Camera, load_gltf};
+use hush_engine::settings::FrameSettings;
+use hush_tests::{oracle, realtime_accumulate, render};
+
+/// Accumulated real-time frames converge to the reference tracer's image. The real-time frame
+/// samples the same integral with a different structure (exhaustive punctual lights, separate
+/// matte and glossy paths with their own MIS), so the two agree only in expectation: the test
+/// measures both images' noise and allows relMSE up to `SLACK` times the noise prediction.
+/// Real-time variance comes from two independent halves a, b: var(mean) = E[(a - b)^2] / 4.
+/// The slack covers the noise of the variance estimate on heavy-tailed pixels (the 0.05-roughness
+/// highlight of point_glossy); a bias of 1% over the image would add 1e-4 and stays visible in
+/// the trimmed mean bias, bounded by 5 standard errors.
+const SLACK: f64 = 2.0;
+
+fn converges(name: &str, size: u32, frames: u32, spp: u32) {
+    let scene = load_gltf(&oracle(name).join(format!("{name}.gltf"))).unwrap();
+    let a = realtime_accumulate(&scene, size, size, frames / 2, 1).unwrap();
+    let b = realtime_accumulate(&scene, size, size, frames / 2, 2).unwrap();
+    let reference = render(&scene, size, size, spp, 3).unwrap();
+    let n = a.data.len();
+    let mut rt = Image::new(size, size);
+    for i in 0..n {
+        rt.data[i] = (a.data[i] + b.data[i]) * 0.5;
+    }
+    let (mut relmse, mut expected) = (0f64, 0f64);
+    let mut diffs: Vec<(f32, usize)> = vec![];
+    for i in 0..n {
+        let y = reference.mean.data[i];
+        for k in 0..3 {
+            let d = (rt.data[i][k] - y[k]) as f64;
+            let var_rt = ((a.data[i][k] - b.data[i][k]) as f64).powi(2) / 4.0;
+            let w = 1.0 / (y[k] as f64 * y[k] as f64 + 0.01);
+            relmse += d * d * w;
+            expected += (var_rt + reference.variance_of_mean.data[i][k] as f64) * w;
+        }
+        assert!(rt.data[i].is_finite(), "{name}: non-finite pixel {i}");
+        diffs.push(((rt.data[i] - y).abs().max_element(), i));
+    }
+    relmse /= (3 * n) as f64;
+    expected /= (3 * n) as f64;
+    diffs.sort_by(|p, q| p.0.total_cmp(&q.0));
+    let keep: Vec<usize> = diffs[..n - n / 1000 - 1].iter().map(|d| d.1).collect();
+    let mut bias = [0f64; 3];
+    let mut allowed = [0f64; 3];
+    for k in 0..3 {
+        let (mut sx, mut sy, mut var) = (0f64, 0f64, 0f64);
+        for &i in &keep {
+            sx += rt.data[i][k] as f64;
+            sy += reference.mean.data[i][k] as f64;
+            var += ((a.data[i][k] - b.data[i][k]) as f64).powi(2) / 4.0 + reference.variance_of_mean.data[i][k] as f64;
+        }
+        bias[k] = (sx - sy) / sy;
+        allowed[k] = 5.0 * var.sqrt() / sy;
+    }
+    println!(
+        "{name}: {size}x{size}, {frames} real-time frames vs {spp} reference spp: relMSE {relmse:.5} (noise predicts {expected:.5}), \
+         trimmed bias {:+.4} {:+.4} {:+.4} (allowed {:.4} {:.4} {:.4})",
+        bias[0], bias[1], bias[2], allowed[0], allowed[1], allowed[2]
+    );
+    assert!(relmse <= SLACK * expected, "{name}: relMSE {relmse} > {SLACK} x predicted {expected}");
+    for k in 0..3 {
+        assert!(bias[k].abs() <= allowed[k], "{name}: channel {k} biased by {:+.4} (allowed {:.4})", bias[k], allowed[k]);
+    }
+}
+
+#[test]
+fn accumulation_converges_to_the_reference_mirror() {
+    converges("cornell_mirror", 48, 256, 256);
+}
+
+#[test]
+fn accumulation_converges_to_the_reference_glossy_point_light() {
+    converges("point_glossy", 48, 256, 256);
+}
+
+#[test]
+fn accumulation_converges_to_the_reference_furnace() {
+    converges("furnace", 32, 64, 64);
+}
+
+#[test]
+fn a_diffuse_only_scene_allocates_no_glossy_buffers() {
+    let scene = load_gltf(&oracle("cornell_diffuse").join("cornell_diffuse.gltf")).unwrap();
+    let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (32, 32)).unwrap();
+    assert!(!r.prepared.features.glossy, "cornell_diffuse has only Lambertian materials");
+    let labels: Vec<String> = r.allocations().into_iter().map(|(l, _)| l).collect();
+    for forbidden in ["trace/glossy", "trace/reflection", "trace/mirror", "scene/object motion", "composite/accumulation"] {
+        assert!(!labels.iter().any(|l| l == forbidden), "{forbidden} allocated: {labels:?}");
+    }
+    // G-buffer 36 + matte 8 + direct 8 + HDR 16 bytes per pixel.
+    assert_eq!(r.bytes_per_pixel(), 68.0, "{}", r.report());
+    let input = FrameInput { camera: r.scene.camera_or_default(), time: 0.0 };
+    r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
+    assert!(r.read_texture(&gpu, "trace/glossy").is_err());
+    let img = r.read_hdr(&gpu).unwrap();
+    assert!(img.data.iter().all(|p| p.is_finite()) && img.data.iter().any(|p| p.max_element() > 0.0));
+}
+
+fn half(b: &[u8]) -> f32 {
+    half_to_f32(u16::from_le_bytes([b[0], b[1]]))
+}
+
+/// IEEE half to f32 (the test reads Rg16Float motion vectors).
+fn half_to_f32(h: u16) -> f32 {
+    let s = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let e = ((h >> 10) & 0x1f) as i32;
+    let m = (h & 0x3ff) as f32;
+    match e {
+        0 => s * m * 2f32.powi(-24),
+        31 => s * f32::INFINITY,
+        _ => s * (1.0 + m / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+fn project(vp: &Mat4, p: Vec3, size: (u32, u32)) -> Vec2 {
+    let c = *vp * p.extend(1.0);
+    let ndc = Vec2::new(c.x, c.y) / c.w;
+    Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * Vec2::new(size.0 as f32, size.1 as f32)
+}
+
+/// Motion vectors under camera and object motion, in the default level: for every pixel with a
+/// surface, the G-buffer's motion must equal the motion computed on the CPU from the exact hit
+/// point (ray through the pixel centre and the stored triangle), the object's motion and the two
+/// cameras. The bound, 0.02 px + 2^-10 of the motion, is the Rg16Float storage precision (10-bit
+/// mantissa) plus f32 projection rounding. Then the previous frame's object ids, fetched at
+/// pixel + motion, must match the current ones where the previous frame's 2x2 footprint around
+/// that point lies on one object (away from silhouettes): at least 98% of those pixels (the rest
+/// are disocclusions; 99.1% match on lavapipe).
+#[test]
+fn motion_vectors_follow_camera_and_object_motion() {
+    let scene = hush_engine::scene::default_level();
+    let size = (96u32, 64u32);
+    let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, size).unwrap();
+    let settings = FrameSettings::default();
+    // Look at the animated cube from near the plinth, then step and turn the camera a little.
+    let cam0 = Camera::look_at(DVec3::new(1.8, 1.6, 3.2), DVec3::new(0.0, 1.4, 0.0), 50.0);
+    let cam1 = Camera::look_at(DVec3::new(1.6, 1.65, 3.0), DVec3::new(0.05, 1.45, 0.0), 50.0);
+    let (t0, t1) = (0.30, 0.35);
+    r.render(&gpu, &FrameInput { camera: cam0, time: t0 }, &settings, None).unwrap();
+    let ids0 = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
+    let setup0 = r.camera_setup(&cam0);
+    r.render(&gpu, &FrameInput { camera: cam1, time: t1 }, &settings, None).unwrap();
+    let ids1 = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
+    let motion = r.read_texture(&gpu, "gbuffer/motion").unwrap().0;
+    let setup1 = r.camera_setup(&cam1);
+    let cube = r.scene.objects.iter().position(|o| o.animation.is_some()).unwrap() as u32;
+
+    let id_at = |ids: &[u8], x: usize, y: usize| -> (u32, u32) {
+        let o = (y * size.0 as usize + x) * 8;
+        (u32::from_le_bytes(ids[o..o + 4].try_into().unwrap()), u32::from_le_bytes(ids[o + 4..o + 8].try_into().unwrap()))
+    };
+    let tris = &r.prepared.tris;
+    let (mut worst, mut checked, mut on_cube, mut matched, mut comparable) = (0f32, 0, 0, 0, 0);
+    for y in 0..size.1 as usize {
+        for x in 0..size.0 as usize {
+            let (obj, slot) = id_at(&ids1, x, y);
+            if slot == u32::MAX {
+                continue;
+            }
+            // The exact hit of the ray through the pixel centre on the stored triangle.
+            let ndc = Vec2::new((x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0);
+            let d = (setup1.fwd + ndc.x * setup1.right + ndc.y * setup1.up).normalize();
+            let v = |k: usize| tris[slot as usize * 3 + k].truncate();
+            let n = (v(1) - v(0)).cross(v(2) - v(0));
+            let t = (v(0) - setup1.pos).dot(n) / d.dot(n);
+            let p = setup1.pos + d * t;
+            let prev = r.prepared.prev_from_current[obj as usize] * Vec4::from((p, 1.0));
+            let expected = project(&setup0.view_proj, prev.truncate() / prev.w, size) - project(&setup1.view_proj, p, size);
+            let o = (y * size.0 as usize + x) * 4;
+            let got = Vec2::new(half(&motion[o..]), half(&motion[o + 2..]));
+            let err = (got - expected).length();
+            let bound = 0.02 + expected.length() / 1024.0;
+            assert!(err <= bound, "pixel ({x}, {y}) object {obj}: motion {got} expected {expected} (error {err} > {bound})");
+            worst = worst.max(err);
+            checked += 1;
+            if obj == cube {
+                on_cube += 1;
+            }
+            let q = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + got;
+            // The 2x2 texels around q (pixel centres at +0.5).
+            let q = q - Vec2::splat(0.5);
+            let (qx, qy) = (q.x.floor() as i64, q.y.floor() as i64);
+            if qx >= 0 && qy >= 0 && qx + 1 < size.0 as i64 && qy + 1 < size.1 as i64 {
+                let around: Vec<u32> = [(0, 0), (1, 0), (0, 1), (1, 1)].iter().map(|(dx, dy)| id_at(&ids0, (qx + dx) as usize, (qy + dy) as usize).0).collect();
+                if around.iter().all(|&i| i == around[0]) {
+                    comparable += 1;
+                    matched += (around[0] == obj) as u32;
+                }
+            }
+        }
+    }
+    let rate = matched as f64 / comparable as f64;
+    println!("motion vectors: {checked} pixels ({on_cube} on the moving cube), worst error {worst:.4} px; previous ids match at {:.2}% of {comparable}", rate * 100.0);
+    assert!(on_cube > 100, "the moving cube covers only {on_cube} pixels");
+    assert!(rate >= 0.98, "reprojected object ids match at only {:.2}%", rate * 100.0);
+}
+
+/// The default level: every debug view renders, nothing is NaN, the glossy buffers exist.
+#[test]
+fn the_default_level_renders_without_nan() {
+    let start = std::time::Instant::now();
+    let scene = hush_engine::scene::default_level();
+    let prepared = hush_engine::gpu::PreparedScene::new(&scene, BvhKind::DEFAULT).unwrap();
+    let load = start.elapsed();
+    println!("default level: {} triangles, built and prepared in {:.1} ms", prepared.triangle_count(), load.as_secs_f64() * 1e3);
+    let gpu = hush_engine::gpu::Gpu::headless(&prepared.realtime_requirements((80, 45))).unwrap();
+    let mut r = Renderer::new(&gpu, scene, prepared, (80, 45)).unwrap();
+    assert!(r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures);
+    let input = FrameInput { camera: r.scene.camera_or_default(), time: 1.0 };
+    r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
+    let img = r.read_hdr(&gpu).unwrap();
+    assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in the default level");
+    // Emission may be off screen; every other view shows something from the level's camera.
+    for v in View::ALL.into_iter().filter(|v| *v != View::Emission) {
+        let settings = FrameSettings { view: v, ..Default::default() };
+        let shown = r.display_image(&gpu, &settings).unwrap();
+        assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "view {} is black", v.name());
+    }
+}
