@@ -21,8 +21,27 @@ enum Command {
     Render(render::RenderArgs),
     /// Compare an image with a reference: RMSE, relMSE, SSIM, FLIP, non-finite pixels.
     Compare(compare::CompareArgs),
+    /// Write the default level (built in code) as glTF: LEVEL.gltf, .bin, PNG textures, EXR sky.
+    Level(LevelArgs),
     /// Measure BVH build, rays per second and reference-tracer samples per second.
     Bench(bench::BenchArgs),
+}
+
+#[derive(clap::Args)]
+struct LevelArgs {
+    /// Output .gltf (side files are written beside it).
+    #[arg(long, default_value = "assets/level/level.gltf")]
+    out: std::path::PathBuf,
+}
+
+fn level(a: LevelArgs) -> Result<()> {
+    if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+    }
+    let scene = hush_engine::scene::default_level();
+    hush_engine::scene::save_gltf(&scene, &a.out)?;
+    eprintln!("wrote {} ({} triangles, {} objects)", a.out.display(), scene.triangle_count(), scene.objects.len());
+    Ok(())
 }
 
 fn main() {
@@ -32,6 +51,7 @@ fn main() {
         Command::Render(a) => render::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Level(a) => level(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

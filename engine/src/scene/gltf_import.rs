@@ -465,6 +465,8 @@ impl Importer<'_> {
                 .filter(|&d| d >= -1 && d <= 1 << 16)
                 .ok_or_else(|| anyhow!("extras.max_depth must be an integer >= -1, got {d}"))? as i32;
         }
+        // Written by Hush's exporter: the environment is the sun's procedural sky.
+        scene.procedural_sky = v.get("procedural_sky").and_then(|b| b.as_bool()).unwrap_or(false);
         if let Some(env) = v.get("environment") {
             if let Some(rad) = env.get("radiance") {
                 let c = rad

@@ -4,6 +4,7 @@
 mod animation;
 mod camera_path;
 mod default_scene;
+mod gltf_export;
 mod level;
 mod environment;
 mod gltf_import;
@@ -16,6 +17,7 @@ pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::default_scene;
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use environment::{EnvMap, Environment};
+pub use gltf_export::save_gltf;
 pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with};
 pub use texture::{Texture, TextureRef, Wrap};
 

@@ -1,0 +1,281 @@
+//! Write a [`Scene`] as glTF 2.0: `NAME.gltf` with `NAME.bin`, textures as PNG and an environment
+//! map as EXR beside it, following the same conventions the importer reads (lights as
+//! KHR_lights_punctual with color x intensity = irradiance or W/sr; emission beyond 1 through
+//! KHR_materials_emissive_strength; KHR_materials_specular; `scenes[0].extras`). The `gltf`
+//! crate only reads, so the JSON is written here with serde_json.
+
+use super::{AlphaMode, Environment, Light, Scene, Track, Wrap};
+use crate::quality::Image;
+use anyhow::{Context, Result};
+use glam::{DMat4, DQuat, DVec3, Vec3};
+use serde_json::{Value, json};
+use std::path::Path;
+
+#[derive(Default)]
+struct Writer {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Writer {
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(t) = target {
+            v["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(v);
+        self.views.len() - 1
+    }
+
+    /// Float accessor of `n`-component elements; min/max as glTF requires for positions and
+    /// animation inputs.
+    fn floats(&mut self, data: &[f32], n: usize, kind: &str, target: Option<u32>, bounds: bool) -> usize {
+        let bytes: Vec<u8> = data.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let view = self.view(&bytes, target);
+        let mut a = json!({"bufferView": view, "componentType": 5126, "count": data.len() / n, "type": kind});
+        if bounds && !data.is_empty() {
+            let mut lo = vec![f32::MAX; n];
+            let mut hi = vec![f32::MIN; n];
+            for c in data.chunks_exact(n) {
+                for k in 0..n {
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
+                }
+            }
+            a["min"] = json!(lo);
+            a["max"] = json!(hi);
+        }
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
+    fn indices(&mut self, idx: &[u32]) -> usize {
+        let bytes: Vec<u8> = idx.iter().flat_map(|i| i.to_le_bytes()).collect();
+        let view = self.view(&bytes, Some(34963));
+        self.accessors.push(json!({"bufferView": view, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
+        self.accessors.len() - 1
+    }
+
+    fn track3(&mut self, t: &Track<DVec3>) -> (usize, usize) {
+        let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
+        let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+        (self.floats(&times, 1, "SCALAR", None, true), self.floats(&values, 3, "VEC3", None, false))
+    }
+}
+
+fn wrap(w: Wrap) -> u32 {
+    match w {
+        Wrap::Repeat => 10497,
+        Wrap::Clamp => 33071,
+        Wrap::Mirror => 33648,
+    }
+}
+
+fn mat(m: DMat4) -> Vec<f64> {
+    m.to_cols_array().to_vec()
+}
+
+/// Rotation taking the node's -Z (where glTF lights and cameras point) to `dir`.
+fn aim(dir: Vec3) -> [f64; 4] {
+    DQuat::from_rotation_arc(DVec3::NEG_Z, dir.as_dvec3().normalize_or(DVec3::NEG_Z)).to_array()
+}
+
+/// Write `scene` to `path` (a `.gltf`); side files share its stem.
+pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
+    let ctx = || format!("writing glTF {}", path.display());
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    let mut w = Writer::default();
+
+    let mut images = vec![];
+    let mut samplers = vec![];
+    let mut textures = vec![];
+    for (i, t) in scene.textures.iter().enumerate() {
+        let file = format!("{stem}_tex{i}.png");
+        let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba8.clone()).context("texture size")?;
+        img.save(dir.join(&file)).with_context(|| format!("writing {file}"))?;
+        images.push(json!({"uri": file, "name": t.name}));
+        samplers.push(json!({"wrapS": wrap(t.wrap_s), "wrapT": wrap(t.wrap_t)}));
+        textures.push(json!({"source": i, "sampler": i}));
+    }
+    let tex = |r: Option<super::TextureRef>| r.map(|r| json!({"index": r.index}));
+
+    let mut uses_strength = false;
+    let materials: Vec<Value> = scene
+        .materials
+        .iter()
+        .map(|m| {
+            let mut pbr = json!({"baseColorFactor": m.base_color.to_array(), "metallicFactor": m.metallic, "roughnessFactor": m.roughness});
+            if let Some(t) = tex(m.base_color_texture) {
+                pbr["baseColorTexture"] = t;
+            }
+            if let Some(t) = tex(m.metallic_roughness_texture) {
+                pbr["metallicRoughnessTexture"] = t;
+            }
+            let mut v = json!({"name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": m.double_sided});
+            let mut ext = serde_json::Map::new();
+            let e = m.emission.max_element();
+            if e > 0.0 {
+                let s = e.max(1.0);
+                v["emissiveFactor"] = json!((m.emission / s).to_array());
+                if s > 1.0 {
+                    ext.insert("KHR_materials_emissive_strength".into(), json!({"emissiveStrength": s}));
+                    uses_strength = true;
+                }
+            }
+            if let Some(t) = tex(m.emissive_texture) {
+                v["emissiveTexture"] = t;
+            }
+            if let Some(t) = tex(m.normal_texture) {
+                v["normalTexture"] = json!({"index": t["index"], "scale": m.normal_scale});
+            }
+            if let AlphaMode::Mask(c) = m.alpha_mode {
+                v["alphaMode"] = json!("MASK");
+                v["alphaCutoff"] = json!(c);
+            }
+            ext.insert("KHR_materials_specular".into(), json!({"specularFactor": m.specular_factor, "specularColorFactor": m.specular_color.to_array()}));
+            v["extensions"] = Value::Object(ext);
+            v
+        })
+        .collect();
+
+    let mut meshes = vec![];
+    for m in &scene.meshes {
+        let pos: Vec<f32> = m.positions.iter().flat_map(|p| p.to_array()).collect();
+        let mut attrs = json!({"POSITION": w.floats(&pos, 3, "VEC3", Some(34962), true)});
+        if m.normals.len() == m.positions.len() {
+            let n: Vec<f32> = m.normals.iter().flat_map(|p| p.to_array()).collect();
+            attrs["NORMAL"] = json!(w.floats(&n, 3, "VEC3", Some(34962), false));
+        }
+        if m.uvs.len() == m.positions.len() {
+            let uv: Vec<f32> = m.uvs.iter().flat_map(|p| p.to_array()).collect();
+            attrs["TEXCOORD_0"] = json!(w.floats(&uv, 2, "VEC2", Some(34962), false));
+        }
+        let indices = w.indices(&m.indices);
+        meshes.push(json!({"primitives": [{"attributes": attrs, "indices": indices, "material": m.material, "mode": 4}]}));
+    }
+
+    let mut nodes = vec![];
+    let mut roots = vec![];
+    let mut animations = vec![];
+    for o in &scene.objects {
+        let mut node = json!({"name": o.name, "mesh": o.mesh});
+        match &o.animation {
+            None => node["matrix"] = json!(mat(o.transform)),
+            Some(a) => {
+                node["translation"] = json!(a.translation.to_array());
+                node["rotation"] = json!(a.rotation.to_array());
+                node["scale"] = json!(a.scale.to_array());
+                let target = nodes.len();
+                let mut samplers = vec![];
+                let mut channels = vec![];
+                let step = |s: bool| if s { "STEP" } else { "LINEAR" };
+                if let Some(t) = &a.translation_track {
+                    let (i, o) = w.track3(t);
+                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "translation"}}));
+                    samplers.push(json!({"input": i, "output": o, "interpolation": step(t.step)}));
+                }
+                if let Some(t) = &a.scale_track {
+                    let (i, o) = w.track3(t);
+                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "scale"}}));
+                    samplers.push(json!({"input": i, "output": o, "interpolation": step(t.step)}));
+                }
+                if let Some(t) = &a.rotation_track {
+                    let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
+                    let values: Vec<f32> = t.values.iter().flat_map(|q| q.as_quat().to_array()).collect();
+                    let (i, o) = (w.floats(&times, 1, "SCALAR", None, true), w.floats(&values, 4, "VEC4", None, false));
+                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "rotation"}}));
+                    samplers.push(json!({"input": i, "output": o, "interpolation": step(t.step)}));
+                }
+                animations.push(json!({"name": o.name, "samplers": samplers, "channels": channels}));
+                if a.parent != DMat4::IDENTITY {
+                    nodes.push(node);
+                    node = json!({"name": format!("{} parent", o.name), "matrix": mat(a.parent), "children": [target]});
+                    nodes.push(node);
+                    roots.push(nodes.len() - 1);
+                    continue;
+                }
+            }
+        }
+        roots.push(nodes.len());
+        nodes.push(node);
+    }
+
+    let mut lights = vec![];
+    for l in &scene.lights {
+        let (kind, c, node) = match *l {
+            Light::Directional { direction, irradiance } => ("directional", irradiance, json!({"rotation": aim(direction)})),
+            Light::Point { position, intensity } => ("point", intensity, json!({"translation": position.to_array()})),
+            Light::Spot { position, direction, intensity, .. } => ("spot", intensity, json!({"translation": position.to_array(), "rotation": aim(direction)})),
+        };
+        let i = c.max_element().max(0.0);
+        let color = if i > 0.0 { c / i } else { Vec3::ONE };
+        let mut light = json!({"type": kind, "color": color.to_array(), "intensity": i});
+        if let Light::Spot { inner_cone, outer_cone, .. } = *l {
+            light["spot"] = json!({"innerConeAngle": inner_cone, "outerConeAngle": outer_cone});
+        }
+        let mut node = node;
+        node["extensions"] = json!({"KHR_lights_punctual": {"light": lights.len()}});
+        lights.push(light);
+        roots.push(nodes.len());
+        nodes.push(node);
+    }
+
+    let mut cameras = vec![];
+    if let Some(c) = &scene.camera {
+        cameras.push(json!({"type": "perspective", "perspective": {"yfov": c.yfov, "znear": 0.01}}));
+        roots.push(nodes.len());
+        nodes.push(json!({"name": "camera", "camera": 0, "matrix": mat(c.world)}));
+    }
+
+    let mut extras = json!({"max_depth": scene.max_depth, "procedural_sky": scene.procedural_sky});
+    if let Some((rw, rh)) = scene.resolution {
+        extras["resolution"] = json!([rw, rh]);
+    }
+    match &scene.environment {
+        Environment::None => {}
+        Environment::Constant(c) => extras["environment"] = json!({"radiance": c.to_array()}),
+        Environment::Map(m) => {
+            let file = format!("{stem}_environment.exr");
+            Image { width: m.width, height: m.height, data: m.rgb.clone() }.save(&dir.join(&file))?;
+            extras["environment"] = json!({"map": file, "intensity": 1.0, "rotation_y_degrees": m.rotation_y_degrees});
+        }
+    }
+
+    let bin_name = format!("{stem}.bin");
+    let mut used = vec!["KHR_materials_specular"];
+    if uses_strength {
+        used.push("KHR_materials_emissive_strength");
+    }
+    if !lights.is_empty() {
+        used.push("KHR_lights_punctual");
+    }
+    let mut doc = json!({
+        "asset": {"version": "2.0", "generator": "Hush"},
+        "extensionsUsed": used,
+        "scene": 0,
+        "scenes": [{"name": scene.name, "nodes": roots, "extras": extras}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": w.accessors,
+        "bufferViews": w.views,
+        "buffers": [{"uri": bin_name, "byteLength": w.bin.len()}],
+    });
+    for (k, v) in [("images", images), ("samplers", samplers), ("textures", textures), ("animations", animations), ("cameras", cameras)] {
+        if !v.is_empty() {
+            doc[k] = Value::Array(v);
+        }
+    }
+    if !lights.is_empty() {
+        doc["extensions"] = json!({"KHR_lights_punctual": {"lights": lights}});
+    }
+    std::fs::write(dir.join(&bin_name), &w.bin).with_context(ctx)?;
+    std::fs::write(path, serde_json::to_string_pretty(&doc)?).with_context(ctx)?;
+    Ok(())
+}
