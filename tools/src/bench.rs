@@ -9,8 +9,15 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// A .gltf/.glb file, or `default`.
+    /// A .gltf/.glb file, `default` or `level`.
     pub scene: String,
+    /// `reference` (BVH build, rays/s, tracer samples/s) or `realtime` (GPU time per pass of the
+    /// real-time frame).
+    #[arg(long, default_value = "reference")]
+    pub mode: String,
+    /// Real-time mode: frames measured (after two warm-up frames).
+    #[arg(long, default_value_t = 32)]
+    pub frames: u32,
     /// BVH layout to measure (bvh2, cwbvh); both when omitted.
     #[arg(long)]
     pub bvh: Option<String>,
@@ -66,6 +73,11 @@ fn mitsuba_rate(scene: &str) -> Option<f64> {
 }
 
 pub fn run(a: BenchArgs) -> Result<()> {
+    match a.mode.as_str() {
+        "reference" => {}
+        "realtime" => return crate::bench_realtime::run(&a),
+        m => anyhow::bail!("--mode {m:?}: use reference or realtime"),
+    }
     let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
     let kinds = match &a.bvh {
         Some(s) => vec![BvhKind::parse(s).with_context(|| format!("--bvh {s:?}"))?],

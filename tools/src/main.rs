@@ -1,6 +1,7 @@
 //! `hush-cli`: headless rendering, image comparison and benchmarks.
 
 mod bench;
+mod bench_realtime;
 mod compare;
 mod realtime;
 mod render;
@@ -23,7 +24,7 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Write the default level (built in code) as glTF: LEVEL.gltf, .bin, PNG textures, EXR sky.
     Level(LevelArgs),
-    /// Measure BVH build, rays per second and reference-tracer samples per second.
+    /// Measure BVH build, rays/s and reference samples/s, or (--mode realtime) GPU time per pass.
     Bench(bench::BenchArgs),
 }
 

@@ -1,0 +1,116 @@
+//! `hush-cli bench --mode realtime`: GPU time per pass of the real-time frame from timestamp
+//! queries (median over frames), the frame total, and the CPU time of a frame.
+
+use crate::bench::BenchArgs;
+use crate::render::{bvh_kind, load_scene};
+use anyhow::{Result, bail};
+use hush_engine::frame::{DisplayTarget, FrameInput, Renderer};
+use hush_engine::settings::FrameSettings;
+use serde::Serialize;
+use std::time::Instant;
+
+#[derive(Serialize)]
+struct PassTime {
+    pass: &'static str,
+    median_ms: f64,
+    min_ms: f64,
+}
+
+#[derive(Serialize)]
+struct RealtimeResult {
+    scene: String,
+    adapter: String,
+    triangles: usize,
+    width: u32,
+    height: u32,
+    frames: u32,
+    passes: Vec<PassTime>,
+    /// Median over frames of the sum of the passes' GPU time.
+    gpu_frame_median_ms: f64,
+    /// Median wall time of a frame on the CPU, submit to finished (includes BVH rebuilds of
+    /// animated scenes and the timestamp readback).
+    cpu_frame_median_ms: f64,
+    /// Per-pixel buffers and textures of the frame, bytes per pixel.
+    bytes_per_pixel: f64,
+    allocations: Vec<(String, u64)>,
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    if v.is_empty() { 0.0 } else { v[v.len() / 2] }
+}
+
+pub fn run(a: &BenchArgs) -> Result<()> {
+    if a.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let size = (a.width, a.height);
+    let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
+    if !gpu.timestamps {
+        bail!("adapter {} has no timestamp queries; per-pass GPU times are not available", gpu.info.name);
+    }
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("bench display target"),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let view = tex.create_view(&Default::default());
+    let target = DisplayTarget { view: &view, format, size };
+    let settings = FrameSettings { max_depth: r.scene.max_depth, ..Default::default() };
+    let camera = r.scene.camera_or_default();
+    let mut per_pass: Vec<(&'static str, Vec<f64>)> = vec![];
+    let (mut totals, mut cpu) = (vec![], vec![]);
+    // Two warm-up frames compile pipelines and fill caches.
+    for k in 0..a.frames + 2 {
+        let input = FrameInput { camera, time: k as f64 / 60.0 };
+        let start = Instant::now();
+        r.render(&gpu, &input, &settings, Some(&target))?;
+        let times = r.pass_times(&gpu)?;
+        let wall = start.elapsed().as_secs_f64() * 1e3;
+        if k < 2 {
+            continue;
+        }
+        cpu.push(wall);
+        totals.push(times.iter().map(|t| t.1).sum());
+        for (name, ms) in times {
+            match per_pass.iter_mut().find(|p| p.0 == name) {
+                Some(p) => p.1.push(ms),
+                None => per_pass.push((name, vec![ms])),
+            }
+        }
+    }
+    let passes = per_pass
+        .into_iter()
+        .map(|(pass, mut v)| PassTime { pass, min_ms: v.iter().cloned().fold(f64::MAX, f64::min), median_ms: median(&mut v) })
+        .collect();
+    let res = RealtimeResult {
+        scene: a.scene.clone(),
+        adapter: gpu.info.name.clone(),
+        triangles: r.prepared.triangle_count(),
+        width: size.0,
+        height: size.1,
+        frames: a.frames,
+        passes,
+        gpu_frame_median_ms: median(&mut totals),
+        cpu_frame_median_ms: median(&mut cpu),
+        bytes_per_pixel: r.bytes_per_pixel(),
+        allocations: r.allocations(),
+    };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&res)?);
+    } else {
+        println!("{} ({} triangles) at {}x{} on {}, median of {} frames", res.scene, res.triangles, res.width, res.height, res.adapter, res.frames);
+        for p in &res.passes {
+            println!("  {:10} {:8.3} ms (min {:.3})", p.pass, p.median_ms, p.min_ms);
+        }
+        println!("  GPU frame  {:8.3} ms; CPU frame {:.3} ms; {:.0} bytes/pixel", res.gpu_frame_median_ms, res.cpu_frame_median_ms, res.bytes_per_pixel);
+    }
+    Ok(())
+}
