@@ -210,6 +210,13 @@ fn the_default_level_renders_without_nan() {
     let prepared = hush_engine::gpu::PreparedScene::new(&scene, BvhKind::DEFAULT).unwrap();
     let load = start.elapsed();
     println!("default level: {} triangles, built and prepared in {:.1} ms", prepared.triangle_count(), load.as_secs_f64() * 1e3);
+    // What animation costs on the CPU per frame: re-flatten the cube, rebuild the BVH.
+    let mut p2 = hush_engine::gpu::PreparedScene::new(&scene, BvhKind::DEFAULT).unwrap();
+    let t = std::time::Instant::now();
+    for k in 1..=10 {
+        assert!(p2.animate(&scene, k as f64 / 60.0));
+    }
+    println!("animation: BVH rebuild and re-flatten {:.2} ms per frame", t.elapsed().as_secs_f64() * 100.0);
     let gpu = hush_engine::gpu::Gpu::headless(&prepared.realtime_requirements((80, 45))).unwrap();
     let mut r = Renderer::new(&gpu, scene, prepared, (80, 45)).unwrap();
     assert!(r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures);
@@ -244,7 +251,7 @@ fn the_default_level_gltf_loads_and_renders_without_nan() {
     let a = built.objects.iter().find(|o| o.animation.is_some()).unwrap();
     let b = scene.objects.iter().find(|o| o.animation.is_some()).expect("the animation survives export");
     for t in [0.0, 0.7, 2.5, 5.1] {
-        let d = (a.transform_at(t).to_cols_array().iter().zip(b.transform_at(t).to_cols_array()).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max));
+        let d = a.transform_at(t).to_cols_array().iter().zip(b.transform_at(t).to_cols_array()).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
         assert!(d < 1e-5, "transform at t = {t} differs by {d}");
     }
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (64, 36)).unwrap();

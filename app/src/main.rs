@@ -293,10 +293,8 @@ impl Running {
         }
         self.gpu.queue.present(frame);
 
-        if actions.sun_changed {
-            if let Some((az, el)) = self.panel.sun {
-                self.renderer.set_sun_direction(&self.gpu, ui::sun_dir(az, el));
-            }
+        if let (true, Some((az, el))) = (actions.sun_changed, self.panel.sun) {
+            self.renderer.set_sun_direction(&self.gpu, ui::sun_dir(az, el));
         }
         if actions.screenshot {
             self.screenshot();

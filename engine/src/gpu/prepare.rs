@@ -278,7 +278,7 @@ impl PreparedScene {
             let now = o.transform_at(time);
             let before = self.world[i];
             self.prev_from_current[i] = if o.animation.is_some() {
-                (rebased(before, self.origin) * rebased(now, self.origin).inverse()).into()
+                rebased(before, self.origin) * rebased(now, self.origin).inverse()
             } else {
                 glam::Mat4::IDENTITY
             };

@@ -149,10 +149,8 @@ impl GpuScene {
         if let Some(l) = &self.lights {
             gpu.queue.write_buffer(l, 0, bytemuck::cast_slice(&p.lights));
         }
-        if let Some(e) = &self.env {
-            if e.size() >= (p.env_data.len() * 4) as u64 {
-                gpu.queue.write_buffer(e, 0, bytemuck::cast_slice(&p.env_data));
-            }
+        if let Some(e) = self.env.as_ref().filter(|e| e.size() >= (p.env_data.len() * 4) as u64) {
+            gpu.queue.write_buffer(e, 0, bytemuck::cast_slice(&p.env_data));
         }
     }
 

@@ -22,16 +22,16 @@ fn texture(name: &str, size: u32, srgb: bool, f: impl Fn(u32, u32) -> [u8; 4]) -
 fn checker(x: u32, y: u32) -> [u8; 4] {
     // Two marble-ish tones with a thin grout line.
     let (cx, cy) = (x / 32, y / 32);
-    if x % 32 == 0 || y % 32 == 0 {
+    if x.is_multiple_of(32) || y.is_multiple_of(32) {
         return [70, 66, 60, 255];
     }
-    if (cx + cy) % 2 == 0 { [210, 204, 192, 255] } else { [120, 112, 100, 255] }
+    if (cx + cy).is_multiple_of(2) { [210, 204, 192, 255] } else { [120, 112, 100, 255] }
 }
 
 fn bricks(x: u32, y: u32) -> [u8; 4] {
     let row = y / 16;
-    let off = if row % 2 == 0 { 0 } else { 16 };
-    let mortar = y % 16 == 0 || (x + off) % 32 == 0;
+    let off = if row.is_multiple_of(2) { 0 } else { 16 };
+    let mortar = y.is_multiple_of(16) || (x + off).is_multiple_of(32);
     // A little per-brick variation from a hash of the brick's index.
     let id = row * 131 + (x + off) / 32;
     let v = ((id.wrapping_mul(2654435761) >> 24) % 30) as u8;
