@@ -2,7 +2,7 @@
 
 use crate::render::{RenderArgs, bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
-use hush_engine::frame::{FrameInput, Renderer};
+use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::scene::CameraPath;
 use hush_engine::settings::FrameSettings;
 
@@ -52,8 +52,23 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     let img = r.read_hdr(&gpu)?;
     let secs = start.elapsed().as_secs_f64();
-    if let Some(out) = &a.out {
-        img.save(out)?;
+    match (&a.out, &a.view) {
+        (Some(out), Some(name)) => {
+            let view = View::ALL.into_iter().find(|v| v.name() == name).with_context(|| {
+                format!("--view {name:?}: use one of {}", View::ALL.map(|v| v.name()).join(", "))
+            })?;
+            if view.needs_glossy() && !r.prepared.features.glossy {
+                bail!("--view {name}: the scene has no glossy buffers");
+            }
+            if out.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
+                bail!("--view writes what the display shows: use a .png --out");
+            }
+            let shown = r.display_image(&gpu, &FrameSettings { view, ..settings })?;
+            shown.save(out).with_context(|| format!("writing {}", out.display()))?;
+        }
+        (Some(out), None) => img.save(out)?,
+        (None, Some(_)) => bail!("--view needs --out FILE.png"),
+        (None, None) => {}
     }
     eprintln!(
         "{name}: {}x{} real-time, {} frames{} in {secs:.2} s on {}",

@@ -29,6 +29,10 @@ pub struct RenderArgs {
     /// Real-time mode: frames per second of the animation clock when no camera path gives times.
     #[arg(long, default_value_t = 60.0)]
     pub fps: f64,
+    /// Real-time mode: write what the display shows for this view (final, gbuffer/normal,
+    /// trace/matte, ...; see the viewer's list) to the --out PNG instead of the HDR image.
+    #[arg(long)]
+    pub view: Option<String>,
     /// Real-time mode: write every frame as linear HDR EXR into this folder (frame_00000.exr, ...).
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
