@@ -42,6 +42,8 @@ fn bad_arguments_are_clear_errors() {
         (vec!["render", "default", "--spp", "1", "--out", "x.bmp"], ".exr or .png"),
         (vec!["render", "/nonexistent.gltf", "--out", "x.exr"], "/nonexistent.gltf"),
         (vec!["render", "default", "--mode", "magic", "--out", "x.exr"], "--mode"),
+        (vec!["render", "level", "--mode", "realtime", "--view", "nope", "--width", "8", "--height", "8", "--out", "x.png"], "--view"),
+        (vec!["render", "level", "--mode", "realtime", "--frames", "0", "--out", "x.exr"], "--frames"),
     ] {
         let o = bin("hush-cli").args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
