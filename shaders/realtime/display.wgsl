@@ -77,8 +77,11 @@ fn debug_view(view: u32, p: vec2i) -> vec4f {
         case 12u: {
             return vec4f(glossy_view(view, p), 1.0);
         }
-        default: {
+        case 13u, 14u, 15u: {
             return vec4f(glossy_view(view, p), 0.0);
+        }
+        default: {
+            return denoise_view(view, p);
         }
     }
 }

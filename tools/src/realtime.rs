@@ -4,11 +4,23 @@ use crate::render::{RenderArgs, bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::scene::CameraPath;
-use hush_engine::settings::FrameSettings;
+use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
+
+pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
+    match s {
+        "none" => Ok(Denoiser::None),
+        "mara" => Ok(Denoiser::Mara),
+        _ => bail!("--denoiser {s:?}: use none or mara"),
+    }
+}
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    if a.denoiser != "none" {
-        bail!("--denoiser {:?} is not available; use none", a.denoiser);
+    let denoiser = parse_denoiser(&a.denoiser)?;
+    let mut matte = MatteSettings::default();
+    for stage in &a.disable {
+        if !matte.disable(stage) {
+            bail!("--disable {stage:?}: the stages are {}", MatteSettings::STAGES.join(", "));
+        }
     }
     if a.frames == 0 {
         bail!("--frames must be at least 1");
@@ -29,7 +41,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.accumulate && path.is_some() {
         bail!("--accumulate needs a still camera; it cannot be combined with --camera-path");
     }
-    let settings = FrameSettings { max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, accumulate: a.accumulate, ..Default::default() };
+    let settings = FrameSettings { max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, accumulate: a.accumulate, denoiser, matte, ..Default::default() };
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;

@@ -20,9 +20,13 @@ pub struct RenderArgs {
     /// Real-time mode: a camera path (JSON, as the viewer records); frame k uses key k.
     #[arg(long)]
     pub camera_path: Option<PathBuf>,
-    /// Real-time mode: the denoiser (only `none` so far).
+    /// Real-time mode: the denoiser, `none` or `mara` (Mara et al. 2017 matte chain + TAA).
     #[arg(long, default_value = "none")]
     pub denoiser: String,
+    /// Real-time mode: denoiser stages to switch off, comma-separated (matte.temporal,
+    /// matte.history_bilateral, matte.disocclusion, matte.firefly, matte.bilateral, taa).
+    #[arg(long, value_delimiter = ',')]
+    pub disable: Vec<String>,
     /// Real-time mode: sum all frames with a still camera and write their mean.
     #[arg(long)]
     pub accumulate: bool,

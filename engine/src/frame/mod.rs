@@ -11,6 +11,8 @@ pub use views::View;
 use crate::accel::BvhKind;
 use crate::gpu::{Gpu, GpuMemory, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
 use crate::passes::composite::{CompositePass, DisplayPass, FrameBuffers};
+use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
+use crate::settings::Denoiser;
 use crate::passes::gbuffer::{self, GBufferPass, GBufferTargets};
 use crate::passes::reference::{TraceParams, TraceView, make_params};
 use crate::passes::trace::{TracePass, TraceTargets};
@@ -24,7 +26,7 @@ use glam::{Mat4, Vec2, Vec3};
 pub const MAX_SIDE: u32 = 8192;
 
 /// Passes that can write timestamps in one frame.
-const TIMED_PASSES: u32 = 8;
+const TIMED_PASSES: u32 = 16;
 
 /// Where the camera is and what time it is in the scene's animation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,6 +51,8 @@ struct Targets {
     trace: TraceTargets,
     hdr: wgpu::Buffer,
     accumulation: Option<wgpu::Buffer>,
+    /// The denoiser's textures, made on its first use.
+    matte: Option<MatteTargets>,
     memory: GpuMemory,
     generation: u64,
 }
@@ -60,7 +64,7 @@ impl Targets {
         let trace = TraceTargets::new(gpu, &mut memory, size, glossy);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let hdr = memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
-        Targets { size, gbuffer, trace, hdr, accumulation: None, memory, generation }
+        Targets { size, gbuffer, trace, hdr, accumulation: None, matte: None, memory, generation }
     }
 }
 
@@ -78,8 +82,15 @@ pub struct Renderer {
     trace: TracePass,
     composite: CompositePass,
     display: Option<DisplayPass>,
+    chain: Option<MatteChain>,
+    denoise_buf: wgpu::Buffer,
+    linear_clamp: wgpu::Sampler,
+    /// Whether the last frame went through the denoiser (its image is then TAA's output).
+    denoised_last: bool,
     timer: Option<GpuTimer>,
     prev_view_proj: Option<Mat4>,
+    /// The previous frame's jittered view-projection (its depth buffer was rasterised with it).
+    prev_jittered: Option<Mat4>,
     frame_index: u32,
     accumulated: u32,
     accumulated_state: Option<(FrameInput, FrameSettings)>,
@@ -131,9 +142,16 @@ impl Renderer {
         let frame_buf = memory.buffer(d, "frame/params", size_of::<FrameParams>() as u64, u);
         let display_buf = memory.buffer(d, "display/options", 16, u);
         let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
+        let denoise_buf = memory.buffer(d, "matte/params", size_of::<DenoiseParams>() as u64, u);
+        let linear_clamp = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("linear clamp"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
         let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
-        let fb = FrameBuffers { frame: &frame_buf, hdr: &targets.hdr, accumulation: &no_accumulation, display: &display_buf };
+        let fb = FrameBuffers { frame: &frame_buf, hdr: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: &targets.trace.matte.1, denoise: None };
         let composite = CompositePass::new(gpu, &targets.gbuffer, &targets.trace, &fb).context("creating the composite pass")?;
         let timer = GpuTimer::new(gpu, TIMED_PASSES);
         let r = Renderer {
@@ -149,8 +167,13 @@ impl Renderer {
             trace,
             composite,
             display: None,
+            chain: None,
+            denoise_buf,
+            linear_clamp,
+            denoised_last: false,
             timer,
             prev_view_proj: None,
+            prev_jittered: None,
             frame_index: 0,
             accumulated: 0,
             accumulated_state: None,
@@ -212,6 +235,8 @@ impl Renderer {
         let g = self.targets.generation + 1;
         self.targets = Targets::new(gpu, size, self.prepared.features.glossy, g);
         self.prev_view_proj = None;
+        self.prev_jittered = None;
+        self.denoised_last = false;
         self.accumulated = 0;
         self.accumulated_state = None;
         Ok(())
@@ -254,10 +279,32 @@ impl Renderer {
             self.accumulated = 0;
             self.accumulated_state = None;
         }
-        let jitter = if settings.accumulate { random_jitter(self.frame_index, settings.seed) } else { Vec2::splat(0.5) };
+        let denoise = settings.denoiser == Denoiser::Mara && !settings.accumulate;
+        if denoise && self.targets.matte.is_none() {
+            self.targets.matte = Some(MatteTargets::new(gpu, &mut self.targets.memory, size));
+            self.targets.generation += 1;
+        }
+        if denoise && self.chain.is_none() {
+            let inputs = self.chain_inputs();
+            self.chain = Some(MatteChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the matte chain")?);
+        }
+        let jitter = if settings.accumulate {
+            random_jitter(self.frame_index, settings.seed)
+        } else if denoise && settings.matte.taa {
+            halton_jitter(self.frame_index)
+        } else {
+            Vec2::splat(0.5)
+        };
         let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
+        let jittered = cam.jittered(jitter, size);
+        if denoise {
+            let history_valid = self.denoised_last && self.prev_jittered.is_some();
+            let prev_inv = self.prev_jittered.unwrap_or(jittered).inverse();
+            let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, jittered.inverse(), prev_inv, history_valid);
+            gpu.queue.write_buffer(&self.denoise_buf, 0, bytemuck::bytes_of(&dp));
+        }
         let fp = FrameParams {
-            view_proj: cam.jittered(jitter, size).to_cols_array_2d(),
+            view_proj: jittered.to_cols_array_2d(),
             unjittered_view_proj: cam.view_proj.to_cols_array_2d(),
             prev_view_proj: prev.to_cols_array_2d(),
             cam_pos: cam.pos.extend(self.prepared.ray_epsilon()).to_array(),
@@ -276,8 +323,9 @@ impl Renderer {
         gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
         gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
 
+        self.denoised_last = denoise;
         if let Some(&DisplayTarget { format, size: tsize, .. }) = target {
-            if self.display.as_ref().is_none_or(|d| d.format != format) {
+            if self.display.as_ref().is_none_or(|d| d.format != format || d.with_denoise != self.targets.matte.is_some()) {
                 let fb = self.frame_buffers();
                 self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, format).context("creating the display pass")?);
             }
@@ -290,27 +338,79 @@ impl Renderer {
             t.begin_frame();
         }
         let key = (self.gpu_scene.generation, self.targets.generation);
+        let parity = (self.frame_index % 2) as usize;
+        self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &self.targets.gbuffer, self.timer.as_mut());
         let t = &self.targets;
-        let fb = FrameBuffers { frame: &self.frame_buf, hdr: &t.hdr, accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation), display: &self.display_buf };
-        self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &t.gbuffer, self.timer.as_mut());
         self.trace.record(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut());
-        self.composite.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut());
+        // The chain's bind groups depend on the scene only through the object-motion buffer.
+        let chain_key = key.0 * 1_000_003 + key.1;
+        let inputs = t.matte.as_ref().filter(|_| denoise).map(|m| ChainInputs {
+            frame: &self.frame_buf,
+            params: &self.denoise_buf,
+            objects: self.gpu_scene.objects.as_ref(),
+            hdr: &t.hdr,
+            gbuffer: &t.gbuffer,
+            trace: &t.trace,
+            matte: m,
+            sampler: &self.linear_clamp,
+        });
+        let denoised_matte = t.matte.as_ref().filter(|_| denoise).map(|m| &m.denoised.1);
+        if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
+            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, false, self.timer.as_mut());
+        }
+        let fb = FrameBuffers {
+            frame: &self.frame_buf,
+            hdr: &t.hdr,
+            accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation),
+            display: &self.display_buf,
+            matte: denoised_matte.unwrap_or(&t.trace.matte.1),
+            denoise: None,
+        };
+        self.composite.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut());
+        if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
+            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, true, self.timer.as_mut());
+        }
+        let shown = FrameBuffers {
+            hdr: t.matte.as_ref().filter(|_| denoise).map_or(&t.hdr, |m| &m.final_image),
+            matte: &t.trace.matte.1,
+            denoise: t.matte.as_ref(),
+            ..fb
+        };
         if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
-            d.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, target.view, self.timer.as_mut());
+            d.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &shown, target.view, self.timer.as_mut());
+        }
+        if let (true, Some(m)) = (denoise, &t.matte) {
+            let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
+            enc.copy_texture_to_texture(t.gbuffer.depth.0.as_image_copy(), m.prev_depth.0.as_image_copy(), extent);
         }
         if let Some(timer) = &self.timer {
             timer.resolve(&mut enc);
         }
         gpu.queue.submit([enc.finish()]);
         self.prev_view_proj = Some(cam.view_proj);
+        self.prev_jittered = Some(jittered);
         self.frame_index = self.frame_index.wrapping_add(1);
         Ok(())
+    }
+
+    fn chain_inputs(&self) -> ChainInputs<'_> {
+        let t = &self.targets;
+        ChainInputs {
+            frame: &self.frame_buf,
+            params: &self.denoise_buf,
+            objects: self.gpu_scene.objects.as_ref(),
+            hdr: &t.hdr,
+            gbuffer: &t.gbuffer,
+            trace: &t.trace,
+            matte: t.matte.as_ref().expect("matte targets exist before the chain"),
+            sampler: &self.linear_clamp,
+        }
     }
 
     /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
     pub fn redisplay(&mut self, gpu: &Gpu, settings: &FrameSettings, target: &DisplayTarget) -> Result<()> {
         gpu.validated("displaying the frame", || {
-            if self.display.as_ref().is_none_or(|d| d.format != target.format) {
+            if self.display.as_ref().is_none_or(|d| d.format != target.format || d.with_denoise != self.targets.matte.is_some()) {
                 let fb = self.frame_buffers();
                 self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, target.format)?);
             }
@@ -325,9 +425,16 @@ impl Renderer {
             gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, target.size.0, target.size.1]));
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             let t = &self.targets;
-            let fb = FrameBuffers { frame: &self.frame_buf, hdr: &t.hdr, accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation), display: &self.display_buf };
+            let fb = FrameBuffers {
+                frame: &self.frame_buf,
+                hdr: t.matte.as_ref().filter(|_| self.denoised_last).map_or(&t.hdr, |m| &m.final_image),
+                accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation),
+                display: &self.display_buf,
+                matte: &t.trace.matte.1,
+                denoise: t.matte.as_ref(),
+            };
             if let Some(d) = self.display.as_mut() {
-                d.record(gpu, &mut enc, t.generation, &t.gbuffer, &t.trace, &fb, target.view, None);
+                d.record(gpu, &mut enc, t.generation * 2 + self.denoised_last as u64, &t.gbuffer, &t.trace, &fb, target.view, None);
             }
             gpu.queue.submit([enc.finish()]);
             Ok(())
@@ -356,7 +463,14 @@ impl Renderer {
 
     fn frame_buffers(&self) -> FrameBuffers<'_> {
         let t = &self.targets;
-        FrameBuffers { frame: &self.frame_buf, hdr: &t.hdr, accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation), display: &self.display_buf }
+        FrameBuffers {
+            frame: &self.frame_buf,
+            hdr: t.matte.as_ref().filter(|_| self.denoised_last).map_or(&t.hdr, |m| &m.final_image),
+            accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation),
+            display: &self.display_buf,
+            matte: &t.trace.matte.1,
+            denoise: t.matte.as_ref(),
+        }
     }
 
     /// GPU milliseconds per pass of the last frame (blocks until it finished); empty without
@@ -377,9 +491,10 @@ impl Renderer {
     pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
         let (w, h) = self.targets.size;
         let n = w as u64 * h as u64 * 16;
+        let shown = self.targets.matte.as_ref().filter(|_| self.denoised_last).map_or(&self.targets.hdr, |m| &m.final_image);
         let (buf, scale) = match (&self.targets.accumulation, self.accumulated) {
             (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
-            _ => (&self.targets.hdr, 1.0),
+            _ => (shown, 1.0),
         };
         let bytes = crate::gpu::readback_buffer(&gpu.device, &gpu.queue, buf, n)?;
         let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
@@ -410,4 +525,19 @@ impl Renderer {
         };
         Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
     }
+}
+
+/// Halton (2, 3) sub-pixel positions, 16 per cycle: the TAA jitter.
+pub fn halton_jitter(frame: u32) -> Vec2 {
+    let h = |mut i: u32, b: u32| {
+        let (mut f, mut r) = (1.0f32, 0.0f32);
+        while i > 0 {
+            f /= b as f32;
+            r += f * (i % b) as f32;
+            i /= b;
+        }
+        r
+    };
+    let i = frame % 16 + 1;
+    Vec2::new(h(i, 2), h(i, 3))
 }

@@ -20,10 +20,16 @@ pub enum View {
     GlossyHitDistance = 13,
     VirtualPosition = 14,
     MirrorDirection = 15,
+    MatteTemporal = 16,
+    MatteConfidence = 17,
+    MatteRejection = 18,
+    MatteRadius = 19,
+    MatteFirefly = 20,
+    MatteDenoised = 21,
 }
 
 impl View {
-    pub const ALL: [View; 16] = [
+    pub const ALL: [View; 22] = [
         View::Final,
         View::Depth,
         View::Normal,
@@ -40,6 +46,12 @@ impl View {
         View::GlossyHitDistance,
         View::VirtualPosition,
         View::MirrorDirection,
+        View::MatteTemporal,
+        View::MatteConfidence,
+        View::MatteRejection,
+        View::MatteRadius,
+        View::MatteFirefly,
+        View::MatteDenoised,
     ];
 
     /// The pass output it shows, as named in labels and the profiler.
@@ -61,11 +73,22 @@ impl View {
             View::GlossyHitDistance => "trace/glossy hit distance",
             View::VirtualPosition => "trace/virtual position",
             View::MirrorDirection => "trace/mirror direction",
+            View::MatteTemporal => "matte/temporal",
+            View::MatteConfidence => "matte/confidence",
+            View::MatteRejection => "matte/history rejection",
+            View::MatteRadius => "matte/disocclusion radius",
+            View::MatteFirefly => "matte/firefly",
+            View::MatteDenoised => "matte/bilateral",
         }
     }
 
     /// Views of buffers that exist only in scenes with a specular lobe.
     pub fn needs_glossy(self) -> bool {
-        (self as u32) >= View::GlossyLight as u32
+        (View::GlossyLight as u32..=View::MirrorDirection as u32).contains(&(self as u32))
+    }
+
+    /// Views of the denoiser's intermediates (black until it has run).
+    pub fn needs_denoiser(self) -> bool {
+        (self as u32) >= View::MatteTemporal as u32
     }
 }

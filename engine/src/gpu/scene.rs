@@ -253,6 +253,17 @@ pub fn compute_pipeline(
     module: &wgpu::ShaderModule,
     layout: &wgpu::BindGroupLayout,
 ) -> wgpu::ComputePipeline {
+    compute_pipeline_at(device, label, module, layout, "main")
+}
+
+/// A compute pipeline with one bind group layout and the given entry point.
+pub fn compute_pipeline_at(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+    entry: &str,
+) -> wgpu::ComputePipeline {
     let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &[Some(layout)],
@@ -262,7 +273,7 @@ pub fn compute_pipeline(
         label: Some(label),
         layout: Some(&pl),
         module,
-        entry_point: Some("main"),
+        entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
     })

@@ -14,43 +14,45 @@ pub const DISPLAY: &str = "display";
 /// The HDR image (and the accumulation sum) as storage buffers: one vec4 (16 bytes) per pixel.
 pub struct FrameBuffers<'a> {
     pub frame: &'a wgpu::Buffer,
+    /// The composite's output; for the display, the image after TAA when the denoiser ran.
     pub hdr: &'a wgpu::Buffer,
     pub accumulation: &'a wgpu::Buffer,
     pub display: &'a wgpu::Buffer,
+    /// The matte light the composite remodulates: raw, or the matte chain's output.
+    pub matte: &'a wgpu::TextureView,
+    /// The chain's intermediates, for the display's debug views.
+    pub denoise: Option<&'a super::matte::MatteTargets>,
 }
 
 fn inputs<'a>(stages: wgpu::ShaderStages, g: &'a GBufferTargets, t: &'a TraceTargets, b: &FrameBuffers<'a>, read_only: bool) -> Bindings<'a> {
     let f = || wgpu::TextureSampleType::Float { filterable: false };
-    let mut s = Bindings::new(stages)
-        .uniform(11, b.frame)
-        .texture(20, &g.depth.1, wgpu::TextureSampleType::Depth)
-        .texture(21, g.view("normal"), f())
-        .texture(22, g.view("motion"), f())
-        .texture(23, g.view("base_color"), f())
-        .texture(24, g.view("specular"), f())
-        .texture(25, g.view("emission"), f())
-        .texture(26, g.view("ids"), wgpu::TextureSampleType::Uint)
-        .texture(27, &t.matte.1, f())
-        .texture(28, &t.direct.1, f());
+    let mut s = super::matte::gbuffer_inputs(Bindings::new(stages).uniform(11, b.frame), g, t, b.matte);
     if let Some(gl) = &t.glossy {
         s = s.texture(29, &gl.light.1, f()).texture(30, &gl.reflection.1, f()).texture(31, &gl.mirror.1, wgpu::TextureSampleType::Uint);
     }
     s = s.storage(32, b.hdr, read_only).storage(33, b.accumulation, read_only);
     if read_only {
         s = s.uniform(34, b.display);
+        if let Some(m) = b.denoise {
+            s = s.texture(45, &m.temporal.1, f()).texture(46, &m.reason.1, wgpu::TextureSampleType::Uint).texture(47, &m.radius.1, f()).texture(48, &m.median.1, f()).texture(49, &m.denoised.1, f());
+        }
     }
     s
 }
 
-fn modules(glossy: bool, last: &'static str) -> Vec<&'static str> {
-    vec![
+fn modules(glossy: bool, denoise: bool, last: &'static str) -> Vec<&'static str> {
+    let mut m = vec![
         "common/math.wgsl",
         "common/rng.wgsl",
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
         if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" },
-        last,
-    ]
+    ];
+    if last == "realtime/display.wgsl" {
+        m.push(if denoise { "realtime/denoise_views.wgsl" } else { "realtime/denoise_views_none.wgsl" });
+    }
+    m.push(last);
+    m
 }
 
 pub struct CompositePass {
@@ -61,7 +63,7 @@ pub struct CompositePass {
 
 impl CompositePass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers) -> Result<CompositePass> {
-        let module = crate::shader::compose(COMPOSITE, "", &modules(t.glossy.is_some(), "realtime/composite.wgsl"))?.create(&gpu.device)?;
+        let module = crate::shader::compose(COMPOSITE, "", &modules(t.glossy.is_some(), false, "realtime/composite.wgsl"))?.create(&gpu.device)?;
         let layout = inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_layout(&gpu.device, COMPOSITE);
         let pipeline = compute_pipeline(&gpu.device, COMPOSITE, &module, &layout);
         Ok(CompositePass { pipeline, layout, bind_group: None })
@@ -84,11 +86,13 @@ pub struct DisplayPass {
     layout: wgpu::BindGroupLayout,
     bind_group: Option<(u64, wgpu::BindGroup)>,
     pub format: wgpu::TextureFormat,
+    /// Whether it shows the denoiser's views (its layout binds their textures).
+    pub with_denoise: bool,
 }
 
 impl DisplayPass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
-        let module = crate::shader::compose(DISPLAY, "", &modules(t.glossy.is_some(), "realtime/display.wgsl"))?.create(&gpu.device)?;
+        let module = crate::shader::compose(DISPLAY, "", &modules(t.glossy.is_some(), b.denoise.is_some(), "realtime/display.wgsl"))?.create(&gpu.device)?;
         let layout = inputs(wgpu::ShaderStages::FRAGMENT, g, t, b, true).create_layout(&gpu.device, DISPLAY);
         let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(DISPLAY), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
         let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -102,7 +106,7 @@ impl DisplayPass {
             multiview_mask: None,
             cache: None,
         });
-        Ok(DisplayPass { pipeline, layout, bind_group: None, format })
+        Ok(DisplayPass { pipeline, layout, bind_group: None, format, with_denoise: b.denoise.is_some() })
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -8,4 +8,5 @@ pub use reference::{Accumulation, ReferenceTracer, TraceView};
 
 pub mod composite;
 pub mod gbuffer;
+pub mod matte;
 pub mod trace;

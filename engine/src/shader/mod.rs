@@ -54,6 +54,16 @@ embed!(
     "realtime/glossy_in_none.wgsl",
     "realtime/composite.wgsl",
     "realtime/display.wgsl",
+    "realtime/denoise_views.wgsl",
+    "realtime/denoise_views_none.wgsl",
+    "matte/common.wgsl",
+    "matte/sparse_bilateral.wgsl",
+    "matte/temporal.wgsl",
+    "matte/history_bilateral.wgsl",
+    "matte/disocclusion.wgsl",
+    "matte/firefly.wgsl",
+    "matte/bilateral.wgsl",
+    "taa/taa.wgsl",
     "accel/raycast.wgsl",
 );
 
@@ -145,9 +155,18 @@ mod tests {
             }
         }
         for glossy in ["realtime/glossy_in.wgsl", "realtime/glossy_in_none.wgsl"] {
-            for last in ["realtime/composite.wgsl", "realtime/display.wgsl"] {
-                let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, last];
-                v.push(compose(last, "", &m).unwrap());
+            let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/composite.wgsl"];
+            v.push(compose("realtime/composite.wgsl", "", &m).unwrap());
+            for views in ["realtime/denoise_views.wgsl", "realtime/denoise_views_none.wgsl"] {
+                let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, views, "realtime/display.wgsl"];
+                v.push(compose("realtime/display.wgsl", "", &m).unwrap());
+            }
+        }
+        for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
+            for stage in [&["matte/temporal.wgsl"][..], &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"], &["matte/disocclusion.wgsl"], &["matte/firefly.wgsl"], &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"], &["taa/taa.wgsl"]] {
+                let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl", motion];
+                m.extend_from_slice(stage);
+                v.push(compose(stage[stage.len() - 1], "", &m).unwrap());
             }
         }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
@@ -249,6 +268,12 @@ mod tests {
         assert_eq!(size as usize, size_of::<FrameParams>());
         assert_eq!(offs[7] as usize, offset_of!(FrameParams, jitter));
         assert_eq!(offs[12] as usize, offset_of!(FrameParams, accumulated));
+        let taa = programs.iter().find(|p| p.label == "taa/taa.wgsl").unwrap();
+        let (size, offs) = wgsl_layout(taa, "DenoiseParams");
+        use crate::passes::matte::DenoiseParams;
+        assert_eq!(size as usize, size_of::<DenoiseParams>());
+        assert_eq!(offs[2] as usize, offset_of!(DenoiseParams, stages));
+        assert_eq!(offs[17] as usize, offset_of!(DenoiseParams, history_valid));
         // obvhs's CWBVH node is read as five vec4u.
         assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
     }

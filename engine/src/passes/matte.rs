@@ -1,0 +1,244 @@
+//! The matte denoise chain of Mara et al. 2017 (§3.4, Figure 2 stages 3-7) and TAA, one compute
+//! pass per stage (shaders/matte/*.wgsl, shaders/taa/taa.wgsl):
+//! `matte/temporal` -> `matte/history_bilateral` (into the history only) -> `matte/disocclusion_h`,
+//! `matte/disocclusion_v` -> `matte/firefly` -> `matte/bilateral`; after the composite, `taa`.
+//! Each stage can be switched off at run time ([`MatteSettings`]); it then passes its input on.
+
+use super::gbuffer::GBufferTargets;
+use super::trace::TraceTargets;
+use crate::gpu::scene::compute_pipeline_at;
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::settings::MatteSettings;
+use anyhow::Result;
+use bytemuck::{Pod, Zeroable};
+
+const RGBA16F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const R32F: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+const R32U: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+/// Mirror of `DenoiseParams` in shaders/matte/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct DenoiseParams {
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub prev_inv_view_proj: [[f32; 4]; 4],
+    pub stages: u32,
+    pub taps: u32,
+    pub parity: u32,
+    pub max_radius_px: f32,
+    pub hysteresis: f32,
+    pub d0_px: f32,
+    pub d1_px: f32,
+    pub clamp_sigma: f32,
+    pub history_radius_px: f32,
+    pub disocclusion_radius_px: f32,
+    pub low_confidence_multiplier: f32,
+    pub normal_power: f32,
+    pub plane_sigma_px: f32,
+    pub taa_alpha: f32,
+    pub rotation: f32,
+    pub history_valid: u32,
+}
+
+impl DenoiseParams {
+    pub fn new(s: &MatteSettings, width: u32, frame: u32, inv: glam::Mat4, prev_inv: glam::Mat4, history_valid: bool) -> DenoiseParams {
+        let w = width as f32;
+        DenoiseParams {
+            inv_view_proj: inv.to_cols_array_2d(),
+            prev_inv_view_proj: prev_inv.to_cols_array_2d(),
+            stages: s.stage_bits(),
+            taps: s.taps.clamp(1, 256),
+            parity: frame % 2,
+            max_radius_px: (s.max_radius_fraction * w).max(0.0),
+            hysteresis: s.hysteresis.clamp(0.0, 1.0),
+            d0_px: s.d0_px.max(0.0),
+            d1_px: s.d1_px.max(s.d0_px + 1e-3),
+            clamp_sigma: s.clamp_sigma.max(0.0),
+            history_radius_px: (s.history_diameter_fraction * w * 0.5).max(0.0),
+            disocclusion_radius_px: (s.disocclusion_fraction * w).clamp(1.0, 512.0),
+            low_confidence_multiplier: s.low_confidence_multiplier.max(0.0),
+            normal_power: s.normal_power.max(0.0),
+            plane_sigma_px: s.plane_sigma_px.max(1e-3),
+            taa_alpha: s.taa_alpha.clamp(0.01, 1.0),
+            // Golden-ratio steps: consecutive frames' tap patterns interleave.
+            rotation: (frame as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU),
+            history_valid: history_valid as u32,
+        }
+    }
+}
+
+/// Per-pixel textures of the chain (made with the frame's other targets).
+pub struct MatteTargets {
+    pub prev_depth: (wgpu::Texture, wgpu::TextureView),
+    pub history: [(wgpu::Texture, wgpu::TextureView); 2],
+    pub temporal: (wgpu::Texture, wgpu::TextureView),
+    pub reason: (wgpu::Texture, wgpu::TextureView),
+    pub min: (wgpu::Texture, wgpu::TextureView),
+    pub radius: (wgpu::Texture, wgpu::TextureView),
+    pub median: (wgpu::Texture, wgpu::TextureView),
+    pub denoised: (wgpu::Texture, wgpu::TextureView),
+    pub taa_history: [(wgpu::Texture, wgpu::TextureView); 2],
+    /// The image after TAA (what the display shows), 16 bytes per pixel.
+    pub final_image: wgpu::Buffer,
+}
+
+impl MatteTargets {
+    pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32)) -> MatteTargets {
+        let d = &gpu.device;
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
+        let history = [t("matte/history 0", RGBA16F), t("matte/history 1", RGBA16F)];
+        let temporal = t("matte/temporal", RGBA16F);
+        let reason = t("matte/reason", R32U);
+        let min = t("matte/disocclusion min", R32F);
+        let radius = t("matte/radius", R32F);
+        let median = t("matte/firefly", RGBA16F);
+        let denoised = t("matte/bilateral", RGBA16F);
+        let taa_history = [t("taa/history 0", RGBA16F), t("taa/history 1", RGBA16F)];
+        let prev_depth = mem.texture(d, "matte/previous depth", size, super::gbuffer::DEPTH_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let final_image = mem.buffer(d, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
+        MatteTargets { prev_depth, history, temporal, reason, min, radius, median, denoised, taa_history, final_image }
+    }
+}
+
+/// Everything a stage may bind.
+pub struct ChainInputs<'a> {
+    pub frame: &'a wgpu::Buffer,
+    pub params: &'a wgpu::Buffer,
+    pub objects: Option<&'a wgpu::Buffer>,
+    pub hdr: &'a wgpu::Buffer,
+    pub gbuffer: &'a GBufferTargets,
+    pub trace: &'a TraceTargets,
+    pub matte: &'a MatteTargets,
+    pub sampler: &'a wgpu::Sampler,
+}
+
+/// The G-buffer and trace textures every stage binds (shaders/realtime/gbuffer_in.wgsl).
+pub fn gbuffer_inputs<'a>(b: Bindings<'a>, g: &'a GBufferTargets, t: &'a TraceTargets, matte: &'a wgpu::TextureView) -> Bindings<'a> {
+    let f = || wgpu::TextureSampleType::Float { filterable: false };
+    b.texture(20, &g.depth.1, wgpu::TextureSampleType::Depth)
+        .texture(21, g.view("normal"), f())
+        .texture(22, g.view("motion"), f())
+        .texture(23, g.view("base_color"), f())
+        .texture(24, g.view("specular"), f())
+        .texture(25, g.view("emission"), f())
+        .texture(26, g.view("ids"), wgpu::TextureSampleType::Uint)
+        .texture(27, matte, f())
+        .texture(28, &t.direct.1, f())
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Kind {
+    Temporal,
+    HistoryBilateral,
+    MinH,
+    MinV,
+    Firefly,
+    Bilateral,
+    Taa,
+}
+
+const STAGES: [(Kind, &str); 7] = [
+    (Kind::Temporal, "matte/temporal"),
+    (Kind::HistoryBilateral, "matte/history_bilateral"),
+    (Kind::MinH, "matte/disocclusion_h"),
+    (Kind::MinV, "matte/disocclusion_v"),
+    (Kind::Firefly, "matte/firefly"),
+    (Kind::Bilateral, "matte/bilateral"),
+    (Kind::Taa, "taa"),
+];
+
+fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> {
+    let m = i.matte;
+    let filterable = wgpu::TextureSampleType::Float { filterable: true };
+    let f = wgpu::TextureSampleType::Float { filterable: false };
+    let mut b = gbuffer_inputs(Bindings::new(wgpu::ShaderStages::COMPUTE).uniform(11, i.frame).uniform(40, i.params), i.gbuffer, i.trace, &i.trace.matte.1);
+    match kind {
+        Kind::Temporal => {
+            b = b
+                .texture(41, &m.prev_depth.1, wgpu::TextureSampleType::Depth)
+                .texture(42, &m.history[parity].1, filterable)
+                .sampler(43, i.sampler)
+                .storage_texture(50, &m.temporal.1, RGBA16F)
+                .storage_texture(51, &m.reason.1, R32U);
+            if let Some(o) = i.objects {
+                b = b.storage(17, o, true);
+            }
+        }
+        Kind::HistoryBilateral => b = b.texture(44, &m.temporal.1, f).storage_texture(50, &m.history[1 - parity].1, RGBA16F),
+        Kind::MinH => b = b.texture(44, &m.temporal.1, f).texture(52, &m.radius.1, f).storage_texture(53, &m.min.1, R32F),
+        Kind::MinV => b = b.texture(44, &m.temporal.1, f).texture(52, &m.min.1, f).storage_texture(53, &m.radius.1, R32F),
+        Kind::Firefly => b = b.texture(44, &m.temporal.1, f).storage_texture(50, &m.median.1, RGBA16F),
+        Kind::Bilateral => b = b.texture(44, &m.median.1, f).texture(52, &m.radius.1, f).storage_texture(50, &m.denoised.1, RGBA16F),
+        Kind::Taa => {
+            b = b
+                .storage(32, i.hdr, true)
+                .texture(42, &m.taa_history[parity].1, filterable)
+                .sampler(43, i.sampler)
+                .storage_texture(50, &m.taa_history[1 - parity].1, RGBA16F)
+                .storage(54, &m.final_image, false)
+        }
+    }
+    b
+}
+
+fn modules(kind: Kind, animated: bool) -> Vec<&'static str> {
+    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl"];
+    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.extend(match kind {
+        Kind::Temporal => vec!["matte/temporal.wgsl"],
+        Kind::HistoryBilateral => vec!["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
+        Kind::MinH | Kind::MinV => vec!["matte/disocclusion.wgsl"],
+        Kind::Firefly => vec!["matte/firefly.wgsl"],
+        Kind::Bilateral => vec!["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"],
+        Kind::Taa => vec!["taa/taa.wgsl"],
+    });
+    m
+}
+
+struct Stage {
+    kind: Kind,
+    label: &'static str,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    /// Bind groups for history parity 0 and 1, and the key they were made for.
+    groups: Option<(u64, [wgpu::BindGroup; 2])>,
+}
+
+pub struct MatteChain {
+    stages: Vec<Stage>,
+}
+
+impl MatteChain {
+    pub fn new(gpu: &Gpu, i: &ChainInputs, animated: bool) -> Result<MatteChain> {
+        let mut stages = vec![];
+        for (kind, label) in STAGES {
+            let module = crate::shader::compose(label, "", &modules(kind, animated))?.create(&gpu.device)?;
+            let layout = bindings(kind, i, 0).create_layout(&gpu.device, label);
+            let entry = match kind {
+                Kind::MinH => "min_h",
+                Kind::MinV => "min_v",
+                _ => "main",
+            };
+            let pipeline = compute_pipeline_at(&gpu.device, label, &module, &layout, entry);
+            stages.push(Stage { kind, label, pipeline, layout, groups: None });
+        }
+        Ok(MatteChain { stages })
+    }
+
+    /// Record stages 3-7 (before the composite) or TAA (after it).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &ChainInputs, parity: usize, size: (u32, u32), taa: bool, mut timer: Option<&mut GpuTimer>) {
+        for s in self.stages.iter_mut().filter(|s| (s.kind == Kind::Taa) == taa) {
+            if s.groups.as_ref().is_none_or(|(k, _)| *k != key) {
+                let g = |p| bindings(s.kind, i, p).create_group(&gpu.device, s.label, &s.layout);
+                s.groups = Some((key, [g(0), g(1)]));
+            }
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.label), timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(s.label)) });
+            pass.set_pipeline(&s.pipeline);
+            pass.set_bind_group(0, &s.groups.as_ref().unwrap().1[parity], &[]);
+            pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        }
+    }
+}

@@ -1,0 +1,48 @@
+// Stage (5): r = (1 - min over a 2R x 2R box of c) x R by two 1D min passes (horizontal, then
+// vertical), times `low_confidence_multiplier` where the pixel's own c < 1/2 (capped at
+// max_radius_px). Entry points: min_h reads c from the temporal output, min_v writes r.
+
+@group(0) @binding(44) var filter_in: texture_2d<f32>;
+@group(0) @binding(52) var min_in: texture_2d<f32>;
+@group(0) @binding(53) var out_min: texture_storage_2d<r32float, write>;
+
+fn box_radius() -> i32 {
+    return max(i32(dn.disocclusion_radius_px), 1);
+}
+
+@compute @workgroup_size(8, 8)
+fn min_h(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    var m = 1.0;
+    let r = box_radius();
+    for (var d = -r; d < r; d++) {
+        let q = vec2i(clamp(p.x + d, 0, i32(frame.size.x) - 1), p.y);
+        // Background pixels carry no confidence but need no filling either.
+        m = min(m, select(1.0, textureLoad(filter_in, q, 0).a, has_surface(q)));
+    }
+    textureStore(out_min, p, vec4f(m, 0.0, 0.0, 0.0));
+}
+
+@compute @workgroup_size(8, 8)
+fn min_v(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    var m = 1.0;
+    let r = box_radius();
+    for (var d = -r; d < r; d++) {
+        m = min(m, textureLoad(min_in, vec2i(p.x, clamp(p.y + d, 0, i32(frame.size.y) - 1)), 0).r);
+    }
+    var radius = (1.0 - m) * dn.disocclusion_radius_px;
+    if textureLoad(filter_in, p, 0).a < 0.5 {
+        radius *= dn.low_confidence_multiplier;
+    }
+    if !stage_on(STAGE_DISOCCLUSION) {
+        radius = 0.0;
+    }
+    textureStore(out_min, p, vec4f(min(radius, dn.max_radius_px), 0.0, 0.0, 0.0));
+}

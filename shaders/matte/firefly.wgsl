@@ -1,0 +1,48 @@
+// Stage (6): 3x3 median per channel, outside the history loop (fireflies still feed the running
+// average, so the image is not darkened, but never reach the screen).
+@group(0) @binding(44) var filter_in: texture_2d<f32>;
+@group(0) @binding(50) var out_median: texture_storage_2d<rgba16float, write>;
+
+fn median9(v: array<f32, 9>) -> f32 {
+    var a = v;
+    // Partial selection sort up to the middle element.
+    for (var i = 0; i < 5; i++) {
+        var k = i;
+        for (var j = i + 1; j < 9; j++) {
+            if a[j] < a[k] {
+                k = j;
+            }
+        }
+        let t = a[i];
+        a[i] = a[k];
+        a[k] = t;
+    }
+    return a[4];
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let centre = textureLoad(filter_in, p, 0);
+    if !stage_on(STAGE_FIREFLY) || !has_surface(p) {
+        textureStore(out_median, p, centre);
+        return;
+    }
+    var r: array<f32, 9>;
+    var g: array<f32, 9>;
+    var b: array<f32, 9>;
+    var k = 0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let s = textureLoad(filter_in, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb;
+            r[k] = s.r;
+            g[k] = s.g;
+            b[k] = s.b;
+            k++;
+        }
+    }
+    textureStore(out_median, p, vec4f(median9(r), median9(g), median9(b), centre.a));
+}

@@ -1,0 +1,17 @@
+// Stage (4): the sparse bilateral applied only to what goes back into the history (Mara et al.
+// §3.4: newly sampled paths are never blurred here; the blur is amortised over frames).
+@group(0) @binding(44) var filter_in: texture_2d<f32>;
+@group(0) @binding(50) var out_history: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    var v = textureLoad(filter_in, p, 0).rgb;
+    if stage_on(STAGE_HISTORY_BILATERAL) {
+        v = sparse_bilateral(p, dn.history_radius_px);
+    }
+    textureStore(out_history, p, vec4f(finite_or_zero(v), 1.0));
+}

@@ -1,0 +1,72 @@
+// Stage (3), matte temporal: reverse-reproject the history with the motion vectors, weigh it by
+// the confidence of eq. (11), c = h smoothstep(d1, d0, |X_expected - X_actual|) (so c falls to 0
+// as the distance grows past d1; the paper writes the arguments in the other order), clamp it to
+// the current 3x3 neighbourhood and blend h c of it in. Output rgb = the blend, a = c.
+
+@group(0) @binding(41) var prev_depth: texture_depth_2d;
+@group(0) @binding(42) var history: texture_2d<f32>;
+@group(0) @binding(43) var linear_clamp: sampler;
+@group(0) @binding(50) var out_temporal: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(51) var out_reason: texture_storage_2d<r32uint, write>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let current = finite_or_zero(textureLoad(tr_matte, p, 0).rgb);
+    if !has_surface(p) || !stage_on(STAGE_TEMPORAL) {
+        textureStore(out_temporal, p, vec4f(current, 0.0));
+        textureStore(out_reason, p, vec4u(select(0u, REASON_DISOCCLUDED, has_surface(p)), 0u, 0u, 0u));
+        return;
+    }
+    // Where this surface was: through the motion vector, and by its own (object) motion.
+    let x = position_at(p);
+    let ids = textureLoad(gb_object, p, 0);
+    let expected = previous_position(ids.x, x);
+    let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
+    let q = vec2i(floor(prev));
+    var reason = 0u;
+    var c = 0.0;
+    if in_bounds(q) && dn.history_valid != 0u {
+        let d = textureLoad(prev_depth, q, 0);
+        if d > 0.0 {
+            let actual = world_from_depth(dn.prev_inv_view_proj, q, d);
+            let f = footprint(x);
+            c = dn.hysteresis * (1.0 - smoothstep(dn.d0_px * f, dn.d1_px * f, length(expected - actual)));
+            if c < 0.5 * dn.hysteresis {
+                reason = REASON_LOW_CONFIDENCE;
+            }
+        } else {
+            reason = REASON_DISOCCLUDED;
+        }
+    } else {
+        reason = REASON_DISOCCLUDED;
+    }
+    var result = current;
+    if c > 0.0 {
+        let hist = finite_or_zero(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        // The current 3x3 neighbourhood's mean and standard deviation.
+        var m1 = vec3f(0.0);
+        var m2 = vec3f(0.0);
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let s = finite_or_zero(textureLoad(tr_matte, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb);
+                m1 += s;
+                m2 += s * s;
+            }
+        }
+        m1 /= 9.0;
+        let sigma = sqrt(max(m2 / 9.0 - m1 * m1, vec3f(0.0)));
+        let lo = m1 - dn.clamp_sigma * sigma;
+        let hi = m1 + dn.clamp_sigma * sigma;
+        let clamped = clamp(hist, lo, hi);
+        if any(clamped != hist) {
+            reason |= REASON_CLAMPED;
+        }
+        result = mix(current, clamped, c);
+    }
+    textureStore(out_temporal, p, vec4f(finite_or_zero(result), c));
+    textureStore(out_reason, p, vec4u(reason, 0u, 0u, 0u));
+}
