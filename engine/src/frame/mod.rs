@@ -105,6 +105,9 @@ impl PreparedScene {
         r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
         // matte, direct, and with a glossy lobe glossy, reflection and mirror.
         r.max_storage_textures_per_shader_stage = if self.features.glossy { 5 } else { 2 };
+        // The display reads the G-buffer (7), trace outputs (2, +3 glossy) and the denoiser's
+        // intermediates (5): 17 in a glossy scene, one over WebGPU's default of 16.
+        r.max_sampled_textures_per_shader_stage = 17;
         r
     }
 }

@@ -17,6 +17,8 @@ pub struct GpuRequirements {
     pub max_storage_buffers_per_shader_stage: u32,
     /// Storage textures written at once by the busiest compute stage.
     pub max_storage_textures_per_shader_stage: u32,
+    /// Sampled textures read at once by the busiest stage (the display's debug views).
+    pub max_sampled_textures_per_shader_stage: u32,
     /// Render-target bytes per sample of the widest render pass (WebGPU's accounting).
     pub max_color_attachment_bytes_per_sample: u32,
     /// Ask for everything the adapter offers (the viewer, which may load larger scenes later).
@@ -32,6 +34,7 @@ impl Default for GpuRequirements {
             max_storage_buffers_per_shader_stage: d.max_storage_buffers_per_shader_stage,
             max_storage_textures_per_shader_stage: d.max_storage_textures_per_shader_stage,
             max_color_attachment_bytes_per_sample: d.max_color_attachment_bytes_per_sample,
+            max_sampled_textures_per_shader_stage: d.max_sampled_textures_per_shader_stage,
             adapter_limits: false,
         }
     }
@@ -83,6 +86,15 @@ impl Gpu {
             .max(req.max_storage_buffers_per_shader_stage);
         limits.max_storage_textures_per_shader_stage = limits.max_storage_textures_per_shader_stage.max(req.max_storage_textures_per_shader_stage);
         limits.max_color_attachment_bytes_per_sample = limits.max_color_attachment_bytes_per_sample.max(req.max_color_attachment_bytes_per_sample);
+        limits.max_sampled_textures_per_shader_stage = limits.max_sampled_textures_per_shader_stage.max(req.max_sampled_textures_per_shader_stage);
+        if limits.max_sampled_textures_per_shader_stage > have.max_sampled_textures_per_shader_stage {
+            return Err(anyhow!(
+                "adapter {:?} allows {} sampled textures per stage; the real-time frame's debug views need {}",
+                info.name,
+                have.max_sampled_textures_per_shader_stage,
+                req.max_sampled_textures_per_shader_stage
+            ));
+        }
         if limits.max_storage_textures_per_shader_stage > have.max_storage_textures_per_shader_stage
             || limits.max_color_attachment_bytes_per_sample > have.max_color_attachment_bytes_per_sample
         {
