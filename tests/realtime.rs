@@ -104,19 +104,7 @@ fn a_diffuse_only_scene_allocates_no_glossy_buffers() {
 }
 
 fn half(b: &[u8]) -> f32 {
-    half_to_f32(u16::from_le_bytes([b[0], b[1]]))
-}
-
-/// IEEE half to f32 (the test reads Rg16Float motion vectors).
-fn half_to_f32(h: u16) -> f32 {
-    let s = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let e = ((h >> 10) & 0x1f) as i32;
-    let m = (h & 0x3ff) as f32;
-    match e {
-        0 => s * m * 2f32.powi(-24),
-        31 => s * f32::INFINITY,
-        _ => s * (1.0 + m / 1024.0) * 2f32.powi(e - 15),
-    }
+    half::f16::from_le_bytes([b[0], b[1]]).to_f32()
 }
 
 fn project(vp: &Mat4, p: Vec3, size: (u32, u32)) -> Vec2 {

@@ -36,6 +36,11 @@ struct DenoiseParams {
     // 0 when there is no usable history (first denoised frame, after a resize or a pause of the
     // denoiser): temporal stages then start over.
     history_valid: u32,
+    // Tests: replace the input with NaN / +Inf / -Inf on 1 pixel in 7.
+    inject_nonfinite: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;
@@ -99,6 +104,22 @@ fn spiral_tap(i: u32, n: u32, r: f32, p: vec2i) -> vec2f {
 }
 
 // NaN and Inf become 0; finite values are clamped to what half floats hold.
+// The matte light entering the chain (with the test's fault injection, when asked for).
+fn matte_input(p: vec2i) -> vec3f {
+    let v = textureLoad(tr_matte, p, 0).rgb;
+    if dn.inject_nonfinite != 0u {
+        let k = u32(p.x * 3 + p.y * 5) % 7u;
+        let zero = f32(dn.stages & 0u);
+        if k == 0u {
+            return vec3f(zero / zero);
+        }
+        if k == 1u {
+            return vec3f(1.0 / zero, v.g, -1.0 / zero);
+        }
+    }
+    return v;
+}
+
 fn finite_or_zero(v: vec3f) -> vec3f {
     return select(vec3f(0.0), clamp(v, vec3f(-65000.0), vec3f(65000.0)), v == v & abs(v) <= vec3f(3.0e38));
 }

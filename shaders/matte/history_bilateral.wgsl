@@ -1,6 +1,8 @@
 // Stage (4): the sparse bilateral applied only to what goes back into the history (Mara et al.
 // §3.4: newly sampled paths are never blurred here; the blur is amortised over frames).
 @group(0) @binding(44) var filter_in: texture_2d<f32>;
+// Reason flags and, above them, the history length n (matte/temporal.wgsl).
+@group(0) @binding(51) var reason_in: texture_2d<u32>;
 @group(0) @binding(50) var out_history: texture_storage_2d<rgba16float, write>;
 
 @compute @workgroup_size(8, 8)
@@ -13,5 +15,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if stage_on(STAGE_HISTORY_BILATERAL) {
         v = sparse_bilateral(p, dn.history_radius_px);
     }
-    textureStore(out_history, p, vec4f(finite_or_zero(v), 1.0));
+    let n = f32(textureLoad(reason_in, p, 0).x >> 8u);
+    textureStore(out_history, p, vec4f(finite_or_zero(v), n));
 }

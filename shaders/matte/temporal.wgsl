@@ -2,6 +2,12 @@
 // the confidence of eq. (11), c = h smoothstep(d1, d0, |X_expected - X_actual|) (so c falls to 0
 // as the distance grows past d1; the paper writes the arguments in the other order), clamp it to
 // the current 3x3 neighbourhood and blend h c of it in. Output rgb = the blend, a = c.
+//
+// One addition to the paper: the history carries its length n (frames since it was reset, in
+// its alpha), and the new sample's weight is max(1 - c, 1 / (n + 1)). A fresh history then
+// averages its first frames equally instead of keeping 0.98^k of its first, noisy sample (after
+// 60 frames that sample would still weigh 30%); once n passes 1 / (1 - h) it is the paper's
+// exponential blend. The reason texture carries n above its 8 flag bits.
 
 @group(0) @binding(41) var prev_depth: texture_depth_2d;
 @group(0) @binding(42) var history: texture_2d<f32>;
@@ -15,10 +21,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !in_bounds(p) {
         return;
     }
-    let current = finite_or_zero(textureLoad(tr_matte, p, 0).rgb);
+    let current = finite_or_zero(matte_input(p));
     if !has_surface(p) || !stage_on(STAGE_TEMPORAL) {
         textureStore(out_temporal, p, vec4f(current, 0.0));
-        textureStore(out_reason, p, vec4u(select(0u, REASON_DISOCCLUDED, has_surface(p)), 0u, 0u, 0u));
+        textureStore(out_reason, p, vec4u(select(0u, REASON_DISOCCLUDED, has_surface(p)) | (1u << 8u), 0u, 0u, 0u));
         return;
     }
     // Where this surface was: through the motion vector, and by its own (object) motion.
@@ -45,14 +51,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         reason = REASON_DISOCCLUDED;
     }
     var result = current;
+    var n = 1.0;
     if c > 0.0 {
+        let n_prev = max(textureLoad(history, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0).a, 1.0);
+        n = min(n_prev + 1.0, 1024.0);
         let hist = finite_or_zero(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
         // The current 3x3 neighbourhood's mean and standard deviation.
         var m1 = vec3f(0.0);
         var m2 = vec3f(0.0);
         for (var dy = -1; dy <= 1; dy++) {
             for (var dx = -1; dx <= 1; dx++) {
-                let s = finite_or_zero(textureLoad(tr_matte, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb);
+                let s = finite_or_zero(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1)));
                 m1 += s;
                 m2 += s * s;
             }
@@ -65,8 +74,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if any(clamped != hist) {
             reason |= REASON_CLAMPED;
         }
-        result = mix(current, clamped, c);
+        result = mix(clamped, current, max(1.0 - c, 1.0 / n));
     }
     textureStore(out_temporal, p, vec4f(finite_or_zero(result), c));
-    textureStore(out_reason, p, vec4u(reason, 0u, 0u, 0u));
+    textureStore(out_reason, p, vec4u(reason | (u32(n) << 8u), 0u, 0u, 0u));
 }

@@ -16,7 +16,7 @@ fn denoise_view(view: u32, p: vec2i) -> vec4f {
         }
         case 18u: {
             // Red: disoccluded; yellow: low confidence; blue: history clamped.
-            let r = textureLoad(dv_reason, p, 0).x;
+            let r = textureLoad(dv_reason, p, 0).x & 255u;
             var c = vec3f(0.0);
             if (r & 1u) != 0u {
                 c = vec3f(1.0, 0.0, 0.0);

@@ -515,6 +515,21 @@ impl Renderer {
             "gbuffer/depth" => &t.gbuffer.depth.0,
             "trace/matte" => &t.trace.matte.0,
             "trace/direct" => &t.trace.direct.0,
+            n if n.starts_with("matte/") || n.starts_with("taa/") => {
+                let m = t.matte.as_ref().with_context(|| format!("no texture {n}: the denoiser has not run"))?;
+                match n {
+                    "matte/history 0" => &m.history[0].0,
+                    "matte/history 1" => &m.history[1].0,
+                    "matte/temporal" => &m.temporal.0,
+                    "matte/reason" => &m.reason.0,
+                    "matte/radius" => &m.radius.0,
+                    "matte/firefly" => &m.median.0,
+                    "matte/bilateral" => &m.denoised.0,
+                    "taa/history 0" => &m.taa_history[0].0,
+                    "taa/history 1" => &m.taa_history[1].0,
+                    _ => bail!("no texture {n}"),
+                }
+            }
             n if n.starts_with("gbuffer/") => &t.gbuffer.color[gbuffer::COLOR_FORMATS.iter().position(|(l, _)| *l == n).with_context(|| format!("no texture {n}"))?].0,
             n => {
                 let g = t.trace.glossy.as_ref().with_context(|| format!("no texture {n}: the scene has no glossy buffers"))?;

@@ -38,6 +38,9 @@ pub struct DenoiseParams {
     pub taa_alpha: f32,
     pub rotation: f32,
     pub history_valid: u32,
+    /// [`MatteSettings::inject_nonfinite`].
+    pub inject_nonfinite: u32,
+    pub _pad: [u32; 3],
 }
 
 impl DenoiseParams {
@@ -63,6 +66,8 @@ impl DenoiseParams {
             // Golden-ratio steps: consecutive frames' tap patterns interleave.
             rotation: (frame as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU),
             history_valid: history_valid as u32,
+            inject_nonfinite: s.inject_nonfinite as u32,
+            _pad: [0; 3],
         }
     }
 }
@@ -166,7 +171,9 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> 
                 b = b.storage(17, o, true);
             }
         }
-        Kind::HistoryBilateral => b = b.texture(44, &m.temporal.1, f).storage_texture(50, &m.history[1 - parity].1, RGBA16F),
+        Kind::HistoryBilateral => {
+            b = b.texture(44, &m.temporal.1, f).texture(51, &m.reason.1, wgpu::TextureSampleType::Uint).storage_texture(50, &m.history[1 - parity].1, RGBA16F)
+        }
         Kind::MinH => b = b.texture(44, &m.temporal.1, f).texture(52, &m.radius.1, f).storage_texture(53, &m.min.1, R32F),
         Kind::MinV => b = b.texture(44, &m.temporal.1, f).texture(52, &m.min.1, f).storage_texture(53, &m.radius.1, R32F),
         Kind::Firefly => b = b.texture(44, &m.temporal.1, f).storage_texture(50, &m.median.1, RGBA16F),
