@@ -2,7 +2,7 @@
 //! views, animation clock, screenshots and camera paths.
 
 use hush_engine::frame::View;
-use hush_engine::settings::FrameSettings;
+use hush_engine::settings::{Denoiser, FrameSettings};
 
 pub struct Panel {
     pub settings: FrameSettings,
@@ -47,6 +47,30 @@ impl Panel {
             ui.radio_value(&mut self.settings.accumulate, false, "real-time");
             ui.radio_value(&mut self.settings.accumulate, true, "accumulate");
         });
+        ui.horizontal(|ui| {
+            ui.label("denoiser");
+            ui.radio_value(&mut self.settings.denoiser, Denoiser::None, "none");
+            ui.radio_value(&mut self.settings.denoiser, Denoiser::Mara, "Mara et al. 2017");
+        });
+        if self.settings.denoiser == Denoiser::Mara {
+            let m = &mut self.settings.matte;
+            ui.collapsing("matte chain and TAA", |ui| {
+                ui.checkbox(&mut m.temporal, "matte/temporal (3)");
+                ui.checkbox(&mut m.history_bilateral, "matte/history_bilateral (4)");
+                ui.checkbox(&mut m.disocclusion, "matte/disocclusion (5)");
+                ui.checkbox(&mut m.firefly, "matte/firefly (6)");
+                ui.checkbox(&mut m.bilateral, "matte/bilateral (7)");
+                ui.checkbox(&mut m.taa, "taa");
+                ui.add(egui::Slider::new(&mut m.hysteresis, 0.5..=0.999).text("hysteresis h"));
+                ui.add(egui::Slider::new(&mut m.clamp_sigma, 0.5..=16.0).text("history clamp (sigma)"));
+                ui.add(egui::Slider::new(&mut m.d0_px, 0.5..=32.0).text("d0 (pixel footprints)"));
+                ui.add(egui::Slider::new(&mut m.d1_px, 0.5..=48.0).text("d1 (pixel footprints)"));
+                ui.add(egui::Slider::new(&mut m.taps, 4..=128).text("bilateral taps"));
+                ui.add(egui::Slider::new(&mut m.history_diameter_fraction, 0.001..=0.05).text("history disk (fraction of width)"));
+                ui.add(egui::Slider::new(&mut m.disocclusion_fraction, 0.005..=0.2).text("R (fraction of width)"));
+                ui.add(egui::Slider::new(&mut m.taa_alpha, 0.02..=1.0).text("TAA current-frame weight"));
+            });
+        }
         ui.add(egui::Slider::new(&mut self.settings.exposure_ev, -8.0..=8.0).text("exposure (EV)"));
         ui.add(egui::Slider::new(&mut self.settings.max_depth, 2..=16).text("max depth"));
         if let Some((az, el)) = &mut self.sun {
