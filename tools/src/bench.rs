@@ -18,6 +18,9 @@ pub struct BenchArgs {
     /// Real-time mode: frames measured (after two warm-up frames).
     #[arg(long, default_value_t = 32)]
     pub frames: u32,
+    /// Real-time mode: the denoiser (`none` or `mara`).
+    #[arg(long, default_value = "mara")]
+    pub denoiser: String,
     /// BVH layout to measure (bvh2, cwbvh); both when omitted.
     #[arg(long)]
     pub bvh: Option<String>,

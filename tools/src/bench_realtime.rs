@@ -63,7 +63,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     });
     let view = tex.create_view(&Default::default());
     let target = DisplayTarget { view: &view, format, size };
-    let settings = FrameSettings { max_depth: r.scene.max_depth, ..Default::default() };
+    let denoiser = crate::realtime::parse_denoiser(&a.denoiser)?;
+    let settings = FrameSettings { max_depth: r.scene.max_depth, denoiser, ..Default::default() };
     let camera = r.scene.camera_or_default();
     let mut per_pass: Vec<(&'static str, Vec<f64>)> = vec![];
     let (mut totals, mut cpu) = (vec![], vec![]);

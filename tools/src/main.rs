@@ -3,6 +3,7 @@
 mod bench;
 mod bench_realtime;
 mod compare;
+mod quality;
 mod realtime;
 mod render;
 
@@ -22,6 +23,8 @@ enum Command {
     Render(render::RenderArgs),
     /// Compare an image with a reference: RMSE, relMSE, SSIM, FLIP, non-finite pixels.
     Compare(compare::CompareArgs),
+    /// Score a denoised stream against per-frame references: CSV, plot, ablations.
+    Quality(quality::QualityArgs),
     /// Write the default level (built in code) as glTF: LEVEL.gltf, .bin, PNG textures, EXR sky.
     Level(LevelArgs),
     /// Measure BVH build, rays/s and reference samples/s, or (--mode realtime) GPU time per pass.
@@ -53,6 +56,7 @@ fn main() {
         Command::Compare(a) => compare::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Level(a) => level(a),
+        Command::Quality(a) => quality::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

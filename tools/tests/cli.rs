@@ -103,10 +103,38 @@ fn realtime_bench_reports_every_pass() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let passes: Vec<&str> = v["passes"].as_array().unwrap().iter().map(|p| p["pass"].as_str().unwrap()).collect();
-    assert_eq!(passes, ["gbuffer", "trace", "composite", "display"]);
+    assert_eq!(passes, ["gbuffer", "trace", "matte/temporal", "matte/history_bilateral", "matte/disocclusion_h", "matte/disocclusion_v", "matte/firefly", "matte/bilateral", "composite", "taa", "display"]);
     for p in v["passes"].as_array().unwrap() {
         assert!(p["median_ms"].as_f64().unwrap() > 0.0, "{p}");
     }
     assert!(v["gpu_frame_median_ms"].as_f64().unwrap() > 0.0);
     assert!(v["bytes_per_pixel"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn quality_writes_scores_and_a_plot() {
+    let dir = temp_dir("quality");
+    let o = bin("hush-cli")
+        .args(["quality", "level", "--frames", "4", "--reference-frames", "4", "--width", "32", "--fps", "30", "--ablations", "--out-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.join("quality.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 5, "{csv}");
+    assert!(rows[0].starts_with("frame,time,flip,relmse,ssim,temporal_error"));
+    for r in &rows[1..] {
+        let v: Vec<f64> = r.split(',').map(|x| x.parse().unwrap()).collect();
+        assert!(v.iter().all(|x| x.is_finite()) && v[2] > 0.0 && v[2] < 1.0, "{r}");
+    }
+    let ablations = std::fs::read_to_string(dir.join("ablations.csv")).unwrap();
+    assert_eq!(ablations.lines().count(), 8, "{ablations}");
+    let png = image_size(&dir.join("quality.png"));
+    assert_eq!(png, (960, 720));
+}
+
+fn image_size(p: &std::path::Path) -> (u32, u32) {
+    let img = hush_engine::quality::Image::load(p).unwrap();
+    (img.width, img.height)
 }

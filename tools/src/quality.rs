@@ -1,0 +1,265 @@
+//! `hush-cli quality`: how close a denoised stream is to the converged image, frame by frame.
+//! For every frame of a camera path (or a still camera) it renders the frame with the denoiser,
+//! the same frame raw, and the reference (the real-time frame accumulated over many frames at
+//! the same camera and time; the accumulation converges to the reference mode, tests/realtime.rs),
+//! then writes quality.csv (FLIP, relMSE, SSIM and the temporal error of Schied et al. 2017: mean
+//! absolute luminance change between consecutive frames) and quality.png. `--ablations` repeats
+//! the denoised stream with each stage off and writes ablations.csv.
+
+use crate::realtime::parse_denoiser;
+use crate::render::{bvh_kind, image_size, load_scene, parse_camera};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use hush_engine::frame::{FrameInput, Renderer};
+use hush_engine::gpu::{Gpu, PreparedScene};
+use hush_engine::quality::{Image, compare, luminance};
+use hush_engine::scene::{CameraPath, Scene};
+use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+#[derive(Args)]
+pub struct QualityArgs {
+    /// A .gltf/.glb file, `default` or `level`.
+    pub scene: String,
+    #[arg(long)]
+    pub camera_path: Option<PathBuf>,
+    /// A still camera, "eye=x,y,z;target=x,y,z;fov=deg" (default: the scene's).
+    #[arg(long)]
+    pub camera: Option<String>,
+    #[arg(long, default_value_t = 60)]
+    pub frames: u32,
+    #[arg(long, default_value = "mara")]
+    pub denoiser: String,
+    /// Stages to switch off (see `render --disable`).
+    #[arg(long, value_delimiter = ',')]
+    pub disable: Vec<String>,
+    /// Frames accumulated for each frame's reference.
+    #[arg(long, default_value_t = 256)]
+    pub reference_frames: u32,
+    #[arg(long, default_value_t = 320)]
+    pub width: u32,
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Animation clock rate for a still camera (frame k is at k / fps seconds); 0 freezes it.
+    #[arg(long, default_value_t = 0.0)]
+    pub fps: f64,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Also run the stream with each denoiser stage off.
+    #[arg(long)]
+    pub ablations: bool,
+    #[arg(long)]
+    pub out_dir: PathBuf,
+}
+
+/// One stream's per-frame scores against the reference.
+#[derive(Default, Clone)]
+pub struct Scores {
+    pub flip: Vec<f64>,
+    pub relmse: Vec<f64>,
+    pub ssim: Vec<f64>,
+    /// Mean |luminance(frame k) - luminance(frame k-1)| (0 for the first frame).
+    pub temporal: Vec<f64>,
+    /// GPU milliseconds of the frame (all passes).
+    pub gpu_ms: Vec<f64>,
+}
+
+impl Scores {
+    fn push(&mut self, img: &Image, prev: Option<&Image>, reference: &Image, ms: f64) -> Result<()> {
+        let m = compare(img, reference)?;
+        self.flip.push(m.flip as f64);
+        self.relmse.push(m.relmse);
+        self.ssim.push(m.ssim as f64);
+        self.temporal.push(prev.map_or(0.0, |p| temporal_error(img, p)));
+        self.gpu_ms.push(ms);
+        Ok(())
+    }
+
+    /// Mean over the second half of the stream (after the history has filled).
+    pub fn settled(v: &[f64]) -> f64 {
+        let tail = &v[v.len() / 2..];
+        tail.iter().sum::<f64>() / tail.len().max(1) as f64
+    }
+}
+
+pub fn temporal_error(a: &Image, b: &Image) -> f64 {
+    a.data.iter().zip(&b.data).map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64).sum::<f64>() / a.data.len() as f64
+}
+
+struct Setup {
+    gpu: Gpu,
+    scene: Scene,
+    size: (u32, u32),
+    inputs: Vec<FrameInput>,
+}
+
+fn renderer(s: &Setup) -> Result<Renderer> {
+    let prepared = PreparedScene::new(&s.scene, bvh_kind(&None)?)?;
+    Renderer::new(&s.gpu, s.scene.clone(), prepared, s.size)
+}
+
+/// Render the stream with `settings`, scoring every frame against `references`.
+fn stream(s: &Setup, settings: &FrameSettings, references: &[Image]) -> Result<(Scores, Vec<Image>)> {
+    let mut r = renderer(s)?;
+    let mut scores = Scores::default();
+    let mut prev: Option<Image> = None;
+    let mut last = vec![];
+    for (k, input) in s.inputs.iter().enumerate() {
+        r.render(&s.gpu, input, settings, None)?;
+        let ms: f64 = r.pass_times(&s.gpu)?.iter().map(|p| p.1).sum();
+        let img = r.read_hdr(&s.gpu)?;
+        scores.push(&img, prev.as_ref(), &references[k], ms)?;
+        if k + 1 == s.inputs.len() {
+            last.push(img.clone());
+        }
+        prev = Some(img);
+    }
+    Ok((scores, last))
+}
+
+pub fn run(a: QualityArgs) -> Result<()> {
+    if a.frames == 0 || a.reference_frames == 0 {
+        bail!("--frames and --reference-frames must be at least 1");
+    }
+    let denoiser = parse_denoiser(&a.denoiser)?;
+    let mut matte = MatteSettings::default();
+    for stage in &a.disable {
+        if !matte.disable(stage) {
+            bail!("--disable {stage:?}: the stages are {}", MatteSettings::STAGES.join(", "));
+        }
+    }
+    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let size = image_size(&scene, Some(a.width), a.height);
+    let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
+    let camera = match &a.camera {
+        Some(c) => parse_camera(c)?,
+        None => scene.camera_or_default(),
+    };
+    let inputs: Vec<FrameInput> = (0..a.frames as usize)
+        .map(|k| match &path {
+            Some(p) => FrameInput { camera: p.frame(k).camera(), time: p.frame(k).time },
+            None => FrameInput { camera, time: if a.fps > 0.0 { k as f64 / a.fps } else { 0.0 } },
+        })
+        .collect();
+    std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
+    let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
+    let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
+    let s = Setup { gpu, scene, size, inputs };
+
+    // References: one accumulation per distinct (camera, time).
+    let mut refr = renderer(&s)?;
+    let acc = FrameSettings { accumulate: true, seed: a.seed.wrapping_add(7919), max_depth: s.scene.max_depth, ..Default::default() };
+    let mut references: Vec<Image> = vec![];
+    for (k, input) in s.inputs.iter().enumerate() {
+        if k > 0 && s.inputs[k - 1] == *input {
+            references.push(references[k - 1].clone());
+            continue;
+        }
+        for _ in 0..a.reference_frames {
+            refr.render(&s.gpu, input, &acc, None)?;
+        }
+        references.push(refr.read_hdr(&s.gpu)?);
+    }
+    // The yardstick: the last frame's view accumulated over 64 frames, raw.
+    let yardstick = FrameSettings { seed: a.seed.wrapping_add(104729), ..acc.clone() };
+    let last_input = s.inputs[s.inputs.len() - 1];
+    for _ in 0..64 {
+        refr.render(&s.gpu, &last_input, &yardstick, None)?;
+    }
+    let flip64 = compare(&refr.read_hdr(&s.gpu)?, &references[references.len() - 1])?.flip;
+    drop(refr);
+
+    let base = FrameSettings { seed: a.seed, max_depth: s.scene.max_depth, denoiser, matte: matte.clone(), ..Default::default() };
+    let (den, last) = stream(&s, &base, &references)?;
+    let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::None, ..base.clone() }, &references)?;
+    if let (Some(d), Some(r), Some(f)) = (last.first(), last_raw.first(), references.last()) {
+        d.save(&a.out_dir.join("last_denoised.png"))?;
+        r.save(&a.out_dir.join("last_raw.png"))?;
+        f.save(&a.out_dir.join("last_reference.png"))?;
+    }
+    write_csv(&a.out_dir.join("quality.csv"), &s.inputs, &den, &raw)?;
+    plot(&a.out_dir.join("quality.png"), &den, &raw, &a.scene)?;
+    println!("{} at {}x{}, {} frames ({} reference frames each), on {}", a.scene, size.0, size.1, a.frames, a.reference_frames, s.gpu.info.name);
+    println!("  stream     mean FLIP  mean relMSE  mean SSIM  temporal error  GPU ms/frame   (second half of the stream)");
+    for (name, sc) in [("denoised", &den), ("raw", &raw)] {
+        println!(
+            "  {name:9}  {:9.4}  {:11.5}  {:9.4}  {:14.5}  {:12.2}",
+            Scores::settled(&sc.flip),
+            Scores::settled(&sc.relmse),
+            Scores::settled(&sc.ssim),
+            Scores::settled(&sc.temporal),
+            Scores::settled(&sc.gpu_ms)
+        );
+    }
+
+    println!("  64 accumulated frames of the last view: FLIP {flip64:.4}");
+    std::fs::write(a.out_dir.join("accumulated64_flip.txt"), format!("{flip64:.5}\n"))?;
+
+    if a.ablations && denoiser == Denoiser::Mara {
+        let mut f = std::fs::File::create(a.out_dir.join("ablations.csv"))?;
+        writeln!(f, "disabled,flip,relmse,ssim,temporal_error,gpu_ms")?;
+        let mut row = |name: &str, sc: &Scores| -> Result<()> {
+            writeln!(f, "{name},{:.5},{:.6},{:.5},{:.6},{:.3}", Scores::settled(&sc.flip), Scores::settled(&sc.relmse), Scores::settled(&sc.ssim), Scores::settled(&sc.temporal), Scores::settled(&sc.gpu_ms))?;
+            println!("  without {name:24} FLIP {:.4} temporal error {:.5} GPU {:.2} ms", Scores::settled(&sc.flip), Scores::settled(&sc.temporal), Scores::settled(&sc.gpu_ms));
+            Ok(())
+        };
+        row("nothing", &den)?;
+        for stage in MatteSettings::STAGES {
+            let mut m = matte.clone();
+            m.disable(stage);
+            let (sc, _) = stream(&s, &FrameSettings { matte: m, ..base.clone() }, &references)?;
+            row(stage, &sc)?;
+        }
+    }
+    Ok(())
+}
+
+fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> Result<()> {
+    let mut f = std::fs::File::create(path).with_context(|| format!("writing {}", path.display()))?;
+    writeln!(f, "frame,time,flip,relmse,ssim,temporal_error,gpu_ms,raw_flip,raw_relmse,raw_ssim,raw_temporal_error,raw_gpu_ms")?;
+    for k in 0..inputs.len() {
+        writeln!(
+            f,
+            "{k},{:.4},{:.5},{:.6},{:.5},{:.6},{:.3},{:.5},{:.6},{:.5},{:.6},{:.3}",
+            inputs[k].time, den.flip[k], den.relmse[k], den.ssim[k], den.temporal[k], den.gpu_ms[k], raw.flip[k], raw.relmse[k], raw.ssim[k], raw.temporal[k], raw.gpu_ms[k]
+        )?;
+    }
+    Ok(())
+}
+
+/// FLIP and temporal error per frame, denoised against raw, as a PNG.
+fn plot(path: &Path, den: &Scores, raw: &Scores, title: &str) -> Result<()> {
+    use plotters::prelude::*;
+    // Text needs a font; egui's default font is a crate away and always the same.
+    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+    let root = BitMapBackend::new(path, (960, 720)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    let panels = root.split_evenly((2, 1));
+    let series = [("FLIP", &den.flip, &raw.flip), ("temporal error (mean |dY|)", &den.temporal, &raw.temporal)];
+    for (area, (name, d, r)) in panels.iter().zip(series) {
+        let n = d.len().max(2);
+        let hi = d.iter().chain(r.iter()).cloned().fold(0.0f64, f64::max).max(1e-6) * 1.05;
+        let mut chart = ChartBuilder::on(area)
+            .caption(format!("{title}: {name}"), ("sans-serif", 20))
+            .margin(10)
+            .x_label_area_size(30)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0..n, 0.0..hi)
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        chart.configure_mesh().x_desc("frame").draw().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        chart
+            .draw_series(LineSeries::new(d.iter().enumerate().map(|(i, v)| (i, *v)), &BLUE))
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?
+            .label("denoised")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+        chart
+            .draw_series(LineSeries::new(r.iter().enumerate().map(|(i, v)| (i, *v)), &RED))
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?
+            .label("raw")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    root.present().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    Ok(())
+}
