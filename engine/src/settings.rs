@@ -20,11 +20,14 @@ pub struct FrameSettings {
     pub view: View,
     pub denoiser: Denoiser,
     pub matte: MatteSettings,
+    /// Indirect paths per pixel per frame (each of the matte and glossy estimators, and the
+    /// area-light sample, is averaged over them). 1 is the paper's real-time setting.
+    pub paths_per_pixel: u32,
 }
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::None, matte: MatteSettings::default() }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::None, matte: MatteSettings::default(), paths_per_pixel: 1 }
     }
 }
 

@@ -21,6 +21,11 @@ struct Frame {
     exposure: f32,
     // Frames summed in the accumulation buffer (accumulate mode), 0 when off.
     accumulated: u32,
+    // Matte and glossy paths traced per pixel (their results are averaged).
+    paths: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(11) var<uniform> frame: Frame;

@@ -128,61 +128,68 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
     }
 
-    let groups = area_groups();
-    let nee_select = 1.0 / f32(max(groups, 1u));
-    if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
-        let ls = sample_area_light(s.p, &rng);
-        let wi = to_local(basis, ls.wi);
-        if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
-            let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-            if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
-                if has_matte {
-                    // Eq. (9): the matte light is L_i cos / pi over the pdf; m (1 - F)^2 comes later.
-                    matte += ls.li * (wi.z * INV_PI) * power_heuristic(ls.pdf, wi.z * INV_PI);
-                }
-                if has_glossy {
-                    let g = glossy_eval(bsdf, wo, wi);
-                    glossy += ls.li * g.f_cos / f_s * power_heuristic(ls.pdf, g.pdf);
+    // `frame.paths` independent samples of the area lights and of each path, averaged.
+    let paths = max(frame.paths, 1u);
+    for (var k = 0u; k < paths; k++) {
+        let groups = area_groups();
+        let nee_select = 1.0 / f32(max(groups, 1u));
+        if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
+            let ls = sample_area_light(s.p, &rng);
+            let wi = to_local(basis, ls.wi);
+            if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
+                let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+                if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
+                    if has_matte {
+                        // Eq. (9): the matte light is L_i cos / pi over the pdf; m (1 - F)^2 comes later.
+                        matte += ls.li * (wi.z * INV_PI) * power_heuristic(ls.pdf, wi.z * INV_PI);
+                    }
+                    if has_glossy {
+                        let g = glossy_eval(bsdf, wo, wi);
+                        glossy += ls.li * g.f_cos / f_s * power_heuristic(ls.pdf, g.pdf);
+                    }
                 }
             }
         }
-    }
 
-    if has_matte {
-        // Cosine sampling cancels eq. (7)'s cos / pi: the path's throughput starts at 1.
-        let wl = cosine_hemisphere(rand2(&rng));
-        let wi = basis * wl;
-        if dot(wi, s.ng) > 0.0 {
-            let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select), &rng);
-            matte += r.radiance;
-        }
-    } else {
-        // Keep the random sequence of the glossy path independent of the material.
-        rand2(&rng);
-    }
-
-    if has_glossy {
-        var wl: vec3f;
-        var start: PathStart;
-        if bsdf.delta {
-            // A mirror: F(h) = F(w_s) exactly, so the demodulated weight is 1.
-            wl = vec3f(-wo.xy, wo.z);
-            start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select);
+        if has_matte {
+            // Cosine sampling cancels eq. (7)'s cos / pi: the path's throughput starts at 1.
+            let wl = cosine_hemisphere(rand2(&rng));
+            let wi = basis * wl;
+            if dot(wi, s.ng) > 0.0 {
+                let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select), &rng);
+                matte += r.radiance;
+            }
         } else {
-            wl = reflect(-wo, sample_vndf(bsdf.alpha, wo, rand2(&rng)));
-            let g = glossy_eval(bsdf, wo, wl);
-            var weight = vec3f(0.0);
-            if g.pdf > 0.0 {
-                weight = g.f_cos / (g.pdf * f_s);
-            }
-            start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select);
+            // Keep the random sequence of the glossy path independent of the material.
+            rand2(&rng);
         }
-        if wl.z > 0.0 && dot(start.rd, s.ng) > 0.0 && max3(start.beta) > 0.0 {
-            let r = trace_path(start, &rng);
-            glossy += r.radiance;
-            glossy_t = r.first_t;
+
+        if has_glossy {
+            var wl: vec3f;
+            var start: PathStart;
+            if bsdf.delta {
+                // A mirror: F(h) = F(w_s) exactly, so the demodulated weight is 1.
+                wl = vec3f(-wo.xy, wo.z);
+                start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select);
+            } else {
+                wl = reflect(-wo, sample_vndf(bsdf.alpha, wo, rand2(&rng)));
+                let g = glossy_eval(bsdf, wo, wl);
+                var weight = vec3f(0.0);
+                if g.pdf > 0.0 {
+                    weight = g.f_cos / (g.pdf * f_s);
+                }
+                start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select);
+            }
+            if wl.z > 0.0 && dot(start.rd, s.ng) > 0.0 && max3(start.beta) > 0.0 {
+                let r = trace_path(start, &rng);
+                glossy += r.radiance;
+                glossy_t = r.first_t;
+            }
         }
     }
+    matte /= f32(paths);
+    glossy /= f32(paths);
+
     write_all(px, matte, direct);
     write_glossy(px, glossy, glossy_t, rd * hit.t, mirror);
 }

@@ -6,6 +6,7 @@ mod compare;
 mod quality;
 mod realtime;
 mod render;
+mod sweep;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Score a denoised stream against per-frame references: CSV, plot, ablations.
     Quality(quality::QualityArgs),
+    /// The speed/accuracy sweep: resolution scale, paths per pixel, path length, denoiser.
+    Sweep(sweep::SweepArgs),
     /// Write the default level (built in code) as glTF: LEVEL.gltf, .bin, PNG textures, EXR sky.
     Level(LevelArgs),
     /// Measure BVH build, rays/s and reference samples/s, or (--mode realtime) GPU time per pass.
@@ -57,6 +60,7 @@ fn main() {
         Command::Bench(a) => bench::run(a),
         Command::Level(a) => level(a),
         Command::Quality(a) => quality::run(a),
+        Command::Sweep(a) => sweep::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

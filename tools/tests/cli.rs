@@ -138,3 +138,21 @@ fn image_size(p: &std::path::Path) -> (u32, u32) {
     let img = hush_engine::quality::Image::load(p).unwrap();
     (img.width, img.height)
 }
+
+#[test]
+fn sweep_marks_a_pareto_front() {
+    let dir = temp_dir("sweep");
+    let o = bin("hush-cli").args(["sweep", "level", "--width", "32", "--frames", "2", "--reference-frames", "2", "--out-dir"]).arg(&dir).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    // 2 scales x 2 denoisers x 3 path counts x 2 path lengths.
+    assert_eq!(rows.len(), 24, "{csv}");
+    assert!(rows.iter().any(|r| r[6] == "true"), "no Pareto point: {csv}");
+    for r in &rows {
+        let ms: f64 = r[4].parse().unwrap();
+        let flip: f64 = r[5].parse().unwrap();
+        assert!(ms > 0.0 && flip > 0.0 && flip < 1.0, "{r:?}");
+    }
+    assert_eq!(image_size(&dir.join("pareto.png")), (960, 640));
+}

@@ -320,6 +320,8 @@ impl Renderer {
             view: settings.view as u32,
             exposure: 2f32.powf(settings.exposure_ev.clamp(-30.0, 30.0)),
             accumulated: self.accumulated,
+            paths: settings.paths_per_pixel.clamp(1, 64),
+            _pad: [0; 3],
         };
         let view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
         let tp = make_params(&self.prepared, &view);

@@ -21,6 +21,8 @@ pub struct FrameParams {
     pub view: u32,
     pub exposure: f32,
     pub accumulated: u32,
+    pub paths: u32,
+    pub _pad: [u32; 3],
 }
 
 /// A camera in the GPU scene's rebased space, as both the raster and the tracer see it.

@@ -268,6 +268,7 @@ mod tests {
         assert_eq!(size as usize, size_of::<FrameParams>());
         assert_eq!(offs[7] as usize, offset_of!(FrameParams, jitter));
         assert_eq!(offs[12] as usize, offset_of!(FrameParams, accumulated));
+        assert_eq!(offs[13] as usize, offset_of!(FrameParams, paths));
         let taa = programs.iter().find(|p| p.label == "taa/taa.wgsl").unwrap();
         let (size, offs) = wgsl_layout(taa, "DenoiseParams");
         use crate::passes::matte::DenoiseParams;
