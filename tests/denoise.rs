@@ -31,9 +31,9 @@ fn mara() -> FrameSettings {
 
 /// After 30 frames of a still camera (cornell_diffuse, 256²), the denoised frame is much closer
 /// to the converged image (256 accumulated frames) than one raw frame. Measured: raw FLIP 0.158,
-/// relMSE 0.19; denoised about 0.085 and 0.004. The bounds (FLIP under 0.65x raw, relMSE under
-/// 0.05x raw) leave room for a different driver's rounding while failing for a chain that does
-/// not filter (FLIP stays at raw) or that is biased (relMSE rises). Knobs for tuning runs:
+/// relMSE 0.19; denoised 0.053 and 0.0028. The bounds (FLIP under 0.5x raw, relMSE under 0.05x
+/// raw) leave room for a different driver's rounding while failing for a chain that does not
+/// filter (FLIP stays at raw) or that is biased (a 4-sigma history clamp gave 0.081 and 0.0033). Knobs for tuning runs:
 /// HUSH_TEST_SIDE, HUSH_TEST_CONVERGED, HUSH_TEST_FRAMES, HUSH_TEST_DISABLE, HUSH_TEST_MATTE
 /// (JSON of MatteSettings), HUSH_TEST_ACC64, HUSH_TEST_IMAGES (a folder for the images).
 #[test]
@@ -65,7 +65,7 @@ fn denoised_frames_beat_raw_ones() {
             i.save(&std::path::Path::new(&dir).join(format!("{n}.png"))).unwrap();
         }
     }
-    assert!(m_dn.flip < 0.65 * m_raw.flip, "denoised FLIP {} is not under 0.65x the raw {}", m_dn.flip, m_raw.flip);
+    assert!(m_dn.flip < 0.5 * m_raw.flip, "denoised FLIP {} is not under half the raw {}", m_dn.flip, m_raw.flip);
     assert!(m_dn.relmse < 0.05 * m_raw.relmse, "denoised relMSE {} vs raw {}", m_dn.relmse, m_raw.relmse);
 }
 
