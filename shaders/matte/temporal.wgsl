@@ -56,45 +56,47 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let n_prev = max(textureLoad(history, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0).a, 1.0);
         n = min(n_prev + 1.0, 1024.0);
         let hist = finite_or_zero(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
-        // The current neighbourhood's mean and standard deviation: the paper's 3x3, plus 24
-        // sparse taps on the same surface within 4 pixels. At one sample per pixel an indirectly
-        // lit region is mostly zeros with rare bright samples; nine samples are then often all
-        // zero (sigma = 0), and clamping to them would erase a correct history every frame (the
-        // living room's interior came out 3x too dark). 33 samples rarely miss every bright one.
-        var m1 = vec3f(0.0);
-        var m2 = vec3f(0.0);
-        var count = 0.0;
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                let s = finite_or_zero(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1)));
+        var clamped = hist;
+        if dn.clamp_sigma > 0.0 {
+            // The current neighbourhood's mean and standard deviation: the paper's 3x3, plus 24
+            // sparse taps on the same surface within 4 pixels. At one sample per pixel an indirectly
+            // lit region is mostly zeros with rare bright samples; nine samples are then often all
+            // zero (sigma = 0), and clamping to them would erase a correct history every frame (the
+            // living room's interior came out 3x too dark). 33 samples rarely miss every bright one.
+            var m1 = vec3f(0.0);
+            var m2 = vec3f(0.0);
+            var count = 0.0;
+            for (var dy = -1; dy <= 1; dy++) {
+                for (var dx = -1; dx <= 1; dx++) {
+                    let s = finite_or_zero(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1)));
+                    m1 += s;
+                    m2 += s * s;
+                    count += 1.0;
+                }
+            }
+            let nc = oct_decode(textureLoad(gb_normal, p, 0).xy);
+            let fc = footprint(x);
+            for (var i = 0u; i < 24u; i++) {
+                let t = p + vec2i(round(spiral_tap(i, 24u, 4.0, p)));
+                if !in_bounds(t) || !has_surface(t) {
+                    continue;
+                }
+                if bilateral_weight(x, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
+                    continue;
+                }
+                let s = finite_or_zero(matte_input(t));
                 m1 += s;
                 m2 += s * s;
                 count += 1.0;
             }
-        }
-        let nc = oct_decode(textureLoad(gb_normal, p, 0).xy);
-        let fc = footprint(x);
-        for (var i = 0u; i < 24u; i++) {
-            let t = p + vec2i(round(spiral_tap(i, 24u, 4.0, p)));
-            if !in_bounds(t) || !has_surface(t) {
-                continue;
+            m1 /= count;
+            let sigma = sqrt(max(m2 / count - m1 * m1, vec3f(0.0)));
+            let lo = m1 - dn.clamp_sigma * sigma;
+            let hi = m1 + dn.clamp_sigma * sigma;
+            clamped = clamp(hist, lo, hi);
+            if any(clamped != hist) {
+                reason |= REASON_CLAMPED;
             }
-            if bilateral_weight(x, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
-                continue;
-            }
-            let s = finite_or_zero(matte_input(t));
-            m1 += s;
-            m2 += s * s;
-            count += 1.0;
-        }
-        m1 /= count;
-        let sigma = sqrt(max(m2 / count - m1 * m1, vec3f(0.0)));
-        let lo = m1 - dn.clamp_sigma * sigma;
-        let hi = m1 + dn.clamp_sigma * sigma;
-        // clamp_sigma = 0 switches the clamp off.
-        let clamped = select(clamp(hist, lo, hi), hist, dn.clamp_sigma <= 0.0);
-        if any(clamped != hist) {
-            reason |= REASON_CLAMPED;
         }
         result = mix(clamped, current, max(1.0 - c, 1.0 / n));
     }
