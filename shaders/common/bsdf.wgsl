@@ -80,6 +80,22 @@ struct BsdfEval {
     pdf: f32,
 }
 
+// The glossy lobe alone: F(h) D G / (4 cos_o) cos_i, and its visible-normal pdf (the real-time
+// trace estimates it separately from the matte lobe, Mara et al. eq. (8)).
+fn glossy_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
+    var r: BsdfEval;
+    r.f_cos = vec3f(0.0);
+    r.pdf = 0.0;
+    if wo.z <= 0.0 || wi.z <= 0.0 || b.delta {
+        return r;
+    }
+    let h = normalize(wi + wo);
+    let g = smith_g1(b.alpha, wo.z) * smith_g1(b.alpha, wi.z);
+    r.f_cos = fresnel(b, dot(wo, h)) * (ggx_d(b.alpha, h.z) * g / (4.0 * wo.z));
+    r.pdf = vndf_pdf(b.alpha, wo, h);
+    return r;
+}
+
 fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
     var r: BsdfEval;
     r.f_cos = vec3f(0.0);
@@ -90,13 +106,10 @@ fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
     let pg = glossy_probability(b, wo.z);
     r.f_cos = matte_weight(b, wo.z) * (INV_PI * wi.z);
     r.pdf = (1.0 - pg) * wi.z * INV_PI;
-    if !b.delta && pg > 0.0 {
-        let h = normalize(wi + wo);
-        let d = ggx_d(b.alpha, h.z);
-        let g = smith_g1(b.alpha, wo.z) * smith_g1(b.alpha, wi.z);
-        let f = fresnel(b, dot(wo, h));
-        r.f_cos += f * (d * g / (4.0 * wo.z));
-        r.pdf += pg * vndf_pdf(b.alpha, wo, h);
+    if pg > 0.0 {
+        let g = glossy_eval(b, wo, wi);
+        r.f_cos += g.f_cos;
+        r.pdf += pg * g.pdf;
     }
     return r;
 }

@@ -14,5 +14,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if stage_on(STAGE_BILATERAL) {
         v = sparse_bilateral(p, textureLoad(radius_in, p, 0).r);
     }
-    textureStore(out_matte, p, vec4f(finite_or_zero(v), 1.0));
+    textureStore(out_matte, p, vec4f(half_safe(v), 1.0));
 }

@@ -103,7 +103,7 @@ fn spiral_tap(i: u32, n: u32, r: f32, p: vec2i) -> vec2f {
     return d * vec2f(cos(a), sin(a));
 }
 
-// NaN and Inf become 0; finite values are clamped to what half floats hold.
+
 // The matte light entering the chain (with the test's fault injection, when asked for).
 fn matte_input(p: vec2i) -> vec3f {
     let v = textureLoad(tr_matte, p, 0).rgb;
@@ -118,8 +118,4 @@ fn matte_input(p: vec2i) -> vec3f {
         }
     }
     return v;
-}
-
-fn finite_or_zero(v: vec3f) -> vec3f {
-    return select(vec3f(0.0), clamp(v, vec3f(-65000.0), vec3f(65000.0)), v == v & abs(v) <= vec3f(3.0e38));
 }

@@ -16,5 +16,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         v = sparse_bilateral(p, dn.history_radius_px);
     }
     let n = f32(textureLoad(reason_in, p, 0).x >> 8u);
-    textureStore(out_history, p, vec4f(finite_or_zero(v), n));
+    textureStore(out_history, p, vec4f(half_safe(v), n));
 }

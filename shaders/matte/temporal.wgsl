@@ -21,7 +21,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !in_bounds(p) {
         return;
     }
-    let current = finite_or_zero(matte_input(p));
+    let current = half_safe(matte_input(p));
     if !has_surface(p) || !stage_on(STAGE_TEMPORAL) {
         textureStore(out_temporal, p, vec4f(current, 0.0));
         textureStore(out_reason, p, vec4u(select(0u, REASON_DISOCCLUDED, has_surface(p)) | (1u << 8u), 0u, 0u, 0u));
@@ -55,7 +55,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if c > 0.0 {
         let n_prev = max(textureLoad(history, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0).a, 1.0);
         n = min(n_prev + 1.0, 1024.0);
-        let hist = finite_or_zero(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        let hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
         var clamped = hist;
         if dn.clamp_sigma > 0.0 {
             // The current neighbourhood's mean and standard deviation: the paper's 3x3, plus 24
@@ -68,7 +68,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             var count = 0.0;
             for (var dy = -1; dy <= 1; dy++) {
                 for (var dx = -1; dx <= 1; dx++) {
-                    let s = finite_or_zero(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1)));
+                    let s = half_safe(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1)));
                     m1 += s;
                     m2 += s * s;
                     count += 1.0;
@@ -84,7 +84,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 if bilateral_weight(x, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
                     continue;
                 }
-                let s = finite_or_zero(matte_input(t));
+                let s = half_safe(matte_input(t));
                 m1 += s;
                 m2 += s * s;
                 count += 1.0;
@@ -100,6 +100,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         result = mix(clamped, current, max(1.0 - c, 1.0 / n));
     }
-    textureStore(out_temporal, p, vec4f(finite_or_zero(result), c));
+    textureStore(out_temporal, p, vec4f(half_safe(result), c));
     textureStore(out_reason, p, vec4u(reason | (u32(n) << 8u), 0u, 0u, 0u));
 }

@@ -38,21 +38,6 @@ fn sample_area_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
     return s;
 }
 
-// The glossy lobe alone: F(h) D G / (4 cos_o) cos_i, and its visible-normal pdf.
-fn glossy_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
-    var r: BsdfEval;
-    r.f_cos = vec3f(0.0);
-    r.pdf = 0.0;
-    if wo.z <= 0.0 || wi.z <= 0.0 || b.delta {
-        return r;
-    }
-    let h = normalize(wi + wo);
-    let g = smith_g1(b.alpha, wo.z) * smith_g1(b.alpha, wi.z);
-    r.f_cos = fresnel(b, dot(wo, h)) * (ggx_d(b.alpha, h.z) * g / (4.0 * wo.z));
-    r.pdf = vndf_pdf(b.alpha, wo, h);
-    return r;
-}
-
 fn write_all(px: vec2u, matte: vec3f, direct: vec3f) {
     textureStore(out_matte, px, vec4f(half_safe(matte), 1.0));
     textureStore(out_direct, px, vec4f(half_safe(direct), 1.0));

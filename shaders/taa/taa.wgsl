@@ -24,7 +24,7 @@ fn from_ycocg(c: vec3f) -> vec3f {
 
 fn hdr_at(p: vec2i) -> vec3f {
     let q = clamp(p, vec2i(0), vec2i(frame.size) - 1);
-    return finite_or_zero(hdr[u32(q.y) * frame.size.x + u32(q.x)].rgb);
+    return half_safe(hdr[u32(q.y) * frame.size.x + u32(q.x)].rgb);
 }
 
 @compute @workgroup_size(8, 8)
@@ -47,11 +47,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 hi = max(hi, s);
             }
         }
-        let hist = finite_or_zero(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        let hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
         let clamped = from_ycocg(clamp(to_ycocg(hist), lo, hi));
         result = mix(clamped, current, dn.taa_alpha);
     }
-    result = finite_or_zero(result);
+    result = half_safe(result);
     textureStore(out_history, p, vec4f(result, 1.0));
     final_image[u32(p.y) * frame.size.x + u32(p.x)] = vec4f(result, 1.0);
 }
