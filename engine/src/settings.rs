@@ -25,6 +25,13 @@ pub struct FrameSettings {
     pub paths_per_pixel: u32,
 }
 
+impl FrameSettings {
+    /// The multiplier 2^EV applied before tone mapping (EV clamped to +-30).
+    pub fn exposure_scale(&self) -> f32 {
+        2f32.powf(self.exposure_ev.clamp(-30.0, 30.0))
+    }
+}
+
 impl Default for FrameSettings {
     fn default() -> Self {
         FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::None, matte: MatteSettings::default(), paths_per_pixel: 1 }

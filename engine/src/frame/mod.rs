@@ -190,7 +190,7 @@ impl Renderer {
     pub fn report(&self) -> String {
         let f = &self.prepared.features;
         let (w, h) = self.targets.size;
-        let per_pixel = self.targets.memory.total_bytes() as f64 / (w as f64 * h as f64);
+        let per_pixel = self.bytes_per_pixel();
         let buffers = self.targets.memory.allocations.iter().map(|(l, b)| format!("{l}={b}")).collect::<Vec<_>>().join(" ");
         format!(
             "real-time frame {w}x{h}: passes gbuffer, trace ({}), composite, display; animated: {}; scene {} bytes, per-pixel targets {} bytes ({per_pixel:.0} B/pixel): {buffers}",
@@ -318,7 +318,7 @@ impl Renderer {
             size: [size.0, size.1],
             index: self.frame_index,
             view: settings.view as u32,
-            exposure: 2f32.powf(settings.exposure_ev.clamp(-30.0, 30.0)),
+            exposure: settings.exposure_scale(),
             accumulated: self.accumulated,
             paths: settings.paths_per_pixel.clamp(1, 64),
             _pad: [0; 3],
@@ -329,13 +329,8 @@ impl Renderer {
         gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
 
         self.denoised_last = denoise;
-        if let Some(&DisplayTarget { format, size: tsize, .. }) = target {
-            if self.display.as_ref().is_none_or(|d| d.format != format || d.with_denoise != self.targets.matte.is_some()) {
-                let fb = self.frame_buffers();
-                self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, format).context("creating the display pass")?);
-            }
-            let srgb = !format.is_srgb() as u32;
-            gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, tsize.0, tsize.1]));
+        if let Some(target) = target {
+            self.prepare_display(gpu, target)?;
         }
 
         let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
@@ -375,12 +370,7 @@ impl Renderer {
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
             chain.record(gpu, &mut enc, chain_key, inputs, parity, size, true, self.timer.as_mut());
         }
-        let shown = FrameBuffers {
-            hdr: t.matte.as_ref().filter(|_| denoise).map_or(&t.hdr, |m| &m.final_image),
-            matte: &t.trace.matte.1,
-            denoise: t.matte.as_ref(),
-            ..fb
-        };
+        let shown = shown_buffers(t, &self.frame_buf, &self.display_buf, &self.no_accumulation, denoise);
         if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
             d.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &shown, target.view, self.timer.as_mut());
         }
@@ -415,29 +405,13 @@ impl Renderer {
     /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
     pub fn redisplay(&mut self, gpu: &Gpu, settings: &FrameSettings, target: &DisplayTarget) -> Result<()> {
         gpu.validated("displaying the frame", || {
-            if self.display.as_ref().is_none_or(|d| d.format != target.format || d.with_denoise != self.targets.matte.is_some()) {
-                let fb = self.frame_buffers();
-                self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, target.format)?);
-            }
+            self.prepare_display(gpu, target)?;
             // Only the view and exposure change; the rest of the uniform is the last frame's.
-            let mut fp: FrameParams = bytemuck::Zeroable::zeroed();
-            fp.view = settings.view as u32;
-            fp.exposure = 2f32.powf(settings.exposure_ev.clamp(-30.0, 30.0));
-            let off = std::mem::offset_of!(FrameParams, view) as u64;
-            gpu.queue.write_buffer(&self.frame_buf, off, bytemuck::cast_slice(&[fp.view]));
-            gpu.queue.write_buffer(&self.frame_buf, off + 4, bytemuck::cast_slice(&[fp.exposure]));
-            let srgb = !target.format.is_srgb() as u32;
-            gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, target.size.0, target.size.1]));
+            gpu.queue.write_buffer(&self.frame_buf, std::mem::offset_of!(FrameParams, view) as u64, bytemuck::bytes_of(&(settings.view as u32)));
+            gpu.queue.write_buffer(&self.frame_buf, std::mem::offset_of!(FrameParams, exposure) as u64, bytemuck::bytes_of(&settings.exposure_scale()));
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             let t = &self.targets;
-            let fb = FrameBuffers {
-                frame: &self.frame_buf,
-                hdr: t.matte.as_ref().filter(|_| self.denoised_last).map_or(&t.hdr, |m| &m.final_image),
-                accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation),
-                display: &self.display_buf,
-                matte: &t.trace.matte.1,
-                denoise: t.matte.as_ref(),
-            };
+            let fb = shown_buffers(t, &self.frame_buf, &self.display_buf, &self.no_accumulation, self.denoised_last);
             if let Some(d) = self.display.as_mut() {
                 d.record(gpu, &mut enc, t.generation * 2 + self.denoised_last as u64, &t.gbuffer, &t.trace, &fb, target.view, None);
             }
@@ -466,16 +440,16 @@ impl Renderer {
         image::RgbaImage::from_raw(w, h, bytes).context("display image has the wrong size")
     }
 
-    fn frame_buffers(&self) -> FrameBuffers<'_> {
-        let t = &self.targets;
-        FrameBuffers {
-            frame: &self.frame_buf,
-            hdr: t.matte.as_ref().filter(|_| self.denoised_last).map_or(&t.hdr, |m| &m.final_image),
-            accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation),
-            display: &self.display_buf,
-            matte: &t.trace.matte.1,
-            denoise: t.matte.as_ref(),
+    /// Make the display pass for `target`'s format (again when the denoiser's views appeared)
+    /// and write its options.
+    fn prepare_display(&mut self, gpu: &Gpu, target: &DisplayTarget) -> Result<()> {
+        if self.display.as_ref().is_none_or(|d| d.format != target.format || d.with_denoise != self.targets.matte.is_some()) {
+            let fb = shown_buffers(&self.targets, &self.frame_buf, &self.display_buf, &self.no_accumulation, self.denoised_last);
+            self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, target.format).context("creating the display pass")?);
         }
+        let srgb = !target.format.is_srgb() as u32;
+        gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, target.size.0, target.size.1]));
+        Ok(())
     }
 
     /// GPU milliseconds per pass of the last frame (blocks until it finished); empty without
@@ -544,6 +518,19 @@ impl Renderer {
             }
         };
         Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
+    }
+}
+
+/// What the display reads: the image after TAA when the denoiser ran, else the composite's;
+/// the raw matte light; the denoiser's intermediates for its views.
+fn shown_buffers<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, display: &'a wgpu::Buffer, no_accumulation: &'a wgpu::Buffer, denoised: bool) -> FrameBuffers<'a> {
+    FrameBuffers {
+        frame,
+        hdr: t.matte.as_ref().filter(|_| denoised).map_or(&t.hdr, |m| &m.final_image),
+        accumulation: t.accumulation.as_ref().unwrap_or(no_accumulation),
+        display,
+        matte: &t.trace.matte.1,
+        denoise: t.matte.as_ref(),
     }
 }
 

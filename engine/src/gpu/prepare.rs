@@ -111,8 +111,6 @@ pub struct PreparedScene {
     pub tex_data: Vec<u32>,
     /// Input triangles dropped: non-finite vertices or zero area.
     pub dropped_triangles: usize,
-    /// Per material: emits light.
-    emissive_materials: Vec<bool>,
     /// Per object: its world transform at `time`, and the rebased transform taking a point on
     /// it now to where it was at the previous `animate` call.
     world: Vec<DMat4>,
@@ -223,7 +221,6 @@ impl PreparedScene {
         };
         let tex_data = pack_textures(scene);
         let alpha_mask = scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_)));
-        let emissive: Vec<bool> = scene.materials.iter().map(|m| crate::quality::luminance(m.emission) > 0.0).collect();
         // Only materials some object uses count (importers append an unused default material).
         let used: std::collections::HashSet<usize> = scene.objects.iter().map(|o| scene.meshes[o.mesh].material as usize).collect();
         let glossy = scene.materials.iter().enumerate().filter(|(i, _)| used.contains(i)).any(|(_, m)| {
@@ -248,7 +245,6 @@ impl PreparedScene {
             shading: vec![],
             tangents: vec![],
             materials,
-            emissive_materials: emissive,
             lights,
             emitters: vec![],
             emit_inv_total: 0.0,
@@ -328,11 +324,11 @@ impl PreparedScene {
         let mut weights = vec![];
         for (slot, &orig) in accel.order.iter().enumerate() {
             let m = mats[orig as usize] as usize;
-            if self.emissive_materials.get(m).copied().unwrap_or(false) {
+            let lum = self.materials.get(m).map_or(0.0, |m| crate::quality::luminance(Vec3::from_slice(&m.emission)));
+            if lum > 0.0 {
                 let t = &tris_in[orig as usize];
                 let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
-                let lum = crate::quality::luminance(Vec3::from_slice(&self.materials[m].emission)) as f64;
-                weights.push(area * lum);
+                weights.push(area * lum as f64);
                 emitters.push([0u32, slot as u32]);
             }
         }
