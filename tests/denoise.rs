@@ -6,6 +6,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::quality::{Image, compare};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
+use hush_tests::half;
 
 const SIZE: (u32, u32) = (96, 54);
 
@@ -114,7 +115,6 @@ fn history_resets_on_disocclusion() {
     let read = |n: &str| r.read_texture(&gpu, n).unwrap().0;
     let (depth1, reason, motion, temporal, input) = (read("gbuffer/depth"), read("matte/reason"), read("gbuffer/motion"), read("matte/temporal"), read("trace/matte"));
     let f32_at = |b: &[u8], i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
-    let half = |b: &[u8]| half::f16::from_le_bytes([b[0], b[1]]).to_f32();
     let (w, h) = (SIZE.0 as i64, SIZE.1 as i64);
     let world = |inv: &glam::Mat4, x: i64, y: i64, d: f32| {
         let ndc = glam::Vec4::new((x as f32 + 0.5) / w as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h as f32 * 2.0, d, 1.0);

@@ -14,9 +14,9 @@
 //!   the oracle measured between two independent Mitsuba renders at 256 spp (its README), as the
 //!   README asks: never tighter than the references' own noise.
 
-use hush_engine::quality::{Image, compare, luminance};
+use hush_engine::quality::{Image, compare};
 use hush_engine::scene::load_gltf;
-use hush_tests::{oracle, render};
+use hush_tests::{oracle, render, trimmed_bias};
 
 const RELMSE_SLACK: f64 = 3.0;
 
@@ -49,23 +49,9 @@ fn parity(c: Case) {
     }
     expected /= (3 * reference.data.len()) as f64;
 
-    // Trimmed per-channel bias and its standard error.
-    let n = reference.data.len();
-    let mut diffs: Vec<(f32, usize)> = (0..n).map(|i| ((luminance(acc.mean.data[i]) - luminance(reference.data[i])).abs(), i)).collect();
-    diffs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let keep: Vec<usize> = diffs[..n - n / 1000 - 1].iter().map(|d| d.1).collect();
-    let mut bias = [0f64; 3];
-    let mut allowed = [0f64; 3];
-    for k in 0..3 {
-        let (mut sx, mut sy, mut var) = (0f64, 0f64, 0f64);
-        for &i in &keep {
-            sx += acc.mean.data[i][k] as f64;
-            sy += reference.data[i][k] as f64;
-            var += acc.variance_of_mean.data[i][k] as f64 * (1.0 + ref_share);
-        }
-        bias[k] = (sx - sy) / sy;
-        allowed[k] = (5.0 * var.sqrt() / sy).max(c.mitsuba_bias_256);
-    }
+    // Trimmed per-channel bias and its standard error; never tighter than the oracle's own bias.
+    let (bias, five_se) = trimmed_bias(&acc.mean, &reference, |i, k| acc.variance_of_mean.data[i][k] as f64 * (1.0 + ref_share));
+    let allowed = five_se.map(|a| a.max(c.mitsuba_bias_256));
     println!(
         "{}: {}x{} {} spp (reference {} spp, box /{}): relMSE {:.5} (noise predicts {:.5}), FLIP {:.4}, SSIM {:.4}, \
          RMSE {:.4}, mean bias {:+.4} {:+.4} {:+.4}, trimmed bias {:+.4} {:+.4} {:+.4} (allowed {:.4} {:.4} {:.4})",

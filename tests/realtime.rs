@@ -7,7 +7,7 @@ use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::quality::Image;
 use hush_engine::scene::{Camera, load_gltf};
 use hush_engine::settings::FrameSettings;
-use hush_tests::{oracle, realtime_accumulate, render};
+use hush_tests::{half, oracle, realtime_accumulate, render, trimmed_bias};
 
 /// Accumulated real-time frames converge to the reference tracer's image. The real-time frame
 /// samples the same integral with a different structure (exhaustive punctual lights, separate
@@ -30,7 +30,6 @@ fn converges(name: &str, size: u32, frames: u32, spp: u32) {
         rt.data[i] = (a.data[i] + b.data[i]) * 0.5;
     }
     let (mut relmse, mut expected) = (0f64, 0f64);
-    let mut diffs: Vec<(f32, usize)> = vec![];
     for i in 0..n {
         let y = reference.mean.data[i];
         for k in 0..3 {
@@ -41,24 +40,10 @@ fn converges(name: &str, size: u32, frames: u32, spp: u32) {
             expected += (var_rt + reference.variance_of_mean.data[i][k] as f64) * w;
         }
         assert!(rt.data[i].is_finite(), "{name}: non-finite pixel {i}");
-        diffs.push(((rt.data[i] - y).abs().max_element(), i));
     }
     relmse /= (3 * n) as f64;
     expected /= (3 * n) as f64;
-    diffs.sort_by(|p, q| p.0.total_cmp(&q.0));
-    let keep: Vec<usize> = diffs[..n - n / 1000 - 1].iter().map(|d| d.1).collect();
-    let mut bias = [0f64; 3];
-    let mut allowed = [0f64; 3];
-    for k in 0..3 {
-        let (mut sx, mut sy, mut var) = (0f64, 0f64, 0f64);
-        for &i in &keep {
-            sx += rt.data[i][k] as f64;
-            sy += reference.mean.data[i][k] as f64;
-            var += ((a.data[i][k] - b.data[i][k]) as f64).powi(2) / 4.0 + reference.variance_of_mean.data[i][k] as f64;
-        }
-        bias[k] = (sx - sy) / sy;
-        allowed[k] = 5.0 * var.sqrt() / sy;
-    }
+    let (bias, allowed) = trimmed_bias(&rt, &reference.mean, |i, k| ((a.data[i][k] - b.data[i][k]) as f64).powi(2) / 4.0 + reference.variance_of_mean.data[i][k] as f64);
     println!(
         "{name}: {size}x{size}, {frames} real-time frames vs {spp} reference spp: relMSE {relmse:.5} (noise predicts {expected:.5}), \
          trimmed bias {:+.4} {:+.4} {:+.4} (allowed {:.4} {:.4} {:.4})",
@@ -101,10 +86,6 @@ fn a_diffuse_only_scene_allocates_no_glossy_buffers() {
     assert!(r.read_texture(&gpu, "trace/glossy").is_err());
     let img = r.read_hdr(&gpu).unwrap();
     assert!(img.data.iter().all(|p| p.is_finite()) && img.data.iter().any(|p| p.max_element() > 0.0));
-}
-
-fn half(b: &[u8]) -> f32 {
-    half::f16::from_le_bytes([b[0], b[1]]).to_f32()
 }
 
 fn project(vp: &Mat4, p: Vec3, size: (u32, u32)) -> Vec2 {

@@ -53,3 +53,33 @@ pub fn realtime_accumulate(scene: &Scene, w: u32, h: u32, frames: u32, seed: u32
     }
     r.read_hdr(&gpu)
 }
+
+/// Per-channel relative mean bias of `test` against `reference` after leaving out the 0.1% of
+/// pixels whose luminances differ most (caustic and highlight pixels whose means a few rare
+/// samples dominate), and 5 standard errors of it: `variance(i, k)` is the variance of pixel
+/// i's difference in channel k.
+pub fn trimmed_bias(test: &hush_engine::quality::Image, reference: &hush_engine::quality::Image, variance: impl Fn(usize, usize) -> f64) -> ([f64; 3], [f64; 3]) {
+    use hush_engine::quality::luminance;
+    let n = reference.data.len();
+    let mut diffs: Vec<(f32, usize)> = (0..n).map(|i| ((luminance(test.data[i]) - luminance(reference.data[i])).abs(), i)).collect();
+    diffs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let keep: Vec<usize> = diffs[..n - n / 1000 - 1].iter().map(|d| d.1).collect();
+    let mut bias = [0f64; 3];
+    let mut five_se = [0f64; 3];
+    for k in 0..3 {
+        let (mut sx, mut sy, mut var) = (0f64, 0f64, 0f64);
+        for &i in &keep {
+            sx += test.data[i][k] as f64;
+            sy += reference.data[i][k] as f64;
+            var += variance(i, k);
+        }
+        bias[k] = (sx - sy) / sy;
+        five_se[k] = 5.0 * var.sqrt() / sy;
+    }
+    (bias, five_se)
+}
+
+/// A little-endian IEEE half (Rg16Float / Rgba16Float texels read back) as f32.
+pub fn half(b: &[u8]) -> f32 {
+    half::f16::from_le_bytes([b[0], b[1]]).to_f32()
+}
