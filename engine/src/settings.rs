@@ -20,6 +20,7 @@ pub struct FrameSettings {
     pub view: View,
     pub denoiser: Denoiser,
     pub matte: MatteSettings,
+    pub glossy: GlossySettings,
     /// Indirect paths per pixel per frame (each of the matte and glossy estimators, and the
     /// area-light sample, is averaged over them). 1 is the paper's real-time setting.
     pub paths_per_pixel: u32,
@@ -34,7 +35,7 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::None, matte: MatteSettings::default(), paths_per_pixel: 1 }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::None, matte: MatteSettings::default(), glossy: GlossySettings::default(), paths_per_pixel: 1 }
     }
 }
 
@@ -124,7 +125,8 @@ impl Default for MatteSettings {
 }
 
 impl MatteSettings {
-    /// Names accepted by `--disable` and shown in the viewer.
+    /// Names accepted by `--disable` and shown in the viewer (the glossy chain's are in
+    /// [`GlossySettings::STAGES`]).
     pub const STAGES: [&str; 6] = ["matte.temporal", "matte.history_bilateral", "matte.disocclusion", "matte.firefly", "matte.bilateral", "taa"];
 
     /// Turn a stage off by name; false for an unknown name.
@@ -150,4 +152,151 @@ impl MatteSettings {
             .map(|(i, on)| (*on as u32) << i)
             .sum()
     }
+}
+
+/// How the glossy chain finds where a reflection was in the previous frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ReflectionMv {
+    /// Surface motion vectors only (the SVGF baseline: reflections smear under motion).
+    Primary,
+    /// Mara et al. §3.4 after Zimmer et al. 2015: reproject the virtual position of what the
+    /// reflection shows (primary hit + secondary hit distance along the camera ray).
+    Virtual,
+    /// Voorhuis §4.1-4.2.1 and Appendix A: diamond search of the previous frame's reflected hit
+    /// positions.
+    #[default]
+    Diamond,
+}
+
+impl ReflectionMv {
+    pub const ALL: [ReflectionMv; 3] = [ReflectionMv::Primary, ReflectionMv::Virtual, ReflectionMv::Diamond];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ReflectionMv::Primary => "primary",
+            ReflectionMv::Virtual => "virtual",
+            ReflectionMv::Diamond => "diamond",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<ReflectionMv> {
+        Self::ALL.into_iter().find(|m| m.name() == s)
+    }
+}
+
+/// The glossy chain: Mara et al. 2017 §3.4 stages 8-10 with the reflection reprojection and
+/// neighbourhood clipping of Voorhuis §4.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct GlossySettings {
+    /// Stage switches. Without `temporal` nothing is reprojected (Voorhuis's "NoSpecReproj").
+    pub temporal: bool,
+    /// Neighbourhood clipping of the reprojected history (Voorhuis §4.2.3).
+    pub clipping: bool,
+    /// The separable bilateral (stages 9 and 10).
+    pub bilateral: bool,
+    pub reflection_mv: ReflectionMv,
+    /// Below this roughness reflections are reprojected with reflection motion vectors; above it
+    /// with the surface's (Voorhuis §4.2.1: 0.4).
+    pub roughness_threshold: f32,
+    /// At or below this roughness a surface is a mirror: its chain matches exact reflected hit
+    /// positions (eq. 1), filters with the reflected surface's normal and demodulates by its
+    /// reflectance (§4.1). Above it, the representative-ray distance of eq. (4)-(5).
+    pub mirror_roughness: f32,
+    /// Neighbourhood clipping applies below this roughness (§4.2.3: 0.9).
+    pub clip_roughness: f32,
+    /// Hysteresis h, as the matte temporal's (Mara: the same confidence and clamping).
+    pub hysteresis: f32,
+    /// First step of the diamond search's large pattern, pixels (Appendix A: 4; 1 = no LDSP
+    /// scaling).
+    pub initial_step: u32,
+    /// Most large-pattern iterations per pixel (bounds the search's cost).
+    pub max_search_steps: u32,
+    /// Eq. (11)'s d0, d1 for mirrors, in pixel footprints at the reflected distance.
+    pub d0_px: f32,
+    pub d1_px: f32,
+    /// Bilateral sigma = scale x roughness^exponent + epsilon pixels (Mara: 7, 0.1, epsilon).
+    /// Epsilon is 1 px so that mirrors (roughness 0) are still filtered, across the reflected
+    /// surface's features.
+    pub sigma_scale: f32,
+    pub sigma_exponent: f32,
+    pub sigma_epsilon_px: f32,
+    /// Voorhuis eq. (6)'s omega, with the ray differential at the secondary hit measured in
+    /// pixel footprints of the primary surface (scale-free, unlike the paper's world units):
+    /// sigma is multiplied by exp(-footprints / omega) below the roughness threshold.
+    pub ray_differential_omega: f32,
+    /// Bilateral weight on roughness differences: exp(-(dr / sigma)^2).
+    pub roughness_sigma: f32,
+    /// Measurements only: also run a brute-force search over a window of this radius (pixels)
+    /// and report the diamond search's distance to it in the search view (0: off).
+    #[serde(skip)]
+    pub reference_search_radius: u32,
+}
+
+impl Default for GlossySettings {
+    fn default() -> Self {
+        GlossySettings {
+            temporal: true,
+            clipping: true,
+            bilateral: true,
+            reflection_mv: ReflectionMv::Diamond,
+            roughness_threshold: 0.4,
+            mirror_roughness: 0.01,
+            clip_roughness: 0.9,
+            hysteresis: 0.98,
+            initial_step: 4,
+            max_search_steps: 32,
+            d0_px: 2.0,
+            d1_px: 4.0,
+            sigma_scale: 7.0,
+            sigma_exponent: 0.1,
+            sigma_epsilon_px: 1.0,
+            ray_differential_omega: 16.0,
+            roughness_sigma: 0.1,
+            reference_search_radius: 0,
+        }
+    }
+}
+
+impl GlossySettings {
+    pub const STAGES: [&str; 3] = ["glossy.temporal", "glossy.clipping", "glossy.bilateral"];
+
+    pub fn disable(&mut self, name: &str) -> bool {
+        let f = match name {
+            "glossy.temporal" => &mut self.temporal,
+            "glossy.clipping" => &mut self.clipping,
+            "glossy.bilateral" => &mut self.bilateral,
+            _ => return false,
+        };
+        *f = false;
+        true
+    }
+
+    /// Stage bits as shaders/glossy/common.wgsl reads them.
+    pub fn stage_bits(&self) -> u32 {
+        self.temporal as u32 | (self.clipping as u32) << 1 | (self.bilateral as u32) << 2
+    }
+
+    /// The glossy bilateral's Gaussian sigma in pixels: Mara et al. §3.4's 7 r^0.1 + epsilon,
+    /// times Voorhuis eq. (6)'s exp(-dP / omega) below the roughness threshold, where
+    /// `footprints` is the secondary hit's ray differential in primary pixel footprints.
+    /// shaders/glossy/common.wgsl's glossy_sigma is the same function.
+    pub fn sigma_px(&self, roughness: f32, footprints: f32) -> f32 {
+        let base = self.sigma_scale * roughness.clamp(0.0, 1.0).powf(self.sigma_exponent) + self.sigma_epsilon_px;
+        let scale = if roughness < self.roughness_threshold { (-footprints.max(0.0) / self.ray_differential_omega.max(1e-3)).exp() } else { 1.0 };
+        (base * scale).clamp(0.0, MAX_GLOSSY_SIGMA_PX)
+    }
+}
+
+/// Largest glossy bilateral sigma, pixels (the kernel reaches 2.5 sigma).
+pub const MAX_GLOSSY_SIGMA_PX: f32 = 9.0;
+
+/// Disable a stage of either chain by its `--disable` name; false for an unknown name.
+pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
+    s.matte.disable(name) || s.glossy.disable(name)
+}
+
+/// Every stage name `--disable` accepts.
+pub fn stage_names() -> Vec<&'static str> {
+    MatteSettings::STAGES.iter().chain(GlossySettings::STAGES.iter()).copied().collect()
 }

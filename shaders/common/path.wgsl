@@ -54,6 +54,11 @@ fn camera_path(ro: vec3f, rd: vec3f) -> PathStart {
 struct PathResult {
     radiance: vec3f,
     first_t: f32,
+    // The first hit's reflectance (matte albedo + F0) and shading normal: the features of the
+    // first non-specular hit that the glossy chain uses behind a mirror (Voorhuis §4.1). A miss
+    // reports reflectance 1 and the normal facing back along the ray.
+    first_reflectance: vec3f,
+    first_normal: vec3f,
 }
 
 fn trace_path(start: PathStart, rng: ptr<function, u32>) -> PathResult {
@@ -68,6 +73,8 @@ fn trace_path(start: PathStart, rng: ptr<function, u32>) -> PathResult {
     var prev_pdf = start.prev_pdf;
     var prev_delta = start.prev_delta;
     var first_t = -1.0;
+    var first_reflectance = vec3f(1.0);
+    var first_normal = -start.rd;
     var prev_select = start.nee_select;
     loop {
         if !depth_ok(segments) {
@@ -96,6 +103,11 @@ fn trace_path(start: PathStart, rng: ptr<function, u32>) -> PathResult {
         }
         let ms = material_at(m, s.uv);
         let emission = ms.emission;
+        if segments == start.segments {
+            let b = material_bsdf(m, ms);
+            first_reflectance = min(b.albedo + b.f0, vec3f(1.0));
+            first_normal = s.ns;
+        }
         if s.front && max3(emission) > 0.0 {
             var w = 1.0;
             if !prev_delta {
@@ -163,6 +175,6 @@ fn trace_path(start: PathStart, rng: ptr<function, u32>) -> PathResult {
             beta /= q;
         }
     }
-    return PathResult(radiance, select(first_t, INF, first_t < 0.0));
+    return PathResult(radiance, select(first_t, INF, first_t < 0.0), first_reflectance, first_normal);
 }
 

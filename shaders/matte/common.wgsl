@@ -119,3 +119,16 @@ fn matte_input(p: vec2i) -> vec3f {
     }
     return v;
 }
+
+// YCoCg, where TAA's box and the glossy chain's neighbourhood clip are drawn (Karis 2014).
+fn to_ycocg(c: vec3f) -> vec3f {
+    return vec3f(
+        0.25 * c.r + 0.5 * c.g + 0.25 * c.b,
+        0.5 * c.r - 0.5 * c.b,
+        -0.25 * c.r + 0.5 * c.g - 0.25 * c.b,
+    );
+}
+
+fn from_ycocg(c: vec3f) -> vec3f {
+    return vec3f(c.x + c.y - c.z, c.x + c.z, c.x - c.y - c.z);
+}

@@ -40,7 +40,7 @@ fn denoise_view(view: u32, p: vec2i) -> vec4f {
             return vec4f(textureLoad(dv_denoised, p, 0).rgb, 1.0);
         }
         default: {
-            return vec4f(0.0);
+            return glossy_chain_view(view, p);
         }
     }
 }

@@ -57,7 +57,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if slot == NO_HIT {
         // Background: what the camera sees of the environment goes straight to the screen.
         write_all(px, vec3f(0.0), env_radiance(rd));
-        write_glossy(px, vec3f(0.0), INF, rd, rd);
+        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd);
         return;
     }
     // Exact barycentrics of this frame's camera ray on the rasterised triangle (no bounds test:
@@ -74,7 +74,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let m = materials[s.material];
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         write_all(px, vec3f(0.0), vec3f(0.0));
-        write_glossy(px, vec3f(0.0), INF, rd, rd);
+        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd);
         return;
     }
     let ms = material_at(m, s.uv);
@@ -91,9 +91,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var glossy = vec3f(0.0);
     var direct = vec3f(0.0);
     var glossy_t = INF;
+    var hit_reflectance = vec3f(1.0);
+    var hit_normal = -mirror;
     if !depth_ok(2) || wo.z <= 0.0 {
         write_all(px, matte, direct);
-        write_glossy(px, glossy, glossy_t, rd * hit.t, mirror);
+        write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal);
         return;
     }
 
@@ -169,6 +171,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 let r = trace_path(start, &rng);
                 glossy += r.radiance;
                 glossy_t = r.first_t;
+                hit_reflectance = r.first_reflectance;
+                hit_normal = r.first_normal;
             }
         }
     }
@@ -176,5 +180,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     glossy /= f32(paths);
 
     write_all(px, matte, direct);
-    write_glossy(px, glossy, glossy_t, rd * hit.t, mirror);
+    write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal);
 }

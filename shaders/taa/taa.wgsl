@@ -10,18 +10,6 @@
 @group(0) @binding(50) var out_history: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(54) var<storage, read_write> final_image: array<vec4f>;
 
-fn to_ycocg(c: vec3f) -> vec3f {
-    return vec3f(
-        0.25 * c.r + 0.5 * c.g + 0.25 * c.b,
-        0.5 * c.r - 0.5 * c.b,
-        -0.25 * c.r + 0.5 * c.g - 0.25 * c.b,
-    );
-}
-
-fn from_ycocg(c: vec3f) -> vec3f {
-    return vec3f(c.x + c.y - c.z, c.x + c.z, c.x - c.y - c.z);
-}
-
 fn hdr_at(p: vec2i) -> vec3f {
     let q = clamp(p, vec2i(0), vec2i(frame.size) - 1);
     return half_safe(hdr[u32(q.y) * frame.size.x + u32(q.x)].rgb);

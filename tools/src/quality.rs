@@ -6,7 +6,7 @@
 //! absolute luminance change between consecutive frames) and quality.png. `--ablations` repeats
 //! the denoised stream with each stage off and writes ablations.csv.
 
-use crate::realtime::parse_denoiser;
+use crate::realtime::denoiser_settings;
 use crate::render::{bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -14,7 +14,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::quality::{Image, compare, luminance};
 use hush_engine::scene::{CameraPath, Scene};
-use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
+use hush_engine::settings::{Denoiser, FrameSettings, stage_names};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -34,6 +34,9 @@ pub struct QualityArgs {
     /// Stages to switch off (see `render --disable`).
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
+    /// Reflection motion vectors of the glossy chain (see `render --reflection-mv`).
+    #[arg(long, default_value = "diamond")]
+    pub reflection_mv: String,
     /// Frames accumulated for each frame's reference.
     #[arg(long, default_value_t = 256)]
     pub reference_frames: u32,
@@ -122,13 +125,8 @@ pub fn run(a: QualityArgs) -> Result<()> {
     if a.frames == 0 || a.reference_frames == 0 {
         bail!("--frames and --reference-frames must be at least 1");
     }
-    let denoiser = parse_denoiser(&a.denoiser)?;
-    let mut matte = MatteSettings::default();
-    for stage in &a.disable {
-        if !matte.disable(stage) {
-            bail!("--disable {stage:?}: the stages are {}", MatteSettings::STAGES.join(", "));
-        }
-    }
+    let chains = denoiser_settings(&a.denoiser, &a.disable, &a.reflection_mv)?;
+    let denoiser = chains.denoiser;
     let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
     let size = image_size(&scene, Some(a.width), a.height);
     let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
@@ -170,7 +168,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let flip64 = compare(&refr.read_hdr(&s.gpu)?, &references[references.len() - 1])?.flip;
     drop(refr);
 
-    let base = FrameSettings { seed: a.seed, max_depth: s.scene.max_depth, denoiser, matte: matte.clone(), ..Default::default() };
+    let base = FrameSettings { seed: a.seed, max_depth: s.scene.max_depth, ..chains };
     let (den, last) = stream(&s, &base, &references)?;
     let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::None, ..base.clone() }, &references)?;
     if let (Some(d), Some(r), Some(f)) = (last.first(), last_raw.first(), references.last()) {
@@ -205,10 +203,10 @@ pub fn run(a: QualityArgs) -> Result<()> {
             Ok(())
         };
         row("nothing", &den)?;
-        for stage in MatteSettings::STAGES {
-            let mut m = matte.clone();
-            m.disable(stage);
-            let (sc, _) = stream(&s, &FrameSettings { matte: m, ..base.clone() }, &references)?;
+        for stage in stage_names() {
+            let mut settings = base.clone();
+            hush_engine::settings::disable_stage(&mut settings, stage);
+            let (sc, _) = stream(&s, &settings, &references)?;
             row(stage, &sc)?;
         }
     }

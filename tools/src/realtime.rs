@@ -4,7 +4,7 @@ use crate::render::{RenderArgs, bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::scene::CameraPath;
-use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
+use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv, disable_stage, stage_names};
 
 pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
     match s {
@@ -14,14 +14,20 @@ pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
     }
 }
 
-pub fn run(a: RenderArgs) -> Result<()> {
-    let denoiser = parse_denoiser(&a.denoiser)?;
-    let mut matte = MatteSettings::default();
-    for stage in &a.disable {
-        if !matte.disable(stage) {
-            bail!("--disable {stage:?}: the stages are {}", MatteSettings::STAGES.join(", "));
+/// `--denoiser`, `--disable` and `--reflection-mv` applied to default settings.
+pub fn denoiser_settings(denoiser: &str, disable: &[String], reflection_mv: &str) -> Result<FrameSettings> {
+    let mut s = FrameSettings { denoiser: parse_denoiser(denoiser)?, ..Default::default() };
+    for stage in disable {
+        if !disable_stage(&mut s, stage) {
+            bail!("--disable {stage:?}: the stages are {}", stage_names().join(", "));
         }
     }
+    s.glossy.reflection_mv = ReflectionMv::parse(reflection_mv).with_context(|| format!("--reflection-mv {reflection_mv:?}: use diamond, virtual or primary"))?;
+    Ok(s)
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    let chains = denoiser_settings(&a.denoiser, &a.disable, &a.reflection_mv)?;
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
@@ -41,7 +47,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.accumulate && path.is_some() {
         bail!("--accumulate needs a still camera; it cannot be combined with --camera-path");
     }
-    let settings = FrameSettings { max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, accumulate: a.accumulate, denoiser, matte, ..Default::default() };
+    let settings = FrameSettings { max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, accumulate: a.accumulate, ..chains };
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;

@@ -24,9 +24,14 @@ pub struct RenderArgs {
     #[arg(long, default_value = "none")]
     pub denoiser: String,
     /// Real-time mode: denoiser stages to switch off, comma-separated (matte.temporal,
-    /// matte.history_bilateral, matte.disocclusion, matte.firefly, matte.bilateral, taa).
+    /// matte.history_bilateral, matte.disocclusion, matte.firefly, matte.bilateral, taa,
+    /// glossy.temporal, glossy.clipping, glossy.bilateral).
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
+    /// Real-time mode: how the glossy chain reprojects reflections: diamond (Voorhuis's search),
+    /// virtual (Mara's virtual position) or primary (surface motion only).
+    #[arg(long, default_value = "diamond")]
+    pub reflection_mv: String,
     /// Real-time mode: sum all frames with a still camera and write their mean.
     #[arg(long)]
     pub accumulate: bool,
@@ -101,12 +106,9 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
 }
 
 pub fn load_scene(path: &str, max_texture_size: u32) -> Result<Scene> {
-    let mut scene = if path == "default" {
-        hush_engine::scene::default_scene()
-    } else if path == "level" {
-        hush_engine::scene::default_level()
-    } else {
-        hush_engine::scene::load_gltf_with(std::path::Path::new(path), max_texture_size)?
+    let mut scene = match hush_engine::scene::builtin_scene(path) {
+        Some(s) => s,
+        None => hush_engine::scene::load_gltf_with(std::path::Path::new(path), max_texture_size)?,
     };
     scene.add_sun_and_sky_if_unlit();
     Ok(scene)

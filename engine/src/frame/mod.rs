@@ -11,6 +11,7 @@ pub use views::View;
 use crate::accel::BvhKind;
 use crate::gpu::{Gpu, GpuMemory, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
 use crate::passes::composite::{CompositePass, DisplayPass, FrameBuffers};
+use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
 use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
 use crate::settings::Denoiser;
 use crate::passes::gbuffer::{self, GBufferPass, GBufferTargets};
@@ -26,7 +27,7 @@ use glam::{Mat4, Vec2, Vec3};
 pub const MAX_SIDE: u32 = 8192;
 
 /// Passes that can write timestamps in one frame.
-const TIMED_PASSES: u32 = 16;
+const TIMED_PASSES: u32 = 24;
 
 /// Where the camera is and what time it is in the scene's animation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,6 +54,8 @@ struct Targets {
     accumulation: Option<wgpu::Buffer>,
     /// The denoiser's textures, made on its first use.
     matte: Option<MatteTargets>,
+    /// The glossy chain's textures, made with the matte ones in scenes with a specular lobe.
+    glossy_chain: Option<GlossyChainTargets>,
     memory: GpuMemory,
     generation: u64,
 }
@@ -64,7 +67,7 @@ impl Targets {
         let trace = TraceTargets::new(gpu, &mut memory, size, glossy);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let hdr = memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
-        Targets { size, gbuffer, trace, hdr, accumulation: None, matte: None, memory, generation }
+        Targets { size, gbuffer, trace, hdr, accumulation: None, matte: None, glossy_chain: None, memory, generation }
     }
 }
 
@@ -83,7 +86,9 @@ pub struct Renderer {
     composite: CompositePass,
     display: Option<DisplayPass>,
     chain: Option<MatteChain>,
+    glossy_chain: Option<GlossyChain>,
     denoise_buf: wgpu::Buffer,
+    glossy_buf: wgpu::Buffer,
     linear_clamp: wgpu::Sampler,
     /// Whether the last frame went through the denoiser (its image is then TAA's output).
     denoised_last: bool,
@@ -103,11 +108,12 @@ impl PreparedScene {
     pub fn realtime_requirements(&self, size: (u32, u32)) -> GpuRequirements {
         let mut r = self.requirements(size.0 as u64 * size.1 as u64 * 16);
         r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
-        // matte, direct, and with a glossy lobe glossy, reflection and mirror.
-        r.max_storage_textures_per_shader_stage = if self.features.glossy { 5 } else { 2 };
-        // The display reads the G-buffer (7), trace outputs (2, +3 glossy) and the denoiser's
-        // intermediates (5): 17 in a glossy scene, one over WebGPU's default of 16.
-        r.max_sampled_textures_per_shader_stage = 17;
+        // matte, direct, and with a glossy lobe glossy, reflection, mirror and mirror hit.
+        r.max_storage_textures_per_shader_stage = if self.features.glossy { 6 } else { 2 };
+        // The display reads the G-buffer (7), trace outputs (2, +4 glossy) and the chains'
+        // intermediates (5 matte, +5 glossy): 23 in a glossy scene (WebGPU's default is 16;
+        // desktop Vulkan, Metal and D3D12 adapters offer far more).
+        r.max_sampled_textures_per_shader_stage = if self.features.glossy { 23 } else { 14 };
         r
     }
 }
@@ -146,6 +152,7 @@ impl Renderer {
         let display_buf = memory.buffer(d, "display/options", 16, u);
         let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
         let denoise_buf = memory.buffer(d, "matte/params", size_of::<DenoiseParams>() as u64, u);
+        let glossy_buf = memory.buffer(d, "glossy/params", size_of::<GlossyParams>() as u64, u);
         let linear_clamp = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("linear clamp"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -154,7 +161,7 @@ impl Renderer {
         });
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
         let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
-        let fb = FrameBuffers { frame: &frame_buf, hdr: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: &targets.trace.matte.1, denoise: None };
+        let fb = FrameBuffers { frame: &frame_buf, hdr: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: &targets.trace.matte.1, glossy: None, denoise: None, glossy_chain: None };
         let composite = CompositePass::new(gpu, &targets.gbuffer, &targets.trace, &fb).context("creating the composite pass")?;
         let timer = GpuTimer::new(gpu, TIMED_PASSES);
         let r = Renderer {
@@ -171,7 +178,9 @@ impl Renderer {
             composite,
             display: None,
             chain: None,
+            glossy_chain: None,
             denoise_buf,
+            glossy_buf,
             linear_clamp,
             denoised_last: false,
             timer,
@@ -285,11 +294,19 @@ impl Renderer {
         let denoise = settings.denoiser == Denoiser::Mara && !settings.accumulate;
         if denoise && self.targets.matte.is_none() {
             self.targets.matte = Some(MatteTargets::new(gpu, &mut self.targets.memory, size));
+            if self.prepared.features.glossy {
+                self.targets.glossy_chain = Some(GlossyChainTargets::new(gpu, &mut self.targets.memory, size));
+            }
             self.targets.generation += 1;
         }
         if denoise && self.chain.is_none() {
             let inputs = self.chain_inputs();
             self.chain = Some(MatteChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the matte chain")?);
+        }
+        if denoise && self.glossy_chain.is_none() {
+            if let Some(inputs) = self.glossy_inputs() {
+                self.glossy_chain = Some(GlossyChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the glossy chain")?);
+            }
         }
         let jitter = if settings.accumulate {
             random_jitter(self.frame_index, settings.seed)
@@ -305,6 +322,8 @@ impl Renderer {
             let prev_inv = self.prev_jittered.unwrap_or(jittered).inverse();
             let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, jittered.inverse(), prev_inv, history_valid);
             gpu.queue.write_buffer(&self.denoise_buf, 0, bytemuck::bytes_of(&dp));
+            let gp = GlossyParams::new(&settings.glossy, self.prepared.extent as f32);
+            gpu.queue.write_buffer(&self.glossy_buf, 0, bytemuck::bytes_of(&gp));
         }
         let fp = FrameParams {
             view_proj: jittered.to_cols_array_2d(),
@@ -358,13 +377,20 @@ impl Renderer {
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
             chain.record(gpu, &mut enc, chain_key, inputs, parity, size, false, self.timer.as_mut());
         }
+        let glossy_inputs = glossy_inputs(t, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref(), &self.linear_clamp).filter(|_| denoise);
+        if let (Some(inputs), Some(chain)) = (&glossy_inputs, self.glossy_chain.as_mut()) {
+            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, &settings.glossy, self.timer.as_mut());
+        }
+        let denoised_glossy = t.glossy_chain.as_ref().filter(|_| denoise).map(|g| &g.denoised.1);
         let fb = FrameBuffers {
             frame: &self.frame_buf,
             hdr: &t.hdr,
             accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation),
             display: &self.display_buf,
             matte: denoised_matte.unwrap_or(&t.trace.matte.1),
+            glossy: denoised_glossy,
             denoise: None,
+            glossy_chain: None,
         };
         self.composite.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut());
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
@@ -400,6 +426,10 @@ impl Renderer {
             matte: t.matte.as_ref().expect("matte targets exist before the chain"),
             sampler: &self.linear_clamp,
         }
+    }
+
+    fn glossy_inputs(&self) -> Option<GlossyInputs<'_>> {
+        glossy_inputs(&self.targets, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref(), &self.linear_clamp)
     }
 
     /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
@@ -506,6 +536,22 @@ impl Renderer {
                     _ => bail!("no texture {n}"),
                 }
             }
+            n if n.starts_with("glossy/") => {
+                let g = t.glossy_chain.as_ref().with_context(|| format!("no texture {n}: the glossy chain has not run"))?;
+                match n {
+                    "glossy/hit 0" => &g.hit[0].0,
+                    "glossy/hit 1" => &g.hit[1].0,
+                    "glossy/motion" => &g.motion.0,
+                    "glossy/search" => &g.search.0,
+                    "glossy/neighbourhood" => &g.neighbourhood.0,
+                    "glossy/scratch" => &g.scratch.0,
+                    "glossy/history 0" => &g.history[0].0,
+                    "glossy/history 1" => &g.history[1].0,
+                    "glossy/info" => &g.info.0,
+                    "glossy/denoised" => &g.denoised.0,
+                    _ => bail!("no texture {n}"),
+                }
+            }
             n if n.starts_with("gbuffer/") => &t.gbuffer.color[gbuffer::COLOR_FORMATS.iter().position(|(l, _)| *l == n).with_context(|| format!("no texture {n}"))?].0,
             n => {
                 let g = t.trace.glossy.as_ref().with_context(|| format!("no texture {n}: the scene has no glossy buffers"))?;
@@ -513,6 +559,7 @@ impl Renderer {
                     "trace/glossy" => &g.light.0,
                     "trace/reflection" => &g.reflection.0,
                     "trace/mirror" => &g.mirror.0,
+                    "trace/mirror hit" => &g.mirror_hit.0,
                     _ => bail!("no texture {n}"),
                 }
             }
@@ -530,8 +577,15 @@ fn shown_buffers<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, display: &'a wgpu:
         accumulation: t.accumulation.as_ref().unwrap_or(no_accumulation),
         display,
         matte: &t.trace.matte.1,
+        glossy: None,
         denoise: t.matte.as_ref(),
+        glossy_chain: t.glossy_chain.as_ref(),
     }
+}
+
+/// What the glossy chain binds, when its targets exist.
+fn glossy_inputs<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, denoise: &'a wgpu::Buffer, params: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>, sampler: &'a wgpu::Sampler) -> Option<GlossyInputs<'a>> {
+    Some(GlossyInputs { frame, denoise, params, objects, gbuffer: &t.gbuffer, trace: &t.trace, matte: t.matte.as_ref()?, glossy: t.glossy_chain.as_ref()?, sampler })
 }
 
 /// Halton (2, 3) sub-pixel positions, 16 per cycle: the TAA jitter.

@@ -26,10 +26,18 @@ pub enum View {
     MatteRadius = 19,
     MatteFirefly = 20,
     MatteDenoised = 21,
+    GlossyMotion = 22,
+    GlossyVirtualMotion = 23,
+    GlossyMotionDisagreement = 24,
+    GlossySearchSteps = 25,
+    GlossyConfidence = 26,
+    GlossyClipping = 27,
+    GlossySigma = 28,
+    GlossyDenoised = 29,
 }
 
 impl View {
-    pub const ALL: [View; 22] = [
+    pub const ALL: [View; 30] = [
         View::Final,
         View::Depth,
         View::Normal,
@@ -52,6 +60,14 @@ impl View {
         View::MatteRadius,
         View::MatteFirefly,
         View::MatteDenoised,
+        View::GlossyMotion,
+        View::GlossyVirtualMotion,
+        View::GlossyMotionDisagreement,
+        View::GlossySearchSteps,
+        View::GlossyConfidence,
+        View::GlossyClipping,
+        View::GlossySigma,
+        View::GlossyDenoised,
     ];
 
     /// The pass output it shows, as named in labels and the profiler.
@@ -79,12 +95,20 @@ impl View {
             View::MatteRadius => "matte/disocclusion radius",
             View::MatteFirefly => "matte/firefly",
             View::MatteDenoised => "matte/bilateral",
+            View::GlossyMotion => "glossy/motion",
+            View::GlossyVirtualMotion => "glossy/virtual motion",
+            View::GlossyMotionDisagreement => "glossy/motion disagreement",
+            View::GlossySearchSteps => "glossy/search steps",
+            View::GlossyConfidence => "glossy/confidence",
+            View::GlossyClipping => "glossy/clipping",
+            View::GlossySigma => "glossy/sigma",
+            View::GlossyDenoised => "glossy/bilateral",
         }
     }
 
     /// Views of buffers that exist only in scenes with a specular lobe.
     pub fn needs_glossy(self) -> bool {
-        (View::GlossyLight as u32..=View::MirrorDirection as u32).contains(&(self as u32))
+        (View::GlossyLight as u32..=View::MirrorDirection as u32).contains(&(self as u32)) || self as u32 >= View::GlossyMotion as u32
     }
 
     /// Views of the denoiser's intermediates (black until it has run).

@@ -20,15 +20,18 @@ pub struct FrameBuffers<'a> {
     pub display: &'a wgpu::Buffer,
     /// The matte light the composite remodulates: raw, or the matte chain's output.
     pub matte: &'a wgpu::TextureView,
-    /// The chain's intermediates, for the display's debug views.
+    /// The glossy light the composite remodulates: the glossy chain's output (None: raw).
+    pub glossy: Option<&'a wgpu::TextureView>,
+    /// The chains' intermediates, for the display's debug views.
     pub denoise: Option<&'a super::matte::MatteTargets>,
+    pub glossy_chain: Option<&'a super::glossy::GlossyChainTargets>,
 }
 
 fn inputs<'a>(stages: wgpu::ShaderStages, g: &'a GBufferTargets, t: &'a TraceTargets, b: &FrameBuffers<'a>, read_only: bool) -> Bindings<'a> {
     let f = || wgpu::TextureSampleType::Float { filterable: false };
     let mut s = super::matte::gbuffer_inputs(Bindings::new(stages).uniform(11, b.frame), g, t, b.matte);
     if let Some(gl) = &t.glossy {
-        s = s.texture(29, &gl.light.1, f()).texture(30, &gl.reflection.1, f()).texture(31, &gl.mirror.1, wgpu::TextureSampleType::Uint);
+        s = super::glossy::glossy_trace_inputs(s, t, b.glossy.unwrap_or(&gl.light.1));
     }
     s = s.storage(32, b.hdr, read_only).storage(33, b.accumulation, read_only);
     if read_only {
@@ -36,11 +39,14 @@ fn inputs<'a>(stages: wgpu::ShaderStages, g: &'a GBufferTargets, t: &'a TraceTar
         if let Some(m) = b.denoise {
             s = s.texture(45, &m.temporal.1, f()).texture(46, &m.reason.1, wgpu::TextureSampleType::Uint).texture(47, &m.radius.1, f()).texture(48, &m.median.1, f()).texture(49, &m.denoised.1, f());
         }
+        if let Some(g) = b.glossy_chain {
+            s = s.texture(72, &g.motion.1, f()).texture(73, &g.search.1, f()).texture(74, &g.info.1, f()).texture(75, &g.scratch.1, f()).texture(76, &g.denoised.1, f());
+        }
     }
     s
 }
 
-fn modules(glossy: bool, denoise: bool, last: &'static str) -> Vec<&'static str> {
+fn modules(glossy: bool, denoise: bool, glossy_chain: bool, last: &'static str) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "common/rng.wgsl",
@@ -50,6 +56,9 @@ fn modules(glossy: bool, denoise: bool, last: &'static str) -> Vec<&'static str>
     ];
     if last == "realtime/display.wgsl" {
         m.push(if denoise { "realtime/denoise_views.wgsl" } else { "realtime/denoise_views_none.wgsl" });
+        if denoise {
+            m.push(if glossy_chain { "glossy/views.wgsl" } else { "glossy/views_none.wgsl" });
+        }
     }
     m.push(last);
     m
@@ -63,7 +72,7 @@ pub struct CompositePass {
 
 impl CompositePass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers) -> Result<CompositePass> {
-        let module = crate::shader::compose(COMPOSITE, "", &modules(t.glossy.is_some(), false, "realtime/composite.wgsl"))?.create(&gpu.device)?;
+        let module = crate::shader::compose(COMPOSITE, "", &modules(t.glossy.is_some(), false, false, "realtime/composite.wgsl"))?.create(&gpu.device)?;
         let layout = inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_layout(&gpu.device, COMPOSITE);
         let pipeline = compute_pipeline(&gpu.device, COMPOSITE, &module, &layout);
         Ok(CompositePass { pipeline, layout, bind_group: None })
@@ -92,7 +101,7 @@ pub struct DisplayPass {
 
 impl DisplayPass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
-        let module = crate::shader::compose(DISPLAY, "", &modules(t.glossy.is_some(), b.denoise.is_some(), "realtime/display.wgsl"))?.create(&gpu.device)?;
+        let module = crate::shader::compose(DISPLAY, "", &modules(t.glossy.is_some(), b.denoise.is_some(), b.glossy_chain.is_some(), "realtime/display.wgsl"))?.create(&gpu.device)?;
         let layout = inputs(wgpu::ShaderStages::FRAGMENT, g, t, b, true).create_layout(&gpu.device, DISPLAY);
         let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(DISPLAY), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
         let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -8,5 +8,6 @@ pub use reference::{Accumulation, ReferenceTracer, TraceView};
 
 pub mod composite;
 pub mod gbuffer;
+pub mod glossy;
 pub mod matte;
 pub mod trace;

@@ -3,7 +3,9 @@
 //! Outputs and their cost per pixel: matte light and direct light (Rgba16Float, 8 bytes each);
 //! in scenes with a specular lobe also the glossy light with its secondary hit distance
 //! (Rgba16Float, 8), the virtual position with that distance (Rgba32Float, 16: positions need
-//! f32) and the representative mirror direction (two snorm16 in R32Uint, 4).
+//! f32), the representative mirror direction (two snorm16 in R32Uint, 4) and what the glossy
+//! path hit first: its reflectance and normal (Rg32Uint, 8), which the glossy chain uses behind
+//! mirrors (Voorhuis §4.1).
 
 use super::gbuffer::GBufferTargets;
 use crate::gpu::scene::compute_pipeline;
@@ -15,6 +17,8 @@ pub const MATTE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const REFLECTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// Octahedral direction packed as two snorm16 (Rg16 is not a storage format in core WebGPU).
 pub const MIRROR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// Reflectance as rgba8 and normal as octahedral snorm16x2.
+pub const MIRROR_HIT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 
 pub struct TraceTargets {
     pub matte: (wgpu::Texture, wgpu::TextureView),
@@ -26,6 +30,7 @@ pub struct GlossyTargets {
     pub light: (wgpu::Texture, wgpu::TextureView),
     pub reflection: (wgpu::Texture, wgpu::TextureView),
     pub mirror: (wgpu::Texture, wgpu::TextureView),
+    pub mirror_hit: (wgpu::Texture, wgpu::TextureView),
 }
 
 impl TraceTargets {
@@ -39,6 +44,7 @@ impl TraceTargets {
                 light: mem.texture(d, "trace/glossy", size, MATTE_FORMAT, usage),
                 reflection: mem.texture(d, "trace/reflection", size, REFLECTION_FORMAT, usage),
                 mirror: mem.texture(d, "trace/mirror", size, MIRROR_FORMAT, usage),
+                mirror_hit: mem.texture(d, "trace/mirror hit", size, MIRROR_HIT_FORMAT, usage),
             }),
         }
     }
@@ -59,7 +65,7 @@ fn bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::
         .storage_texture(13, &t.matte.1, MATTE_FORMAT)
         .storage_texture(14, &t.direct.1, MATTE_FORMAT);
     if let Some(gl) = &t.glossy {
-        b = b.storage_texture(15, &gl.light.1, MATTE_FORMAT).storage_texture(16, &gl.reflection.1, REFLECTION_FORMAT).storage_texture(18, &gl.mirror.1, MIRROR_FORMAT);
+        b = b.storage_texture(15, &gl.light.1, MATTE_FORMAT).storage_texture(16, &gl.reflection.1, REFLECTION_FORMAT).storage_texture(18, &gl.mirror.1, MIRROR_FORMAT).storage_texture(19, &gl.mirror_hit.1, MIRROR_HIT_FORMAT);
     }
     b
 }

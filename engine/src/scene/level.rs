@@ -9,7 +9,7 @@ use super::{Animation, Camera, Environment, Material, Mesh, Object, Scene, Textu
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 
 /// A procedural texture: `f(x, y)` -> sRGB bytes.
-fn texture(name: &str, size: u32, srgb: bool, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
+pub(super) fn texture(name: &str, size: u32, srgb: bool, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
     let mut rgba8 = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
         for x in 0..size {
@@ -19,7 +19,7 @@ fn texture(name: &str, size: u32, srgb: bool, f: impl Fn(u32, u32) -> [u8; 4]) -
     Texture { name: name.into(), width: size, height: size, rgba8, srgb, wrap_s: Wrap::Repeat, wrap_t: Wrap::Repeat }
 }
 
-fn checker(x: u32, y: u32) -> [u8; 4] {
+pub(super) fn checker(x: u32, y: u32) -> [u8; 4] {
     // Two marble-ish tones with a thin grout line.
     let (cx, cy) = (x / 32, y / 32);
     if x.is_multiple_of(32) || y.is_multiple_of(32) {
@@ -28,7 +28,7 @@ fn checker(x: u32, y: u32) -> [u8; 4] {
     if (cx + cy).is_multiple_of(2) { [210, 204, 192, 255] } else { [120, 112, 100, 255] }
 }
 
-fn bricks(x: u32, y: u32) -> [u8; 4] {
+pub(super) fn bricks(x: u32, y: u32) -> [u8; 4] {
     let row = y / 16;
     let off = if row.is_multiple_of(2) { 0 } else { 16 };
     let mortar = y.is_multiple_of(16) || (x + off).is_multiple_of(32);
@@ -39,7 +39,7 @@ fn bricks(x: u32, y: u32) -> [u8; 4] {
 }
 
 /// Scale a mesh's texture coordinates (tiling).
-fn tiled(mut m: Mesh, s: Vec2) -> Mesh {
+pub(super) fn tiled(mut m: Mesh, s: Vec2) -> Mesh {
     for uv in &mut m.uvs {
         *uv *= s;
     }

@@ -6,6 +6,7 @@ mod camera_path;
 mod default_scene;
 mod gltf_export;
 mod level;
+mod reflections;
 mod environment;
 mod gltf_import;
 mod paths;
@@ -16,6 +17,7 @@ pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::default_scene;
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
+pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
 pub use environment::{EnvMap, Environment};
 pub use gltf_export::save_gltf;
 pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with};
@@ -173,16 +175,12 @@ pub struct Scene {
 pub const DEFAULT_MAX_DEPTH: i32 = 6;
 
 impl Scene {
-    /// Load a `.gltf`/`.glb` file, `default` for the built-in room or `level` for the default
-    /// level.
+    /// Load a `.gltf`/`.glb` file or a built-in scene by name ([`BUILTIN_SCENES`]).
     pub fn load(path_or_default: &str) -> Result<Scene> {
-        if path_or_default == "default" {
-            return Ok(default_scene());
+        match builtin_scene(path_or_default) {
+            Some(s) => Ok(s),
+            None => load_gltf(Path::new(path_or_default)),
         }
-        if path_or_default == "level" {
-            return Ok(default_level());
-        }
-        load_gltf(Path::new(path_or_default))
     }
 
     pub fn is_animated(&self) -> bool {

@@ -64,6 +64,14 @@ embed!(
     "matte/firefly.wgsl",
     "matte/bilateral.wgsl",
     "taa/taa.wgsl",
+    "glossy/common.wgsl",
+    "glossy/diamond.wgsl",
+    "glossy/motion.wgsl",
+    "glossy/prefilter.wgsl",
+    "glossy/temporal.wgsl",
+    "glossy/bilateral.wgsl",
+    "glossy/views.wgsl",
+    "glossy/views_none.wgsl",
     "accel/raycast.wgsl",
 );
 
@@ -157,8 +165,10 @@ mod tests {
         for glossy in ["realtime/glossy_in.wgsl", "realtime/glossy_in_none.wgsl"] {
             let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/composite.wgsl"];
             v.push(compose("realtime/composite.wgsl", "", &m).unwrap());
-            for views in ["realtime/denoise_views.wgsl", "realtime/denoise_views_none.wgsl"] {
-                let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, views, "realtime/display.wgsl"];
+            let display = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/denoise_views_none.wgsl", "realtime/display.wgsl"];
+            v.push(compose("realtime/display.wgsl", "", &display).unwrap());
+            for chain in ["glossy/views.wgsl", "glossy/views_none.wgsl"] {
+                let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/denoise_views.wgsl", chain, "realtime/display.wgsl"];
                 v.push(compose("realtime/display.wgsl", "", &m).unwrap());
             }
         }
@@ -167,6 +177,11 @@ mod tests {
                 let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl", motion];
                 m.extend_from_slice(stage);
                 v.push(compose(stage[stage.len() - 1], "", &m).unwrap());
+            }
+        }
+        for animated in [false, true] {
+            for stage in ["glossy/motion.wgsl", "glossy/prefilter.wgsl", "glossy/temporal.wgsl", "glossy/bilateral.wgsl"] {
+                v.push(compose(stage, "", &crate::passes::glossy::modules(stage, animated)).unwrap());
             }
         }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
@@ -275,6 +290,12 @@ mod tests {
         assert_eq!(size as usize, size_of::<DenoiseParams>());
         assert_eq!(offs[2] as usize, offset_of!(DenoiseParams, stages));
         assert_eq!(offs[17] as usize, offset_of!(DenoiseParams, history_valid));
+        let temporal = programs.iter().find(|p| p.label == "glossy/temporal.wgsl").unwrap();
+        let (size, offs) = wgsl_layout(temporal, "GlossyParams");
+        use crate::passes::glossy::GlossyParams;
+        assert_eq!(size as usize, size_of::<GlossyParams>());
+        assert_eq!(offs[5] as usize, offset_of!(GlossyParams, roughness_threshold));
+        assert_eq!(offs[17] as usize, offset_of!(GlossyParams, max_sigma_px));
         // obvhs's CWBVH node is read as five vec4u.
         assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
     }

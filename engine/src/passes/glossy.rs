@@ -1,0 +1,238 @@
+//! The glossy denoise chain: Mara et al. 2017 §3.4 stages 8-10 with the reflection reprojection
+//! and neighbourhood clipping of Voorhuis §4, one compute pass per stage (shaders/glossy/*.wgsl):
+//! `glossy/motion` (reflection motion vectors) -> `glossy/prefilter_h`, `glossy/prefilter_v`
+//! (the clip's pre-blurred neighbourhood) -> `glossy/temporal` -> `glossy/bilateral_h`,
+//! `glossy/bilateral_v`. The composite then remodulates the output with F(w_s).
+//! Runs in scenes with a specular lobe when the denoiser is on; [`GlossySettings`] switches it.
+
+use super::gbuffer::GBufferTargets;
+use super::matte::{MatteTargets, gbuffer_inputs};
+use super::trace::TraceTargets;
+use crate::gpu::scene::compute_pipeline_at;
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
+use anyhow::Result;
+use bytemuck::{Pod, Zeroable};
+
+const RGBA16F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// Mirror of `GlossyParams` in shaders/glossy/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GlossyParams {
+    pub stages: u32,
+    pub mode: u32,
+    pub initial_step: u32,
+    pub max_search_steps: u32,
+    pub reference_radius: u32,
+    pub roughness_threshold: f32,
+    pub mirror_roughness: f32,
+    pub clip_roughness: f32,
+    pub hysteresis: f32,
+    pub d0_px: f32,
+    pub d1_px: f32,
+    pub sigma_scale: f32,
+    pub sigma_exponent: f32,
+    pub sigma_epsilon_px: f32,
+    pub omega: f32,
+    pub roughness_sigma: f32,
+    pub far: f32,
+    pub max_sigma_px: f32,
+    pub _pad: [u32; 2],
+}
+
+impl GlossyParams {
+    /// `extent`: the scene's bounding-box diagonal (an escaped reflection stands at 4 extents).
+    pub fn new(s: &GlossySettings, extent: f32) -> GlossyParams {
+        GlossyParams {
+            stages: s.stage_bits(),
+            mode: match s.reflection_mv {
+                ReflectionMv::Primary => 0,
+                ReflectionMv::Virtual => 1,
+                ReflectionMv::Diamond => 2,
+            },
+            initial_step: s.initial_step.clamp(1, 64),
+            max_search_steps: s.max_search_steps.clamp(1, 256),
+            reference_radius: s.reference_search_radius.min(256),
+            roughness_threshold: s.roughness_threshold,
+            mirror_roughness: s.mirror_roughness,
+            clip_roughness: s.clip_roughness,
+            hysteresis: s.hysteresis.clamp(0.0, 1.0),
+            d0_px: s.d0_px.max(0.0),
+            d1_px: s.d1_px.max(s.d0_px + 1e-3),
+            sigma_scale: s.sigma_scale.max(0.0),
+            sigma_exponent: s.sigma_exponent,
+            sigma_epsilon_px: s.sigma_epsilon_px.max(0.0),
+            omega: s.ray_differential_omega.max(1e-3),
+            roughness_sigma: s.roughness_sigma.max(1e-4),
+            far: (4.0 * extent).max(1e-3),
+            max_sigma_px: MAX_GLOSSY_SIGMA_PX,
+            _pad: [0; 2],
+        }
+    }
+}
+
+/// Per-pixel textures of the glossy chain (made with the denoiser's other targets), 112 bytes.
+pub struct GlossyChainTargets {
+    /// Representative hits (eq. 4) of this frame and the previous one, by parity.
+    pub hit: [(wgpu::Texture, wgpu::TextureView); 2],
+    pub motion: (wgpu::Texture, wgpu::TextureView),
+    pub search: (wgpu::Texture, wgpu::TextureView),
+    /// The pre-blurred neighbourhood the temporal clips to.
+    pub neighbourhood: (wgpu::Texture, wgpu::TextureView),
+    /// The prefilter's and the bilateral's horizontal pass (its alpha: sigma).
+    pub scratch: (wgpu::Texture, wgpu::TextureView),
+    pub history: [(wgpu::Texture, wgpu::TextureView); 2],
+    pub info: (wgpu::Texture, wgpu::TextureView),
+    /// The chain's output: remodulated glossy light for the composite.
+    pub denoised: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl GlossyChainTargets {
+    pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32)) -> GlossyChainTargets {
+        let d = &gpu.device;
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
+        GlossyChainTargets {
+            hit: [t("glossy/hit 0", RGBA32F), t("glossy/hit 1", RGBA32F)],
+            motion: t("glossy/motion", RGBA32F),
+            search: t("glossy/search", RGBA16F),
+            neighbourhood: t("glossy/neighbourhood", RGBA16F),
+            scratch: t("glossy/scratch", RGBA16F),
+            history: [t("glossy/history 0", RGBA16F), t("glossy/history 1", RGBA16F)],
+            info: t("glossy/info", RGBA16F),
+            denoised: t("glossy/denoised", RGBA16F),
+        }
+    }
+}
+
+pub struct GlossyInputs<'a> {
+    pub frame: &'a wgpu::Buffer,
+    /// The matte chain's DenoiseParams (camera matrices, parity, history validity).
+    pub denoise: &'a wgpu::Buffer,
+    pub params: &'a wgpu::Buffer,
+    pub objects: Option<&'a wgpu::Buffer>,
+    pub gbuffer: &'a GBufferTargets,
+    pub trace: &'a TraceTargets,
+    pub matte: &'a MatteTargets,
+    pub glossy: &'a GlossyChainTargets,
+    pub sampler: &'a wgpu::Sampler,
+}
+
+/// The glossy trace outputs every glossy stage reads (shaders/realtime/glossy_in.wgsl).
+pub fn glossy_trace_inputs<'a>(b: Bindings<'a>, t: &'a TraceTargets, light: &'a wgpu::TextureView) -> Bindings<'a> {
+    let f = || wgpu::TextureSampleType::Float { filterable: false };
+    match &t.glossy {
+        Some(gl) => b.texture(29, light, f()).texture(30, &gl.reflection.1, f()).texture(31, &gl.mirror.1, wgpu::TextureSampleType::Uint).texture(35, &gl.mirror_hit.1, wgpu::TextureSampleType::Uint),
+        None => b,
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Kind {
+    Motion,
+    PrefilterH,
+    PrefilterV,
+    Temporal,
+    BilateralH,
+    BilateralV,
+}
+
+const STAGES: [(Kind, &str, &str, &str); 6] = [
+    (Kind::Motion, "glossy/motion", "glossy/motion.wgsl", "main"),
+    (Kind::PrefilterH, "glossy/prefilter_h", "glossy/prefilter.wgsl", "pre_h"),
+    (Kind::PrefilterV, "glossy/prefilter_v", "glossy/prefilter.wgsl", "pre_v"),
+    (Kind::Temporal, "glossy/temporal", "glossy/temporal.wgsl", "main"),
+    (Kind::BilateralH, "glossy/bilateral_h", "glossy/bilateral.wgsl", "bilateral_h"),
+    (Kind::BilateralV, "glossy/bilateral_v", "glossy/bilateral.wgsl", "bilateral_v"),
+];
+
+fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a> {
+    let g = i.glossy;
+    let f = wgpu::TextureSampleType::Float { filterable: false };
+    let filterable = wgpu::TextureSampleType::Float { filterable: true };
+    let light = &i.trace.glossy.as_ref().expect("the glossy chain runs in glossy scenes").light.1;
+    let mut b = Bindings::new(wgpu::ShaderStages::COMPUTE).uniform(11, i.frame).uniform(40, i.denoise).uniform(60, i.params);
+    b = glossy_trace_inputs(gbuffer_inputs(b, i.gbuffer, i.trace, &i.trace.matte.1), i.trace, light);
+    let depth = wgpu::TextureSampleType::Depth;
+    match kind {
+        Kind::Motion => b
+            .texture(41, &i.matte.prev_depth.1, depth)
+            .texture(61, &g.hit[parity].1, f)
+            .storage_texture(62, &g.motion.1, RGBA32F)
+            .storage_texture(63, &g.search.1, RGBA16F)
+            .storage_texture(64, &g.hit[1 - parity].1, RGBA32F),
+        Kind::PrefilterH => b.texture(65, &g.neighbourhood.1, f).storage_texture(66, &g.scratch.1, RGBA16F),
+        Kind::PrefilterV => b.texture(65, &g.scratch.1, f).storage_texture(66, &g.neighbourhood.1, RGBA16F),
+        Kind::Temporal => {
+            b = b
+                .texture(41, &i.matte.prev_depth.1, depth)
+                .texture(42, &g.history[parity].1, filterable)
+                .sampler(43, i.sampler)
+                .texture(61, &g.hit[parity].1, f)
+                .texture(65, &g.neighbourhood.1, f)
+                .storage_texture(66, &g.history[1 - parity].1, RGBA16F)
+                .texture(67, &g.motion.1, f)
+                .storage_texture(68, &g.info.1, RGBA16F);
+            if let Some(o) = i.objects {
+                b = b.storage(17, o, true);
+            }
+            b
+        }
+        Kind::BilateralH => b.texture(65, &g.history[1 - parity].1, f).storage_texture(66, &g.scratch.1, RGBA16F),
+        Kind::BilateralV => b.texture(65, &g.scratch.1, f).storage_texture(66, &g.denoised.1, RGBA16F),
+    }
+}
+
+/// The modules of a glossy stage's program.
+pub fn modules(stage: &'static str, animated: bool) -> Vec<&'static str> {
+    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "realtime/glossy_in.wgsl", "matte/common.wgsl", "glossy/common.wgsl"];
+    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    if stage == "glossy/motion.wgsl" {
+        m.push("glossy/diamond.wgsl");
+    }
+    m.push(stage);
+    m
+}
+
+struct Stage {
+    label: &'static str,
+    kind: Kind,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    groups: Option<(u64, [wgpu::BindGroup; 2])>,
+}
+
+pub struct GlossyChain {
+    stages: Vec<Stage>,
+}
+
+impl GlossyChain {
+    pub fn new(gpu: &Gpu, i: &GlossyInputs, animated: bool) -> Result<GlossyChain> {
+        let mut stages = vec![];
+        for (kind, label, file, entry) in STAGES {
+            let module = crate::shader::compose(label, "", &modules(file, animated))?.create(&gpu.device)?;
+            let layout = bindings(kind, i, 0).create_layout(&gpu.device, label);
+            let pipeline = compute_pipeline_at(&gpu.device, label, &module, &layout, entry);
+            stages.push(Stage { label, kind, pipeline, layout, groups: None });
+        }
+        Ok(GlossyChain { stages })
+    }
+
+    /// Record the chain. The prefilter runs only when the clip uses it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &GlossyInputs, parity: usize, size: (u32, u32), settings: &GlossySettings, mut timer: Option<&mut GpuTimer>) {
+        let clip = settings.temporal && settings.clipping;
+        for s in self.stages.iter_mut().filter(|s| clip || !matches!(s.kind, Kind::PrefilterH | Kind::PrefilterV)) {
+            if s.groups.as_ref().is_none_or(|(k, _)| *k != key) {
+                let g = |p| bindings(s.kind, i, p).create_group(&gpu.device, s.label, &s.layout);
+                s.groups = Some((key, [g(0), g(1)]));
+            }
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.label), timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(s.label)) });
+            pass.set_pipeline(&s.pipeline);
+            pass.set_bind_group(0, &s.groups.as_ref().unwrap().1[parity], &[]);
+            pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        }
+    }
+}

@@ -1,0 +1,220 @@
+// Shared by the glossy chain's stages (Mara et al. 2017 §3.4 stages 8-10, with the reflection
+// reprojection and neighbourhood clipping of Voorhuis §4). engine/src/passes/glossy.rs mirrors
+// GlossyParams; the chain also reads the matte chain's DenoiseParams (matte/common.wgsl) for the
+// camera matrices, the history parity and whether history exists.
+
+struct GlossyParams {
+    // Stage switches (GSTAGE_*).
+    stages: u32,
+    // Reflection motion vectors: 0 surface (primary), 1 virtual position, 2 diamond search.
+    mode: u32,
+    // Diamond search: first large-pattern step in pixels, most iterations.
+    initial_step: u32,
+    max_search_steps: u32,
+    // Brute-force search radius for measurements (0: off).
+    reference_radius: u32,
+    roughness_threshold: f32,
+    mirror_roughness: f32,
+    clip_roughness: f32,
+    hysteresis: f32,
+    // Eq. (11) for mirrors, in pixel footprints at the reflected distance.
+    d0_px: f32,
+    d1_px: f32,
+    sigma_scale: f32,
+    sigma_exponent: f32,
+    sigma_epsilon_px: f32,
+    omega: f32,
+    roughness_sigma: f32,
+    // Distance that stands for a reflection that left the scene (a few scene extents).
+    far: f32,
+    max_sigma_px: f32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(60) var<uniform> gp: GlossyParams;
+
+const GSTAGE_TEMPORAL: u32 = 1u;
+const GSTAGE_CLIPPING: u32 = 2u;
+const GSTAGE_BILATERAL: u32 = 4u;
+
+const MV_PRIMARY: u32 = 0u;
+const MV_VIRTUAL: u32 = 1u;
+const MV_DIAMOND: u32 = 2u;
+
+fn gstage_on(bit: u32) -> bool {
+    return (gp.stages & bit) != 0u;
+}
+
+fn roughness_at(p: vec2i) -> f32 {
+    return textureLoad(gb_specular, p, 0).a;
+}
+
+fn is_mirror(roughness: f32) -> bool {
+    return roughness <= gp.mirror_roughness;
+}
+
+fn hit_reflectance(p: vec2i) -> vec3f {
+    return unpack4x8unorm(textureLoad(tr_mirror_hit, p, 0).x).rgb;
+}
+
+fn hit_normal(p: vec2i) -> vec3f {
+    return oct_decode(unpack2x16snorm(textureLoad(tr_mirror_hit, p, 0).y));
+}
+
+fn mirror_direction(p: vec2i) -> vec3f {
+    return oct_decode(unpack2x16snorm(textureLoad(tr_mirror, p, 0).x));
+}
+
+// Behind a mirror the chain filters light divided by the reflected surface's reflectance
+// (Voorhuis §4.1), so that the texture seen in the mirror is not blurred; the last stage
+// multiplies it back. The floor keeps black reflected surfaces from amplifying noise.
+fn demodulation(p: vec2i) -> vec3f {
+    if is_mirror(roughness_at(p)) {
+        return max(hit_reflectance(p), vec3f(0.02));
+    }
+    return vec3f(1.0);
+}
+
+fn glossy_input(p: vec2i) -> vec3f {
+    return half_safe(glossy_light(p) / demodulation(p));
+}
+
+// The glossy path's secondary hit distance; an escaped path stands at `far`.
+fn secondary_t(p: vec2i) -> f32 {
+    let t = textureLoad(tr_glossy, p, 0).a;
+    return select(t, gp.far, t >= 65000.0);
+}
+
+// Eq. (4): the representative ray (primary hit x, mirror direction) extended by the sample's
+// depth: the most likely secondary hit. For a mirror it is the secondary hit itself.
+fn representative_hit(p: vec2i, x: vec3f) -> vec3f {
+    return x + mirror_direction(p) * secondary_t(p);
+}
+
+// Eq. (5): the distance from the nearer representative hit to the other representative ray.
+fn ray_distance(oa: vec3f, ha: vec3f, ob: vec3f, hb: vec3f) -> f32 {
+    let ta = length(ha - oa);
+    let tb = length(hb - ob);
+    var near = ha;
+    var o_far = ob;
+    var h_far = hb;
+    if ta > tb {
+        near = hb;
+        o_far = oa;
+        h_far = ha;
+    }
+    let d = h_far - o_far;
+    let l = length(d);
+    if l <= 0.0 {
+        return length(near - o_far);
+    }
+    return length(cross(d / l, near - o_far));
+}
+
+// Mara et al. §3.4: sigma = 7 roughness^0.1 + epsilon pixels; below the roughness threshold
+// scaled by Voorhuis eq. (6), exp(-dP / omega), with dP the secondary hit's ray differential in
+// pixel footprints of the primary surface. GlossySettings::sigma_px is the same function.
+fn glossy_sigma(roughness: f32, footprints: f32) -> f32 {
+    let base = gp.sigma_scale * pow(clamp(roughness, 0.0, 1.0), gp.sigma_exponent) + gp.sigma_epsilon_px;
+    var scale = 1.0;
+    if roughness < gp.roughness_threshold {
+        scale = exp(-max(footprints, 0.0) / max(gp.omega, 1e-3));
+    }
+    return clamp(base * scale, 0.0, gp.max_sigma_px);
+}
+
+// Rebased world position to this frame's (unjittered) pixel coordinates, and the previous
+// frame's; None-like: w < 0 when behind the camera.
+fn to_pixels_of(m: mat4x4f, x: vec3f) -> vec3f {
+    let c = m * vec4f(x, 1.0);
+    if c.w <= 0.0 {
+        return vec3f(0.0, 0.0, -1.0);
+    }
+    let ndc = c.xy / c.w;
+    return vec3f((ndc.x * 0.5 + 0.5) * f32(frame.size.x), (0.5 - ndc.y * 0.5) * f32(frame.size.y), 1.0);
+}
+
+// Mara's virtual position (after Zimmer et al. 2015): what the reflection shows seen through
+// the mirror lies along the camera ray at the primary distance plus the secondary distance.
+// Its motion from this frame to the previous is the reflection's motion vector.
+fn virtual_motion(p: vec2i, x: vec3f) -> vec3f {
+    let cam = frame.cam_pos.xyz;
+    let v = cam + normalize(x - cam) * (length(x - cam) + secondary_t(p));
+    let now = to_pixels_of(frame.unjittered_view_proj, x);
+    let before = to_pixels_of(frame.prev_view_proj, v);
+    if now.z < 0.0 || before.z < 0.0 {
+        return vec3f(0.0, 0.0, -1.0);
+    }
+    return vec3f(before.xy - now.xy, 1.0);
+}
+
+// The secondary hit's ray differential in primary pixel footprints: how far the neighbouring
+// pixels' mirror rays, carried the same distance, land from this one's (Igehy 1999 with the
+// distance held fixed). 1 for a plane mirror at contact, larger where the reflection minifies.
+fn ray_differential(p: vec2i, x: vec3f) -> f32 {
+    let t = secondary_t(p);
+    let h = x + mirror_direction(p) * t;
+    var sum = 0.0;
+    var count = 0.0;
+    for (var k = 0; k < 2; k++) {
+        let q = p + select(vec2i(0, 1), vec2i(1, 0), k == 0);
+        let qq = select(q, p - (q - p), !in_bounds(q));
+        if in_bounds(qq) && has_surface(qq) {
+            let xq = position_at(qq);
+            sum += length(xq + mirror_direction(qq) * t - h);
+            count += 1.0;
+        }
+    }
+    return select(1.0, sum / max(count, 1.0) / footprint(x), count > 0.0);
+}
+
+// A pixel's size at the reflected hit: at least the footprint at the primary plus secondary
+// distance (a plane mirror), more where a curved mirror minifies (the ray differential).
+fn reflected_footprint(p: vec2i, x: vec3f) -> f32 {
+    let f = footprint(x);
+    let plane = f * (1.0 + secondary_t(p) / max(length(x - frame.cam_pos.xyz), 1e-6));
+    return max(plane, ray_differential(p, x) * f);
+}
+
+// The representative-hit texture's w: which kind of surface the pixel had (a mirror's search
+// matches only mirrors, a glossy surface's only glossy ones) and its secondary distance.
+const HIT_NONE: u32 = 0u;
+const HIT_ROUGH: u32 = 1u;
+const HIT_GLOSSY: u32 = 2u;
+const HIT_MIRROR: u32 = 3u;
+
+fn hit_class(roughness: f32) -> u32 {
+    if roughness >= gp.roughness_threshold {
+        return HIT_ROUGH;
+    }
+    return select(HIT_GLOSSY, HIT_MIRROR, is_mirror(roughness));
+}
+
+// none: 0; rough: 1e30; glossy: t + 1; mirror: -(t + 1).
+fn encode_hit_w(class: u32, t: f32) -> f32 {
+    switch class {
+        case 1u: {
+            return 1e30;
+        }
+        case 2u: {
+            return min(t, 1e29) + 1.0;
+        }
+        case 3u: {
+            return -(min(t, 1e29) + 1.0);
+        }
+        default: {
+            return 0.0;
+        }
+    }
+}
+
+fn decode_hit_class(w: f32) -> u32 {
+    if w == 0.0 {
+        return HIT_NONE;
+    }
+    if w < 0.0 {
+        return HIT_MIRROR;
+    }
+    return select(HIT_GLOSSY, HIT_ROUGH, w >= 1e30);
+}

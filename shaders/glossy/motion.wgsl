@@ -1,0 +1,87 @@
+// Glossy motion: where each pixel's reflection was in the previous frame (Voorhuis §4.1-4.2.1;
+// Mara et al. §3.4's virtual position), and this frame's representative hits for the next
+// frame's search. Outputs:
+//   motion: xy = the motion vector the glossy temporal uses (pixels, previous - current),
+//           zw = the virtual-position motion vector (both kinds, for the debug views);
+//   search: x = diamond iterations, y = disagreement in pixels (diamond vs virtual, or vs the
+//           brute-force search when it runs), z = best distance in reflected pixel footprints;
+//   hit:    xyz = representative hit (eq. 4), w = surface kind and secondary distance
+//           (encode_hit_w).
+
+@group(0) @binding(41) var prev_depth: texture_depth_2d;
+@group(0) @binding(61) var prev_hit: texture_2d<f32>;
+@group(0) @binding(62) var out_motion: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(63) var out_search: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(64) var out_hit: texture_storage_2d<rgba32float, write>;
+
+struct Probe {
+    // Primary hit and representative hit of the pixel searched for, and its kind (HIT_*).
+    o: vec3f,
+    h: vec3f,
+    class: u32,
+}
+
+// Eq. (1) for mirrors (reflected positions), eq. (5) otherwise (representative rays).
+fn search_distance(q: vec2i, probe: Probe) -> f32 {
+    if !in_bounds(q) {
+        return INF;
+    }
+    let ph = textureLoad(prev_hit, q, 0);
+    if decode_hit_class(ph.w) != probe.class {
+        return INF;
+    }
+    if probe.class == HIT_MIRROR {
+        return length(probe.h - ph.xyz);
+    }
+    let oq = world_from_depth(dn.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));
+    return ray_distance(probe.o, probe.h, oq, ph.xyz);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let surface_mv = textureLoad(gb_motion, p, 0).xy;
+    if !has_surface(p) {
+        textureStore(out_motion, p, vec4f(surface_mv, surface_mv));
+        textureStore(out_search, p, vec4f(0.0));
+        textureStore(out_hit, p, vec4f(0.0, 0.0, 0.0, encode_hit_w(HIT_NONE, 0.0)));
+        return;
+    }
+    let x = position_at(p);
+    let h = representative_hit(p, x);
+    let roughness = roughness_at(p);
+    textureStore(out_hit, p, vec4f(h, encode_hit_w(hit_class(roughness), secondary_t(p))));
+
+    let reflective = roughness < gp.roughness_threshold;
+    let v = virtual_motion(p, x);
+    let virtual_mv = select(surface_mv, v.xy, v.z > 0.0);
+    var mv = surface_mv;
+    var search = vec4f(0.0);
+    if reflective && gp.mode == MV_VIRTUAL {
+        mv = virtual_mv;
+    }
+    if reflective && gp.mode == MV_DIAMOND && dn.history_valid != 0u {
+        let probe = Probe(x, h, hit_class(roughness));
+        let start = vec2i(floor(vec2f(p) + 0.5 + surface_mv));
+        let r = diamond_search(p, start, gp.initial_step, gp.max_search_steps, probe);
+        if r.dist < INF {
+            mv = r.coord - (vec2f(p) + 0.5);
+        }
+        let reach = reflected_footprint(p, x);
+        search = vec4f(f32(r.steps), length(mv - virtual_mv), r.dist / reach, 0.0);
+        if gp.reference_radius > 0u {
+            let b = brute_force_search(p, i32(gp.reference_radius), probe);
+            let ref_mv = select(mv, b.coord - (vec2f(p) + 0.5), b.dist < INF);
+            search.y = length(mv - ref_mv);
+            // The reference's answer replaces the virtual one in zw.
+            textureStore(out_motion, p, vec4f(mv, ref_mv));
+            textureStore(out_search, p, vec4f(search.x, search.y, search.z, b.dist / reach));
+            return;
+        }
+    }
+    textureStore(out_motion, p, vec4f(mv, virtual_mv));
+    textureStore(out_search, p, search);
+}

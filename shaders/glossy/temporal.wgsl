@@ -1,0 +1,93 @@
+// Stage (8), glossy temporal (Mara et al. §3.4; Voorhuis §4.2.3): reproject the glossy history
+// with the reflection motion vectors of glossy/motion.wgsl, weigh it by a confidence, clip it to
+// the pre-blurred current neighbourhood and blend as the matte temporal does (history length n
+// in alpha; new sample weight max(1 - c, 1 / n)).
+//
+// Confidence c, by how the pixel was reprojected:
+// - surface motion vectors (rough surfaces, or --reflection-mv primary): eq. (11) on the primary
+//   surface, as the matte temporal;
+// - reflection motion vectors on a mirror: eq. (11) on the reflected hit (exact for mirrors),
+//   in pixel footprints at the reflected hit (reflected_footprint: curved mirrors minify);
+// - reflection motion vectors on a glossy surface: h wherever the previous pixel had a glossy
+//   surface. Its samples scatter, so a position test would reject good history; Voorhuis drops
+//   the consistency test there and lets the neighbourhood clip remove ghosts.
+// Output: history (rgb, n) and info (c, clip amount, n, 0).
+
+@group(0) @binding(41) var prev_depth: texture_depth_2d;
+@group(0) @binding(42) var history: texture_2d<f32>;
+@group(0) @binding(43) var linear_clamp: sampler;
+@group(0) @binding(61) var prev_hit: texture_2d<f32>;
+@group(0) @binding(65) var neighbourhood: texture_2d<f32>;
+@group(0) @binding(66) var dst: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(67) var motion: texture_2d<f32>;
+@group(0) @binding(68) var out_info: texture_storage_2d<rgba16float, write>;
+
+// Clip h towards the box centre along the line between them (Karis 2014), in YCoCg.
+fn clip_to_box(h: vec3f, lo: vec3f, hi: vec3f) -> vec3f {
+    let centre = 0.5 * (lo + hi);
+    let extent = max(0.5 * (hi - lo), vec3f(1e-6));
+    let d = h - centre;
+    let t = max3(abs(d) / extent);
+    if t <= 1.0 {
+        return h;
+    }
+    return centre + d / t;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let current = glossy_input(p);
+    if !has_surface(p) || !gstage_on(GSTAGE_TEMPORAL) {
+        textureStore(dst, p, vec4f(current, 1.0));
+        textureStore(out_info, p, vec4f(0.0, 0.0, 1.0, 0.0));
+        return;
+    }
+    let x = position_at(p);
+    let roughness = roughness_at(p);
+    let reflected = roughness < gp.roughness_threshold && gp.mode != MV_PRIMARY;
+    let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
+    let q = vec2i(floor(prev));
+    var c = 0.0;
+    if in_bounds(q) && dn.history_valid != 0u && decode_hit_class(textureLoad(prev_hit, q, 0).w) != HIT_NONE {
+        let f = footprint(x);
+        if !reflected {
+            let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
+            let actual = world_from_depth(dn.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));
+            c = gp.hysteresis * (1.0 - smoothstep(dn.d0_px * f, dn.d1_px * f, length(expected - actual)));
+        } else if is_mirror(roughness) {
+            let reach = reflected_footprint(p, x);
+            let d = length(representative_hit(p, x) - textureLoad(prev_hit, q, 0).xyz) / reach;
+            c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, d));
+        } else {
+            c = gp.hysteresis;
+        }
+    }
+    var result = current;
+    var n = 1.0;
+    var clip = 0.0;
+    if c > 0.0 {
+        n = min(max(textureLoad(history, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0).a, 1.0) + 1.0, 1024.0);
+        let hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        var clipped = hist;
+        if gstage_on(GSTAGE_CLIPPING) && roughness < gp.clip_roughness {
+            var lo = vec3f(3.0e38);
+            var hi = vec3f(-3.0e38);
+            for (var dy = -2; dy <= 2; dy++) {
+                for (var dx = -2; dx <= 2; dx++) {
+                    let s = to_ycocg(textureLoad(neighbourhood, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb);
+                    lo = min(lo, s);
+                    hi = max(hi, s);
+                }
+            }
+            clipped = from_ycocg(clip_to_box(to_ycocg(hist), lo, hi));
+            clip = clamp(length(clipped - hist) / max(length(hist), 1e-4), 0.0, 1.0);
+        }
+        result = mix(clipped, current, max(1.0 - c, 1.0 / n));
+    }
+    textureStore(dst, p, vec4f(half_safe(result), n));
+    textureStore(out_info, p, vec4f(c, clip, n, 0.0));
+}
