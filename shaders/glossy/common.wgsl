@@ -192,8 +192,8 @@ fn hit_class(roughness: f32) -> u32 {
 }
 
 // none: 0; rough: 1e30; glossy: t + 1; mirror: -(t + 1).
-fn encode_hit_w(class: u32, t: f32) -> f32 {
-    switch class {
+fn encode_hit_w(kind: u32, t: f32) -> f32 {
+    switch kind {
         case 1u: {
             return 1e30;
         }

@@ -18,7 +18,7 @@ struct Probe {
     // Primary hit and representative hit of the pixel searched for, and its kind (HIT_*).
     o: vec3f,
     h: vec3f,
-    class: u32,
+    kind: u32,
 }
 
 // Eq. (1) for mirrors (reflected positions), eq. (5) otherwise (representative rays).
@@ -27,10 +27,10 @@ fn search_distance(q: vec2i, probe: Probe) -> f32 {
         return INF;
     }
     let ph = textureLoad(prev_hit, q, 0);
-    if decode_hit_class(ph.w) != probe.class {
+    if decode_hit_class(ph.w) != probe.kind {
         return INF;
     }
-    if probe.class == HIT_MIRROR {
+    if probe.kind == HIT_MIRROR {
         return length(probe.h - ph.xyz);
     }
     let oq = world_from_depth(dn.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));
