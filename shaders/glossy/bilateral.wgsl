@@ -38,7 +38,8 @@ fn features(p: vec2i, centre: bool) -> Features {
 fn sigma_at(p: vec2i) -> f32 {
     let r = roughness_at(p);
     var dp = 0.0;
-    if r < gp.roughness_threshold {
+    // A reflection of the environment has no secondary hit to differentiate (and is smooth).
+    if r < gp.roughness_threshold && secondary_t(p) < gp.far {
         dp = ray_differential(p, position_at(p));
     }
     return glossy_sigma(r, dp);

@@ -160,7 +160,8 @@ fn ray_differential(p: vec2i, x: vec3f) -> f32 {
     for (var k = 0; k < 2; k++) {
         let q = p + select(vec2i(0, 1), vec2i(1, 0), k == 0);
         let qq = select(q, p - (q - p), !in_bounds(q));
-        if in_bounds(qq) && has_surface(qq) {
+        // Only neighbours on the same object: across a silhouette the difference is the edge.
+        if in_bounds(qq) && has_surface(qq) && textureLoad(gb_object, qq, 0).x == textureLoad(gb_object, p, 0).x {
             let xq = position_at(qq);
             sum += length(xq + mirror_direction(qq) * t - h);
             count += 1.0;

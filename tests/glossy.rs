@@ -1,0 +1,219 @@
+//! The glossy chain (Mara et al. 2017 §3.4 stages 8-10, Voorhuis §4): the diamond search on a
+//! synthetic motion, the virtual-position reprojection of a plane mirror against geometry, and
+//! the bilateral's sigma.
+
+use glam::{DVec3, Vec2, Vec4};
+use hush_engine::accel::BvhKind;
+use hush_engine::frame::{FrameInput, Renderer};
+use hush_engine::gpu::{Gpu, GpuRequirements};
+use hush_engine::scene::Camera;
+use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, ReflectionMv};
+use hush_tests::half;
+
+/// The search of shaders/glossy/diamond.wgsl over a synthetic previous frame whose world
+/// position is (pixel centre, 0): the pixel p of this frame shows the point at p + motion.
+const DIAMOND_TEST: &str = r#"
+struct Probe {
+    h: vec3f,
+}
+
+struct TestParams {
+    motion: vec2f,
+    size: vec2u,
+    initial_step: u32,
+    max_steps: u32,
+    _pad: vec2u,
+}
+
+@group(0) @binding(0) var<uniform> u: TestParams;
+@group(0) @binding(1) var<storage, read_write> result: array<vec4f>;
+
+fn search_distance(q: vec2i, probe: Probe) -> f32 {
+    if any(q < vec2i(0)) || q.x >= i32(u.size.x) || q.y >= i32(u.size.y) {
+        return INF;
+    }
+    return length(vec3f(vec2f(q) + 0.5, 0.0) - probe.h);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    if gid.x >= u.size.x || gid.y >= u.size.y {
+        return;
+    }
+    let p = vec2i(gid.xy);
+    let centre = vec2f(p) + 0.5;
+    let r = diamond_search(p, p, u.initial_step, u.max_steps, Probe(vec3f(centre + u.motion, 0.0)));
+    result[gid.y * u.size.x + gid.x] = vec4f(r.coord - centre, f32(r.steps), r.dist);
+}
+"#;
+
+/// (motion found, iterations, distance) per pixel.
+fn run_diamond(gpu: &Gpu, size: (u32, u32), motion: Vec2, initial_step: u32) -> Vec<Vec4> {
+    use wgpu::util::DeviceExt;
+    let program = hush_engine::shader::compose("diamond test", DIAMOND_TEST, &["common/math.wgsl", "glossy/diamond.wgsl"]).unwrap();
+    let module = program.create(&gpu.device).unwrap();
+    let d = &gpu.device;
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor { label: Some("diamond test"), layout: None, module: &module, entry_point: Some("main"), compilation_options: Default::default(), cache: None });
+    let params: [u32; 8] = [motion.x.to_bits(), motion.y.to_bits(), size.0, size.1, initial_step, 64, 0, 0];
+    let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::cast_slice(&params), usage: wgpu::BufferUsages::UNIFORM });
+    let n = (size.0 * size.1) as u64 * 16;
+    let out = d.create_buffer(&wgpu::BufferDescriptor { label: None, size: n, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() }],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+    }
+    gpu.queue.submit([enc.finish()]);
+    let bytes = hush_engine::gpu::readback_buffer(&gpu.device, &gpu.queue, &out, n).unwrap();
+    bytemuck::cast_slice::<u8, [f32; 4]>(&bytes).iter().map(|v| Vec4::from_array(*v)).collect()
+}
+
+/// Integer motions, small and larger than the first step, are found exactly (distance 0 takes
+/// all of eq. (2)'s weight) wherever the moved pixel is on screen; a sub-pixel motion lands
+/// within half a pixel (eq. (3) interpolates between the best 2x2 block's centres).
+#[test]
+fn diamond_search_finds_a_known_motion() {
+    let gpu = Gpu::headless(&GpuRequirements::default()).unwrap();
+    let size = (64u32, 48u32);
+    for (motion, exact) in [(Vec2::ZERO, true), (Vec2::new(3.0, -2.0), true), (Vec2::new(13.0, 7.0), true), (Vec2::new(-21.0, 5.0), true), (Vec2::new(2.25, -1.5), false)] {
+        for initial_step in [4, 1] {
+            let out = run_diamond(&gpu, size, motion, initial_step);
+            let mut worst = 0.0f32;
+            let mut checked = 0;
+            for y in 0..size.1 {
+                for x in 0..size.0 {
+                    let target = Vec2::new(x as f32, y as f32) + 0.5 + motion;
+                    // Pixels whose answer lies on screen with a margin for the 2x2 refinement.
+                    if target.x < 1.0 || target.y < 1.0 || target.x > size.0 as f32 - 1.0 || target.y > size.1 as f32 - 1.0 {
+                        continue;
+                    }
+                    let v = out[(y * size.0 + x) as usize];
+                    worst = worst.max((v.truncate().truncate() - motion).length());
+                    checked += 1;
+                }
+            }
+            assert!(checked > 500, "{checked}");
+            let bound = if exact { 1e-4 } else { 0.5 };
+            assert!(worst <= bound, "motion {motion}, first step {initial_step}: worst error {worst} px (bound {bound})");
+        }
+    }
+}
+
+/// A camera above the `reflections` scene's mirror floor, looking at its back wall (z = -8).
+fn camera(x: f64) -> Camera {
+    Camera::look_at(DVec3::new(x, 1.2, 3.0), DVec3::new(x, 0.2, -4.0), 50.0)
+}
+
+/// Mara's virtual position for a plane mirror: the wall seen in the floor lies, unfolded, on
+/// the camera ray where it meets the plane z = -8, so its motion vector is that point projected
+/// by the previous camera, minus the pixel. Checked on every floor pixel that reflects the wall;
+/// the diamond search must agree with it there.
+#[test]
+fn virtual_position_of_a_plane_mirror_is_analytic() {
+    let size = (96u32, 54u32);
+    let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
+    let mut s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    s.matte.taa = false; // samples at pixel centres
+    s.glossy.reflection_mv = ReflectionMv::Diamond;
+    let (before, now) = (camera(-0.15), camera(0.15));
+    r.render(&gpu, &FrameInput { camera: before, time: 0.0 }, &s, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: now, time: 0.0 }, &s, None).unwrap();
+    let (motion, _) = r.read_texture(&gpu, "glossy/motion").unwrap();
+    let motion: &[[f32; 4]] = bytemuck::cast_slice(&motion);
+    let (glossy, _) = r.read_texture(&gpu, "trace/glossy").unwrap();
+    let origin = r.prepared.origin.as_vec3();
+    let cur = r.camera_setup(&now);
+    let prev = r.camera_setup(&before);
+    let (mut n, mut worst, mut diamond_err, mut within) = (0, 0.0f32, 0.0f32, 0);
+    for y in 0..size.1 {
+        for x in 0..size.0 {
+            let ndc = Vec2::new((x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0);
+            let d = (cur.fwd + ndc.x * cur.right + ndc.y * cur.up).normalize();
+            let c = cur.pos + origin;
+            if d.y >= 0.0 {
+                continue;
+            }
+            let s_floor = -c.y / d.y;
+            let s_wall = (-8.0 - c.z) / d.z;
+            let wall_y = -(c.y + d.y * s_wall);
+            let i = (y * size.0 + x) as usize;
+            let t = half(&glossy[i * 8 + 6..i * 8 + 8]);
+            // Floor pixels whose mirror ray reaches the wall unobstructed (its secondary distance,
+            // stored as a half float, is the analytic one), away from the wall's top edge.
+            if s_wall <= s_floor || !(0.1..3.8).contains(&wall_y) || ((s_wall - s_floor) - t).abs() > 4e-3 {
+                continue;
+            }
+            let v = c + d * s_wall - origin;
+            let clip = prev.view_proj * v.extend(1.0);
+            let ndc_prev = clip.truncate().truncate() / clip.w;
+            let expected = Vec2::new((ndc_prev.x * 0.5 + 0.5) * size.0 as f32, (0.5 - ndc_prev.y * 0.5) * size.1 as f32) - Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let m = motion[i];
+            if std::env::var("HUSH_TEST_VERBOSE").is_ok() && (Vec2::new(m[2], m[3]) - expected).length() > 0.05 {
+                println!("({x},{y}) expected {expected} virtual {:?} diamond {:?} t {t} s_floor {s_floor} s_wall {s_wall}", (m[2], m[3]), (m[0], m[1]));
+            }
+            worst = worst.max((Vec2::new(m[2], m[3]) - expected).length());
+            let e = (Vec2::new(m[0], m[1]) - expected).length();
+            diamond_err += e;
+            within += (e <= 1.0) as u32;
+            n += 1;
+        }
+    }
+    assert!(n > 200, "only {n} floor pixels reflect the wall");
+    // The secondary distance is a half float (steps of 2-4 mm at 3-8 m): hundredths of a pixel.
+    assert!(worst < 0.05, "virtual position off by up to {worst} px over {n} pixels");
+    // The search is exact to the pixel; eq. (3)'s sub-pixel step weighs the best 2x2 block by
+    // distance products, which is not linear interpolation (measured: 0.53 px mean here).
+    let mean = diamond_err / n as f32;
+    let share = within as f32 / n as f32;
+    println!("diamond vs analytic: mean {mean:.3} px, {:.1}% within 1 px, {n} pixels", share * 100.0);
+    assert!(mean < 0.75 && share > 0.9, "diamond search {mean} px from the analytic motion on average, {share} within 1 px ({n} pixels)");
+}
+
+/// Sigma = 7 r^0.1 + epsilon (Mara §3.4): exact on rough surfaces (no ray-differential term
+/// above the roughness threshold); below it reduced by Voorhuis eq. (6): on the plane mirror
+/// floor between no reduction and a ray differential of 12 footprints (1 to 9 in this view), on
+/// the spheres (which minify what they reflect) anywhere down to 0.
+#[test]
+fn glossy_bilateral_sigma() {
+    let g = GlossySettings::default();
+    assert!((g.sigma_px(1.0, 0.0) - 8.0).abs() < 1e-5);
+    assert!((g.sigma_px(0.2, 0.0) - (7.0 * 0.2f32.powf(0.1) + 1.0)).abs() < 1e-5);
+    assert!((g.sigma_px(0.2, 16.0) - (7.0 * 0.2f32.powf(0.1) + 1.0) * (-1.0f32).exp()).abs() < 1e-5);
+    assert_eq!(g.sigma_px(0.6, 16.0), g.sigma_px(0.6, 0.0));
+    assert!((g.sigma_px(0.0, 0.0) - 1.0).abs() < 1e-6);
+
+    let size = (96u32, 54u32);
+    let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
+    let s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0 }, &s, None).unwrap();
+    let (scratch, _) = r.read_texture(&gpu, "glossy/scratch").unwrap();
+    let (specular, _) = r.read_texture(&gpu, "gbuffer/specular").unwrap();
+    let (ids, _) = r.read_texture(&gpu, "gbuffer/ids").unwrap();
+    let mut seen = [0; 3];
+    for i in 0..(size.0 * size.1) as usize {
+        if u32::from_le_bytes(ids[i * 8 + 4..i * 8 + 8].try_into().unwrap()) == u32::MAX {
+            continue;
+        }
+        let roughness = specular[i * 4 + 3] as f32 / 255.0;
+        let sigma = half(&scratch[i * 8 + 6..i * 8 + 8]);
+        let object = u32::from_le_bytes(ids[i * 8..i * 8 + 4].try_into().unwrap());
+        // Object 0 is the floor (scene::reflection_scene).
+        let most = if object == 0 || roughness >= g.roughness_threshold { 12.0 } else { 1e4 };
+        let (lo, hi) = (g.sigma_px(roughness, most), g.sigma_px(roughness, 0.0));
+        if std::env::var("HUSH_TEST_VERBOSE").is_ok() && !(sigma >= lo - 0.01 * hi - 1e-3 && sigma <= hi * 1.01 + 1e-3) {
+            println!("pixel ({}, {}) roughness {roughness} sigma {sigma} [{lo}, {hi}]", i % size.0 as usize, i / size.0 as usize);
+            continue;
+        }
+        let tol = 0.01 * hi + 1e-3; // half-float storage
+        assert!(sigma >= lo - tol && sigma <= hi + tol, "pixel {i}: roughness {roughness}, sigma {sigma} outside [{lo}, {hi}]");
+        seen[if roughness >= g.roughness_threshold { 0 } else if roughness > g.mirror_roughness { 1 } else { 2 }] += 1;
+    }
+    assert!(seen.iter().all(|&k| k > 20), "rough, glossy, mirror pixels: {seen:?}");
+}
