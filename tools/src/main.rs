@@ -5,6 +5,7 @@ mod bench_realtime;
 mod compare;
 mod quality;
 mod realtime;
+mod reflections;
 mod render;
 mod sweep;
 
@@ -26,6 +27,9 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Score a denoised stream against per-frame references: CSV, plot, ablations.
     Quality(quality::QualityArgs),
+    /// Reflection reprojection: temporal error, FLIP and ghosting under a strafe, motion vector
+    /// accuracy against a brute-force search (Voorhuis §7.3-7.4).
+    Reflections(reflections::ReflectionsArgs),
     /// The speed/accuracy sweep: resolution scale, paths per pixel, path length, denoiser.
     Sweep(sweep::SweepArgs),
     /// Write the default level (built in code) as glTF: LEVEL.gltf, .bin, PNG textures, EXR sky.
@@ -61,6 +65,7 @@ fn main() {
         Command::Level(a) => level(a),
         Command::Quality(a) => quality::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Reflections(a) => reflections::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

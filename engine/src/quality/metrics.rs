@@ -60,6 +60,16 @@ pub fn display(c: f32) -> f32 {
 
 /// LDR-FLIP (nv-flip, 67 pixels per degree) of T(x) against T(y).
 pub fn flip_ldr(x: &Image, y: &Image) -> f64 {
+    let err = flip_error(x, y);
+    nv_flip::FlipPool::from_image(&err).mean() as f64
+}
+
+/// Per-pixel LDR-FLIP of T(x) against T(y), row-major (to score a region of the image).
+pub fn flip_map(x: &Image, y: &Image) -> Vec<f32> {
+    flip_error(x, y).to_vec()
+}
+
+fn flip_error(x: &Image, y: &Image) -> nv_flip::FlipImageFloat {
     let to8 = |img: &Image| -> Vec<u8> {
         img.data
             .iter()
@@ -69,8 +79,7 @@ pub fn flip_ldr(x: &Image, y: &Image) -> f64 {
     };
     let t = nv_flip::FlipImageRgb8::with_data(x.width, x.height, &to8(x));
     let r = nv_flip::FlipImageRgb8::with_data(y.width, y.height, &to8(y));
-    let err = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
-    nv_flip::FlipPool::from_image(&err).mean() as f64
+    nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE)
 }
 
 pub fn compare(test: &Image, reference: &Image) -> Result<Metrics> {
