@@ -2,7 +2,7 @@
 //! views, animation clock, screenshots and camera paths.
 
 use hush_engine::frame::View;
-use hush_engine::settings::{Denoiser, FrameSettings};
+use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv};
 
 pub struct Panel {
     pub settings: FrameSettings,
@@ -70,6 +70,25 @@ impl Panel {
                 ui.add(egui::Slider::new(&mut m.disocclusion_fraction, 0.005..=0.2).text("R (fraction of width)"));
                 ui.add(egui::Slider::new(&mut m.taa_alpha, 0.02..=1.0).text("TAA current-frame weight"));
             });
+            if self.glossy {
+                let g = &mut self.settings.glossy;
+                ui.collapsing("glossy chain", |ui| {
+                    ui.checkbox(&mut g.temporal, "glossy/temporal (8; off: no reprojection)");
+                    ui.checkbox(&mut g.clipping, "glossy/temporal neighbourhood clipping");
+                    ui.checkbox(&mut g.bilateral, "glossy/bilateral (9, 10)");
+                    egui::ComboBox::from_label("reflection motion vectors").selected_text(g.reflection_mv.name()).show_ui(ui, |ui| {
+                        for mv in ReflectionMv::ALL {
+                            ui.selectable_value(&mut g.reflection_mv, mv, mv.name());
+                        }
+                    });
+                    ui.add(egui::Slider::new(&mut g.roughness_threshold, 0.0..=1.0).text("reflection MV roughness threshold"));
+                    ui.add(egui::Slider::new(&mut g.initial_step, 1..=16).text("diamond first step (px)"));
+                    ui.add(egui::Slider::new(&mut g.hysteresis, 0.5..=0.999).text("hysteresis h"));
+                    ui.add(egui::Slider::new(&mut g.sigma_scale, 0.0..=12.0).text("sigma scale (px)"));
+                    ui.add(egui::Slider::new(&mut g.sigma_epsilon_px, 0.0..=4.0).text("sigma epsilon (px)"));
+                    ui.add(egui::Slider::new(&mut g.ray_differential_omega, 1.0..=64.0).text("ray differential omega (footprints)"));
+                });
+            }
         }
         ui.add(egui::Slider::new(&mut self.settings.exposure_ev, -8.0..=8.0).text("exposure (EV)"));
         ui.add(egui::Slider::new(&mut self.settings.max_depth, 2..=16).text("max depth"));

@@ -1,8 +1,9 @@
 //! `hush-cli reflections`: how well the glossy chain reprojects reflections, measured as
 //! Voorhuis §7.3-7.4 does.
 //! 1. Temporal error (Schied et al.: mean |luminance change| between consecutive frames, still
-//!    camera and scene) of the glossy chain's output on surfaces with a specular lobe, for each
-//!    reflection motion vector (diamond, virtual, primary) and with no reprojection at all.
+//!    camera and scene) on surfaces with a specular lobe, of the glossy chain's output (TAA and
+//!    its jitter off) and of the final image (TAA on), for each reflection motion vector
+//!    (diamond, virtual, primary) and with no glossy reprojection at all.
 //! 2. A camera strafe (with the scene's animation running): FLIP of the final image against a
 //!    per-frame accumulated reference on reflective pixels (roughness under the threshold), and
 //!    on the ghost region: reflective pixels whose reference changed since the previous frame
@@ -19,7 +20,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::quality::{Image, flip_map, luminance};
 use hush_engine::scene::{Camera, Scene};
-use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv};
+use hush_engine::settings::{FrameSettings, ReflectionMv};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -49,6 +50,9 @@ pub struct ReflectionsArgs {
     /// Brute-force search radius in pixels.
     #[arg(long, default_value_t = 32)]
     pub search_radius: u32,
+    /// Stages to switch off in every configuration (see `render --disable`), for ablations.
+    #[arg(long, value_delimiter = ',')]
+    pub disable: Vec<String>,
     #[arg(long)]
     pub out_dir: PathBuf,
 }
@@ -101,14 +105,14 @@ fn new_renderer(gpu: &Gpu, scene: &Scene, size: (u32, u32)) -> Result<Renderer> 
 }
 
 /// The four ways of reprojecting reflections that are compared.
-fn configs() -> Vec<(&'static str, FrameSettings)> {
+fn configs(base: &FrameSettings) -> Vec<(&'static str, FrameSettings)> {
     let mut v = vec![];
     for mv in [ReflectionMv::Diamond, ReflectionMv::Virtual, ReflectionMv::Primary] {
-        let mut s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+        let mut s = base.clone();
         s.glossy.reflection_mv = mv;
         v.push((mv.name(), s));
     }
-    let mut off = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let mut off = base.clone();
     off.glossy.temporal = false;
     v.push(("no reprojection", off));
     v
@@ -126,43 +130,57 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     let size = image_size(&scene, Some(a.width), a.height);
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
-    let threshold = FrameSettings::default().glossy.roughness_threshold;
+    let base = crate::realtime::denoiser_settings("mara", &a.disable, "diamond")?;
+    let threshold = base.glossy.roughness_threshold;
     let camera = scene.camera_or_default();
     let mut csv = std::fs::File::create(a.out_dir.join("reflections.csv"))?;
     writeln!(csv, "part,config,metric,value")?;
     println!("{} at {}x{} on {}", a.scene, size.0, size.1, gpu.info.name);
 
-    // 1. Temporal error, still camera and scene.
-    println!("  still camera, {} frames: temporal error of the glossy output (mean |dY|, second half)", a.frames);
+    // 1. Temporal error, still camera and scene: the chain's output on a still raster (TAA off:
+    // its sub-pixel jitter changes what every pixel samples, and that aliasing is TAA's to
+    // remove), and the final image with TAA on glossy pixels.
+    println!("  still camera, {} frames: temporal error (mean |dY| on glossy pixels, second half)", a.frames);
+    println!("    {:16} {:>14} {:>14} {:>14}", "", "chain output", "final image", "raw glossy");
     let mut still = vec![];
-    for (name, s) in configs() {
-        let mut r = new_renderer(&gpu, &scene, size)?;
-        let mut prev: Option<Vec<f32>> = None;
-        let mut errors = vec![];
-        let mut raw_errors = vec![];
-        let mut prev_raw: Option<Vec<f32>> = None;
-        for _ in 0..a.frames {
-            r.render(&gpu, &FrameInput { camera, time: 0.0 }, &s, None)?;
-            let m = mask(&r, &gpu, threshold)?;
-            let y: Vec<f32> = read_vec4(&r, &gpu, "glossy/denoised")?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect();
-            let raw: Vec<f32> = read_vec4(&r, &gpu, "trace/glossy")?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect();
-            if let (Some(p), Some(pr)) = (&prev, &prev_raw) {
-                errors.push(masked_mean(y.iter().zip(p).map(|(a, b)| (a - b).abs() as f64), &m.glossy));
-                raw_errors.push(masked_mean(raw.iter().zip(pr).map(|(a, b)| (a - b).abs() as f64), &m.glossy));
+    for (name, s) in configs(&base) {
+        let mut row = vec![];
+        for taa in [false, true] {
+            let mut s = s.clone();
+            s.matte.taa = taa;
+            let mut r = new_renderer(&gpu, &scene, size)?;
+            let mut prev: Option<(Vec<f32>, Vec<f32>)> = None;
+            let (mut chain_err, mut raw_err) = (vec![], vec![]);
+            for _ in 0..a.frames {
+                r.render(&gpu, &FrameInput { camera, time: 0.0 }, &s, None)?;
+                let m = mask(&r, &gpu, threshold)?;
+                let y: Vec<f32> = if taa {
+                    r.read_hdr(&gpu)?.data.iter().map(|v| luminance(*v)).collect()
+                } else {
+                    read_vec4(&r, &gpu, "glossy/denoised")?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect()
+                };
+                let raw: Vec<f32> = read_vec4(&r, &gpu, "trace/glossy")?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect();
+                if let Some((p, pr)) = &prev {
+                    chain_err.push(masked_mean(y.iter().zip(p).map(|(a, b)| (a - b).abs() as f64), &m.glossy));
+                    raw_err.push(masked_mean(raw.iter().zip(pr).map(|(a, b)| (a - b).abs() as f64), &m.glossy));
+                }
+                prev = Some((y, raw));
             }
-            prev = Some(y);
-            prev_raw = Some(raw);
+            row.push(crate::quality::Scores::settled(&chain_err));
+            if taa {
+                row.push(crate::quality::Scores::settled(&raw_err));
+            }
         }
-        let te = crate::quality::Scores::settled(&errors);
-        let raw = crate::quality::Scores::settled(&raw_errors);
-        println!("    {name:16} {te:.5}   (undenoised glossy light {raw:.5})");
-        writeln!(csv, "still,{name},temporal_error,{te:.6}")?;
-        still.push((name, te));
+        println!("    {name:16} {:14.5} {:14.5} {:14.5}", row[0], row[1], row[2]);
+        writeln!(csv, "still,{name},temporal_error_chain_output,{:.6}", row[0])?;
+        writeln!(csv, "still,{name},temporal_error_final_image,{:.6}", row[1])?;
+        still.push((name, row[0], row[1]));
     }
-    let off = still.iter().find(|(n, _)| *n == "no reprojection").map_or(0.0, |s| s.1);
-    for (name, te) in &still {
-        if *name != "no reprojection" {
-            println!("    no reprojection / {name}: {:.2}x", off / te.max(1e-12));
+    if let Some(off) = still.iter().find(|s| s.0 == "no reprojection").cloned() {
+        for (name, chain, fin) in &still {
+            if *name != "no reprojection" {
+                println!("    no reprojection / {name}: {:.2}x (chain output), {:.2}x (final image)", off.1 / chain.max(1e-12), off.2 / fin.max(1e-12));
+            }
         }
     }
 
@@ -181,7 +199,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     println!("  camera strafe, {} frames ({} reference frames each): FLIP of reflective pixels, and of the ghost region", a.path_frames, a.reference_frames);
     let mut flips = std::fs::File::create(a.out_dir.join("strafe.csv"))?;
     writeln!(flips, "frame,config,flip_reflective,flip_ghost_region")?;
-    for (name, s) in configs() {
+    for (name, s) in configs(&base) {
         let mut r = new_renderer(&gpu, &scene, size)?;
         let (mut fr, mut fg) = (vec![], vec![]);
         for (k, input) in inputs.iter().enumerate() {
@@ -215,7 +233,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     let mv_camera = mv_scene.camera_or_default();
     println!("  motion vectors on {} against a brute-force search of {}x{} pixels (strafe {} per frame)", a.mv_scene, 2 * a.search_radius + 1, 2 * a.search_radius + 1, a.step * 3.0);
     for initial_step in [4u32, 1] {
-        let mut s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+        let mut s = base.clone();
         s.glossy.initial_step = initial_step;
         s.glossy.reference_search_radius = a.search_radius;
         let mut r = new_renderer(&gpu, &mv_scene, size)?;

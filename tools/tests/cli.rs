@@ -44,6 +44,8 @@ fn bad_arguments_are_clear_errors() {
         (vec!["render", "default", "--mode", "magic", "--out", "x.exr"], "--mode"),
         (vec!["render", "level", "--mode", "realtime", "--view", "nope", "--width", "8", "--height", "8", "--out", "x.png"], "--view"),
         (vec!["render", "level", "--mode", "realtime", "--frames", "0", "--out", "x.exr"], "--frames"),
+        (vec!["render", "level", "--mode", "realtime", "--denoiser", "mara", "--reflection-mv", "sideways", "--out", "x.exr"], "--reflection-mv"),
+        (vec!["render", "level", "--mode", "realtime", "--denoiser", "mara", "--disable", "glossy.nothing", "--out", "x.exr"], "glossy.bilateral"),
     ] {
         let o = bin("hush-cli").args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
@@ -103,7 +105,10 @@ fn realtime_bench_reports_every_pass() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let passes: Vec<&str> = v["passes"].as_array().unwrap().iter().map(|p| p["pass"].as_str().unwrap()).collect();
-    assert_eq!(passes, ["gbuffer", "trace", "matte/temporal", "matte/history_bilateral", "matte/disocclusion_h", "matte/disocclusion_v", "matte/firefly", "matte/bilateral", "composite", "taa", "display"]);
+    assert_eq!(passes, [
+        "gbuffer", "trace", "matte/temporal", "matte/history_bilateral", "matte/disocclusion_h", "matte/disocclusion_v", "matte/firefly", "matte/bilateral",
+        "glossy/motion", "glossy/prefilter_h", "glossy/prefilter_v", "glossy/temporal", "glossy/bilateral_h", "glossy/bilateral_v", "composite", "taa", "display",
+    ]);
     for p in v["passes"].as_array().unwrap() {
         assert!(p["median_ms"].as_f64().unwrap() > 0.0, "{p}");
     }
@@ -129,7 +134,8 @@ fn quality_writes_scores_and_a_plot() {
         assert!(v.iter().all(|x| x.is_finite()) && v[2] > 0.0 && v[2] < 1.0, "{r}");
     }
     let ablations = std::fs::read_to_string(dir.join("ablations.csv")).unwrap();
-    assert_eq!(ablations.lines().count(), 8, "{ablations}");
+    // Header, the full chain, and each of the 6 matte and 3 glossy stages off.
+    assert_eq!(ablations.lines().count(), 11, "{ablations}");
     let png = image_size(&dir.join("quality.png"));
     assert_eq!(png, (960, 720));
 }
@@ -155,4 +161,25 @@ fn sweep_marks_a_pareto_front() {
         assert!(ms > 0.0 && flip > 0.0 && flip < 1.0, "{r:?}");
     }
     assert_eq!(image_size(&dir.join("pareto.png")), (960, 640));
+}
+
+#[test]
+fn reflections_measures_every_reprojection() {
+    let dir = temp_dir("reflections");
+    let o = bin("hush-cli")
+        .args(["reflections", "reflections", "--width", "32", "--frames", "3", "--path-frames", "3", "--reference-frames", "2", "--search-radius", "4", "--out-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.join("reflections.csv")).unwrap();
+    // 4 configurations x (2 temporal errors + 2 FLIPs), 2 sphere kinds x 2 searches x 2 stats.
+    assert_eq!(csv.lines().count(), 1 + 16 + 8, "{csv}");
+    for name in ["diamond", "virtual", "primary", "no reprojection"] {
+        assert!(csv.contains(&format!("still,{name},temporal_error_chain_output,")), "{csv}");
+    }
+    for row in csv.lines().skip(1) {
+        let v: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
+        assert!(v.is_finite() && v >= 0.0, "{row}");
+    }
 }
