@@ -227,6 +227,13 @@ pub struct GlossySettings {
     pub ray_differential_omega: f32,
     /// Bilateral weight on roughness differences: exp(-(dr / sigma)^2).
     pub roughness_sigma: f32,
+    /// Trace each glossy pixel's representative (mirror) ray below the roughness threshold, and
+    /// search by eq. (1) on its real hit; off, eq. (4) extends the ray by the sample's depth and
+    /// the search uses eq. (5). On the `spheres` strafe (160x90, against a 65x65 brute-force
+    /// search) the glossy sphere's vectors were 8.05 px off on average (42.6% within 1 px) with
+    /// sampled depths, whose jumps between near and far geometry make eq. (5)'s minimum
+    /// ambiguous, and 0.31 px (92.6%) with traced ones, for one closest-hit ray per such pixel.
+    pub trace_representative_ray: bool,
     /// Measurements only: also run a brute-force search over a window of this radius (pixels)
     /// and report the diamond search's distance to it in the search view (0: off).
     #[serde(skip)]
@@ -253,6 +260,7 @@ impl Default for GlossySettings {
             sigma_epsilon_px: 1.0,
             ray_differential_omega: 16.0,
             roughness_sigma: 0.1,
+            trace_representative_ray: true,
             reference_search_radius: 0,
         }
     }

@@ -28,7 +28,8 @@ struct GlossyParams {
     // Distance that stands for a reflection that left the scene (a few scene extents).
     far: f32,
     max_sigma_px: f32,
-    _pad0: u32,
+    // 1: the representative hits of glossy surfaces come from traced mirror rays.
+    representative_traced: u32,
     _pad1: u32,
 }
 
@@ -80,14 +81,16 @@ fn glossy_input(p: vec2i) -> vec3f {
     return half_safe(glossy_light(p) / demodulation(p));
 }
 
-// The glossy path's secondary hit distance; an escaped path stands at `far`.
+// The representative ray's hit distance (the trace traces the mirror ray of glossy surfaces
+// under the roughness threshold; mirrors' samples are that ray); an escaped ray stands at `far`.
 fn secondary_t(p: vec2i) -> f32 {
-    let t = textureLoad(tr_glossy, p, 0).a;
-    return select(t, gp.far, t >= 65000.0);
+    let t = textureLoad(tr_reflection, p, 0).w;
+    return select(t, gp.far, t >= 3.0e38);
 }
 
-// Eq. (4): the representative ray (primary hit x, mirror direction) extended by the sample's
-// depth: the most likely secondary hit. For a mirror it is the secondary hit itself.
+// Eq. (4): the representative ray (primary hit x, mirror direction) extended to its hit: the
+// most likely secondary hit. Its distance is the traced mirror ray's (GlossySettings::
+// trace_representative_ray) or, as Voorhuis, the sample's; for a mirror they are the same.
 fn representative_hit(p: vec2i, x: vec3f) -> vec3f {
     return x + mirror_direction(p) * secondary_t(p);
 }

@@ -21,7 +21,7 @@ struct Probe {
     kind: u32,
 }
 
-// Eq. (1) for mirrors (reflected positions), eq. (5) otherwise (representative rays).
+// Distance to the previous frame's pixel q with the same kind of surface.
 fn search_distance(q: vec2i, probe: Probe) -> f32 {
     if !in_bounds(q) {
         return INF;
@@ -30,7 +30,9 @@ fn search_distance(q: vec2i, probe: Probe) -> f32 {
     if decode_hit_class(ph.w) != probe.kind {
         return INF;
     }
-    if probe.kind == HIT_MIRROR {
+    // Eq. (1) wherever the representative hit is a real hit: on mirrors, and on glossy surfaces
+    // when the trace traced their representative ray; eq. (5) on sampled depths.
+    if probe.kind == HIT_MIRROR || gp.representative_traced != 0u {
         return length(probe.h - ph.xyz);
     }
     let oq = world_from_depth(dn.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));

@@ -23,7 +23,8 @@ struct Frame {
     accumulated: u32,
     // Matte and glossy paths traced per pixel (their results are averaged).
     paths: u32,
-    _pad0: u32,
+    // Glossy surfaces below this roughness also trace their representative (mirror) ray.
+    representative_roughness: f32,
     _pad1: u32,
     _pad2: u32,
 }

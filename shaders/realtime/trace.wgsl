@@ -57,7 +57,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if slot == NO_HIT {
         // Background: what the camera sees of the environment goes straight to the screen.
         write_all(px, vec3f(0.0), env_radiance(rd));
-        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd);
+        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd, INF);
         return;
     }
     // Exact barycentrics of this frame's camera ray on the rasterised triangle (no bounds test:
@@ -74,7 +74,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let m = materials[s.material];
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         write_all(px, vec3f(0.0), vec3f(0.0));
-        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd);
+        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd, INF);
         return;
     }
     let ms = material_at(m, s.uv);
@@ -95,7 +95,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var hit_normal = -mirror;
     if !depth_ok(2) || wo.z <= 0.0 {
         write_all(px, matte, direct);
-        write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal);
+        write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal, glossy_t);
         return;
     }
 
@@ -179,6 +179,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     matte /= f32(paths);
     glossy /= f32(paths);
 
+    // The representative ray's own hit distance (Voorhuis eq. (4) uses the sample's, which at
+    // roughness 0.2 jumps between near and far geometry from pixel to pixel and makes the
+    // reflection search ambiguous): one more closest-hit ray, only below the chain's threshold.
+    var representative_t = glossy_t;
+    if has_glossy && !bsdf.delta && ms.roughness < frame.representative_roughness && dot(mirror, s.ng) > 0.0 {
+        representative_t = traverse(origin, mirror, INF, false).t;
+    }
     write_all(px, matte, direct);
-    write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal);
+    write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal, representative_t);
 }

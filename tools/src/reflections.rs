@@ -10,7 +10,8 @@
 //!    (where a reflected object was and no longer is, or arrived), where a ghost trail shows.
 //! 3. Motion vector accuracy on `--mv-scene` (default `spheres`: a mirror and a glossy sphere,
 //!    no other specular surface): the diamond search against a brute-force search of a
-//!    (2R + 1)^2 window, with and without LDSP scaling: mean error and share within one pixel.
+//!    (2R + 1)^2 window, with and without LDSP scaling, and with the sampled depth of eq. (4)-(5)
+//!    instead of the traced representative ray: mean error and share within one pixel.
 
 use crate::render::{bvh_kind, image_size, load_scene};
 use anyhow::{Context, Result};
@@ -232,9 +233,10 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     let mv_scene = load_scene(&a.mv_scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
     let mv_camera = mv_scene.camera_or_default();
     println!("  motion vectors on {} against a brute-force search of {}x{} pixels (strafe {} per frame)", a.mv_scene, 2 * a.search_radius + 1, 2 * a.search_radius + 1, a.step * 3.0);
-    for initial_step in [4u32, 1] {
+    for (initial_step, traced) in [(4u32, true), (1, true), (4, false)] {
         let mut s = base.clone();
         s.glossy.initial_step = initial_step;
+        s.glossy.trace_representative_ray = traced;
         s.glossy.reference_search_radius = a.search_radius;
         let mut r = new_renderer(&gpu, &mv_scene, size)?;
         // (sum of errors, within one pixel, count) for mirror and glossy pixels.
@@ -260,7 +262,11 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
                 c.2 += 1;
             }
         }
-        let scaling = if initial_step > 1 { "with LDSP scaling" } else { "without LDSP scaling" };
+        let scaling = match (initial_step > 1, traced) {
+            (true, true) => "with LDSP scaling",
+            (false, true) => "without LDSP scaling",
+            _ => "sampled depth, eq. 5",
+        };
         for (kind, (sum, within, n)) in ["mirror sphere", "glossy sphere"].iter().zip(stats) {
             let mean = sum / n.max(1) as f64;
             let share = within as f64 / n.max(1) as f64 * 100.0;

@@ -173,8 +173,8 @@ fn reflections_measures_every_reprojection() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(dir.join("reflections.csv")).unwrap();
-    // 4 configurations x (2 temporal errors + 2 FLIPs), 2 sphere kinds x 2 searches x 2 stats.
-    assert_eq!(csv.lines().count(), 1 + 16 + 8, "{csv}");
+    // 4 configurations x (2 temporal errors + 2 FLIPs), 2 sphere kinds x 3 searches x 2 stats.
+    assert_eq!(csv.lines().count(), 1 + 16 + 12, "{csv}");
     for name in ["diamond", "virtual", "primary", "no reprojection"] {
         assert!(csv.contains(&format!("still,{name},temporal_error_chain_output,")), "{csv}");
     }

@@ -340,7 +340,8 @@ impl Renderer {
             exposure: settings.exposure_scale(),
             accumulated: self.accumulated,
             paths: settings.paths_per_pixel.clamp(1, 64),
-            _pad: [0; 3],
+            representative_roughness: if denoise && settings.glossy.trace_representative_ray && settings.glossy.reflection_mv != crate::settings::ReflectionMv::Primary { settings.glossy.roughness_threshold } else { 0.0 },
+            _pad: [0; 2],
         };
         let view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
         let tp = make_params(&self.prepared, &view);

@@ -22,7 +22,10 @@ pub struct FrameParams {
     pub exposure: f32,
     pub accumulated: u32,
     pub paths: u32,
-    pub _pad: [u32; 3],
+    /// Glossy surfaces below this roughness also trace their representative (mirror) ray for
+    /// the glossy chain's reflection motion vectors (0: none do).
+    pub representative_roughness: f32,
+    pub _pad: [u32; 2],
 }
 
 /// A camera in the GPU scene's rebased space, as both the raster and the tracer see it.

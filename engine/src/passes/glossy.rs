@@ -39,7 +39,8 @@ pub struct GlossyParams {
     pub roughness_sigma: f32,
     pub far: f32,
     pub max_sigma_px: f32,
-    pub _pad: [u32; 2],
+    pub representative_traced: u32,
+    pub _pad: u32,
 }
 
 impl GlossyParams {
@@ -68,7 +69,8 @@ impl GlossyParams {
             roughness_sigma: s.roughness_sigma.max(1e-4),
             far: (4.0 * extent).max(1e-3),
             max_sigma_px: MAX_GLOSSY_SIGMA_PX,
-            _pad: [0; 2],
+            representative_traced: s.trace_representative_ray as u32,
+            _pad: 0,
         }
     }
 }
