@@ -30,7 +30,8 @@ struct GlossyParams {
     max_sigma_px: f32,
     // 1: the representative hits of glossy surfaces come from traced mirror rays.
     representative_traced: u32,
-    _pad1: u32,
+    // The bilateral's sigma shrinks as 1 / sqrt(history length) beyond this many frames.
+    sigma_full_frames: f32,
 }
 
 @group(0) @binding(60) var<uniform> gp: GlossyParams;

@@ -40,7 +40,7 @@ pub struct GlossyParams {
     pub far: f32,
     pub max_sigma_px: f32,
     pub representative_traced: u32,
-    pub _pad: u32,
+    pub sigma_full_frames: f32,
 }
 
 impl GlossyParams {
@@ -70,7 +70,7 @@ impl GlossyParams {
             far: (4.0 * extent).max(1e-3),
             max_sigma_px: MAX_GLOSSY_SIGMA_PX,
             representative_traced: s.trace_representative_ray as u32,
-            _pad: 0,
+            sigma_full_frames: s.sigma_full_frames,
         }
     }
 }
