@@ -52,7 +52,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
     let q = vec2i(floor(prev));
     var c = 0.0;
-    if in_bounds(q) && dn.history_valid != 0u && decode_hit_class(textureLoad(prev_hit, q, 0).w) != HIT_NONE {
+    let ph = textureLoad(prev_hit, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0);
+    if in_bounds(q) && dn.history_valid != 0u && decode_hit_class(ph.w) != HIT_NONE {
         let f = footprint(x);
         if !reflected {
             let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
@@ -60,7 +61,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             c = gp.hysteresis * (1.0 - smoothstep(dn.d0_px * f, dn.d1_px * f, length(expected - actual)));
         } else if is_mirror(roughness) {
             let reach = reflected_footprint(p, x);
-            let d = length(representative_hit(p, x) - textureLoad(prev_hit, q, 0).xyz) / reach;
+            let d = length(representative_hit(p, x) - ph.xyz) / reach;
             c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, d));
         } else {
             c = gp.hysteresis;

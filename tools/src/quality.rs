@@ -98,8 +98,13 @@ struct Setup {
 }
 
 fn renderer(s: &Setup) -> Result<Renderer> {
-    let prepared = PreparedScene::new(&s.scene, bvh_kind(&None)?)?;
-    Renderer::new(&s.gpu, s.scene.clone(), prepared, s.size)
+    new_renderer(&s.gpu, &s.scene, s.size)
+}
+
+/// A real-time frame of `scene` on an open device (the default BVH layout).
+pub fn new_renderer(gpu: &Gpu, scene: &Scene, size: (u32, u32)) -> Result<Renderer> {
+    let prepared = PreparedScene::new(scene, bvh_kind(&None)?)?;
+    Renderer::new(gpu, scene.clone(), prepared, size)
 }
 
 /// Render the stream with `settings`, scoring every frame against `references`.

@@ -13,6 +13,7 @@
 //!    (2R + 1)^2 window, with and without LDSP scaling, and with the sampled depth of eq. (4)-(5)
 //!    instead of the traced representative ray: mean error and share within one pixel.
 
+use crate::quality::new_renderer;
 use crate::render::{bvh_kind, image_size, load_scene};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -20,7 +21,7 @@ use glam::{DMat4, DVec3, Vec3};
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::quality::{Image, flip_map, luminance};
-use hush_engine::scene::{Camera, Scene};
+use hush_engine::scene::Camera;
 use hush_engine::settings::{FrameSettings, ReflectionMv};
 use std::io::Write;
 use std::path::PathBuf;
@@ -98,11 +99,6 @@ fn masked_mean(values: impl Iterator<Item = f64>, mask: &[bool]) -> f64 {
         }
     }
     if n == 0 { 0.0 } else { s / n as f64 }
-}
-
-fn new_renderer(gpu: &Gpu, scene: &Scene, size: (u32, u32)) -> Result<Renderer> {
-    let prepared = PreparedScene::new(scene, bvh_kind(&None)?)?;
-    Renderer::new(gpu, scene.clone(), prepared, size)
 }
 
 /// The four ways of reprojecting reflections that are compared.

@@ -303,10 +303,11 @@ impl Renderer {
             let inputs = self.chain_inputs();
             self.chain = Some(MatteChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the matte chain")?);
         }
-        if denoise && self.glossy_chain.is_none() {
-            if let Some(inputs) = self.glossy_inputs() {
-                self.glossy_chain = Some(GlossyChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the glossy chain")?);
-            }
+        if denoise
+            && self.glossy_chain.is_none()
+            && let Some(inputs) = self.glossy_inputs()
+        {
+            self.glossy_chain = Some(GlossyChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the glossy chain")?);
         }
         let jitter = if settings.accumulate {
             random_jitter(self.frame_index, settings.seed)

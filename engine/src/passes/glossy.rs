@@ -8,7 +8,7 @@
 use super::gbuffer::GBufferTargets;
 use super::matte::{MatteTargets, gbuffer_inputs};
 use super::trace::TraceTargets;
-use crate::gpu::scene::compute_pipeline_at;
+use super::chain::ChainStage;
 use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
 use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 use anyhow::Result;
@@ -198,26 +198,15 @@ pub fn modules(stage: &'static str, animated: bool) -> Vec<&'static str> {
     m
 }
 
-struct Stage {
-    label: &'static str,
-    kind: Kind,
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
-    groups: Option<(u64, [wgpu::BindGroup; 2])>,
-}
-
 pub struct GlossyChain {
-    stages: Vec<Stage>,
+    stages: Vec<(Kind, ChainStage)>,
 }
 
 impl GlossyChain {
     pub fn new(gpu: &Gpu, i: &GlossyInputs, animated: bool) -> Result<GlossyChain> {
         let mut stages = vec![];
         for (kind, label, file, entry) in STAGES {
-            let module = crate::shader::compose(label, "", &modules(file, animated))?.create(&gpu.device)?;
-            let layout = bindings(kind, i, 0).create_layout(&gpu.device, label);
-            let pipeline = compute_pipeline_at(&gpu.device, label, &module, &layout, entry);
-            stages.push(Stage { label, kind, pipeline, layout, groups: None });
+            stages.push((kind, ChainStage::new(gpu, label, &modules(file, animated), entry, bindings(kind, i, 0))?));
         }
         Ok(GlossyChain { stages })
     }
@@ -226,15 +215,8 @@ impl GlossyChain {
     #[allow(clippy::too_many_arguments)]
     pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &GlossyInputs, parity: usize, size: (u32, u32), settings: &GlossySettings, mut timer: Option<&mut GpuTimer>) {
         let clip = settings.temporal && settings.clipping;
-        for s in self.stages.iter_mut().filter(|s| clip || !matches!(s.kind, Kind::PrefilterH | Kind::PrefilterV)) {
-            if s.groups.as_ref().is_none_or(|(k, _)| *k != key) {
-                let g = |p| bindings(s.kind, i, p).create_group(&gpu.device, s.label, &s.layout);
-                s.groups = Some((key, [g(0), g(1)]));
-            }
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.label), timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(s.label)) });
-            pass.set_pipeline(&s.pipeline);
-            pass.set_bind_group(0, &s.groups.as_ref().unwrap().1[parity], &[]);
-            pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        for (kind, s) in self.stages.iter_mut().filter(|(k, _)| clip || !matches!(k, Kind::PrefilterH | Kind::PrefilterV)) {
+            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p));
         }
     }
 }

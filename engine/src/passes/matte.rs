@@ -6,7 +6,7 @@
 
 use super::gbuffer::GBufferTargets;
 use super::trace::TraceTargets;
-use crate::gpu::scene::compute_pipeline_at;
+use super::chain::ChainStage;
 use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
 use crate::settings::MatteSettings;
 use anyhow::Result;
@@ -204,32 +204,20 @@ fn modules(kind: Kind, animated: bool) -> Vec<&'static str> {
     m
 }
 
-struct Stage {
-    kind: Kind,
-    label: &'static str,
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
-    /// Bind groups for history parity 0 and 1, and the key they were made for.
-    groups: Option<(u64, [wgpu::BindGroup; 2])>,
-}
-
 pub struct MatteChain {
-    stages: Vec<Stage>,
+    stages: Vec<(Kind, ChainStage)>,
 }
 
 impl MatteChain {
     pub fn new(gpu: &Gpu, i: &ChainInputs, animated: bool) -> Result<MatteChain> {
         let mut stages = vec![];
         for (kind, label) in STAGES {
-            let module = crate::shader::compose(label, "", &modules(kind, animated))?.create(&gpu.device)?;
-            let layout = bindings(kind, i, 0).create_layout(&gpu.device, label);
             let entry = match kind {
                 Kind::MinH => "min_h",
                 Kind::MinV => "min_v",
                 _ => "main",
             };
-            let pipeline = compute_pipeline_at(&gpu.device, label, &module, &layout, entry);
-            stages.push(Stage { kind, label, pipeline, layout, groups: None });
+            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated), entry, bindings(kind, i, 0))?));
         }
         Ok(MatteChain { stages })
     }
@@ -237,15 +225,8 @@ impl MatteChain {
     /// Record stages 3-7 (before the composite) or TAA (after it).
     #[allow(clippy::too_many_arguments)]
     pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &ChainInputs, parity: usize, size: (u32, u32), taa: bool, mut timer: Option<&mut GpuTimer>) {
-        for s in self.stages.iter_mut().filter(|s| (s.kind == Kind::Taa) == taa) {
-            if s.groups.as_ref().is_none_or(|(k, _)| *k != key) {
-                let g = |p| bindings(s.kind, i, p).create_group(&gpu.device, s.label, &s.layout);
-                s.groups = Some((key, [g(0), g(1)]));
-            }
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.label), timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(s.label)) });
-            pass.set_pipeline(&s.pipeline);
-            pass.set_bind_group(0, &s.groups.as_ref().unwrap().1[parity], &[]);
-            pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        for (kind, s) in self.stages.iter_mut().filter(|(k, _)| (*k == Kind::Taa) == taa) {
+            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p));
         }
     }
 }
