@@ -3,6 +3,7 @@
 //! glossy path and no glossy buffers; no animation: no object motion buffer and no BVH rebuilds).
 
 mod params;
+mod reload;
 mod views;
 
 pub use params::{CameraSetup, FrameParams, random_jitter};

@@ -49,6 +49,8 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// Whether timestamp queries were granted (used by benchmarks when the adapter has them).
     pub timestamps: bool,
+    /// Where shader text comes from (embedded unless `$HUSH_SHADERS` or the caller says).
+    pub shaders: crate::shader::ShaderLibrary,
 }
 
 impl Gpu {
@@ -157,7 +159,8 @@ impl Gpu {
         device.on_uncaptured_error(std::sync::Arc::new(|e| {
             log::error!("wgpu: {e}");
         }));
-        Ok(Gpu { instance, adapter, device, queue, info, timestamps })
+        let shaders = crate::shader::ShaderLibrary::from_env_or(None)?;
+        Ok(Gpu { instance, adapter, device, queue, info, timestamps, shaders })
     }
 
     /// Run `f` inside a validation error scope: what wgpu would only log becomes an error with
@@ -168,7 +171,8 @@ impl Gpu {
         let e = pollster::block_on(scope.pop());
         let v = r?;
         match e {
-            Some(e) => Err(anyhow!("{what}: {e}")),
+            // The error's sources say which binding, entry point or limit was wrong.
+            Some(e) => Err(anyhow::Error::new(e).context(what.to_string())),
             None => Ok(v),
         }
     }

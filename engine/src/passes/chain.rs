@@ -3,11 +3,12 @@
 
 use crate::gpu::scene::compute_pipeline_at;
 use crate::gpu::{Bindings, Gpu, GpuTimer};
+use crate::shader::Reloadable;
 use anyhow::Result;
 
 pub struct ChainStage {
     pub label: &'static str,
-    pipeline: wgpu::ComputePipeline,
+    pub pipeline: Reloadable<wgpu::ComputePipeline>,
     layout: wgpu::BindGroupLayout,
     groups: Option<(u64, [wgpu::BindGroup; 2])>,
 }
@@ -15,9 +16,9 @@ pub struct ChainStage {
 impl ChainStage {
     /// `layout`: the stage's bindings for either parity (only their types matter here).
     pub fn new(gpu: &Gpu, label: &'static str, modules: &[&'static str], entry: &str, layout: Bindings) -> Result<ChainStage> {
-        let module = crate::shader::compose(label, "", modules)?.create(&gpu.device)?;
         let layout = layout.create_layout(&gpu.device, label);
-        let pipeline = compute_pipeline_at(&gpu.device, label, &module, &layout, entry);
+        let (l, entry) = (layout.clone(), entry.to_string());
+        let pipeline = Reloadable::new(gpu, label, "", modules, move |d, m| compute_pipeline_at(d, label, m, &l, &entry))?;
         Ok(ChainStage { label, pipeline, layout, groups: None })
     }
 
@@ -29,7 +30,7 @@ impl ChainStage {
             self.groups = Some((key, [g(0), g(1)]));
         }
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.label), timestamp_writes: timer.and_then(|t| t.compute(self.label)) });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(self.pipeline.get());
         pass.set_bind_group(0, &self.groups.as_ref().unwrap().1[parity], &[]);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }

@@ -6,6 +6,7 @@ use super::gbuffer::GBufferTargets;
 use super::trace::TraceTargets;
 use crate::gpu::scene::compute_pipeline;
 use crate::gpu::{Bindings, Gpu, GpuTimer};
+use crate::shader::Reloadable;
 use anyhow::Result;
 
 pub const COMPOSITE: &str = "composite";
@@ -65,16 +66,16 @@ fn modules(glossy: bool, denoise: bool, glossy_chain: bool, last: &'static str) 
 }
 
 pub struct CompositePass {
-    pipeline: wgpu::ComputePipeline,
+    pub pipeline: Reloadable<wgpu::ComputePipeline>,
     layout: wgpu::BindGroupLayout,
     bind_group: Option<(u64, wgpu::BindGroup)>,
 }
 
 impl CompositePass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers) -> Result<CompositePass> {
-        let module = crate::shader::compose(COMPOSITE, "", &modules(t.glossy.is_some(), false, false, "realtime/composite.wgsl"))?.create(&gpu.device)?;
         let layout = inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_layout(&gpu.device, COMPOSITE);
-        let pipeline = compute_pipeline(&gpu.device, COMPOSITE, &module, &layout);
+        let l = layout.clone();
+        let pipeline = Reloadable::new(gpu, COMPOSITE, "", &modules(t.glossy.is_some(), false, false, "realtime/composite.wgsl"), move |d, m| compute_pipeline(d, COMPOSITE, m, &l))?;
         Ok(CompositePass { pipeline, layout, bind_group: None })
     }
 
@@ -84,14 +85,14 @@ impl CompositePass {
             self.bind_group = Some((key, inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_group(&gpu.device, COMPOSITE, &self.layout)));
         }
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(COMPOSITE), timestamp_writes: timer.and_then(|t| t.compute(COMPOSITE)) });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(self.pipeline.get());
         pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }
 }
 
 pub struct DisplayPass {
-    pipeline: wgpu::RenderPipeline,
+    pub pipeline: Reloadable<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
     bind_group: Option<(u64, wgpu::BindGroup)>,
     pub format: wgpu::TextureFormat,
@@ -101,20 +102,22 @@ pub struct DisplayPass {
 
 impl DisplayPass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
-        let module = crate::shader::compose(DISPLAY, "", &modules(t.glossy.is_some(), b.denoise.is_some(), b.glossy_chain.is_some(), "realtime/display.wgsl"))?.create(&gpu.device)?;
         let layout = inputs(wgpu::ShaderStages::FRAGMENT, g, t, b, true).create_layout(&gpu.device, DISPLAY);
         let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(DISPLAY), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
-        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(DISPLAY),
-            layout: Some(&pl),
-            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &[Some(format.into())] }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let modules = modules(t.glossy.is_some(), b.denoise.is_some(), b.glossy_chain.is_some(), "realtime/display.wgsl");
+        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, move |d, module| {
+            d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(DISPLAY),
+                layout: Some(&pl),
+                vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &[Some(format.into())] }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })?;
         Ok(DisplayPass { pipeline, layout, bind_group: None, format, with_denoise: b.denoise.is_some() })
     }
 
@@ -131,7 +134,7 @@ impl DisplayPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(self.pipeline.get());
         pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
         pass.draw(0..3, 0..1);
     }

@@ -17,6 +17,7 @@
 //! asks for 40, which every native backend grants.
 
 use crate::gpu::{Bindings, Gpu, GpuMemory, GpuScene, GpuTimer};
+use crate::shader::Reloadable;
 use anyhow::Result;
 
 pub const LABEL: &str = "gbuffer";
@@ -53,7 +54,7 @@ impl GBufferTargets {
 }
 
 pub struct GBufferPass {
-    pipeline: wgpu::RenderPipeline,
+    pub pipeline: Reloadable<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
     bind_group: Option<(u64, wgpu::BindGroup)>,
 }
@@ -88,14 +89,13 @@ impl GBufferPass {
             if f.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" },
             "realtime/gbuffer.wgsl",
         ];
-        let module = crate::shader::compose(LABEL, "", &modules)?.create(&gpu.device)?;
         let layout = bindings(scene, frame).create_layout(&gpu.device, LABEL);
         let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(LABEL), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
         let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
-        let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let pipeline = Reloadable::new(gpu, LABEL, "", &modules, move |d, module| d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(LABEL),
             layout: Some(&pl),
-            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+            vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
             primitive: wgpu::PrimitiveState { cull_mode: None, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
@@ -106,10 +106,10 @@ impl GBufferPass {
                 bias: Default::default(),
             }),
             multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
+            fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
             multiview_mask: None,
             cache: None,
-        });
+        }))?;
         Ok(GBufferPass { pipeline, layout, bind_group: None })
     }
 
@@ -139,7 +139,7 @@ impl GBufferPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(self.pipeline.get());
         pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
         pass.draw(0..scene.triangle_count * 3, 0..1);
     }

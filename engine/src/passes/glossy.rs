@@ -203,6 +203,11 @@ pub struct GlossyChain {
 }
 
 impl GlossyChain {
+    /// The stages' pipelines, for hot reload.
+    pub fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
+        self.stages.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
+    }
+
     pub fn new(gpu: &Gpu, i: &GlossyInputs, animated: bool) -> Result<GlossyChain> {
         let mut stages = vec![];
         for (kind, label, file, entry) in STAGES {

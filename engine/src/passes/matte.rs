@@ -209,6 +209,11 @@ pub struct MatteChain {
 }
 
 impl MatteChain {
+    /// The stages' pipelines, for hot reload.
+    pub fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
+        self.stages.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
+    }
+
     pub fn new(gpu: &Gpu, i: &ChainInputs, animated: bool) -> Result<MatteChain> {
         let mut stages = vec![];
         for (kind, label) in STAGES {

@@ -32,7 +32,7 @@ impl Raycaster {
             "common/alpha_none.wgsl",
             "accel/raycast.wgsl",
         ];
-        let program = crate::shader::compose(LABEL, "", &modules)?;
+        let program = gpu.shaders.compose(LABEL, "", &modules)?;
         let module = program.create(&gpu.device)?;
         let entries = [
             uniform_entry(0),

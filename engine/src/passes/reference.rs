@@ -77,7 +77,7 @@ impl ReferenceTracer {
         }
         let mut modules = scene.shading_modules();
         modules.push("reference/trace.wgsl");
-        let program = crate::shader::compose(LABEL, &scene.prelude(), &modules)?;
+        let program = gpu.shaders.compose(LABEL, &scene.prelude(), &modules)?;
         let module = program.create(&gpu.device)?;
         let mut memory = GpuMemory::default();
         let accum = memory.buffer(

@@ -51,7 +51,7 @@ impl TraceTargets {
 }
 
 pub struct TracePass {
-    pipeline: wgpu::ComputePipeline,
+    pub pipeline: crate::shader::Reloadable<wgpu::ComputePipeline>,
     layout: wgpu::BindGroupLayout,
     bind_group: Option<((u64, u64), wgpu::BindGroup)>,
 }
@@ -76,9 +76,9 @@ impl TracePass {
         modules.push("realtime/frame.wgsl");
         modules.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
         modules.push("realtime/trace.wgsl");
-        let module = crate::shader::compose(LABEL, &scene.prelude(), &modules)?.create(&gpu.device)?;
         let layout = bindings(scene, params, frame, g, t).create_layout(&gpu.device, LABEL);
-        let pipeline = compute_pipeline(&gpu.device, LABEL, &module, &layout);
+        let l = layout.clone();
+        let pipeline = crate::shader::Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, move |d, m| compute_pipeline(d, LABEL, m, &l))?;
         Ok(TracePass { pipeline, layout, bind_group: None })
     }
 
@@ -89,7 +89,7 @@ impl TracePass {
             self.bind_group = Some((key, bindings(scene, params, frame, g, t).create_group(&gpu.device, LABEL, &self.layout)));
         }
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(self.pipeline.get());
         pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
     }

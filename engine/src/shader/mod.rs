@@ -6,6 +6,18 @@
 //! bindings and code do not exist in the program at all. Sources are embedded in the binary;
 //! every program is validated with naga before it reaches the driver, so errors name the WGSL
 //! line rather than a backend's translation of it.
+//!
+//! Every program records the modules it was composed from, which is what hot reload uses to
+//! rebuild exactly the pipelines a changed file feeds (`reload.rs`); `library.rs` says where the
+//! text comes from (embedded, or a folder on disk that `watch.rs` watches).
+
+mod library;
+mod reload;
+mod watch;
+
+pub use library::{SHADER_DIR_VAR, ShaderLibrary, source_tree_dir};
+pub use reload::{Reload, Reloadable, ReloadOutcome};
+pub use watch::ShaderWatcher;
 
 use anyhow::{Result, anyhow};
 
@@ -90,12 +102,17 @@ pub struct Program {
     pub text: String,
 }
 
-/// Concatenate `prelude` and `modules`, each preceded by a marker naming the file.
+/// Concatenate `prelude` and the embedded `modules`, each preceded by a marker naming the file.
 pub fn compose(label: &str, prelude: &str, modules: &[&'static str]) -> Result<Program> {
+    compose_with(label, prelude, modules, |m| source(m).map(std::sync::Arc::from))
+}
+
+/// `compose` with the text of each module given by `source`.
+pub fn compose_with(label: &str, prelude: &str, modules: &[&'static str], source: impl Fn(&str) -> Result<std::sync::Arc<str>>) -> Result<Program> {
     let mut text = String::from(prelude);
     for m in modules {
         text.push_str(&format!("\n// ---- {m}\n"));
-        text.push_str(source(m)?);
+        text.push_str(&source(m)?);
     }
     Ok(Program { label: label.to_string(), modules: modules.to_vec(), text })
 }
@@ -117,17 +134,25 @@ impl Program {
         (file, line.saturating_sub(start))
     }
 
+    /// "file:line" of a line of the composed text, as editors and terminals link it.
+    fn at(&self, line: Option<usize>) -> String {
+        line.map_or("an unknown line".to_string(), |l| {
+            let (file, line) = self.locate(l);
+            format!("{file}:{line}")
+        })
+    }
+
     /// Parse and validate with naga; errors name the source file and line.
     pub fn validate(&self) -> Result<naga::Module> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
-            let at = e.location(&self.text).filter(|l| l.length > 0).map(|l| self.locate(l.line_number as usize));
-            anyhow!("{}: WGSL parse error at {:?}: {}", self.label, at, e.message())
+            let at = self.at(e.location(&self.text).filter(|l| l.length > 0).map(|l| l.line_number as usize));
+            anyhow!("{}: WGSL parse error at {at}: {}", self.label, e.message())
         })?;
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
             .validate(&module)
             .map_err(|e| {
-                let at = e.spans().next().map(|(s, _)| self.locate(s.location(&self.text).line_number as usize));
-                anyhow!("{}: WGSL validation error at {:?}: {}", self.label, at, e.as_inner())
+                let at = self.at(e.spans().next().map(|(s, _)| s.location(&self.text).line_number as usize));
+                anyhow!("{}: WGSL validation error at {at}: {}", self.label, e.as_inner())
             })?;
         Ok(module)
     }
@@ -237,7 +262,7 @@ mod tests {
     fn errors_name_the_file_and_line() {
         let p = Program { label: "t".into(), modules: vec![], text: "// ---- a.wgsl\nfn f() {}\n// ---- b.wgsl\nfn g() -> u32 {\n  return 1u +;\n}\n".into() };
         let e = format!("{:#}", p.validate().unwrap_err());
-        assert!(e.contains("b.wgsl") && e.contains(", 2)"), "{e}");
+        assert!(e.contains("b.wgsl:2"), "{e}");
     }
 
     /// Size and member offsets of a WGSL struct as naga lays it out for storage/uniform use.

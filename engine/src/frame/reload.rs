@@ -1,0 +1,41 @@
+//! Hot reload of the frame's pipelines: a changed module rebuilds exactly the pipelines whose
+//! programs contain it (each pipeline records its modules); the others are not touched.
+
+use super::Renderer;
+use crate::gpu::Gpu;
+use crate::shader::{Reload, ReloadOutcome};
+
+impl Renderer {
+    /// Every pipeline of the frame that exists now (the chains and the display are made on
+    /// first use).
+    pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
+        let mut v: Vec<&mut dyn Reload> = vec![&mut self.gbuffer.pipeline, &mut self.trace.pipeline, &mut self.composite.pipeline];
+        if let Some(d) = self.display.as_mut() {
+            v.push(&mut d.pipeline);
+        }
+        if let Some(c) = self.chain.as_mut() {
+            v.extend(c.pipelines());
+        }
+        if let Some(c) = self.glossy_chain.as_mut() {
+            v.extend(c.pipelines());
+        }
+        v
+    }
+
+    /// Rebuild the pipelines that use any of `changed` (module paths under `shaders/`, already
+    /// refreshed in `gpu.shaders`). A pipeline that fails keeps its last good version.
+    pub fn reload_shaders(&mut self, gpu: &Gpu, changed: &[&str]) -> Vec<ReloadOutcome> {
+        let mut out = vec![];
+        for p in self.pipelines() {
+            if p.modules().iter().any(|m| changed.contains(m)) {
+                out.push(p.reload(gpu));
+            }
+        }
+        out
+    }
+
+    /// (pipeline, error) for every pipeline whose last reload failed.
+    pub fn shader_errors(&mut self) -> Vec<(String, String)> {
+        self.pipelines().into_iter().filter_map(|p| p.error().map(|e| (p.label().to_string(), e.to_string()))).collect()
+    }
+}

@@ -1,0 +1,105 @@
+//! Pipelines that can be rebuilt from their shader text while Hush runs. A pipeline keeps the
+//! program it came from (label, prelude, modules) and how to build it from a shader module; a
+//! reload composes the text again, validates it with naga, then creates the module and the
+//! pipeline inside a wgpu validation error scope, and swaps only when all of that succeeded.
+//! On failure the last good pipeline keeps rendering and the error (file and line) is kept
+//! until a later reload of the same pipeline succeeds.
+
+use crate::gpu::Gpu;
+use anyhow::{Context, Result};
+use std::time::Instant;
+
+type Build<P> = Box<dyn Fn(&wgpu::Device, &wgpu::ShaderModule) -> P + Send + Sync>;
+
+pub struct Reloadable<P> {
+    label: String,
+    prelude: String,
+    modules: Vec<&'static str>,
+    build: Build<P>,
+    current: P,
+    builds: u32,
+    error: Option<String>,
+}
+
+/// What one pipeline's reload did.
+#[derive(Clone, Debug)]
+pub struct ReloadOutcome {
+    pub label: String,
+    /// Compose, validate, create module and pipeline, in milliseconds.
+    pub ms: f64,
+    pub error: Option<String>,
+}
+
+/// A pipeline the renderer can rebuild when one of its modules changes.
+pub trait Reload {
+    fn label(&self) -> &str;
+    fn modules(&self) -> &[&'static str];
+    /// How many times a pipeline was built (1 after creation; +1 per successful reload).
+    fn builds(&self) -> u32;
+    /// The error of the last failed reload, cleared by a successful one.
+    fn error(&self) -> Option<&str>;
+    fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome;
+}
+
+impl<P> Reloadable<P> {
+    /// Compose and build the pipeline; `build` makes it from a shader module (and is kept to
+    /// make it again).
+    pub fn new(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], build: impl Fn(&wgpu::Device, &wgpu::ShaderModule) -> P + Send + Sync + 'static) -> Result<Reloadable<P>> {
+        let build: Build<P> = Box::new(build);
+        let current = make(gpu, label, prelude, modules, &build)?;
+        Ok(Reloadable { label: label.to_string(), prelude: prelude.to_string(), modules: modules.to_vec(), build, current, builds: 1, error: None })
+    }
+
+    pub fn get(&self) -> &P {
+        &self.current
+    }
+}
+
+fn make<P>(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], build: &Build<P>) -> Result<P> {
+    let program = gpu.shaders.compose(label, prelude, modules)?;
+    program.validate()?;
+    // naga accepts some programs the pipeline still rejects (a binding the layout lacks, an
+    // entry point that is gone); the error scope turns those into errors too.
+    gpu.validated(&format!("creating pipeline {label}"), || {
+        let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(program.text.as_str().into()) });
+        Ok(build(&gpu.device, &module))
+    })
+    .with_context(|| format!("pipeline {label} ({})", modules.join(", ")))
+}
+
+impl<P> Reload for Reloadable<P> {
+    fn label(&self) -> &str {
+        &self.label
+    }
+
+    fn modules(&self) -> &[&'static str] {
+        &self.modules
+    }
+
+    fn builds(&self) -> u32 {
+        self.builds
+    }
+
+    fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome {
+        let start = Instant::now();
+        let result = make(gpu, &self.label, &self.prelude, &self.modules, &self.build);
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        self.error = match result {
+            Ok(p) => {
+                self.current = p;
+                self.builds += 1;
+                None
+            }
+            Err(e) => {
+                let e = format!("{e:#}");
+                log::error!("shader reload failed, keeping the last good pipeline: {e}");
+                Some(e)
+            }
+        };
+        ReloadOutcome { label: self.label.clone(), ms, error: self.error.clone() }
+    }
+}
