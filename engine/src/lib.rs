@@ -8,6 +8,7 @@ pub mod accel;
 pub mod frame;
 pub mod gpu;
 pub mod passes;
+pub mod profile;
 pub mod quality;
 pub mod scene;
 pub mod settings;

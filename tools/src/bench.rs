@@ -37,6 +37,10 @@ pub struct BenchArgs {
     pub rays: u32,
     #[arg(long)]
     pub json: bool,
+    /// Real-time mode: write a puffin capture of the measured frames (CPU scopes and the GPU
+    /// passes) to this `.puffin` file (open it with puffin_viewer).
+    #[arg(long)]
+    pub profile: Option<std::path::PathBuf>,
 }
 
 #[derive(Serialize)]

@@ -5,6 +5,7 @@ use crate::bench::BenchArgs;
 use crate::render::{bvh_kind, load_scene};
 use anyhow::{Result, bail};
 use hush_engine::frame::{DisplayTarget, FrameInput, Renderer};
+use hush_engine::profile::puffin;
 use hush_engine::settings::FrameSettings;
 use serde::Serialize;
 use std::time::Instant;
@@ -68,12 +69,20 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let camera = r.scene.camera_or_default();
     let mut per_pass: Vec<(&'static str, Vec<f64>)> = vec![];
     let (mut totals, mut cpu) = (vec![], vec![]);
+    let mut capture = None;
     // Two warm-up frames compile pipelines and fill caches.
     for k in 0..a.frames + 2 {
+        if k == 2 && a.profile.is_some() {
+            capture = Some(hush_engine::profile::Capture::start(a.frames as usize));
+        }
         let input = FrameInput { camera, time: k as f64 / 60.0 };
         let start = Instant::now();
-        r.render(&gpu, &input, &settings, Some(&target))?;
-        let times = r.pass_times(&gpu)?;
+        {
+            puffin::profile_scope!("frame");
+            r.render(&gpu, &input, &settings, Some(&target))?;
+        }
+        let times: Vec<(&'static str, f64)> = r.pass_spans(&gpu)?.into_iter().map(|s| (s.label, s.ms)).collect();
+        hush_engine::profile::end_frame();
         let wall = start.elapsed().as_secs_f64() * 1e3;
         if k < 2 {
             continue;
@@ -91,6 +100,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         .into_iter()
         .map(|(pass, mut v)| PassTime { pass, min_ms: v.iter().cloned().fold(f64::MAX, f64::min), median_ms: median(&mut v) })
         .collect();
+    if let (Some(c), Some(path)) = (capture, &a.profile) {
+        let n = c.write(path)?;
+        eprintln!("wrote {n} profiled frames to {}", path.display());
+    }
     let res = RealtimeResult {
         scene: a.scene.clone(),
         adapter: gpu.info.name.clone(),

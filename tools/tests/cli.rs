@@ -101,7 +101,8 @@ fn realtime_sequences_are_deterministic_and_ordered() {
 
 #[test]
 fn realtime_bench_reports_every_pass() {
-    let o = bin("hush-cli").args(["bench", "level", "--mode", "realtime", "--json", "--width", "32", "--height", "18", "--frames", "3"]).output().unwrap();
+    let profile = temp_dir("bench-profile").join("bench.puffin");
+    let o = bin("hush-cli").args(["bench", "level", "--mode", "realtime", "--json", "--width", "32", "--height", "18", "--frames", "3", "--profile"]).arg(&profile).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let passes: Vec<&str> = v["passes"].as_array().unwrap().iter().map(|p| p["pass"].as_str().unwrap()).collect();
@@ -114,6 +115,19 @@ fn realtime_bench_reports_every_pass() {
     }
     assert!(v["gpu_frame_median_ms"].as_f64().unwrap() > 0.0);
     assert!(v["bytes_per_pixel"].as_f64().unwrap() > 0.0);
+    // The headless capture: every pass that ran has a CPU scope and a GPU scope with non-zero
+    // time in each of the 3 frames, inside a frame scope.
+    let scopes = hush_engine::profile::read_capture(&profile).unwrap();
+    let find = |gpu: bool, name: &str| scopes.iter().find(|(t, n, _, _)| (t == hush_engine::profile::GPU_THREAD) == gpu && n == name);
+    for p in &passes {
+        let (_, _, ns, count) = find(true, p).unwrap_or_else(|| panic!("no GPU scope for {p} in {scopes:?}"));
+        assert!(*ns > 0 && *count == 3, "GPU {p}: {ns} ns over {count} frames");
+        assert!(find(false, p).is_some_and(|s| s.3 == 3), "no CPU scope for {p} in {scopes:?}");
+    }
+    for cpu in ["frame", "Renderer::record_frame", "animate", "upload", "encode", "submit"] {
+        assert!(find(false, cpu).is_some(), "no CPU scope {cpu} in {scopes:?}");
+    }
+    assert!(find(true, hush_engine::profile::GPU_FRAME).is_some_and(|s| s.2 > 0));
 }
 
 #[test]

@@ -271,7 +271,9 @@ impl Renderer {
     }
 
     fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
+        puffin::profile_function!();
         if self.prepared.features.animated {
+            puffin::profile_scope!("animate");
             let moved = self.prepared.animate(&self.scene, input.time);
             self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
         }
@@ -300,6 +302,7 @@ impl Renderer {
             }
             self.targets.generation += 1;
         }
+        let setup = crate::profile::scope("upload");
         if denoise && self.chain.is_none() {
             let inputs = self.chain_inputs();
             self.chain = Some(MatteChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the matte chain")?);
@@ -355,15 +358,21 @@ impl Renderer {
             self.prepare_display(gpu, target)?;
         }
 
+        drop(setup);
+        let encode = crate::profile::scope("encode");
         let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         if let Some(t) = self.timer.as_mut() {
             t.begin_frame();
         }
         let key = (self.gpu_scene.generation, self.targets.generation);
         let parity = (self.frame_index % 2) as usize;
+        let pass = crate::profile::scope(gbuffer::LABEL);
         self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &self.targets.gbuffer, self.timer.as_mut());
+        drop(pass);
         let t = &self.targets;
+        let pass = crate::profile::scope(crate::passes::trace::LABEL);
         self.trace.record(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut());
+        drop(pass);
         // The chain's bind groups depend on the scene only through the object-motion buffer.
         let chain_key = key.0 * 1_000_003 + key.1;
         let inputs = t.matte.as_ref().filter(|_| denoise).map(|m| ChainInputs {
@@ -395,12 +404,15 @@ impl Renderer {
             denoise: None,
             glossy_chain: None,
         };
+        let pass = crate::profile::scope(crate::passes::composite::COMPOSITE);
         self.composite.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut());
+        drop(pass);
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
             chain.record(gpu, &mut enc, chain_key, inputs, parity, size, true, self.timer.as_mut());
         }
         let shown = shown_buffers(t, &self.frame_buf, &self.display_buf, &self.no_accumulation, denoise);
         if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
+            let _pass = crate::profile::scope(crate::passes::composite::DISPLAY);
             d.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &shown, target.view, self.timer.as_mut());
         }
         if let (true, Some(m)) = (denoise, &t.matte) {
@@ -409,6 +421,11 @@ impl Renderer {
         }
         if let Some(timer) = &self.timer {
             timer.resolve(&mut enc);
+        }
+        drop(encode);
+        let _submit = crate::profile::scope("submit");
+        if let Some(timer) = self.timer.as_mut() {
+            timer.submitted_ns = puffin::now_ns();
         }
         gpu.queue.submit([enc.finish()]);
         self.prev_view_proj = Some(cam.view_proj);
@@ -492,6 +509,15 @@ impl Renderer {
             Some(t) => t.read(gpu),
             None => Ok(vec![]),
         }
+    }
+
+    /// Each pass of the last frame with its start and duration (blocks until it finished); when
+    /// puffin's scopes are on, also reported as the frame's GPU timeline.
+    pub fn pass_spans(&self, gpu: &Gpu) -> Result<Vec<crate::profile::PassSpan>> {
+        let Some(t) = &self.timer else { return Ok(vec![]) };
+        let spans = t.read_spans(gpu)?;
+        crate::profile::report_gpu(t.submitted_ns, &spans);
+        Ok(spans)
     }
 
     /// Frames summed in accumulate mode (0 when off).

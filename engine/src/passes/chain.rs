@@ -29,6 +29,7 @@ impl ChainStage {
             let g = |p| bindings(p).create_group(&gpu.device, self.label, &self.layout);
             self.groups = Some((key, [g(0), g(1)]));
         }
+        let _scope = crate::profile::scope(self.label);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.label), timestamp_writes: timer.and_then(|t| t.compute(self.label)) });
         pass.set_pipeline(self.pipeline.get());
         pass.set_bind_group(0, &self.groups.as_ref().unwrap().1[parity], &[]);
