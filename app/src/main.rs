@@ -2,6 +2,8 @@
 //! shows the real-time frame, with a fly camera and a side panel of settings and debug views.
 
 mod fly;
+mod profiler;
+mod settings_ui;
 mod ui;
 
 use anyhow::{Context, Result};
@@ -9,8 +11,10 @@ use hush_engine::accel::BvhKind;
 use hush_engine::frame::{DisplayTarget, FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::scene::{CameraKey, CameraPath, Scene};
+use hush_engine::shader::{ShaderLibrary, ShaderWatcher, source_tree_dir};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use hush_engine::profile::puffin;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -22,13 +26,30 @@ const NO_DISPLAY: &str = "hush needs a display (no X11 or Wayland display was fo
 without a window use the command-line tool, e.g.\n    hush-cli render level --mode realtime --frames 16 --out image.png";
 
 const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-path PATH.json]
+            [--preset SETTINGS.toml] [--shaders DIR] [--puffin-http [PORT]]
   no scene: the default level. Keys: WASD move, Q/E down/up, right-drag look, wheel speed,
-  shift run, F12 screenshot (PNG + EXR), R record a camera path, P play it, Esc quit.
-  Drop a .gltf/.glb on the window to load it.";
+  shift run, F12 screenshot (PNG + EXR), R record a camera path, P play it, F9 profiler,
+  F10 capture frames to a .puffin file, Esc quit. Drop a .gltf/.glb on the window to load it.
+  Shaders reload when their files change: debug builds read the source tree's shaders/,
+  release builds embed them unless --shaders DIR or $HUSH_SHADERS names a folder.
+  --puffin-http serves profiles to puffin_viewer on 127.0.0.1 (default port 8585).";
 
 struct Args {
     scene: String,
     camera_path: Option<PathBuf>,
+    preset: Option<PathBuf>,
+    shaders: Option<PathBuf>,
+    puffin_http: Option<u16>,
+}
+
+/// The shader folder: --shaders, else $HUSH_SHADERS, else (debug builds) the source tree's.
+fn shader_library(arg: Option<&Path>) -> Result<ShaderLibrary> {
+    if let Some(d) = arg {
+        return ShaderLibrary::from_dir(d).context("--shaders");
+    }
+    let tree = source_tree_dir();
+    let fallback = (cfg!(debug_assertions) && tree.is_dir()).then_some(tree);
+    ShaderLibrary::from_env_or(fallback.as_deref())
 }
 
 fn load_scene(path: &str) -> Result<Scene> {
@@ -60,6 +81,12 @@ struct Running {
     recording: Option<CameraPath>,
     path: Option<CameraPath>,
     playback: Option<usize>,
+    watcher: Option<ShaderWatcher>,
+    /// Shader files that could not be read, and the last frame's render error (both shown over
+    /// the image until they clear).
+    shader_read_errors: Vec<String>,
+    render_error: Option<String>,
+    profiler: profiler::Profiler,
 }
 
 struct Viewer {
@@ -82,6 +109,7 @@ fn panel_for(r: &Renderer, message: String) -> ui::Panel {
         message,
         recording: false,
         playing: false,
+        preset_path: "presets/my.toml".into(),
     }
 }
 
@@ -100,7 +128,15 @@ impl Viewer {
         // The viewer asks for the adapter's own limits: scenes dropped on it later may be larger.
         let mut req = prepared.realtime_requirements((w, h));
         req.adapter_limits = true;
-        let gpu = Gpu::for_surface(instance, &surface, &req)?;
+        let mut gpu = Gpu::for_surface(instance, &surface, &req)?;
+        gpu.shaders = shader_library(self.args.shaders.as_deref())?;
+        let watcher = match gpu.shaders.dir() {
+            Some(dir) => {
+                log::warn!("shaders from {} (reloaded on change)", dir.display());
+                Some(ShaderWatcher::new(&gpu.shaders)?)
+            }
+            None => None,
+        };
         let caps = surface.get_capabilities(&gpu.adapter);
         // egui blends in gamma space: prefer a non-sRGB surface (the display pass then encodes sRGB).
         let format = caps.formats.iter().copied().find(|f| !f.is_srgb()).or(caps.formats.first().copied()).context("the surface offers no format")?;
@@ -119,13 +155,38 @@ impl Viewer {
         let extent = prepared.extent;
         let renderer = Renderer::new(&gpu, scene, prepared, (w, h))?;
         let fly = fly::FlyCamera::from_camera(&renderer.scene.camera_or_default(), extent);
-        let panel = panel_for(&renderer, format!("loaded in {load_ms:.0} ms"));
+        let mut panel = panel_for(&renderer, format!("loaded in {load_ms:.0} ms"));
+        if let Some(p) = &self.args.preset {
+            panel.settings = hush_engine::settings::FrameSettings::load_preset(p)?;
+            panel.preset_path = p.display().to_string();
+        }
+        let profiler = profiler::Profiler::new(self.args.puffin_http)?;
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(egui_ctx.clone(), egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), None, Some(gpu.device.limits().max_texture_dimension_2d as usize));
         let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
         let path = self.args.camera_path.as_deref().map(CameraPath::load).transpose()?;
         let playback = path.as_ref().map(|_| 0);
-        self.state = Some(Running { window, surface, config, gpu, renderer, fly, panel, egui_ctx, egui_state, egui_renderer, last: Instant::now(), cursor: None, recording: None, path, playback });
+        self.state = Some(Running {
+            window,
+            surface,
+            config,
+            gpu,
+            renderer,
+            fly,
+            panel,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            last: Instant::now(),
+            cursor: None,
+            recording: None,
+            path,
+            playback,
+            watcher,
+            shader_read_errors: vec![],
+            render_error: None,
+            profiler,
+        });
         Ok(())
     }
 }
@@ -209,10 +270,61 @@ impl Running {
         self.panel.playing = self.playback.is_some();
     }
 
+    /// Rebuild the pipelines whose shader files changed since the last frame.
+    fn reload_shaders(&mut self) {
+        let Some(w) = &self.watcher else { return };
+        let changed = w.changed(&self.gpu.shaders);
+        if changed.is_empty() {
+            return;
+        }
+        let (changed, errors) = self.gpu.shaders.refresh(&changed);
+        self.shader_read_errors = errors;
+        if changed.is_empty() {
+            return;
+        }
+        let outcomes = self.renderer.reload_shaders(&self.gpu, &changed);
+        let ms: f64 = outcomes.iter().map(|o| o.ms).sum();
+        let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
+        self.panel.message = format!("{}: rebuilt {} of {} pipelines in {ms:.0} ms{}", changed.join(", "), outcomes.len() - failed, outcomes.len(), if failed > 0 { format!(", {failed} kept their last good version") } else { String::new() });
+        log::warn!("{}", self.panel.message);
+        // A pass made after a failed reload (the display, the chains) may have failed for the
+        // same reason; let the next frame try again.
+        self.render_error = None;
+    }
+
+    /// Shader and render errors over the image, with file and line.
+    fn error_overlay(ctx: &egui::Context, errors: &[String]) {
+        if errors.is_empty() {
+            return;
+        }
+        egui::Area::new(egui::Id::unique("hush error overlay")).anchor(egui::Align2::LEFT_TOP, egui::vec2(8.0, 8.0)).show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).fill(egui::Color32::from_black_alpha(220)).show(ui, |ui| {
+                ui.set_max_width(720.0);
+                for e in errors {
+                    ui.label(egui::RichText::new(e).color(egui::Color32::from_rgb(255, 110, 100)).monospace());
+                }
+            });
+        });
+    }
+
     fn frame(&mut self) -> Result<()> {
         if self.config.width == 0 || self.config.height == 0 || self.window.is_minimized() == Some(true) {
             return Ok(());
         }
+        {
+            puffin::profile_scope!("frame");
+            self.frame_inner()?;
+        }
+        let spans = self.renderer.pass_spans(&self.gpu).unwrap_or_default();
+        self.panel.pass_ms = spans.into_iter().map(|s| (s.label, s.ms)).collect();
+        hush_engine::profile::end_frame();
+        self.profiler.after_frame();
+        self.window.request_redraw();
+        Ok(())
+    }
+
+    fn frame_inner(&mut self) -> Result<()> {
+        self.reload_shaders();
         let now = Instant::now();
         let dt = (now - self.last).as_secs_f64();
         self.last = now;
@@ -248,20 +360,43 @@ impl Running {
         };
         let view = frame.texture.create_view(&Default::default());
         let target = DisplayTarget { view: &view, format: self.config.format, size: (self.config.width, self.config.height) };
-        self.renderer.render(&self.gpu, &input, &self.panel.settings, Some(&target))?;
-        self.panel.pass_ms = self.renderer.pass_times(&self.gpu).unwrap_or_default();
+        if self.render_error.is_none() {
+            // A failed frame (a pass that cannot be made while a shader is broken) stays on
+            // screen as an error until a reload or a settings change lets it through.
+            let r = {
+                puffin::profile_scope!("render");
+                self.renderer.render(&self.gpu, &input, &self.panel.settings, Some(&target))
+            };
+            if let Err(e) = r {
+                log::error!("{e:#}");
+                self.render_error = Some(format!("{e:#}"));
+            }
+        }
         if accumulate {
             self.panel.message = format!("accumulated {} frames", self.renderer.accumulated());
         }
 
+        let ui_scope = hush_engine::profile::scope("ui");
         let raw = self.egui_state.take_egui_input(&self.window);
         let mut actions = ui::Actions::default();
         let panel = &mut self.panel;
+        let profiler = &mut self.profiler;
+        let mut errors: Vec<String> = self.renderer.shader_errors().into_iter().map(|(_, e)| e).collect();
+        errors.extend(self.shader_read_errors.iter().cloned());
+        errors.extend(self.render_error.iter().cloned());
+        let settings_before = panel.settings.clone();
         let out = self.egui_ctx.run_ui(raw, |ui| {
             egui::Panel::right("settings").show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| actions = panel.show(ui));
             });
+            Self::error_overlay(ui.ctx(), &errors);
+            if profiler.open {
+                profiler.window(ui.ctx());
+            }
         });
+        if panel.settings != settings_before {
+            self.render_error = None;
+        }
         self.egui_state.handle_platform_output(&self.window, out.platform_output);
         let jobs = self.egui_ctx.tessellate(out.shapes, out.pixels_per_point);
         let mut textures = out.textures_delta;
@@ -291,6 +426,8 @@ impl Running {
         for id in textures.free.drain() {
             self.egui_renderer.free_texture(&id);
         }
+        drop(ui_scope);
+        let _present = hush_engine::profile::scope("present");
         self.gpu.queue.present(frame);
 
         if let (true, Some((az, el))) = (actions.sun_changed, self.panel.sun) {
@@ -305,8 +442,33 @@ impl Running {
         if actions.toggle_play {
             self.toggle_play();
         }
-        self.window.request_redraw();
+        if actions.toggle_profiler {
+            self.profiler.toggle();
+        }
+        if actions.save_preset || actions.load_preset {
+            self.preset(actions.save_preset);
+        }
+        if !self.profiler.message.is_empty() {
+            self.panel.message = std::mem::take(&mut self.profiler.message);
+        }
         Ok(())
+    }
+
+    fn preset(&mut self, save: bool) {
+        let path = PathBuf::from(&self.panel.preset_path);
+        let r = if save {
+            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                let _ = std::fs::create_dir_all(dir);
+            }
+            self.panel.settings.save_preset(&path).map(|_| format!("saved {}", path.display()))
+        } else {
+            hush_engine::settings::FrameSettings::load_preset(&path).map(|s| {
+                self.panel.settings = s;
+                self.render_error = None;
+                format!("loaded {}", path.display())
+            })
+        };
+        self.panel.message = r.unwrap_or_else(|e| format!("{e:#}"));
     }
 
     /// Returns true when the viewer should quit.
@@ -331,6 +493,8 @@ impl Running {
                             KeyCode::F12 => self.screenshot(),
                             KeyCode::KeyR => self.toggle_record(),
                             KeyCode::KeyP => self.toggle_play(),
+                            KeyCode::F9 => self.profiler.toggle(),
+                            KeyCode::F10 => self.profiler.start_capture(unix_seconds()),
                             _ => {}
                         }
                     }
@@ -387,17 +551,29 @@ fn has_display() -> bool {
 
 fn parse_args() -> Result<Option<Args>> {
     let mut scene = None;
-    let mut camera_path = None;
-    let mut it = std::env::args().skip(1);
+    let (mut camera_path, mut preset, mut shaders, mut puffin_http) = (None, None, None, None);
+    let mut it = std::env::args().skip(1).peekable();
     while let Some(a) = it.next() {
         match a.as_str() {
             "-h" | "--help" => return Ok(None),
             "--camera-path" => camera_path = Some(PathBuf::from(it.next().context("--camera-path needs a file")?)),
+            "--preset" => preset = Some(PathBuf::from(it.next().context("--preset needs a file")?)),
+            "--shaders" => shaders = Some(PathBuf::from(it.next().context("--shaders needs a folder")?)),
+            "--puffin-http" => {
+                let port = match it.peek().and_then(|p| p.parse::<u16>().ok()) {
+                    Some(p) => {
+                        it.next();
+                        p
+                    }
+                    None => puffin_http::DEFAULT_PORT,
+                };
+                puffin_http = Some(port);
+            }
             s if s.starts_with('-') => anyhow::bail!("unknown option {s}\n{USAGE}"),
             s => scene = Some(s.to_string()),
         }
     }
-    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path }))
+    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path, preset, shaders, puffin_http }))
 }
 
 fn run() -> Result<()> {

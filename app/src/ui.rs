@@ -1,8 +1,8 @@
-//! The side panel: frame time, per-pass GPU time, resolution scale, mode, sun, exposure, debug
-//! views, animation clock, screenshots and camera paths.
+//! The side panel: frame time, resolution scale, sun, animation clock, the frame's chain of
+//! passes with their GPU time and settings, presets, screenshots, camera paths and the profiler.
 
-use hush_engine::frame::View;
-use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv};
+use crate::settings_ui;
+use hush_engine::settings::FrameSettings;
 
 pub struct Panel {
     pub settings: FrameSettings,
@@ -19,6 +19,8 @@ pub struct Panel {
     pub message: String,
     pub recording: bool,
     pub playing: bool,
+    /// Where presets are saved and loaded (TOML).
+    pub preset_path: String,
 }
 
 #[derive(Default)]
@@ -27,6 +29,9 @@ pub struct Actions {
     pub screenshot: bool,
     pub toggle_record: bool,
     pub toggle_play: bool,
+    pub toggle_profiler: bool,
+    pub save_preset: bool,
+    pub load_preset: bool,
 }
 
 impl Panel {
@@ -34,64 +39,7 @@ impl Panel {
         let mut a = Actions::default();
         ui.heading("Hush");
         ui.label(format!("frame {:.1} ms (CPU, whole loop)", self.frame_ms));
-        let gpu_total: f64 = self.pass_ms.iter().map(|p| p.1).sum();
-        if !self.pass_ms.is_empty() {
-            ui.label(format!("GPU {gpu_total:.2} ms"));
-            for (name, ms) in &self.pass_ms {
-                ui.label(format!("  {name}: {ms:.2} ms"));
-            }
-        }
-        ui.separator();
         ui.add(egui::Slider::new(&mut self.resolution_scale, 0.25..=1.0).text("resolution scale"));
-        ui.horizontal(|ui| {
-            ui.radio_value(&mut self.settings.accumulate, false, "real-time");
-            ui.radio_value(&mut self.settings.accumulate, true, "accumulate");
-        });
-        ui.horizontal(|ui| {
-            ui.label("denoiser");
-            ui.radio_value(&mut self.settings.denoiser, Denoiser::None, "none");
-            ui.radio_value(&mut self.settings.denoiser, Denoiser::Mara, "Mara et al. 2017");
-        });
-        if self.settings.denoiser == Denoiser::Mara {
-            let m = &mut self.settings.matte;
-            ui.collapsing("matte chain and TAA", |ui| {
-                ui.checkbox(&mut m.temporal, "matte/temporal (3)");
-                ui.checkbox(&mut m.history_bilateral, "matte/history_bilateral (4)");
-                ui.checkbox(&mut m.disocclusion, "matte/disocclusion (5)");
-                ui.checkbox(&mut m.firefly, "matte/firefly (6)");
-                ui.checkbox(&mut m.bilateral, "matte/bilateral (7)");
-                ui.checkbox(&mut m.taa, "taa");
-                ui.add(egui::Slider::new(&mut m.hysteresis, 0.5..=0.999).text("hysteresis h"));
-                ui.add(egui::Slider::new(&mut m.clamp_sigma, 0.5..=16.0).text("history clamp (sigma)"));
-                ui.add(egui::Slider::new(&mut m.d0_px, 0.5..=32.0).text("d0 (pixel footprints)"));
-                ui.add(egui::Slider::new(&mut m.d1_px, 0.5..=48.0).text("d1 (pixel footprints)"));
-                ui.add(egui::Slider::new(&mut m.taps, 4..=128).text("bilateral taps"));
-                ui.add(egui::Slider::new(&mut m.history_diameter_fraction, 0.001..=0.05).text("history disk (fraction of width)"));
-                ui.add(egui::Slider::new(&mut m.disocclusion_fraction, 0.005..=0.2).text("R (fraction of width)"));
-                ui.add(egui::Slider::new(&mut m.taa_alpha, 0.02..=1.0).text("TAA current-frame weight"));
-            });
-            if self.glossy {
-                let g = &mut self.settings.glossy;
-                ui.collapsing("glossy chain", |ui| {
-                    ui.checkbox(&mut g.temporal, "glossy/temporal (8; off: no reprojection)");
-                    ui.checkbox(&mut g.clipping, "glossy/temporal neighbourhood clipping");
-                    ui.checkbox(&mut g.bilateral, "glossy/bilateral (9, 10)");
-                    egui::ComboBox::from_label("reflection motion vectors").selected_text(g.reflection_mv.name()).show_ui(ui, |ui| {
-                        for mv in ReflectionMv::ALL {
-                            ui.selectable_value(&mut g.reflection_mv, mv, mv.name());
-                        }
-                    });
-                    ui.add(egui::Slider::new(&mut g.roughness_threshold, 0.0..=1.0).text("reflection MV roughness threshold"));
-                    ui.add(egui::Slider::new(&mut g.initial_step, 1..=16).text("diamond first step (px)"));
-                    ui.add(egui::Slider::new(&mut g.hysteresis, 0.5..=0.999).text("hysteresis h"));
-                    ui.add(egui::Slider::new(&mut g.sigma_scale, 0.0..=12.0).text("sigma scale (px)"));
-                    ui.add(egui::Slider::new(&mut g.sigma_epsilon_px, 0.0..=4.0).text("sigma epsilon (px)"));
-                    ui.add(egui::Slider::new(&mut g.ray_differential_omega, 1.0..=64.0).text("ray differential omega (footprints)"));
-                });
-            }
-        }
-        ui.add(egui::Slider::new(&mut self.settings.exposure_ev, -8.0..=8.0).text("exposure (EV)"));
-        ui.add(egui::Slider::new(&mut self.settings.max_depth, 2..=16).text("max depth"));
         if let Some((az, el)) = &mut self.sun {
             let c1 = ui.add(egui::Slider::new(az, -180.0..=180.0).text("sun azimuth (deg)")).changed();
             let c2 = ui.add(egui::Slider::new(el, 1.0..=89.0).text("sun elevation (deg)")).changed();
@@ -102,12 +50,15 @@ impl Panel {
             ui.label(format!("t = {:.2} s", self.time));
         });
         ui.separator();
-        egui::ComboBox::from_label("view").selected_text(self.settings.view.name()).show_ui(ui, |ui| {
-            for v in View::ALL {
-                if self.glossy || !v.needs_glossy() {
-                    ui.selectable_value(&mut self.settings.view, v, v.name());
-                }
-            }
+        self.chain(ui);
+        ui.separator();
+        ui.horizontal(|ui| {
+            ui.label("preset");
+            ui.text_edit_singleline(&mut self.preset_path);
+        });
+        ui.horizontal(|ui| {
+            a.save_preset = ui.button("save").clicked();
+            a.load_preset = ui.button("load").clicked();
         });
         ui.separator();
         a.screenshot = ui.button("screenshot (F12)").clicked();
@@ -115,6 +66,7 @@ impl Panel {
         a.toggle_record = ui.button(rec).clicked();
         let play = if self.playing { "stop playback (P)" } else { "play camera path (P)" };
         a.toggle_play = ui.button(play).clicked();
+        a.toggle_profiler = ui.button("profiler (F9)").clicked();
         if !self.message.is_empty() {
             ui.separator();
             ui.label(&self.message);
@@ -122,6 +74,57 @@ impl Panel {
         ui.separator();
         ui.collapsing("allocations", |ui| ui.label(&self.report));
         a
+    }
+
+    /// The frame as a list of its stages in the order they ran, each with its GPU time and the
+    /// settings of that stage; settings groups with no pass this frame (the frame's own, and
+    /// the chains while the denoiser is off) follow.
+    fn chain(&mut self, ui: &mut egui::Ui) {
+        let gpu_total: f64 = self.pass_ms.iter().map(|p| p.1).sum();
+        ui.label(format!("frame chain: GPU {gpu_total:.2} ms"));
+        let defaults = FrameSettings::default().to_value();
+        let mut v = self.settings.to_value();
+        let mut changed = false;
+        let groups = settings_ui::groups();
+        let glossy = self.glossy;
+        let relevant = |g: &str| glossy || !g.starts_with("glossy/");
+        let group_of = |pass: &str| groups.iter().copied().find(|g| pass == *g || pass.strip_prefix(*g).is_some_and(|r| r.starts_with('_')));
+        let mut shown: Vec<&str> = vec![];
+        let mut rows: Vec<(String, f64, Option<&'static str>)> = vec![];
+        for (pass, ms) in &self.pass_ms {
+            match group_of(pass) {
+                Some(g) if shown.contains(&g) => {
+                    if let Some(row) = rows.iter_mut().find(|r| r.2 == Some(g)) {
+                        row.0 = format!("{g} ({})", pass.trim_start_matches(g).trim_start_matches('_'));
+                        row.1 += ms;
+                    }
+                }
+                Some(g) => {
+                    shown.push(g);
+                    rows.push((g.to_string(), *ms, Some(g)));
+                }
+                None => rows.push((pass.to_string(), *ms, None)),
+            }
+        }
+        for (label, ms, g) in &rows {
+            let frac = if gpu_total > 0.0 { (ms / gpu_total) as f32 } else { 0.0 };
+            let title = format!("{label}  {ms:.2} ms");
+            match g {
+                Some(g) => {
+                    egui::CollapsingHeader::new(title).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults));
+                }
+                None => {
+                    ui.label(title);
+                }
+            }
+            ui.add(egui::ProgressBar::new(frac).desired_height(3.0));
+        }
+        for g in groups.iter().filter(|g| !shown.contains(g) && relevant(g)) {
+            egui::CollapsingHeader::new(*g).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults));
+        }
+        if changed && let Err(e) = settings_ui::apply(&mut self.settings, &v) {
+            self.message = e;
+        }
     }
 }
 

@@ -18,9 +18,12 @@ pub struct BenchArgs {
     /// Real-time mode: frames measured (after two warm-up frames).
     #[arg(long, default_value_t = 32)]
     pub frames: u32,
-    /// Real-time mode: the denoiser (`none` or `mara`).
-    #[arg(long, default_value = "mara")]
-    pub denoiser: String,
+    /// Real-time mode: the denoiser (`none` or `mara`); default mara, or the preset's.
+    #[arg(long)]
+    pub denoiser: Option<String>,
+    /// Real-time mode: measure the settings of this preset file (TOML, as the viewer saves).
+    #[arg(long)]
+    pub preset: Option<std::path::PathBuf>,
     /// BVH layout to measure (bvh2, cwbvh); both when omitted.
     #[arg(long)]
     pub bvh: Option<String>,

@@ -64,8 +64,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     });
     let view = tex.create_view(&Default::default());
     let target = DisplayTarget { view: &view, format, size };
-    let denoiser = crate::realtime::parse_denoiser(&a.denoiser)?;
-    let settings = FrameSettings { max_depth: r.scene.max_depth, denoiser, ..Default::default() };
+    let settings = match &a.preset {
+        Some(p) => crate::realtime::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)?,
+        None => FrameSettings { max_depth: r.scene.max_depth, ..crate::realtime::denoiser_settings(a.denoiser.as_deref().unwrap_or("mara"), &[], "diamond")? },
+    };
     let camera = r.scene.camera_or_default();
     let mut per_pass: Vec<(&'static str, Vec<f64>)> = vec![];
     let (mut totals, mut cpu) = (vec![], vec![]);

@@ -16,18 +16,33 @@ pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
 
 /// `--denoiser`, `--disable` and `--reflection-mv` applied to default settings.
 pub fn denoiser_settings(denoiser: &str, disable: &[String], reflection_mv: &str) -> Result<FrameSettings> {
-    let mut s = FrameSettings { denoiser: parse_denoiser(denoiser)?, ..Default::default() };
+    chain_settings(FrameSettings::default(), Some(denoiser), disable, Some(reflection_mv))
+}
+
+/// The settings of `--preset` (or the defaults) with `--denoiser`, `--disable` and
+/// `--reflection-mv` applied where given.
+pub fn preset_settings(preset: Option<&std::path::Path>, denoiser: Option<&str>, disable: &[String], reflection_mv: Option<&str>) -> Result<FrameSettings> {
+    let base = preset.map(FrameSettings::load_preset).transpose()?.unwrap_or_default();
+    chain_settings(base, denoiser, disable, reflection_mv)
+}
+
+fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[String], reflection_mv: Option<&str>) -> Result<FrameSettings> {
+    if let Some(d) = denoiser {
+        s.denoiser = parse_denoiser(d)?;
+    }
     for stage in disable {
         if !disable_stage(&mut s, stage) {
             bail!("--disable {stage:?}: the stages are {}", stage_names().join(", "));
         }
     }
-    s.glossy.reflection_mv = ReflectionMv::parse(reflection_mv).with_context(|| format!("--reflection-mv {reflection_mv:?}: use diamond, virtual or primary"))?;
+    if let Some(mv) = reflection_mv {
+        s.glossy.reflection_mv = ReflectionMv::parse(mv).with_context(|| format!("--reflection-mv {mv:?}: use diamond, virtual or primary"))?;
+    }
     Ok(s)
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    let chains = denoiser_settings(&a.denoiser, &a.disable, &a.reflection_mv)?;
+    let chains = preset_settings(a.preset.as_deref(), a.denoiser.as_deref(), &a.disable, a.reflection_mv.as_deref())?;
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
@@ -47,7 +62,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.accumulate && path.is_some() {
         bail!("--accumulate needs a still camera; it cannot be combined with --camera-path");
     }
-    let settings = FrameSettings { max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, accumulate: a.accumulate, ..chains };
+    // The scene's path length unless --max-depth or the preset says otherwise.
+    let max_depth = a.max_depth.unwrap_or(if a.preset.is_some() { chains.max_depth } else { scene.max_depth });
+    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, ..chains };
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;

@@ -20,9 +20,14 @@ pub struct RenderArgs {
     /// Real-time mode: a camera path (JSON, as the viewer records); frame k uses key k.
     #[arg(long)]
     pub camera_path: Option<PathBuf>,
-    /// Real-time mode: the denoiser, `none` or `mara` (Mara et al. 2017 matte chain + TAA).
-    #[arg(long, default_value = "none")]
-    pub denoiser: String,
+    /// Real-time mode: the denoiser, `none` or `mara` (Mara et al. 2017 matte chain + TAA);
+    /// default none, or the preset's.
+    #[arg(long)]
+    pub denoiser: Option<String>,
+    /// Real-time mode: start from the settings of this preset file (TOML, as the viewer saves);
+    /// --denoiser, --disable and --reflection-mv then override it.
+    #[arg(long)]
+    pub preset: Option<PathBuf>,
     /// Real-time mode: denoiser stages to switch off, comma-separated (matte.temporal,
     /// matte.history_bilateral, matte.disocclusion, matte.firefly, matte.bilateral, taa,
     /// glossy.temporal, glossy.clipping, glossy.bilateral).
@@ -30,8 +35,9 @@ pub struct RenderArgs {
     pub disable: Vec<String>,
     /// Real-time mode: how the glossy chain reprojects reflections: diamond (Voorhuis's search),
     /// virtual (Mara's virtual position) or primary (surface motion only).
-    #[arg(long, default_value = "diamond")]
-    pub reflection_mv: String,
+    /// Default diamond, or the preset's.
+    #[arg(long)]
+    pub reflection_mv: Option<String>,
     /// Real-time mode: sum all frames with a still camera and write their mean.
     #[arg(long)]
     pub accumulate: bool,

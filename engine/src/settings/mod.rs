@@ -1,4 +1,10 @@
-//! Tunables of the real-time frame, with their units and defaults.
+//! Tunables of the real-time frame, with their units and defaults. `fields.rs` describes each
+//! one for panels and presets; `preset.rs` saves and loads them as TOML.
+
+mod fields;
+mod preset;
+
+pub use fields::{FIELDS, Field, Kind, get as get_field, get_mut as get_field_mut, leaves};
 
 use crate::frame::View;
 use serde::{Deserialize, Serialize};

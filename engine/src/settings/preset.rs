@@ -1,0 +1,56 @@
+//! Presets: settings saved as TOML files. A preset may hold only some settings (the rest keep
+//! their defaults); unknown names and out-of-range values are errors that name the setting.
+
+use super::FrameSettings;
+use anyhow::{Context, Result};
+use std::path::Path;
+
+impl FrameSettings {
+    pub fn to_toml(&self) -> Result<String> {
+        toml::to_string_pretty(self).context("writing settings as TOML")
+    }
+
+    pub fn from_toml(text: &str) -> Result<FrameSettings> {
+        let v: serde_json::Value = toml::from_str(text).context("reading TOML settings")?;
+        FrameSettings::from_value(&v)
+    }
+
+    pub fn save_preset(&self, path: &Path) -> Result<()> {
+        std::fs::write(path, self.to_toml()?).with_context(|| format!("writing preset {}", path.display()))
+    }
+
+    pub fn load_preset(path: &Path) -> Result<FrameSettings> {
+        let text = std::fs::read_to_string(path).with_context(|| format!("reading preset {}", path.display()))?;
+        FrameSettings::from_toml(&text).with_context(|| format!("preset {}", path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::{Denoiser, ReflectionMv};
+
+    #[test]
+    fn settings_round_trip_through_a_preset_file() {
+        let mut s = FrameSettings { exposure_ev: -1.25, max_depth: 4, seed: 7, denoiser: Denoiser::Mara, paths_per_pixel: 2, view: crate::frame::View::GlossySigma, ..Default::default() };
+        s.matte.hysteresis = 0.9;
+        s.matte.firefly = false;
+        s.matte.taps = 32;
+        s.glossy.reflection_mv = ReflectionMv::Virtual;
+        s.glossy.sigma_full_frames = 0.0;
+        s.glossy.roughness_sigma = 0.123;
+        let path = std::env::temp_dir().join(format!("hush-preset-{}.toml", std::process::id()));
+        s.save_preset(&path).unwrap();
+        let back = FrameSettings::load_preset(&path).unwrap();
+        let _ = std::fs::remove_file(&path);
+        assert_eq!(back, s);
+    }
+
+    #[test]
+    fn a_partial_preset_keeps_the_other_defaults() {
+        let s = FrameSettings::from_toml("denoiser = \"Mara\"\n[matte]\nfirefly = false\n").unwrap();
+        assert_eq!(s, FrameSettings { denoiser: Denoiser::Mara, matte: crate::settings::MatteSettings { firefly: false, ..Default::default() }, ..Default::default() });
+        let e = format!("{:#}", FrameSettings::from_toml("[glossy]\nsigma_scael = 3.0\n").unwrap_err());
+        assert!(e.contains("glossy.sigma_scael"), "{e}");
+    }
+}
