@@ -26,13 +26,13 @@ const NO_DISPLAY: &str = "hush needs a display (no X11 or Wayland display was fo
 without a window use the command-line tool, e.g.\n    hush-cli render level --mode realtime --frames 16 --out image.png";
 
 const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-path PATH.json]
-            [--preset SETTINGS.toml] [--shaders DIR] [--puffin-http [PORT]]
+            [--preset SETTINGS.toml] [--shaders DIR] [--profiler] [--puffin-http [PORT]]
   no scene: the default level. Keys: WASD move, Q/E down/up, right-drag look, wheel speed,
   shift run, F12 screenshot (PNG + EXR), R record a camera path, P play it, F9 profiler,
   F10 capture frames to a .puffin file, Esc quit. Drop a .gltf/.glb on the window to load it.
   Shaders reload when their files change: debug builds read the source tree's shaders/,
   release builds embed them unless --shaders DIR or $HUSH_SHADERS names a folder.
-  --puffin-http serves profiles to puffin_viewer on 127.0.0.1 (default port 8585).";
+  --profiler opens the profiler window at start; --puffin-http serves profiles to puffin_viewer on 127.0.0.1 (default port 8585).";
 
 struct Args {
     scene: String,
@@ -40,6 +40,7 @@ struct Args {
     preset: Option<PathBuf>,
     shaders: Option<PathBuf>,
     puffin_http: Option<u16>,
+    profiler: bool,
 }
 
 /// The shader folder: --shaders, else $HUSH_SHADERS, else (debug builds) the source tree's.
@@ -160,7 +161,10 @@ impl Viewer {
             panel.settings = hush_engine::settings::FrameSettings::load_preset(p)?;
             panel.preset_path = p.display().to_string();
         }
-        let profiler = profiler::Profiler::new(self.args.puffin_http)?;
+        let mut profiler = profiler::Profiler::new(self.args.puffin_http)?;
+        if self.args.profiler {
+            profiler.toggle();
+        }
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(egui_ctx.clone(), egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), None, Some(gpu.device.limits().max_texture_dimension_2d as usize));
         let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
@@ -399,6 +403,9 @@ impl Running {
         }
         self.egui_state.handle_platform_output(&self.window, out.platform_output);
         let jobs = self.egui_ctx.tessellate(out.shapes, out.pixels_per_point);
+        drop(ui_scope);
+        // Drawing the UI waits for the GPU where the driver throttles submissions.
+        let draw_scope = hush_engine::profile::scope("ui draw");
         let mut textures = out.textures_delta;
         let (d, q) = (&self.gpu.device, &self.gpu.queue);
         for (id, deltas) in textures.set.drain() {
@@ -426,7 +433,7 @@ impl Running {
         for id in textures.free.drain() {
             self.egui_renderer.free_texture(&id);
         }
-        drop(ui_scope);
+        drop(draw_scope);
         let _present = hush_engine::profile::scope("present");
         self.gpu.queue.present(frame);
 
@@ -551,7 +558,7 @@ fn has_display() -> bool {
 
 fn parse_args() -> Result<Option<Args>> {
     let mut scene = None;
-    let (mut camera_path, mut preset, mut shaders, mut puffin_http) = (None, None, None, None);
+    let (mut camera_path, mut preset, mut shaders, mut puffin_http, mut profiler) = (None, None, None, None, false);
     let mut it = std::env::args().skip(1).peekable();
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -559,6 +566,7 @@ fn parse_args() -> Result<Option<Args>> {
             "--camera-path" => camera_path = Some(PathBuf::from(it.next().context("--camera-path needs a file")?)),
             "--preset" => preset = Some(PathBuf::from(it.next().context("--preset needs a file")?)),
             "--shaders" => shaders = Some(PathBuf::from(it.next().context("--shaders needs a folder")?)),
+            "--profiler" => profiler = true,
             "--puffin-http" => {
                 let port = match it.peek().and_then(|p| p.parse::<u16>().ok()) {
                     Some(p) => {
@@ -573,7 +581,7 @@ fn parse_args() -> Result<Option<Args>> {
             s => scene = Some(s.to_string()),
         }
     }
-    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path, preset, shaders, puffin_http }))
+    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path, preset, shaders, puffin_http, profiler }))
 }
 
 fn run() -> Result<()> {

@@ -133,7 +133,7 @@ fn flame_graph(ui: &mut egui::Ui, view: &puffin::FrameView) {
             painter.rect_filled(r, 2.0, egui::ecolor::Hsva::new(hue, 0.45, 0.75, 1.0));
             let ms = s.record.duration_ns as f64 * 1e-6;
             if r.width() > 40.0 {
-                painter.text(r.left_center() + egui::vec2(2.0, 0.0), egui::Align2::LEFT_CENTER, format!("{name} {ms:.2}"), egui::FontId::monospace(10.0), egui::Color32::BLACK);
+                painter.with_clip_rect(r).text(r.left_center() + egui::vec2(2.0, 0.0), egui::Align2::LEFT_CENTER, format!("{name} {ms:.2}"), egui::FontId::monospace(10.0), egui::Color32::BLACK);
             }
             if pointer.is_some_and(|p| r.contains(p)) {
                 egui::Tooltip::always_open(ui.ctx().clone(), ui.layer_id(), egui::Id::unique("hush profiler scope tip"), egui::PopupAnchor::Pointer).show(|ui| ui.label(format!("{}: {name}, {ms:.3} ms", thread.name)));

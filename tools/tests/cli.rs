@@ -36,7 +36,12 @@ fn render_then_compare_round_trips_through_files() {
 
 #[test]
 fn bad_arguments_are_clear_errors() {
+    let bad_preset = temp_dir("bad-preset").join("bad.toml");
+    std::fs::write(&bad_preset, "[matte]\nhysteresis = 2.0\n").unwrap();
+    let bad_preset = bad_preset.to_str().unwrap().to_string();
     for (args, needle) in [
+        (vec!["render", "level", "--mode", "realtime", "--preset", &bad_preset, "--out", "x.exr"], "matte.hysteresis"),
+        (vec!["bench", "level", "--mode", "realtime", "--preset", "/nonexistent.toml"], "/nonexistent.toml"),
         (vec!["render", "default", "--camera", "eye=0,0,0;target=0,0,0", "--out", "x.exr"], "coincide"),
         (vec!["render", "default", "--spp", "0", "--out", "x.exr"], "--spp"),
         (vec!["render", "default", "--spp", "1", "--out", "x.bmp"], ".exr or .png"),
@@ -196,4 +201,22 @@ fn reflections_measures_every_reprojection() {
         let v: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
         assert!(v.is_finite() && v >= 0.0, "{row}");
     }
+}
+
+#[test]
+fn a_preset_sets_the_frame() {
+    let dir = temp_dir("preset");
+    // Direct light only: the indirect light of the level's courtyard and hall goes.
+    let preset = dir.join("direct.toml");
+    std::fs::write(&preset, "max_depth = 2\n").unwrap();
+    let mean = |extra: &[&str], name: &str| {
+        let out = dir.join(name);
+        let o = bin("hush-cli").args(["render", "level", "--mode", "realtime", "--width", "32", "--height", "18"]).args(extra).arg("--out").arg(&out).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let img = image::open(&out).unwrap().to_rgb8();
+        img.pixels().map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>()).sum::<f64>() / img.pixels().len() as f64
+    };
+    let plain = mean(&[], "plain.png");
+    let direct = mean(&["--preset", preset.to_str().unwrap()], "direct.png");
+    assert!(direct < plain * 0.95, "max_depth 2 from the preset: mean {direct:.1} vs {plain:.1}");
 }

@@ -53,4 +53,17 @@ mod tests {
         let e = format!("{:#}", FrameSettings::from_toml("[glossy]\nsigma_scael = 3.0\n").unwrap_err());
         assert!(e.contains("glossy.sigma_scael"), "{e}");
     }
+
+    #[test]
+    fn the_shipped_presets_load() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets");
+        let mut n = 0;
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            let s = FrameSettings::load_preset(&p).unwrap_or_else(|e| panic!("{e:#}"));
+            assert_ne!(s, FrameSettings::default(), "{} changes nothing", p.display());
+            n += 1;
+        }
+        assert!(n >= 2);
+    }
 }
