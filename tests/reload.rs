@@ -110,6 +110,16 @@ fn reload_rebuilds_dependents_keeps_last_good_and_recovers() {
     let ms: Vec<String> = outcomes.iter().map(|o| format!("{} {:.1} ms", o.label, o.ms)).collect();
     println!("reloading {bsdf}: {}", ms.join(", "));
     assert!(outcomes.iter().any(|o| o.label == "trace") && outcomes.iter().all(|o| o.error.is_none()), "{outcomes:?}");
+    // Where a reload's time goes, for the trace (the largest program): composing the text and
+    // naga's validation against the driver's pipeline compile.
+    let t = Instant::now();
+    let program = r.pipelines().iter().find(|p| p.label() == "trace").unwrap().program(&gpu).unwrap();
+    let compose_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    program.validate().unwrap();
+    let validate_ms = t.elapsed().as_secs_f64() * 1e3;
+    let total = outcomes.iter().find(|o| o.label == "trace").unwrap().ms;
+    println!("trace reload {total:.1} ms: compose {compose_ms:.3} ms, naga parse + validate {validate_ms:.1} ms, the rest in the driver");
     let after = builds(&mut r);
 
     // 2. A syntax error: the composite keeps its last good pipeline; the error names the file

@@ -24,7 +24,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         l += g.emission + textureLoad(tr_matte, p, 0).rgb * albedo * one_minus_f * one_minus_f;
         l += glossy_light(p) * f_s;
     }
-    l = select(vec3f(0.0), l, l == l & abs(l) <= vec3f(3.0e38));
+    l = select(vec3f(0.0), l, (l == l) & (abs(l) <= vec3f(3.0e38)));
     let i = px.y * frame.size.x + px.x;
     hdr[i] = vec4f(l, 1.0);
     if frame.accumulated > 0u {

@@ -61,5 +61,5 @@ fn oct_decode(e: vec2f) -> vec3f {
 // Largest finite half float is 65504: clamp below it and drop NaN/Inf so that nothing a pass
 // writes can poison a later one (or, in later chains, the history).
 fn half_safe(v: vec3f) -> vec3f {
-    return select(vec3f(0.0), clamp(v, vec3f(-65000.0), vec3f(65000.0)), v == v & abs(v) <= vec3f(3.0e38));
+    return select(vec3f(0.0), clamp(v, vec3f(-65000.0), vec3f(65000.0)), (v == v) & (abs(v) <= vec3f(3.0e38)));
 }

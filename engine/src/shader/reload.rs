@@ -39,6 +39,8 @@ pub trait Reload {
     /// The error of the last failed reload, cleared by a successful one.
     fn error(&self) -> Option<&str>;
     fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome;
+    /// The program as it would be built now (the text the driver gets).
+    fn program(&self, gpu: &Gpu) -> Result<super::Program>;
 }
 
 impl<P> Reloadable<P> {
@@ -82,6 +84,10 @@ impl<P> Reload for Reloadable<P> {
 
     fn error(&self) -> Option<&str> {
         self.error.as_deref()
+    }
+
+    fn program(&self, gpu: &Gpu) -> Result<super::Program> {
+        gpu.shaders.compose(&self.label, &self.prelude, &self.modules)
     }
 
     fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome {
