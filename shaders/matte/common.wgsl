@@ -38,7 +38,8 @@ struct DenoiseParams {
     history_valid: u32,
     // Tests: replace the input with NaN / +Inf / -Inf on 1 pixel in 7.
     inject_nonfinite: u32,
-    _pad0: u32,
+    // The history bilateral's disk shrinks as 1 / sqrt(n) past this history length (0: never).
+    history_full_frames: f32,
     _pad1: u32,
     _pad2: u32,
 }

@@ -12,9 +12,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     var v = textureLoad(filter_in, p, 0).rgb;
-    if stage_on(STAGE_HISTORY_BILATERAL) {
-        v = sparse_bilateral(p, dn.history_radius_px);
-    }
     let n = f32(textureLoad(reason_in, p, 0).x >> 8u);
+    if stage_on(STAGE_HISTORY_BILATERAL) {
+        // The disk shrinks as 1 / sqrt(n) past history_full_frames (settings: MatteSettings).
+        var radius = dn.history_radius_px;
+        if dn.history_full_frames > 0.0 {
+            radius *= sqrt(min(1.0, dn.history_full_frames / max(n, 1.0)));
+        }
+        v = sparse_bilateral(p, radius);
+    }
     textureStore(out_history, p, vec4f(half_safe(v), n));
 }

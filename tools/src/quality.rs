@@ -6,7 +6,7 @@
 //! absolute luminance change between consecutive frames) and quality.png. `--ablations` repeats
 //! the denoised stream with each stage off and writes ablations.csv.
 
-use crate::realtime::denoiser_settings;
+use crate::realtime::preset_settings;
 use crate::render::{bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -29,14 +29,20 @@ pub struct QualityArgs {
     pub camera: Option<String>,
     #[arg(long, default_value_t = 60)]
     pub frames: u32,
-    #[arg(long, default_value = "mara")]
-    pub denoiser: String,
+    /// `none` or `mara`; default mara, or the preset's.
+    #[arg(long)]
+    pub denoiser: Option<String>,
+    /// Start from the settings of this preset file (TOML); --denoiser, --disable and
+    /// --reflection-mv then override it.
+    #[arg(long)]
+    pub preset: Option<PathBuf>,
     /// Stages to switch off (see `render --disable`).
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
     /// Reflection motion vectors of the glossy chain (see `render --reflection-mv`).
-    #[arg(long, default_value = "diamond")]
-    pub reflection_mv: String,
+    /// Default diamond, or the preset's.
+    #[arg(long)]
+    pub reflection_mv: Option<String>,
     /// Frames accumulated for each frame's reference.
     #[arg(long, default_value_t = 256)]
     pub reference_frames: u32,
@@ -130,7 +136,8 @@ pub fn run(a: QualityArgs) -> Result<()> {
     if a.frames == 0 || a.reference_frames == 0 {
         bail!("--frames and --reference-frames must be at least 1");
     }
-    let chains = denoiser_settings(&a.denoiser, &a.disable, &a.reflection_mv)?;
+    let denoiser = a.denoiser.as_deref().or(if a.preset.is_none() { Some("mara") } else { None });
+    let chains = preset_settings(a.preset.as_deref(), denoiser, &a.disable, a.reflection_mv.as_deref())?;
     let denoiser = chains.denoiser;
     let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
     let size = image_size(&scene, Some(a.width), a.height);
@@ -173,7 +180,9 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let flip64 = compare(&refr.read_hdr(&s.gpu)?, &references[references.len() - 1])?.flip;
     drop(refr);
 
-    let base = FrameSettings { seed: a.seed, max_depth: s.scene.max_depth, ..chains };
+    // The scene's path length unless the preset sets one (the references use the scene's).
+    let max_depth = if a.preset.is_some() { chains.max_depth } else { s.scene.max_depth };
+    let base = FrameSettings { seed: a.seed, max_depth, ..chains };
     let (den, last) = stream(&s, &base, &references)?;
     let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::None, ..base.clone() }, &references)?;
     if let (Some(d), Some(r), Some(f)) = (last.first(), last_raw.first(), references.last()) {

@@ -40,7 +40,9 @@ pub struct DenoiseParams {
     pub history_valid: u32,
     /// [`MatteSettings::inject_nonfinite`].
     pub inject_nonfinite: u32,
-    pub _pad: [u32; 3],
+    /// [`MatteSettings::history_full_frames`].
+    pub history_full_frames: f32,
+    pub _pad: [u32; 2],
 }
 
 impl DenoiseParams {
@@ -67,7 +69,8 @@ impl DenoiseParams {
             rotation: (frame as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU),
             history_valid: history_valid as u32,
             inject_nonfinite: s.inject_nonfinite as u32,
-            _pad: [0; 3],
+            history_full_frames: s.history_full_frames.max(0.0),
+            _pad: [0; 2],
         }
     }
 }

@@ -68,6 +68,7 @@ pub const FIELDS: &[Field] = &[
     f("matte.history_bilateral", "matte/history_bilateral", "", Bool, "Stage 4: sparse bilateral on what is written back to history."),
     f("matte.taps", "matte/history_bilateral", "taps", Int(1, 256), "Taps of both sparse bilaterals (paper 50)."),
     f("matte.history_diameter_fraction", "matte/history_bilateral", "of width", Float(0.0, 0.2, 0.0005), "Disk diameter of the history bilateral (paper 1%)."),
+    f("matte.history_full_frames", "matte/history_bilateral", "frames", Float(0.0, 1024.0, 0.1), "Past this history length the disk shrinks as 1/sqrt(length) (0: fixed)."),
     f("matte.normal_power", "matte/history_bilateral", "exponent", Float(0.0, 512.0, 0.5), "Bilateral normal weight: cos^power (both sparse bilaterals)."),
     f("matte.plane_sigma_px", "matte/history_bilateral", "footprints", Float(0.0, 64.0, 0.05), "Bilateral plane-distance sigma (both sparse bilaterals)."),
     f("matte.disocclusion", "matte/disocclusion", "", Bool, "Stage 5: the disocclusion-driven radius r = (1 - min c) R."),
