@@ -154,7 +154,8 @@ impl Viewer {
         };
         surface.configure(&gpu.device, &config);
         let extent = prepared.extent;
-        let renderer = Renderer::new(&gpu, scene, prepared, (w, h))?;
+        let mut renderer = Renderer::new(&gpu, scene, prepared, (w, h))?;
+        renderer.set_async_timings(true);
         let fly = fly::FlyCamera::from_camera(&renderer.scene.camera_or_default(), extent);
         let mut panel = panel_for(&renderer, format!("loaded in {load_ms:.0} ms"));
         if let Some(p) = &self.args.preset {
@@ -215,7 +216,8 @@ impl Running {
             let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
             let extent = prepared.extent;
             let size = self.frame_size();
-            let r = Renderer::new(&self.gpu, scene, prepared, size)?;
+            let mut r = Renderer::new(&self.gpu, scene, prepared, size)?;
+            r.set_async_timings(true);
             Ok((r, extent))
         });
         match r {
@@ -319,8 +321,10 @@ impl Running {
             puffin::profile_scope!("frame");
             self.frame_inner()?;
         }
-        let spans = self.renderer.pass_spans(&self.gpu).unwrap_or_default();
-        self.panel.pass_ms = spans.into_iter().map(|s| (s.label, s.ms)).collect();
+        // The times of a frame the GPU finished (one or two frames back); never waits.
+        if let Some(spans) = self.renderer.poll_pass_spans(&self.gpu) {
+            self.panel.pass_ms = spans.into_iter().map(|s| (s.label, s.ms)).collect();
+        }
         hush_engine::profile::end_frame();
         self.profiler.after_frame();
         self.window.request_redraw();

@@ -94,6 +94,8 @@ pub struct Renderer {
     /// Whether the last frame went through the denoiser (its image is then TAA's output).
     denoised_last: bool,
     timer: Option<GpuTimer>,
+    /// Pass times are picked up by [`Renderer::poll_pass_spans`] frames later, not read back.
+    async_timings: bool,
     prev_view_proj: Option<Mat4>,
     /// The previous frame's jittered view-projection (its depth buffer was rasterised with it).
     prev_jittered: Option<Mat4>,
@@ -185,6 +187,7 @@ impl Renderer {
             linear_clamp,
             denoised_last: false,
             timer,
+            async_timings: false,
             prev_view_proj: None,
             prev_jittered: None,
             frame_index: 0,
@@ -419,8 +422,8 @@ impl Renderer {
             let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
             enc.copy_texture_to_texture(t.gbuffer.depth.0.as_image_copy(), m.prev_depth.0.as_image_copy(), extent);
         }
-        if let Some(timer) = &self.timer {
-            timer.resolve(&mut enc);
+        if let Some(timer) = self.timer.as_mut() {
+            timer.resolve(&gpu.device, &mut enc, self.async_timings);
         }
         drop(encode);
         let _submit = crate::profile::scope("submit");
@@ -428,6 +431,9 @@ impl Renderer {
             timer.submitted_ns = puffin::now_ns();
         }
         gpu.queue.submit([enc.finish()]);
+        if let Some(timer) = self.timer.as_mut() {
+            timer.submitted();
+        }
         self.prev_view_proj = Some(cam.view_proj);
         self.prev_jittered = Some(jittered);
         self.frame_index = self.frame_index.wrapping_add(1);
@@ -518,6 +524,20 @@ impl Renderer {
         let spans = t.read_spans(gpu)?;
         crate::profile::report_gpu(t.submitted_ns, &spans);
         Ok(spans)
+    }
+
+    /// Keep per-pass times for [`Renderer::poll_pass_spans`] instead of [`Renderer::pass_spans`]
+    /// (the viewer: reading times back never waits for the GPU).
+    pub fn set_async_timings(&mut self, on: bool) {
+        self.async_timings = on;
+    }
+
+    /// The passes of the oldest frame that finished since the last call, without waiting
+    /// (frames with async timings on); reported to puffin as that frame's GPU timeline.
+    pub fn poll_pass_spans(&mut self, gpu: &Gpu) -> Option<Vec<crate::profile::PassSpan>> {
+        let (submitted, spans) = self.timer.as_mut()?.poll(gpu)?;
+        crate::profile::report_gpu(submitted, &spans);
+        Some(spans)
     }
 
     /// Frames summed in accumulate mode (0 when off).
