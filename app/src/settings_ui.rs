@@ -19,8 +19,11 @@ fn show(v: &Value) -> String {
     }
 }
 
+/// Which choices of a field the scene offers: (field path, choice) -> shown.
+pub type Offered<'a> = &'a dyn Fn(&str, &str) -> bool;
+
 /// One field's row; true when the value changed.
-fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value) -> bool {
+fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value, offered: Offered) -> bool {
     let mut changed = false;
     let hover = format!("{}\n{}: default {}{}", f.help, f.path, show(default), if f.unit.is_empty() { String::new() } else { format!(" {}", f.unit) });
     ui.horizontal(|ui| {
@@ -54,7 +57,7 @@ fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value) -
             Kind::Choice(choices) => {
                 let mut s = value.as_str().unwrap_or_default().to_string();
                 let r = egui::ComboBox::from_id_salt(f.path).selected_text(&s).show_ui(ui, |ui| {
-                    for c in choices() {
+                    for c in choices().into_iter().filter(|c| offered(f.path, c)) {
                         ui.selectable_value(&mut s, c.clone(), c);
                     }
                 });
@@ -84,11 +87,11 @@ fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value) -
 }
 
 /// The fields of `group`; returns true when one changed. `v` is the settings' serde form.
-pub fn group(ui: &mut egui::Ui, group: &str, v: &mut Value, defaults: &Value) -> bool {
+pub fn group(ui: &mut egui::Ui, group: &str, v: &mut Value, defaults: &Value, offered: Offered) -> bool {
     let mut changed = false;
     for f in FIELDS.iter().filter(|f| f.group == group) {
         if let (Some(value), Some(default)) = (get_field_mut(v, f.path), get_field(defaults, f.path)) {
-            changed |= field_row(ui, f, value, default);
+            changed |= field_row(ui, f, value, default, offered);
         }
     }
     changed

@@ -2,6 +2,7 @@
 //! passes with their GPU time and settings, presets, screenshots, camera paths and the profiler.
 
 use crate::settings_ui;
+use hush_engine::frame::View;
 use hush_engine::settings::FrameSettings;
 
 pub struct Panel {
@@ -88,6 +89,8 @@ impl Panel {
         let groups = settings_ui::groups();
         let glossy = self.glossy;
         let relevant = |g: &str| glossy || !g.starts_with("glossy/");
+        // Scenes without a glossy lobe have no glossy buffers to show.
+        let offered = |path: &str, choice: &str| path != "view" || glossy || serde_json::from_value::<View>(serde_json::Value::String(choice.into())).is_ok_and(|v| !v.needs_glossy());
         let group_of = |pass: &str| groups.iter().copied().find(|g| pass == *g || pass.strip_prefix(*g).is_some_and(|r| r.starts_with('_')));
         let mut shown: Vec<&str> = vec![];
         let mut rows: Vec<(String, f64, Option<&'static str>)> = vec![];
@@ -111,7 +114,7 @@ impl Panel {
             let title = format!("{label}  {ms:.2} ms");
             match g {
                 Some(g) => {
-                    egui::CollapsingHeader::new(title).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults));
+                    egui::CollapsingHeader::new(title).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults, &offered));
                 }
                 None => {
                     ui.label(title);
@@ -120,7 +123,7 @@ impl Panel {
             ui.add(egui::ProgressBar::new(frac).desired_height(3.0));
         }
         for g in groups.iter().filter(|g| !shown.contains(g) && relevant(g)) {
-            egui::CollapsingHeader::new(*g).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults));
+            egui::CollapsingHeader::new(*g).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults, &offered));
         }
         if changed && let Err(e) = settings_ui::apply(&mut self.settings, &v) {
             self.message = e;
