@@ -97,6 +97,12 @@ pub fn group(ui: &mut egui::Ui, group: &str, v: &mut Value, defaults: &Value, of
     changed
 }
 
+/// The defaults' serde form, made once (the panel compares against it every frame).
+pub fn defaults() -> &'static Value {
+    static DEFAULTS: std::sync::OnceLock<Value> = std::sync::OnceLock::new();
+    DEFAULTS.get_or_init(|| FrameSettings::default().to_value())
+}
+
 /// Groups in the order FIELDS lists them.
 pub fn groups() -> Vec<&'static str> {
     let mut g: Vec<&'static str> = vec![];

@@ -83,7 +83,7 @@ impl Panel {
     fn chain(&mut self, ui: &mut egui::Ui) {
         let gpu_total: f64 = self.pass_ms.iter().map(|p| p.1).sum();
         ui.label(format!("frame chain: GPU {gpu_total:.2} ms"));
-        let defaults = FrameSettings::default().to_value();
+        let defaults = settings_ui::defaults();
         let mut v = self.settings.to_value();
         let mut changed = false;
         let groups = settings_ui::groups();
@@ -114,7 +114,7 @@ impl Panel {
             let title = format!("{label}  {ms:.2} ms");
             match g {
                 Some(g) => {
-                    egui::CollapsingHeader::new(title).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults, &offered));
+                    egui::CollapsingHeader::new(title).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, defaults, &offered));
                 }
                 None => {
                     ui.label(title);
@@ -123,7 +123,7 @@ impl Panel {
             ui.add(egui::ProgressBar::new(frac).desired_height(3.0));
         }
         for g in groups.iter().filter(|g| !shown.contains(g) && relevant(g)) {
-            egui::CollapsingHeader::new(*g).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, &defaults, &offered));
+            egui::CollapsingHeader::new(*g).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, defaults, &offered));
         }
         if changed && let Err(e) = settings_ui::apply(&mut self.settings, &v) {
             self.message = e;

@@ -511,10 +511,7 @@ impl Renderer {
     /// GPU milliseconds per pass of the last frame (blocks until it finished); empty without
     /// timestamp queries.
     pub fn pass_times(&self, gpu: &Gpu) -> Result<Vec<(&'static str, f64)>> {
-        match &self.timer {
-            Some(t) => t.read(gpu),
-            None => Ok(vec![]),
-        }
+        Ok(self.pass_spans(gpu)?.into_iter().map(|s| (s.label, s.ms)).collect())
     }
 
     /// Each pass of the last frame with its start and duration (blocks until it finished); when

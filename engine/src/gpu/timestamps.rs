@@ -138,12 +138,8 @@ impl GpuTimer {
         Some((slot.submitted_ns, spans?.ok()?))
     }
 
-    /// (pass, milliseconds) of the last resolved frame; blocks until the GPU is done with it.
-    pub fn read(&self, gpu: &Gpu) -> Result<Vec<(&'static str, f64)>> {
-        Ok(self.read_spans(gpu)?.into_iter().map(|s| (s.label, s.ms)).collect())
-    }
-
-    /// Each pass of the last resolved frame with its start after the frame's first timestamp.
+    /// Each pass of the last resolved frame with its start after the frame's first timestamp;
+    /// blocks until the GPU is done with it.
     pub fn read_spans(&self, gpu: &Gpu) -> Result<Vec<PassSpan>> {
         let n = self.labels.len() as u64 * 2;
         if n == 0 {
