@@ -12,7 +12,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
-use hush_engine::quality::{Image, compare, luminance};
+use hush_engine::quality::{Image, compare, luminance, save_flip_heatmap};
 use hush_engine::scene::{CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings, stage_names};
 use std::io::Write;
@@ -177,7 +177,8 @@ pub fn run(a: QualityArgs) -> Result<()> {
     for _ in 0..64 {
         refr.render(&s.gpu, &last_input, &yardstick, None)?;
     }
-    let flip64 = compare(&refr.read_hdr(&s.gpu)?, &references[references.len() - 1])?.flip;
+    let accumulated64 = refr.read_hdr(&s.gpu)?;
+    let flip64 = compare(&accumulated64, &references[references.len() - 1])?.flip;
     drop(refr);
 
     // The scene's path length unless the preset sets one (the references use the scene's).
@@ -186,9 +187,14 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let (den, last) = stream(&s, &base, &references)?;
     let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::None, ..base.clone() }, &references)?;
     if let (Some(d), Some(r), Some(f)) = (last.first(), last_raw.first(), references.last()) {
-        d.save(&a.out_dir.join("last_denoised.png"))?;
-        r.save(&a.out_dir.join("last_raw.png"))?;
-        f.save(&a.out_dir.join("last_reference.png"))?;
+        // The last frame as seen and in linear HDR, and where FLIP sees the error (denoised and
+        // the 64-spp yardstick side by side show whether the denoiser's error is noise or bias).
+        for (name, img) in [("denoised", d), ("raw", r), ("reference", f), ("accumulated64", &accumulated64)] {
+            img.save(&a.out_dir.join(format!("last_{name}.png")))?;
+            img.save(&a.out_dir.join(format!("last_{name}.exr")))?;
+        }
+        save_flip_heatmap(d, f, &a.out_dir.join("last_flip_denoised.png"))?;
+        save_flip_heatmap(&accumulated64, f, &a.out_dir.join("last_flip_accumulated64.png"))?;
     }
     write_csv(&a.out_dir.join("quality.csv"), &s.inputs, &den, &raw)?;
     plot(&a.out_dir.join("quality.png"), &den, &raw, &a.scene)?;

@@ -1,5 +1,5 @@
 use super::{Image, ssim_luma};
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -67,6 +67,17 @@ pub fn flip_ldr(x: &Image, y: &Image) -> f64 {
 /// Per-pixel LDR-FLIP of T(x) against T(y), row-major (to score a region of the image).
 pub fn flip_map(x: &Image, y: &Image) -> Vec<f32> {
     flip_error(x, y).to_vec()
+}
+
+/// The per-pixel LDR-FLIP of `x` against `y` in FLIP's magma colour map (black: no visible
+/// difference), as FLIP's own tool draws it, written as a PNG.
+pub fn save_flip_heatmap(x: &Image, y: &Image, path: &std::path::Path) -> Result<()> {
+    check_sizes(x, y)?;
+    let rgb = flip_error(x, y).apply_color_lut(&nv_flip::magma_lut());
+    image::RgbImage::from_raw(x.width, x.height, rgb.to_vec())
+        .ok_or_else(|| anyhow::anyhow!("FLIP map of {}x{} has the wrong size", x.width, x.height))?
+        .save(path)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 fn flip_error(x: &Image, y: &Image) -> nv_flip::FlipImageFloat {
