@@ -69,14 +69,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let probe = Probe(x, h, hit_class(roughness));
         let start = vec2i(floor(vec2f(p) + 0.5 + surface_mv));
         let r = diamond_search(p, start, gp.initial_step, gp.max_search_steps, probe);
+        // The search matches samples; the two frames sampled their pixels at different jitters.
         if r.dist < INF {
-            mv = r.coord - (vec2f(p) + 0.5);
+            mv = r.coord - (vec2f(p) + 0.5) + dn.jitter_shift;
         }
         let reach = reflected_footprint(p, x);
         search = vec4f(f32(r.steps), length(mv - virtual_mv), r.dist / reach, 0.0);
         if gp.reference_radius > 0u {
             let b = brute_force_search(p, i32(gp.reference_radius), probe);
-            let ref_mv = select(mv, b.coord - (vec2f(p) + 0.5), b.dist < INF);
+            let ref_mv = select(mv, b.coord - (vec2f(p) + 0.5) + dn.jitter_shift, b.dist < INF);
             search.y = length(mv - ref_mv);
             // The reference's answer replaces the virtual one in zw.
             textureStore(out_motion, p, vec4f(mv, ref_mv));

@@ -50,29 +50,36 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let roughness = roughness_at(p);
     let reflected = roughness < gp.roughness_threshold && gp.mode != MV_PRIMARY;
     let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
-    let q = vec2i(floor(prev));
+    var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     var c = 0.0;
-    let ph = textureLoad(prev_hit, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0);
-    if in_bounds(q) && dn.history_valid != 0u && decode_hit_class(ph.w) != HIT_NONE {
-        let f = footprint(x);
+    if dn.history_valid != 0u {
         if !reflected {
             let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
-            let actual = world_from_depth(dn.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));
-            c = gp.hysteresis * (1.0 - smoothstep(dn.d0_px * f, dn.d1_px * f, length(expected - actual)));
-        } else if is_mirror(roughness) {
-            let reach = reflected_footprint(p, x);
-            let d = length(representative_hit(p, x) - ph.xyz) / reach;
-            c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, d));
-        } else {
-            c = gp.hysteresis;
+            r = reproject(prev_depth, prev, expected, surface_footprint(p, x));
+        }
+        // The previous pixel must have had a glossy lobe (its hit class is set).
+        if in_bounds(r.texel) && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
+            if !reflected {
+                c = confidence(gp.hysteresis, r.distance);
+            } else if is_mirror(roughness) {
+                let reach = reflected_footprint(p, x);
+                let d = length(representative_hit(p, x) - textureLoad(prev_hit, r.texel, 0).xyz) / reach;
+                c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, d));
+            } else {
+                c = gp.hysteresis;
+            }
         }
     }
     var result = current;
     var n = 1.0;
     var clip = 0.0;
     if c > 0.0 {
-        n = min(max(textureLoad(history, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0).a, 1.0) + 1.0, 1024.0);
-        let hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        let texel = textureLoad(history, r.texel, 0);
+        n = min(max(texel.a, 1.0) + 1.0, 1024.0);
+        var hist = half_safe(texel.rgb);
+        if r.bilinear {
+            hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        }
         var clipped = hist;
         if gstage_on(GSTAGE_CLIPPING) && roughness < gp.clip_roughness {
             var lo = vec3f(3.0e38);

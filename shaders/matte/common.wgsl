@@ -40,8 +40,10 @@ struct DenoiseParams {
     inject_nonfinite: u32,
     // The history bilateral's disk shrinks as 1 / sqrt(n) past this history length (0: never).
     history_full_frames: f32,
-    _pad1: u32,
-    _pad2: u32,
+    // The previous frame's sub-pixel jitter minus this frame's, pixels. Motion vectors found by
+    // matching the two frames' samples (the glossy chain's search) carry it; history is kept per
+    // pixel, so it is taken out of them.
+    jitter_shift: vec2f,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;
@@ -88,11 +90,74 @@ fn footprint(x: vec3f) -> f32 {
     return 2.0 * z * length(frame.cam_up.xyz) / f32(frame.size.y);
 }
 
+// The same along the surface at p: a pixel's footprint stretched by the view's slant (to at most
+// 10x, 84 degrees from the normal). The raster's jitter moves a pixel's sample by up to a pixel,
+// which on a surface seen at a grazing angle is many frontal footprints; eq. (11)'s test in
+// frontal footprints rejected every thin ledge and far floor of a still view.
+fn surface_footprint(p: vec2i, x: vec3f) -> f32 {
+    let n = oct_decode(textureLoad(gb_normal, p, 0).xy);
+    let cosine = abs(dot(n, normalize(frame.cam_pos.xyz - x)));
+    return footprint(x) / max(cosine, 0.1);
+}
+
 // Cross-bilateral weight of a tap (Mara et al. §3.4: camera-space plane distance and normals).
 fn bilateral_weight(xc: vec3f, nc: vec3f, fc: f32, xt: vec3f, nt: vec3f) -> f32 {
     let plane = abs(dot(nc, xt - xc)) / (dn.plane_sigma_px * fc);
     let wn = pow(max(dot(nc, nt), 0.0), dn.normal_power);
     return wn * exp(-plane * plane);
+}
+
+// Eq. (11)'s reprojection, made robust to the raster's jitter. The previous frame sampled each
+// pixel at another sub-pixel position, so at a silhouette the texel under the motion vector often
+// holds the other surface, although a neighbour holds this one: testing that texel alone reset
+// the history of every edge pixel of a still view about every other frame (the level at 160x90:
+// a line along every silhouette), and stage (5) then blurred a band R wide around each one. When
+// the texel under the motion vector fails, its 3x3 neighbours are tried and the one closest to
+// the expected position is read instead (point sampled; the history moves by at most a pixel,
+// on the same surface). Returns the texel, whether to sample bilinearly at `prev` (the texel
+// under the vector passed), and the distance |X_expected - X_actual| in footprints (-1: no
+// texel held a surface).
+struct Reprojection {
+    texel: vec2i,
+    bilinear: bool,
+    distance: f32,
+}
+
+fn previous_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, f: f32) -> f32 {
+    if !in_bounds(t) {
+        return -1.0;
+    }
+    let d = textureLoad(depth, t, 0);
+    if d <= 0.0 {
+        return -1.0;
+    }
+    return length(expected - world_from_depth(dn.prev_inv_view_proj, t, d)) / f;
+}
+
+fn reproject(depth: texture_depth_2d, prev: vec2f, expected: vec3f, f: f32) -> Reprojection {
+    let q = vec2i(floor(prev));
+    var best = Reprojection(q, true, previous_distance(depth, q, expected, f));
+    if best.distance >= 0.0 && best.distance <= dn.d0_px {
+        return best;
+    }
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let t = q + vec2i(dx, dy);
+            let d = previous_distance(depth, t, expected, f);
+            if d >= 0.0 && (best.distance < 0.0 || d < best.distance) {
+                best = Reprojection(t, all(t == q), d);
+            }
+        }
+    }
+    return best;
+}
+
+// Eq. (11): c = h smoothstep(d1, d0, distance), distance in footprints (0 without a surface).
+fn confidence(h: f32, distance: f32) -> f32 {
+    if distance < 0.0 {
+        return 0.0;
+    }
+    return h * (1.0 - smoothstep(dn.d0_px, dn.d1_px, distance));
 }
 
 // Tap i of n in a disk of radius r: a golden-angle spiral (uniform density), rotated per frame

@@ -1,4 +1,5 @@
-// Stage (3), matte temporal: reverse-reproject the history with the motion vectors, weigh it by
+// Stage (3), matte temporal: reverse-reproject the history with the motion vectors (through
+// `reproject`, which tolerates the raster's jitter at silhouettes), weigh it by
 // the confidence of eq. (11), c = h smoothstep(d1, d0, |X_expected - X_actual|) (so c falls to 0
 // as the distance grows past d1; the paper writes the arguments in the other order), clamp it to
 // the current 3x3 neighbourhood and blend h c of it in. Output rgb = the blend, a = c.
@@ -32,30 +33,29 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let ids = textureLoad(gb_object, p, 0);
     let expected = previous_position(ids.x, x);
     let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
-    let q = vec2i(floor(prev));
     var reason = 0u;
     var c = 0.0;
-    if in_bounds(q) && dn.history_valid != 0u {
-        let d = textureLoad(prev_depth, q, 0);
-        if d > 0.0 {
-            let actual = world_from_depth(dn.prev_inv_view_proj, q, d);
-            let f = footprint(x);
-            c = dn.hysteresis * (1.0 - smoothstep(dn.d0_px * f, dn.d1_px * f, length(expected - actual)));
-            if c < 0.5 * dn.hysteresis {
-                reason = REASON_LOW_CONFIDENCE;
-            }
-        } else {
-            reason = REASON_DISOCCLUDED;
-        }
-    } else {
+    var r = Reprojection(vec2i(floor(prev)), true, -1.0);
+    if dn.history_valid != 0u {
+        r = reproject(prev_depth, prev, expected, surface_footprint(p, x));
+    }
+    if r.distance < 0.0 {
         reason = REASON_DISOCCLUDED;
+    } else {
+        c = confidence(dn.hysteresis, r.distance);
+        if c < 0.5 * dn.hysteresis {
+            reason = REASON_LOW_CONFIDENCE;
+        }
     }
     var result = current;
     var n = 1.0;
     if c > 0.0 {
-        let n_prev = max(textureLoad(history, clamp(q, vec2i(0), vec2i(frame.size) - 1), 0).a, 1.0);
-        n = min(n_prev + 1.0, 1024.0);
-        let hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        let texel = textureLoad(history, r.texel, 0);
+        n = min(max(texel.a, 1.0) + 1.0, 1024.0);
+        var hist = half_safe(texel.rgb);
+        if r.bilinear {
+            hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+        }
         var clamped = hist;
         if dn.clamp_sigma > 0.0 {
             // The current neighbourhood's mean and standard deviation: the paper's 3x3, plus 24

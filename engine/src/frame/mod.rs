@@ -13,7 +13,7 @@ use crate::accel::BvhKind;
 use crate::gpu::{Gpu, GpuMemory, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
 use crate::passes::composite::{CompositePass, DisplayPass, FrameBuffers};
 use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
-use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
+use crate::passes::matte::{ChainInputs, ChainView, DenoiseParams, MatteChain, MatteTargets};
 use crate::settings::Denoiser;
 use crate::passes::gbuffer::{self, GBufferPass, GBufferTargets};
 use crate::passes::reference::{TraceParams, TraceView, make_params};
@@ -97,8 +97,9 @@ pub struct Renderer {
     /// Pass times are picked up by [`Renderer::poll_pass_spans`] frames later, not read back.
     async_timings: bool,
     prev_view_proj: Option<Mat4>,
-    /// The previous frame's jittered view-projection (its depth buffer was rasterised with it).
-    prev_jittered: Option<Mat4>,
+    /// The previous frame's jittered view-projection (its depth buffer was rasterised with it)
+    /// and its jitter.
+    prev_jittered: Option<(Mat4, Vec2)>,
     frame_index: u32,
     accumulated: u32,
     accumulated_state: Option<(FrameInput, FrameSettings)>,
@@ -327,8 +328,9 @@ impl Renderer {
         let jittered = cam.jittered(jitter, size);
         if denoise {
             let history_valid = self.denoised_last && self.prev_jittered.is_some();
-            let prev_inv = self.prev_jittered.unwrap_or(jittered).inverse();
-            let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, jittered.inverse(), prev_inv, history_valid);
+            let (prev_jittered, prev_jitter) = self.prev_jittered.unwrap_or((jittered, jitter));
+            let view = ChainView { inv_view_proj: jittered.inverse(), prev_inv_view_proj: prev_jittered.inverse(), jitter_shift: prev_jitter - jitter, history_valid };
+            let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, &view);
             gpu.queue.write_buffer(&self.denoise_buf, 0, bytemuck::bytes_of(&dp));
             let gp = GlossyParams::new(&settings.glossy, self.prepared.extent as f32);
             gpu.queue.write_buffer(&self.glossy_buf, 0, bytemuck::bytes_of(&gp));
@@ -435,7 +437,7 @@ impl Renderer {
             timer.submitted();
         }
         self.prev_view_proj = Some(cam.view_proj);
-        self.prev_jittered = Some(jittered);
+        self.prev_jittered = Some((jittered, jitter));
         self.frame_index = self.frame_index.wrapping_add(1);
         Ok(())
     }

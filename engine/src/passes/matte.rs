@@ -42,15 +42,29 @@ pub struct DenoiseParams {
     pub inject_nonfinite: u32,
     /// [`MatteSettings::history_full_frames`].
     pub history_full_frames: f32,
-    pub _pad: [u32; 2],
+    /// [`ChainView::jitter_shift`].
+    pub jitter_shift: [f32; 2],
+}
+
+/// What the chains need to know of this frame's camera and the previous one's.
+pub struct ChainView {
+    /// Rebased world from clip, this frame and the previous one (both with their jitter, as
+    /// their depth buffers were rasterised).
+    pub inv_view_proj: glam::Mat4,
+    pub prev_inv_view_proj: glam::Mat4,
+    /// The previous frame's sub-pixel jitter minus this frame's, pixels: what separates the two
+    /// frames' samples of one pixel in a still view.
+    pub jitter_shift: glam::Vec2,
+    /// False when there is no usable history (first denoised frame, resize, denoiser paused).
+    pub history_valid: bool,
 }
 
 impl DenoiseParams {
-    pub fn new(s: &MatteSettings, width: u32, frame: u32, inv: glam::Mat4, prev_inv: glam::Mat4, history_valid: bool) -> DenoiseParams {
+    pub fn new(s: &MatteSettings, width: u32, frame: u32, view: &ChainView) -> DenoiseParams {
         let w = width as f32;
         DenoiseParams {
-            inv_view_proj: inv.to_cols_array_2d(),
-            prev_inv_view_proj: prev_inv.to_cols_array_2d(),
+            inv_view_proj: view.inv_view_proj.to_cols_array_2d(),
+            prev_inv_view_proj: view.prev_inv_view_proj.to_cols_array_2d(),
             stages: s.stage_bits(),
             taps: s.taps.clamp(1, 256),
             parity: frame % 2,
@@ -67,10 +81,10 @@ impl DenoiseParams {
             taa_alpha: s.taa_alpha.clamp(0.01, 1.0),
             // Golden-ratio steps: consecutive frames' tap patterns interleave.
             rotation: (frame as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU),
-            history_valid: history_valid as u32,
+            history_valid: view.history_valid as u32,
             inject_nonfinite: s.inject_nonfinite as u32,
             history_full_frames: s.history_full_frames.max(0.0),
-            _pad: [0; 2],
+            jitter_shift: view.jitter_shift.to_array(),
         }
     }
 }
