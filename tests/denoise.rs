@@ -126,10 +126,11 @@ fn oct_decode(x: f32, y: f32) -> glam::Vec3 {
 /// step past the arcade's pillars, the test recomputes eq. (11)'s distance on the CPU for every
 /// pixel (this frame's position from its depth, the previous frame's positions around pixel +
 /// motion from the previous depth, both through their jittered cameras), as the shader's
-/// jitter-robust reprojection reads it: the closest of the 3x3 previous pixels, in footprints
-/// along the surface (the frontal footprint over the view's cosine, at most 10x). Where even
-/// that distance is clearly past d1 (1.5 x d1: a surface that was hidden or off screen), the
-/// pixel must be flagged and its temporal output must be exactly this frame's sample.
+/// jitter-robust reprojection reads it: the closest of the 3x3 previous pixels, with the
+/// distance off the surface's plane in footprints and the distance along it in footprints
+/// stretched by the view's slant (at most 10x). Where even that distance is clearly past d1
+/// (1.5 x d1: a surface that was hidden or off screen), the pixel must be flagged and its
+/// temporal output must be exactly this frame's sample.
 #[test]
 fn history_resets_on_disocclusion() {
     use hush_engine::frame::halton_jitter;
@@ -162,8 +163,8 @@ fn history_resets_on_disocclusion() {
             }
             let p = world(&inv1, x, y, d);
             let n = oct_decode(half(&normal[i * 4..]), half(&normal[i * 4 + 2..]));
-            let cosine = n.dot((setup1.pos - p).normalize()).abs().max(0.1);
-            let foot = 2.0 * (p - setup1.pos).dot(setup1.fwd) * setup1.up.length() / h as f32 / cosine;
+            let stretch = 1.0 / n.dot((setup1.pos - p).normalize()).abs().max(0.1);
+            let foot = 2.0 * (p - setup1.pos).dot(setup1.fwd) * setup1.up.length() / h as f32;
             let q = (x as f32 + 0.5 + half(&motion[i * 4..]), y as f32 + 0.5 + half(&motion[i * 4 + 2..]));
             let (qx, qy) = (q.0.floor() as i64, q.1.floor() as i64);
             let closest = (-1..=1)
@@ -171,7 +172,11 @@ fn history_resets_on_disocclusion() {
                 .filter(|&(tx, ty)| tx >= 0 && ty >= 0 && tx < w && ty < h)
                 .filter_map(|(tx, ty)| {
                     let dq = f32_at(&depth0, (ty * w + tx) as usize);
-                    (dq > 0.0).then(|| (world(&inv0, tx, ty, dq) - p).length())
+                    (dq > 0.0).then(|| {
+                        let delta = world(&inv0, tx, ty, dq) - p;
+                        let off_plane = n.dot(delta);
+                        off_plane.abs().max((delta - n * off_plane).length() / stretch)
+                    })
                 })
                 .fold(f32::INFINITY, f32::min);
             if closest <= 1.5 * d1 * foot {

@@ -34,6 +34,36 @@ fn clip_to_box(h: vec3f, lo: vec3f, hi: vec3f) -> vec3f {
     return centre + d / t;
 }
 
+// Eq. (11) on the reflected hit, as `reproject` does it on the surface (matte/common.wgsl): the
+// previous frame saw each pixel's reflection at another jitter, so where the pixel under the
+// reflection motion vector shows another point, its 3x3 neighbours are tried and the closest
+// reflected hit is read (point sampled). Distances are in reflected footprints (`reach`). Testing
+// the one pixel alone cut the history of curved mirrors (the hall's metal spheres) short in
+// every frame of a still view, and their bilateral then ran at full sigma.
+fn reproject_mirror(prev: vec2f, hit: vec3f, reach: f32) -> Reprojection {
+    let q = vec2i(floor(prev));
+    var best = Reprojection(q, true, -1.0);
+    for (var k = 0; k < 9; k++) {
+        // The pixel under the vector first (k = 0 is the centre of the 3x3).
+        let t = q + vec2i((k + 4) % 3 - 1, (k + 4) / 3 % 3 - 1);
+        if !in_bounds(t) {
+            continue;
+        }
+        let ph = textureLoad(prev_hit, t, 0);
+        if decode_hit_class(ph.w) != HIT_MIRROR {
+            continue;
+        }
+        let d = length(hit - ph.xyz) / reach;
+        if best.distance < 0.0 || d < best.distance {
+            best = Reprojection(t, k == 0, d);
+        }
+        if k == 0 && d <= gp.d0_px {
+            break;
+        }
+    }
+    return best;
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     let p = vec2i(gid.xy);
@@ -55,16 +85,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if dn.history_valid != 0u {
         if !reflected {
             let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
-            r = reproject(prev_depth, prev, expected, surface_footprint(p, x));
+            r = reproject(prev_depth, prev, expected, surface_frame(p, x));
         }
         // The previous pixel must have had a glossy lobe (its hit class is set).
         if in_bounds(r.texel) && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
             if !reflected {
                 c = confidence(gp.hysteresis, r.distance);
             } else if is_mirror(roughness) {
-                let reach = reflected_footprint(p, x);
-                let d = length(representative_hit(p, x) - textureLoad(prev_hit, r.texel, 0).xyz) / reach;
-                c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, d));
+                r = reproject_mirror(prev, representative_hit(p, x), reflected_footprint(p, x));
+                if r.distance >= 0.0 {
+                    c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, r.distance));
+                }
             } else {
                 c = gp.hysteresis;
             }

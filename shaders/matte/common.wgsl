@@ -90,14 +90,19 @@ fn footprint(x: vec3f) -> f32 {
     return 2.0 * z * length(frame.cam_up.xyz) / f32(frame.size.y);
 }
 
-// The same along the surface at p: a pixel's footprint stretched by the view's slant (to at most
-// 10x, 84 degrees from the normal). The raster's jitter moves a pixel's sample by up to a pixel,
-// which on a surface seen at a grazing angle is many frontal footprints; eq. (11)'s test in
-// frontal footprints rejected every thin ledge and far floor of a still view.
-fn surface_footprint(p: vec2i, x: vec3f) -> f32 {
+// The frame in which eq. (11)'s distance is measured at pixel p: the surface normal, the pixel
+// footprint and how far the view's slant stretches it along the surface (to at most 10x, 84
+// degrees from the normal).
+struct SurfaceFrame {
+    n: vec3f,
+    footprint: f32,
+    stretch: f32,
+}
+
+fn surface_frame(p: vec2i, x: vec3f) -> SurfaceFrame {
     let n = oct_decode(textureLoad(gb_normal, p, 0).xy);
     let cosine = abs(dot(n, normalize(frame.cam_pos.xyz - x)));
-    return footprint(x) / max(cosine, 0.1);
+    return SurfaceFrame(n, footprint(x), 1.0 / max(cosine, 0.1));
 }
 
 // Cross-bilateral weight of a tap (Mara et al. §3.4: camera-space plane distance and normals).
@@ -110,20 +115,24 @@ fn bilateral_weight(xc: vec3f, nc: vec3f, fc: f32, xt: vec3f, nt: vec3f) -> f32 
 // Eq. (11)'s reprojection, made robust to the raster's jitter. The previous frame sampled each
 // pixel at another sub-pixel position, so at a silhouette the texel under the motion vector often
 // holds the other surface, although a neighbour holds this one: testing that texel alone reset
-// the history of every edge pixel of a still view about every other frame (the level at 160x90:
-// a line along every silhouette), and stage (5) then blurred a band R wide around each one. When
+// the history of every edge pixel of a still view about every other frame (tests/denoise.rs:
+// still_view_keeps_its_history), and stage (5) then blurred a band R wide around each one. When
 // the texel under the motion vector fails, its 3x3 neighbours are tried and the one closest to
 // the expected position is read instead (point sampled; the history moves by at most a pixel,
-// on the same surface). Returns the texel, whether to sample bilinearly at `prev` (the texel
-// under the vector passed), and the distance |X_expected - X_actual| in footprints (-1: no
-// texel held a surface).
+// on the same surface).
+// The distance is in footprints, split by the surface: off the surface's plane it is the pixel
+// footprint (a sample of another surface is rejected), along it the footprint stretched by the
+// slant (a jittered sample of a ledge or a far floor seen at a grazing angle lies many frontal
+// footprints away, on the same surface).
+// Returns the texel, whether to sample bilinearly at `prev` (the texel under the vector passed),
+// and the distance (-1: no texel held a surface).
 struct Reprojection {
     texel: vec2i,
     bilinear: bool,
     distance: f32,
 }
 
-fn previous_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, f: f32) -> f32 {
+fn previous_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, s: SurfaceFrame) -> f32 {
     if !in_bounds(t) {
         return -1.0;
     }
@@ -131,19 +140,22 @@ fn previous_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, f: f32)
     if d <= 0.0 {
         return -1.0;
     }
-    return length(expected - world_from_depth(dn.prev_inv_view_proj, t, d)) / f;
+    let delta = world_from_depth(dn.prev_inv_view_proj, t, d) - expected;
+    let off_plane = dot(s.n, delta);
+    let along = length(delta - s.n * off_plane);
+    return max(abs(off_plane), along / s.stretch) / s.footprint;
 }
 
-fn reproject(depth: texture_depth_2d, prev: vec2f, expected: vec3f, f: f32) -> Reprojection {
+fn reproject(depth: texture_depth_2d, prev: vec2f, expected: vec3f, s: SurfaceFrame) -> Reprojection {
     let q = vec2i(floor(prev));
-    var best = Reprojection(q, true, previous_distance(depth, q, expected, f));
+    var best = Reprojection(q, true, previous_distance(depth, q, expected, s));
     if best.distance >= 0.0 && best.distance <= dn.d0_px {
         return best;
     }
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let t = q + vec2i(dx, dy);
-            let d = previous_distance(depth, t, expected, f);
+            let d = previous_distance(depth, t, expected, s);
             if d >= 0.0 && (best.distance < 0.0 || d < best.distance) {
                 best = Reprojection(t, all(t == q), d);
             }

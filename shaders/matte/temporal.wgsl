@@ -37,7 +37,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var c = 0.0;
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     if dn.history_valid != 0u {
-        r = reproject(prev_depth, prev, expected, surface_footprint(p, x));
+        r = reproject(prev_depth, prev, expected, surface_frame(p, x));
     }
     if r.distance < 0.0 {
         reason = REASON_DISOCCLUDED;
