@@ -81,10 +81,7 @@ fn bilateral_h(@builtin(global_invocation_id) gid: vec3u) {
     if has_surface(p) && gstage_on(GSTAGE_BILATERAL) {
         sigma = sigma_at(p);
         // The temporal stage's history length (alpha): sigma^2 x frames stays constant.
-        let n = max(textureLoad(src, p, 0).a, 1.0);
-        if gp.sigma_full_frames > 0.0 {
-            sigma *= sqrt(min(1.0, gp.sigma_full_frames / n));
-        }
+        sigma *= history_falloff(gp.sigma_full_frames, textureLoad(src, p, 0).a);
     }
     textureStore(dst, p, vec4f(half_safe(bilateral(p, vec2i(1, 0), sigma)), sigma));
 }

@@ -44,8 +44,7 @@ fn reproject_mirror(prev: vec2f, hit: vec3f, reach: f32) -> Reprojection {
     let q = vec2i(floor(prev));
     var best = Reprojection(q, true, -1.0);
     for (var k = 0; k < 9; k++) {
-        // The pixel under the vector first (k = 0 is the centre of the 3x3).
-        let t = q + vec2i((k + 4) % 3 - 1, (k + 4) / 3 % 3 - 1);
+        let t = q + neighbour_3x3(k);
         if !in_bounds(t) {
             continue;
         }

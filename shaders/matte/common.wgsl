@@ -146,22 +146,36 @@ fn previous_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, s: Surf
     return max(abs(off_plane), along / s.stretch) / s.footprint;
 }
 
+// Offset k of a 3x3 neighbourhood, its centre first (k = 0).
+fn neighbour_3x3(k: i32) -> vec2i {
+    return vec2i((k + 4) % 3 - 1, (k + 4) / 3 % 3 - 1);
+}
+
 fn reproject(depth: texture_depth_2d, prev: vec2f, expected: vec3f, s: SurfaceFrame) -> Reprojection {
     let q = vec2i(floor(prev));
-    var best = Reprojection(q, true, previous_distance(depth, q, expected, s));
-    if best.distance >= 0.0 && best.distance <= dn.d0_px {
-        return best;
-    }
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let t = q + vec2i(dx, dy);
-            let d = previous_distance(depth, t, expected, s);
-            if d >= 0.0 && (best.distance < 0.0 || d < best.distance) {
-                best = Reprojection(t, all(t == q), d);
-            }
+    var best = Reprojection(q, true, -1.0);
+    for (var k = 0; k < 9; k++) {
+        let t = q + neighbour_3x3(k);
+        let d = previous_distance(depth, t, expected, s);
+        if d >= 0.0 && (best.distance < 0.0 || d < best.distance) {
+            best = Reprojection(t, k == 0, d);
+        }
+        // The texel under the vector passed: keep it, sampled bilinearly.
+        if k == 0 && d >= 0.0 && d <= dn.d0_px {
+            break;
         }
     }
     return best;
+}
+
+// The blur of a filter that runs every frame shrinks as 1 / sqrt(n) past `full_frames` of
+// history n, so that its variance times the frames it acts on stays constant (0: never shrinks).
+// The matte history bilateral's radius and the glossy bilateral's sigma follow it.
+fn history_falloff(full_frames: f32, n: f32) -> f32 {
+    if full_frames <= 0.0 {
+        return 1.0;
+    }
+    return sqrt(min(1.0, full_frames / max(n, 1.0)));
 }
 
 // Eq. (11): c = h smoothstep(d1, d0, distance), distance in footprints (0 without a surface).

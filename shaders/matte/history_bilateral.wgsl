@@ -14,12 +14,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var v = textureLoad(filter_in, p, 0).rgb;
     let n = f32(textureLoad(reason_in, p, 0).x >> 8u);
     if stage_on(STAGE_HISTORY_BILATERAL) {
-        // The disk shrinks as 1 / sqrt(n) past history_full_frames (settings: MatteSettings).
-        var radius = dn.history_radius_px;
-        if dn.history_full_frames > 0.0 {
-            radius *= sqrt(min(1.0, dn.history_full_frames / max(n, 1.0)));
-        }
-        v = sparse_bilateral(p, radius);
+        // The disk shrinks past history_full_frames (settings: MatteSettings).
+        v = sparse_bilateral(p, dn.history_radius_px * history_falloff(dn.history_full_frames, n));
     }
     textureStore(out_history, p, vec4f(half_safe(v), n));
 }

@@ -3,7 +3,8 @@
 //! the same frame raw, and the reference (the real-time frame accumulated over many frames at
 //! the same camera and time; the accumulation converges to the reference mode, tests/realtime.rs),
 //! then writes quality.csv (FLIP, relMSE, SSIM and the temporal error of Schied et al. 2017: mean
-//! absolute luminance change between consecutive frames) and quality.png. `--ablations` repeats
+//! absolute luminance change between consecutive frames), quality.png, the last frames (PNG and
+//! EXR) and FLIP heat maps of the last denoised frame and the 64-spp yardstick. `--ablations` repeats
 //! the denoised stream with each stage off and writes ablations.csv.
 
 use crate::realtime::preset_settings;
