@@ -161,7 +161,15 @@ impl Program {
             .validate(&module)
             .map_err(|e| {
                 let at = self.at(e.spans().next().map(|(s, _)| s.location(&self.text).line_number as usize));
-                anyhow!("{}: WGSL validation error at {at}: {}", self.label, e.as_inner())
+                // naga nests the cause (an entry point is invalid because a function is, because
+                // one expression is): name every level.
+                let mut why = e.as_inner().to_string();
+                let mut source = std::error::Error::source(e.as_inner());
+                while let Some(s) = source {
+                    why += &format!(": {s}");
+                    source = s.source();
+                }
+                anyhow!("{}: WGSL validation error at {at}: {why}", self.label)
             })?;
         Ok(module)
     }
