@@ -3,7 +3,7 @@
 use glam::DVec3;
 use hush_engine::accel::BvhKind;
 use hush_engine::frame::{FrameInput, Renderer};
-use hush_engine::quality::{Image, compare};
+use hush_engine::quality::{Image, compare, luminance};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
 use hush_tests::half;
@@ -111,6 +111,35 @@ fn still_view_keeps_its_history() {
     let reset: Vec<usize> = (0..pixels).filter(|&i| surface(i) && u32::from_le_bytes(reason[i * 4..i * 4 + 4].try_into().unwrap()) & 3 != 0).collect();
     println!("still view, 8th frame: {} of {pixels} pixels reset their history", reset.len());
     assert!(reset.len() * 1000 <= pixels, "{} pixels reset their history in a still view: {:?}", reset.len(), &reset[..reset.len().min(20)]);
+}
+
+/// Temporal error (Schied et al.: mean absolute luminance change between consecutive frames) of
+/// a still view over frames 40 to 44, against the raw stream's: the issue asks for at most a tenth.
+/// The exponential TAA blend (taa_still_frames = 0) keeps weighing the latest Halton offsets
+/// most, so edges keep flickering; the equal-age blend of a still pixel settles them. Measured
+/// at 96x54, 4 frame pairs: raw 0.113, exponential TAA 0.0041 (1/28), defaults 0.0025 (1/45).
+/// The bounds: a tenth of raw, and under 0.75x the exponential blend (a chain that does not
+/// settle edges lands at 1x; the measured ratio is 0.61).
+#[test]
+fn still_view_flickers_at_a_tenth_of_raw() {
+    const PAIRS: u32 = 4;
+    let flicker = |s: &FrameSettings| {
+        let (gpu, mut r) = level();
+        let mut a = frames(&mut r, &gpu, s, view(), 40);
+        let mut sum = 0.0;
+        for _ in 0..PAIRS {
+            let b = frames(&mut r, &gpu, s, view(), 1);
+            sum += a.data.iter().zip(&b.data).map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64).sum::<f64>() / a.data.len() as f64;
+            a = b;
+        }
+        sum / PAIRS as f64
+    };
+    let raw = flicker(&FrameSettings::default());
+    let exponential = flicker(&FrameSettings { matte: MatteSettings { taa_still_frames: 0.0, ..Default::default() }, ..mara() });
+    let settled = flicker(&mara());
+    println!("temporal error: raw {raw:.4}, exponential TAA {exponential:.4}, defaults {settled:.4}");
+    assert!(settled <= 0.1 * raw, "temporal error {settled} is over a tenth of raw's {raw}");
+    assert!(settled < 0.75 * exponential, "temporal error {settled} against {exponential} with the exponential TAA blend");
 }
 
 /// The G-buffer's octahedral normal (shaders/realtime/frame.wgsl: oct_decode).

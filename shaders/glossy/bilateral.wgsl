@@ -4,8 +4,8 @@
 // normal, plane distance and roughness. Behind mirrors the weights use the reflected surface's
 // normal and position instead (Voorhuis §4.1). No firefly filter: glossy highlights are real.
 // bilateral_h writes (light, sigma); bilateral_v remodulates and writes the chain's output.
-// Sigma shrinks as 1 / sqrt(history length) past GlossySettings::sigma_full_frames (a departure
-// from the paper's fixed sigma, measured in settings.rs).
+// Sigma shrinks as 1 / history length past GlossySettings::sigma_full_frames (a departure from
+// the paper's fixed sigma, measured in settings.rs).
 
 @group(0) @binding(65) var src: texture_2d<f32>;
 @group(0) @binding(66) var dst: texture_storage_2d<rgba16float, write>;
@@ -80,8 +80,11 @@ fn bilateral_h(@builtin(global_invocation_id) gid: vec3u) {
     var sigma = 0.0;
     if has_surface(p) && gstage_on(GSTAGE_BILATERAL) {
         sigma = sigma_at(p);
-        // The temporal stage's history length (alpha): sigma^2 x frames stays constant.
-        sigma *= history_falloff(gp.sigma_full_frames, textureLoad(src, p, 0).a);
+        // The temporal stage's history length n (alpha): sigma falls as 1 / n, so the blur's
+        // variance reduction (sigma^2) fades faster than the history's grows, and a converged
+        // reflection ends unblurred.
+        let falloff = history_falloff(gp.sigma_full_frames, textureLoad(src, p, 0).a);
+        sigma *= falloff * falloff;
     }
     textureStore(dst, p, vec4f(half_safe(bilateral(p, vec2i(1, 0), sigma)), sigma));
 }

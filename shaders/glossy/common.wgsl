@@ -32,6 +32,12 @@ struct GlossyParams {
     representative_traced: u32,
     // The bilateral's sigma shrinks as 1 / sqrt(history length) beyond this many frames.
     sigma_full_frames: f32,
+    // 1 when neither the camera nor an object moved since the previous frame: every reflection
+    // then stands still, and the reflection motion is the surface's (zero) in every mode.
+    static_view: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(60) var<uniform> gp: GlossyParams;

@@ -98,6 +98,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             return;
         }
     }
+    // A static view: whatever the search found (the two frames' representative hits differ by
+    // their jitter and, on rough surfaces, by the sampled ray), the reflection stood still. The
+    // search still runs, for its debug views and so that the frame's cost does not depend on
+    // whether the camera moves.
+    if gp.static_view != 0u {
+        mv = surface_mv;
+    }
     textureStore(out_motion, p, vec4f(mv, virtual_mv));
     textureStore(out_search, p, search);
 }

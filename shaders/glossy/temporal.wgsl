@@ -4,8 +4,8 @@
 // in alpha; new sample weight max(1 - c, 1 / n)).
 //
 // Confidence c, by how the pixel was reprojected:
-// - surface motion vectors (rough surfaces, or --reflection-mv primary): eq. (11) on the primary
-//   surface, as the matte temporal;
+// - surface motion vectors (rough surfaces, --reflection-mv primary, or a static view): eq. (11)
+//   on the primary surface, as the matte temporal;
 // - reflection motion vectors on a mirror: eq. (11) on the reflected hit (exact for mirrors),
 //   in pixel footprints at the reflected hit (reflected_footprint: curved mirrors minify);
 // - reflection motion vectors on a glossy surface: h wherever the previous pixel had a glossy
@@ -77,7 +77,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let x = position_at(p);
     let roughness = roughness_at(p);
-    let reflected = roughness < gp.roughness_threshold && gp.mode != MV_PRIMARY;
+    // In a static view the reflection stood still too (glossy/motion.wgsl): the surface test
+    // is then exact for every lobe, mirrors included, and does not depend on the reflected hits,
+    // which differ between frames with the jitter and the sampled ray.
+    let reflected = roughness < gp.roughness_threshold && gp.mode != MV_PRIMARY && gp.static_view == 0u;
     let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     var c = 0.0;

@@ -44,6 +44,8 @@ struct DenoiseParams {
     // matching the two frames' samples (the glossy chain's search) carry it; history is kept per
     // pixel, so it is taken out of them.
     jitter_shift: vec2f,
+    // TAA: frames a still pixel averages with equal weights (MatteSettings::taa_still_frames).
+    taa_still_frames: f32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;

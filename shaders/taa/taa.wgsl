@@ -3,6 +3,16 @@
 // the current 3x3 neighbourhood in YCoCg (Karis 2014), which bounds ghosting to colours present
 // now; then blended with weight taa_alpha for the current frame. Without a history (first frame,
 // off screen, no surface) the current colour is used as is.
+//
+// The history's alpha carries n, its length in frames, and the current frame weighs 2 / (n + 1):
+// the exponential blend whose samples are as old on average as an n-frame mean's, so that the
+// first frames (denoised from little history) fade faster than in a plain mean. A still pixel
+// (zero motion: its history texel is read exactly, not resampled) whose history the clamp left
+// alone lets the weight fall to 1 / taa_still_frames: a long blend over whole Halton cycles
+// converges to the box-filtered pixel, where taa_alpha weighs the latest offsets most and keeps
+// an edge pixel off by a fraction of the edge's contrast. Moving or clamped, the weight is held
+// at taa_alpha: bilinear resampling blurs a long history, and a clamp means the history no
+// longer matches what the pixel shows.
 
 @group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
 @group(0) @binding(42) var history: texture_2d<f32>;
@@ -23,6 +33,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let current = hdr_at(p);
     var result = current;
+    var n = 1.0;
     let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
     let on_screen = all(prev >= vec2f(0.0)) && all(prev < vec2f(frame.size));
     if stage_on(STAGE_TAA) && on_screen && dn.history_valid != 0u {
@@ -35,11 +46,19 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 hi = max(hi, s);
             }
         }
-        let hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
-        let clamped = from_ycocg(clamp(to_ycocg(hist), lo, hi));
-        result = mix(clamped, current, dn.taa_alpha);
+        let texel = textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0);
+        let hist = half_safe(texel.rgb);
+        let y = to_ycocg(hist);
+        let yc = clamp(y, lo, hi);
+        let clamped = from_ycocg(yc);
+        let still = dot(prev - vec2f(p) - 0.5, prev - vec2f(p) - 0.5) < 1e-4;
+        // A clamp by more than half-precision rounding.
+        let held = any(abs(yc - y) > vec3f(1e-3 * max(abs(y.x), 1e-2)));
+        let weight_floor = select(dn.taa_alpha, min(dn.taa_alpha, 1.0 / max(dn.taa_still_frames, 1.0)), still && !held);
+        n = clamp(select(texel.a, 1.0, texel.a != texel.a) + 1.0, 1.0, 2.0 / weight_floor - 1.0);
+        result = mix(clamped, current, 2.0 / (n + 1.0));
     }
     result = half_safe(result);
-    textureStore(out_history, p, vec4f(result, 1.0));
+    textureStore(out_history, p, vec4f(result, n));
     final_image[u32(p.y) * frame.size.x + u32(p.x)] = vec4f(result, 1.0);
 }

@@ -276,9 +276,10 @@ impl Renderer {
 
     fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
         puffin::profile_function!();
+        let mut moved = false;
         if self.prepared.features.animated {
             puffin::profile_scope!("animate");
-            let moved = self.prepared.animate(&self.scene, input.time);
+            moved = self.prepared.animate(&self.scene, input.time);
             self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
         }
         let size = self.targets.size;
@@ -332,7 +333,10 @@ impl Renderer {
             let view = ChainView { inv_view_proj: jittered.inverse(), prev_inv_view_proj: prev_jittered.inverse(), jitter_shift: prev_jitter - jitter, history_valid };
             let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, &view);
             gpu.queue.write_buffer(&self.denoise_buf, 0, bytemuck::bytes_of(&dp));
-            let gp = GlossyParams::new(&settings.glossy, self.prepared.extent as f32);
+            // Neither the camera nor any object moved since the last frame: nothing seen in a
+            // reflection moved either.
+            let static_view = !moved && self.prev_view_proj == Some(cam.view_proj);
+            let gp = GlossyParams::new(&settings.glossy, self.prepared.extent as f32, static_view);
             gpu.queue.write_buffer(&self.glossy_buf, 0, bytemuck::bytes_of(&gp));
         }
         let fp = FrameParams {
@@ -636,7 +640,10 @@ fn glossy_inputs<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, denoise: &'a wgpu:
     Some(GlossyInputs { frame, denoise, params, objects, gbuffer: &t.gbuffer, trace: &t.trace, matte: t.matte.as_ref()?, glossy: t.glossy_chain.as_ref()?, sampler })
 }
 
-/// Halton (2, 3) sub-pixel positions, 16 per cycle: the TAA jitter.
+/// Halton (2, 3) sub-pixel positions, 64 per cycle: the TAA jitter. A still pixel averages up
+/// to `taa_still_frames` (64) of them, so the cycle is that long: the first 16 points cover a
+/// horizontal edge at mid-pixel 9 times in 16 (a 6% coverage error); 64 points, within 2%
+/// in x and 4% in y at any edge position, better than 64 random positions (about 10%).
 pub fn halton_jitter(frame: u32) -> Vec2 {
     let h = |mut i: u32, b: u32| {
         let (mut f, mut r) = (1.0f32, 0.0f32);
@@ -647,6 +654,6 @@ pub fn halton_jitter(frame: u32) -> Vec2 {
         }
         r
     };
-    let i = frame % 16 + 1;
+    let i = frame % 64 + 1;
     Vec2::new(h(i, 2), h(i, 3))
 }

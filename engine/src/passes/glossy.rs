@@ -41,11 +41,14 @@ pub struct GlossyParams {
     pub max_sigma_px: f32,
     pub representative_traced: u32,
     pub sigma_full_frames: f32,
+    pub static_view: u32,
+    pub _pad: [u32; 3],
 }
 
 impl GlossyParams {
     /// `extent`: the scene's bounding-box diagonal (an escaped reflection stands at 4 extents).
-    pub fn new(s: &GlossySettings, extent: f32) -> GlossyParams {
+    /// `static_view`: neither the camera nor an object moved since the previous frame.
+    pub fn new(s: &GlossySettings, extent: f32, static_view: bool) -> GlossyParams {
         GlossyParams {
             stages: s.stage_bits(),
             mode: match s.reflection_mv {
@@ -71,6 +74,8 @@ impl GlossyParams {
             max_sigma_px: MAX_GLOSSY_SIGMA_PX,
             representative_traced: s.trace_representative_ray as u32,
             sigma_full_frames: s.sigma_full_frames,
+            static_view: static_view as u32,
+            _pad: [0; 3],
         }
     }
 }

@@ -44,6 +44,9 @@ pub struct DenoiseParams {
     pub history_full_frames: f32,
     /// [`ChainView::jitter_shift`].
     pub jitter_shift: [f32; 2],
+    /// [`MatteSettings::taa_still_frames`].
+    pub taa_still_frames: f32,
+    pub _pad: [f32; 3],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -85,6 +88,8 @@ impl DenoiseParams {
             inject_nonfinite: s.inject_nonfinite as u32,
             history_full_frames: s.history_full_frames.max(0.0),
             jitter_shift: view.jitter_shift.to_array(),
+            taa_still_frames: s.taa_still_frames.clamp(0.0, 1024.0),
+            _pad: [0.0; 3],
         }
     }
 }

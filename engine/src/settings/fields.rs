@@ -79,6 +79,7 @@ pub const FIELDS: &[Field] = &[
     f("matte.max_radius_fraction", "matte/bilateral", "of width", Float(0.0, 0.5, 0.001), "Largest final-bilateral radius."),
     f("matte.taa", "taa", "", Bool, "Temporal anti-aliasing with a jittered raster and YCoCg clamping."),
     f("matte.taa_alpha", "taa", "", Float(0.0, 1.0, 0.005), "Weight of the current frame in TAA's blend."),
+    f("matte.taa_still_frames", "taa", "", Float(0.0, 256.0, 1.0), "TAA in a still view: the current frame's weight falls to 1 / this (0: always taa_alpha)."),
     f("glossy.reflection_mv", "glossy/motion", "", Choice(reflection_mvs), "Reflection motion: surface (primary), virtual position, or diamond search."),
     f("glossy.roughness_threshold", "glossy/motion", "roughness", Float(0.0, 1.0, 0.005), "Reflection motion below this roughness, surface motion above (Voorhuis 0.4)."),
     f("glossy.mirror_roughness", "glossy/motion", "roughness", Float(0.0, 1.0, 0.001), "At or below this roughness a surface is a mirror (exact reflected hits)."),
