@@ -1,5 +1,9 @@
 // Stage (7): the final sparse bilateral, with the per-pixel radius of stage (5); it fills
-// disocclusions and removes low-frequency noise.
+// disocclusions and removes low-frequency noise. The radius is at least min_radius_px (a
+// departure from the paper, whose r = (1 - c) R all but vanishes at full confidence): outside
+// the history loop the blur does not compound, and the normal and plane weights keep it on
+// the surface, so it trades little bias for the residual noise of a history tens of frames
+// long (MatteSettings::min_radius_fraction).
 @group(0) @binding(44) var filter_in: texture_2d<f32>;
 @group(0) @binding(52) var radius_in: texture_2d<f32>;
 @group(0) @binding(50) var out_matte: texture_storage_2d<rgba16float, write>;
@@ -12,7 +16,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     var v = textureLoad(filter_in, p, 0).rgb;
     if stage_on(STAGE_BILATERAL) {
-        v = sparse_bilateral(p, textureLoad(radius_in, p, 0).r);
+        v = sparse_bilateral(p, max(textureLoad(radius_in, p, 0).r, dn.min_radius_px));
     }
     textureStore(out_matte, p, vec4f(half_safe(v), 1.0));
 }

@@ -46,6 +46,8 @@ struct DenoiseParams {
     jitter_shift: vec2f,
     // TAA: frames a still pixel averages with equal weights (MatteSettings::taa_still_frames).
     taa_still_frames: f32,
+    // Smallest radius of the final bilateral, pixels.
+    min_radius_px: f32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;

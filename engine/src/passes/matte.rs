@@ -46,7 +46,9 @@ pub struct DenoiseParams {
     pub jitter_shift: [f32; 2],
     /// [`MatteSettings::taa_still_frames`].
     pub taa_still_frames: f32,
-    pub _pad: [f32; 3],
+    /// [`MatteSettings::min_radius_fraction`] in pixels.
+    pub min_radius_px: f32,
+    pub _pad: [f32; 2],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -89,7 +91,8 @@ impl DenoiseParams {
             history_full_frames: s.history_full_frames.max(0.0),
             jitter_shift: view.jitter_shift.to_array(),
             taa_still_frames: s.taa_still_frames.clamp(0.0, 1024.0),
-            _pad: [0.0; 3],
+            min_radius_px: (s.min_radius_fraction * w).clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
+            _pad: [0.0; 2],
         }
     }
 }
