@@ -48,6 +48,8 @@ struct DenoiseParams {
     taa_still_frames: f32,
     // Smallest radius of the final bilateral, pixels.
     min_radius_px: f32,
+    // Its luminance edge-stop, in standard deviations of the history's noise (0: none).
+    edge_stop_sigmas: f32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;

@@ -48,7 +48,9 @@ pub struct DenoiseParams {
     pub taa_still_frames: f32,
     /// [`MatteSettings::min_radius_fraction`] in pixels.
     pub min_radius_px: f32,
-    pub _pad: [f32; 2],
+    /// [`MatteSettings::edge_stop_sigmas`].
+    pub edge_stop_sigmas: f32,
+    pub _pad: f32,
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -92,7 +94,8 @@ impl DenoiseParams {
             jitter_shift: view.jitter_shift.to_array(),
             taa_still_frames: s.taa_still_frames.clamp(0.0, 1024.0),
             min_radius_px: (s.min_radius_fraction * w).clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
-            _pad: [0.0; 2],
+            edge_stop_sigmas: if s.edge_stop_sigmas > 0.0 { s.edge_stop_sigmas } else { f32::INFINITY },
+            _pad: 0.0,
         }
     }
 }
@@ -202,7 +205,7 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> 
         Kind::MinH => b = b.texture(44, &m.temporal.1, f).texture(52, &m.radius.1, f).storage_texture(53, &m.min.1, R32F),
         Kind::MinV => b = b.texture(44, &m.temporal.1, f).texture(52, &m.min.1, f).storage_texture(53, &m.radius.1, R32F),
         Kind::Firefly => b = b.texture(44, &m.temporal.1, f).storage_texture(50, &m.median.1, RGBA16F),
-        Kind::Bilateral => b = b.texture(44, &m.median.1, f).texture(52, &m.radius.1, f).storage_texture(50, &m.denoised.1, RGBA16F),
+        Kind::Bilateral => b = b.texture(44, &m.median.1, f).texture(52, &m.radius.1, f).texture(51, &m.reason.1, wgpu::TextureSampleType::Uint).storage_texture(50, &m.denoised.1, RGBA16F),
         Kind::Taa => {
             b = b
                 .storage(32, i.hdr, true)

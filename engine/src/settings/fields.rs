@@ -78,6 +78,7 @@ pub const FIELDS: &[Field] = &[
     f("matte.bilateral", "matte/bilateral", "", Bool, "Stage 7: final sparse bilateral with radius r."),
     f("matte.max_radius_fraction", "matte/bilateral", "of width", Float(0.0, 0.5, 0.001), "Largest final-bilateral radius."),
     f("matte.min_radius_fraction", "matte/bilateral", "of width", Float(0.0, 0.5, 0.001), "Smallest final-bilateral radius (0: the paper's (1 - c) R alone)."),
+    f("matte.edge_stop_sigmas", "matte/bilateral", "sigma", Float(0.0, 256.0, 0.5), "Final bilateral's luminance edge-stop, in standard deviations of the history's noise (0: none)."),
     f("matte.taa", "taa", "", Bool, "Temporal anti-aliasing with a jittered raster and YCoCg clamping."),
     f("matte.taa_alpha", "taa", "", Float(0.0, 1.0, 0.005), "Weight of the current frame in TAA's blend."),
     f("matte.taa_still_frames", "taa", "", Float(0.0, 256.0, 1.0), "TAA in a still view: the current frame's weight falls to 1 / this (0: always taa_alpha)."),

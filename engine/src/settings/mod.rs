@@ -111,13 +111,18 @@ pub struct MatteSettings {
     /// r = (1 - c) R alone, which at full confidence is 2% of R, a fraction of a pixel). Stage
     /// (7) is outside the history loop, so its blur does not compound; a still view's history
     /// of tens of frames still carries noise it removes. FLIP at 160x90, 60 still frames,
-    /// 256-frame references (living room, level): 0 gives 0.1778 and 0.0601, 3% (the default)
-    /// 0.1652 and 0.0565. Also measured, with an SVGF-style luminance edge-stop at k standard
-    /// deviations of the history's noise: 3% with k = 4, 8, 16, 64: 0.1676 / 0.0574, 0.1664 /
-    /// 0.0567, 0.1657 / 0.0560, 0.1650 / 0.0550; 5% with k = 4: 0.1710 / 0.0586 (the 50 taps
-    /// spread thinner). The edge-stop only pays where it hardly stops anything (k = 64), so the
-    /// filter has none.
+    /// 256-frame references (living room, level, FlightHelmet): 0 gives 0.1778, 0.0601 and
+    /// 0.0113; 3% without an edge-stop 0.1652, 0.0565 and 0.0125; 5% (with edge_stop_sigmas
+    /// 4) 0.1710 and 0.0586 on the first two: the 50 taps spread thinner.
     pub min_radius_fraction: f32,
+    /// The final bilateral also weighs taps by exp(-|luminance difference| / (k sigma)), sigma
+    /// the standard deviation of the history's mean (the input's spread over 16 taps on the
+    /// surface, over sqrt(history length)): SVGF's luminance edge-stop. A converged history
+    /// then keeps the fine shading (FlightHelmet's contact shadows) that the minimum radius
+    /// would blur, while a noisy one is still filtered. 0: no edge-stop. FLIP as above (living
+    /// room, level, FlightHelmet) for k = 4, 8, 16: 0.1676 / 0.0574 / 0.0116, 0.1664 / 0.0567 /
+    /// 0.0119, 0.1657 / 0.0560 / 0.0122; Lantern 0.0023 with 4 and 16, 0.0025 with none.
+    pub edge_stop_sigmas: f32,
     /// Bilateral weights: cosine power on normals, plane-distance sigma in pixel footprints.
     pub normal_power: f32,
     pub plane_sigma_px: f32,
@@ -161,6 +166,7 @@ impl Default for MatteSettings {
             low_confidence_multiplier: 6.0,
             max_radius_fraction: 0.1,
             min_radius_fraction: 0.03,
+            edge_stop_sigmas: 8.0,
             normal_power: 32.0,
             plane_sigma_px: 2.0,
             taa_alpha: 0.1,
