@@ -13,14 +13,10 @@
 @group(0) @binding(51) var reason_in: texture_2d<u32>;
 @group(0) @binding(50) var out_matte: texture_storage_2d<rgba16float, write>;
 
-fn lum(c: vec3f) -> f32 {
-    return dot(c, vec3f(0.2126, 0.7152, 0.0722));
-}
-
 // Standard deviation of the n-frame mean at p: the raw input's spread over 16 taps on p's
 // surface within 3 pixels, over sqrt(n).
 fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32) -> f32 {
-    var m1 = lum(half_safe(matte_input(p)));
+    var m1 = luminance(half_safe(matte_input(p)));
     var m2 = m1 * m1;
     var count = 1.0;
     for (var i = 0u; i < 16u; i++) {
@@ -31,7 +27,7 @@ fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32) -> f32 {
         if bilateral_weight(xc, nc, fc, position_at(q), oct_decode(textureLoad(gb_normal, q, 0).xy)) < 0.3 {
             continue;
         }
-        let s = lum(half_safe(matte_input(q)));
+        let s = luminance(half_safe(matte_input(q)));
         m1 += s;
         m2 += s * s;
         count += 1.0;
@@ -50,7 +46,7 @@ fn final_bilateral(p: vec2i, radius: f32) -> vec3f {
     let nc = oct_decode(textureLoad(gb_normal, p, 0).xy);
     let fc = footprint(xc);
     let sigma_l = dn.edge_stop_sigmas * history_noise(p, xc, nc, fc) + 1e-6;
-    let lc = lum(c);
+    let lc = luminance(c);
     var sum = c;
     var wsum = 1.0;
     for (var i = 0u; i < dn.taps; i++) {
@@ -59,7 +55,7 @@ fn final_bilateral(p: vec2i, radius: f32) -> vec3f {
             continue;
         }
         let t = textureLoad(filter_in, q, 0).rgb;
-        let w = exp(-abs(lum(t) - lc) / sigma_l) * bilateral_weight(xc, nc, fc, position_at(q), oct_decode(textureLoad(gb_normal, q, 0).xy));
+        let w = exp(-abs(luminance(t) - lc) / sigma_l) * bilateral_weight(xc, nc, fc, position_at(q), oct_decode(textureLoad(gb_normal, q, 0).xy));
         sum += t * w;
         wsum += w;
     }
