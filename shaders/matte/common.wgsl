@@ -44,7 +44,7 @@ struct DenoiseParams {
     // matching the two frames' samples (the glossy chain's search) carry it; history is kept per
     // pixel, so it is taken out of them.
     jitter_shift: vec2f,
-    // TAA: frames a still pixel averages with equal weights (MatteSettings::taa_still_frames).
+    // TAA: in a still view the current frame's weight falls to 1 / this (MatteSettings::taa_still_frames).
     taa_still_frames: f32,
     // Smallest radius of the final bilateral, pixels.
     min_radius_px: f32,
@@ -176,7 +176,7 @@ fn reproject(depth: texture_depth_2d, prev: vec2f, expected: vec3f, s: SurfaceFr
 
 // The blur of a filter that runs every frame shrinks as 1 / sqrt(n) past `full_frames` of
 // history n, so that its variance times the frames it acts on stays constant (0: never shrinks).
-// The matte history bilateral's radius and the glossy bilateral's sigma follow it.
+// The matte history bilateral's radius follows it, the glossy bilateral's sigma its square.
 fn history_falloff(full_frames: f32, n: f32) -> f32 {
     if full_frames <= 0.0 {
         return 1.0;

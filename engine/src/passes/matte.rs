@@ -94,7 +94,7 @@ impl DenoiseParams {
             jitter_shift: view.jitter_shift.to_array(),
             taa_still_frames: s.taa_still_frames.clamp(0.0, 1024.0),
             min_radius_px: (s.min_radius_fraction * w).clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
-            edge_stop_sigmas: if s.edge_stop_sigmas > 0.0 { s.edge_stop_sigmas } else { f32::INFINITY },
+            edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
             _pad: 0.0,
         }
     }
