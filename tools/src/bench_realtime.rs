@@ -69,7 +69,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let view = tex.create_view(&Default::default());
     let target = DisplayTarget { view: &view, format, size };
     let settings = match &a.preset {
-        Some(p) => crate::realtime::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)?,
+        Some(p) => FrameSettings { max_depth: crate::realtime::path_length(None, Some(p), r.scene.max_depth)?, ..crate::realtime::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)? },
         None => FrameSettings { max_depth: r.scene.max_depth, ..crate::realtime::denoiser_settings(a.denoiser.as_deref().unwrap_or("mara"), &[], "diamond")? },
     };
     let camera = r.scene.camera_or_default();

@@ -61,6 +61,12 @@ pub struct QualityArgs {
     pub ablations: bool,
     #[arg(long)]
     pub out_dir: PathBuf,
+    /// Keep each reference as an EXR in this folder, named by what it depends on (scene file,
+    /// size, camera, time, reference frames, seed, path length), and reuse it when a later run
+    /// asks for the same one: a converged reference of an interior takes thousands of frames,
+    /// and comparing settings needs it only once.
+    #[arg(long)]
+    pub reference_cache: Option<PathBuf>,
 }
 
 /// One stream's per-frame scores against the reference.
@@ -167,10 +173,30 @@ pub fn run(a: QualityArgs) -> Result<()> {
             references.push(references[k - 1].clone());
             continue;
         }
+        let cached = match &a.reference_cache {
+            Some(dir) => Some(dir.join(format!("reference_{:016x}.exr", reference_key(&a, &s, input, &acc)))),
+            None => None,
+        };
+        if let Some(path) = cached.as_ref().filter(|p| p.exists()) {
+            let img = Image::load(path).with_context(|| format!("reading the cached reference {}", path.display()))?;
+            if (img.width, img.height) != s.size {
+                bail!("cached reference {} is {}x{}, not {}x{}", path.display(), img.width, img.height, s.size.0, s.size.1);
+            }
+            references.push(img);
+            continue;
+        }
+        if let Some(path) = &cached {
+            eprintln!("rendering the reference of frame {k} into {}", path.display());
+        }
         for _ in 0..a.reference_frames {
             refr.render(&s.gpu, input, &acc, None)?;
         }
-        references.push(refr.read_hdr(&s.gpu)?);
+        let img = refr.read_hdr(&s.gpu)?;
+        if let Some(path) = &cached {
+            std::fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).with_context(|| format!("creating the folder of {}", path.display()))?;
+            img.save(path)?;
+        }
+        references.push(img);
     }
     // The yardstick: the last frame's view accumulated over 64 frames, raw.
     let yardstick = FrameSettings { seed: a.seed.wrapping_add(104729), ..acc.clone() };
@@ -182,8 +208,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let flip64 = compare(&accumulated64, &references[references.len() - 1])?.flip;
     drop(refr);
 
-    // The scene's path length unless the preset sets one (the references use the scene's).
-    let max_depth = if a.preset.is_some() { chains.max_depth } else { s.scene.max_depth };
+    let max_depth = crate::realtime::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
     let (den, last) = stream(&s, &base, &references)?;
     let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::None, ..base.clone() }, &references)?;
@@ -212,7 +237,8 @@ pub fn run(a: QualityArgs) -> Result<()> {
         );
     }
 
-    println!("  64 accumulated frames of the last view: FLIP {flip64:.4}");
+    let last_flip = den.flip.last().copied().unwrap_or(f64::NAN);
+    println!("  last frame ({}): denoised FLIP {last_flip:.4}; 64 accumulated frames of its view: FLIP {flip64:.4}", den.flip.len());
     std::fs::write(a.out_dir.join("accumulated64_flip.txt"), format!("{flip64:.5}\n"))?;
 
     if a.ablations && denoiser == Denoiser::Mara {
@@ -232,6 +258,20 @@ pub fn run(a: QualityArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// What a reference depends on, hashed with FNV-1a: the standard library's hasher may change
+/// between Rust releases, and a cache key has to outlive the build that wrote it.
+fn reference_key(a: &QualityArgs, s: &Setup, input: &FrameInput, acc: &FrameSettings) -> u64 {
+    // A scene file's size and modification time stand for its content. `default` and `level`
+    // are built in: their key changes with Hush's version only, so clear the cache after
+    // editing them.
+    let stamp = match std::fs::metadata(&a.scene) {
+        Ok(m) => format!("{} {:?}", m.len(), m.modified().ok()),
+        Err(_) => format!("built-in {}", env!("CARGO_PKG_VERSION")),
+    };
+    let key = format!("{} {stamp} {:?} {:?} {} {} {:?}", a.scene, s.size, input, a.reference_frames, acc.seed, acc.max_depth);
+    key.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
 }
 
 fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> Result<()> {

@@ -26,6 +26,19 @@ pub fn preset_settings(preset: Option<&std::path::Path>, denoiser: Option<&str>,
     chain_settings(base, denoiser, disable, reflection_mv)
 }
 
+/// The path length of a run: --max-depth, else the preset's if it names one, else the scene's
+/// (a preset that leaves it out must not fall back to the default's, which is not the scene's
+/// and not what its references are rendered with).
+pub fn path_length(max_depth: Option<i32>, preset: Option<&std::path::Path>, scene_depth: i32) -> Result<i32> {
+    if let Some(d) = max_depth {
+        return Ok(d);
+    }
+    Ok(match preset {
+        Some(p) => FrameSettings::preset_max_depth(p)?.unwrap_or(scene_depth),
+        None => scene_depth,
+    })
+}
+
 fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[String], reflection_mv: Option<&str>) -> Result<FrameSettings> {
     if let Some(d) = denoiser {
         s.denoiser = parse_denoiser(d)?;
@@ -62,8 +75,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.accumulate && path.is_some() {
         bail!("--accumulate needs a still camera; it cannot be combined with --camera-path");
     }
-    // The scene's path length unless --max-depth or the preset says otherwise.
-    let max_depth = a.max_depth.unwrap_or(if a.preset.is_some() { chains.max_depth } else { scene.max_depth });
+    let max_depth = path_length(a.max_depth, a.preset.as_deref(), scene.max_depth)?;
     let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, ..chains };
     let name = scene.name.clone();
     let start = std::time::Instant::now();

@@ -19,6 +19,14 @@ impl FrameSettings {
         std::fs::write(path, self.to_toml()?).with_context(|| format!("writing preset {}", path.display()))
     }
 
+    /// The path length a preset file names, if it names one: a preset saved without
+    /// `max_depth` keeps the scene's instead of the default's.
+    pub fn preset_max_depth(path: &Path) -> Result<Option<i32>> {
+        let text = std::fs::read_to_string(path).with_context(|| format!("reading preset {}", path.display()))?;
+        let v: toml::Value = toml::from_str(&text).with_context(|| format!("reading TOML settings of preset {}", path.display()))?;
+        Ok(v.get("max_depth").and_then(|d| d.as_integer()).map(|d| d as i32))
+    }
+
     pub fn load_preset(path: &Path) -> Result<FrameSettings> {
         let text = std::fs::read_to_string(path).with_context(|| format!("reading preset {}", path.display()))?;
         FrameSettings::from_toml(&text).with_context(|| format!("preset {}", path.display()))
@@ -52,6 +60,17 @@ mod tests {
         assert_eq!(s, FrameSettings { denoiser: Denoiser::Mara, matte: crate::settings::MatteSettings { firefly: false, ..Default::default() }, ..Default::default() });
         let e = format!("{:#}", FrameSettings::from_toml("[glossy]\nsigma_scael = 3.0\n").unwrap_err());
         assert!(e.contains("glossy.sigma_scael"), "{e}");
+    }
+
+    #[test]
+    fn a_preset_names_its_path_length_only_when_it_sets_one() {
+        let path = std::env::temp_dir().join(format!("hush-preset-depth-{}.toml", std::process::id()));
+        std::fs::write(&path, "denoiser = \"Mara\"\n").unwrap();
+        let without = FrameSettings::preset_max_depth(&path).unwrap();
+        std::fs::write(&path, "max_depth = 3\n").unwrap();
+        let with = FrameSettings::preset_max_depth(&path).unwrap();
+        let _ = std::fs::remove_file(&path);
+        assert_eq!((without, with), (None, Some(3)));
     }
 
     #[test]
