@@ -160,6 +160,33 @@ fn quality_writes_scores_and_a_plot() {
     assert_eq!(png, (960, 720));
 }
 
+#[test]
+fn quality_reuses_a_cached_reference() {
+    let dir = temp_dir("quality-cache");
+    let cache = dir.join("references");
+    let run = |out: &str| {
+        let o = bin("hush-cli")
+            .args(["quality", "level", "--frames", "3", "--reference-frames", "4", "--width", "32", "--reference-cache"])
+            .arg(&cache)
+            .arg("--out-dir")
+            .arg(dir.join(out))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (String::from_utf8_lossy(&o.stderr).into_owned(), std::fs::read_to_string(dir.join(out).join("quality.csv")).unwrap())
+    };
+    let (first_log, first) = run("first");
+    // A still camera has one reference, rendered once and kept.
+    let kept: Vec<_> = std::fs::read_dir(&cache).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(kept.len(), 1, "{kept:?}");
+    assert!(first_log.contains("rendering the reference"), "{first_log}");
+    let (second_log, second) = run("second");
+    assert!(!second_log.contains("rendering the reference"), "{second_log}");
+    // The EXR holds the reference exactly (32-bit floats), so the scores repeat.
+    let flips = |csv: &str| csv.lines().skip(1).map(|r| r.split(',').nth(2).unwrap().to_string()).collect::<Vec<_>>();
+    assert_eq!(flips(&first), flips(&second));
+}
+
 fn image_size(p: &std::path::Path) -> (u32, u32) {
     let img = hush_engine::quality::Image::load(p).unwrap();
     (img.width, img.height)
