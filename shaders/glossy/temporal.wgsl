@@ -15,10 +15,9 @@
 
 @group(0) @binding(41) var prev_depth: texture_depth_2d;
 @group(0) @binding(42) var history: texture_2d<f32>;
-@group(0) @binding(43) var linear_clamp: sampler;
 @group(0) @binding(61) var prev_hit: texture_2d<f32>;
 @group(0) @binding(65) var neighbourhood: texture_2d<f32>;
-@group(0) @binding(66) var dst: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(66) var dst: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(67) var motion: texture_2d<f32>;
 @group(0) @binding(68) var out_info: texture_storage_2d<rgba16float, write>;
 
@@ -111,7 +110,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         n = min(max(texel.a, 1.0) + 1.0, 1024.0);
         var hist = half_safe(texel.rgb);
         if r.bilinear {
-            hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+            hist = half_safe(load_bilinear(history, prev).rgb);
         }
         var clipped = hist;
         if gstage_on(GSTAGE_CLIPPING) && roughness < gp.clip_roughness {

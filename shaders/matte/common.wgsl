@@ -152,6 +152,20 @@ fn previous_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, s: Surf
     return max(abs(off_plane), along / s.stretch) / s.footprint;
 }
 
+// Bilinear fetch of a history at pixel coordinates `at` (texel centres at +0.5), edges clamped.
+// The histories are 32-bit floats, which WebGPU does not filter without an optional feature.
+fn load_bilinear(t: texture_2d<f32>, at: vec2f) -> vec4f {
+    let f = at - 0.5;
+    let base = vec2i(floor(f));
+    let w = f - floor(f);
+    let hi = vec2i(frame.size) - 1;
+    let a = textureLoad(t, clamp(base, vec2i(0), hi), 0);
+    let b = textureLoad(t, clamp(base + vec2i(1, 0), vec2i(0), hi), 0);
+    let c = textureLoad(t, clamp(base + vec2i(0, 1), vec2i(0), hi), 0);
+    let d = textureLoad(t, clamp(base + vec2i(1, 1), vec2i(0), hi), 0);
+    return mix(mix(a, b, w.x), mix(c, d, w.x), w.y);
+}
+
 // Offset k of a 3x3 neighbourhood, its centre first (k = 0).
 fn neighbour_3x3(k: i32) -> vec2i {
     return vec2i((k + 4) % 3 - 1, (k + 4) / 3 % 3 - 1);

@@ -3,7 +3,7 @@
 @group(0) @binding(44) var filter_in: texture_2d<f32>;
 // Reason flags and, above them, the history length n (matte/temporal.wgsl).
 @group(0) @binding(51) var reason_in: texture_2d<u32>;
-@group(0) @binding(50) var out_history: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(50) var out_history: texture_storage_2d<rgba32float, write>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

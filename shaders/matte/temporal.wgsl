@@ -12,8 +12,7 @@
 
 @group(0) @binding(41) var prev_depth: texture_depth_2d;
 @group(0) @binding(42) var history: texture_2d<f32>;
-@group(0) @binding(43) var linear_clamp: sampler;
-@group(0) @binding(50) var out_temporal: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(50) var out_temporal: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(51) var out_reason: texture_storage_2d<r32uint, write>;
 
 @compute @workgroup_size(8, 8)
@@ -54,7 +53,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         n = min(max(texel.a, 1.0) + 1.0, 1024.0);
         var hist = half_safe(texel.rgb);
         if r.bilinear {
-            hist = half_safe(textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0).rgb);
+            hist = half_safe(load_bilinear(history, prev).rgb);
         }
         var clamped = hist;
         if dn.clamp_sigma > 0.0 {

@@ -16,8 +16,7 @@
 
 @group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
 @group(0) @binding(42) var history: texture_2d<f32>;
-@group(0) @binding(43) var linear_clamp: sampler;
-@group(0) @binding(50) var out_history: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(50) var out_history: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(54) var<storage, read_write> final_image: array<vec4f>;
 
 fn hdr_at(p: vec2i) -> vec3f {
@@ -46,7 +45,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 hi = max(hi, s);
             }
         }
-        let texel = textureSampleLevel(history, linear_clamp, prev / vec2f(frame.size), 0.0);
+        let texel = load_bilinear(history, prev);
         let hist = half_safe(texel.rgb);
         let y = to_ycocg(hist);
         let yc = clamp(y, lo, hi);

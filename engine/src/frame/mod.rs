@@ -90,7 +90,6 @@ pub struct Renderer {
     glossy_chain: Option<GlossyChain>,
     denoise_buf: wgpu::Buffer,
     glossy_buf: wgpu::Buffer,
-    linear_clamp: wgpu::Sampler,
     /// Whether the last frame went through the denoiser (its image is then TAA's output).
     denoised_last: bool,
     timer: Option<GpuTimer>,
@@ -157,12 +156,6 @@ impl Renderer {
         let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
         let denoise_buf = memory.buffer(d, "matte/params", size_of::<DenoiseParams>() as u64, u);
         let glossy_buf = memory.buffer(d, "glossy/params", size_of::<GlossyParams>() as u64, u);
-        let linear_clamp = d.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("linear clamp"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
         let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
         let fb = FrameBuffers { frame: &frame_buf, hdr: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: &targets.trace.matte.1, glossy: None, denoise: None, glossy_chain: None };
@@ -185,7 +178,6 @@ impl Renderer {
             glossy_chain: None,
             denoise_buf,
             glossy_buf,
-            linear_clamp,
             denoised_last: false,
             timer,
             async_timings: false,
@@ -392,13 +384,12 @@ impl Renderer {
             gbuffer: &t.gbuffer,
             trace: &t.trace,
             matte: m,
-            sampler: &self.linear_clamp,
         });
         let denoised_matte = t.matte.as_ref().filter(|_| denoise).map(|m| &m.denoised.1);
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
             chain.record(gpu, &mut enc, chain_key, inputs, parity, size, false, self.timer.as_mut());
         }
-        let glossy_inputs = glossy_inputs(t, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref(), &self.linear_clamp).filter(|_| denoise);
+        let glossy_inputs = glossy_inputs(t, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref()).filter(|_| denoise);
         if let (Some(inputs), Some(chain)) = (&glossy_inputs, self.glossy_chain.as_mut()) {
             chain.record(gpu, &mut enc, chain_key, inputs, parity, size, &settings.glossy, self.timer.as_mut());
         }
@@ -456,12 +447,11 @@ impl Renderer {
             gbuffer: &t.gbuffer,
             trace: &t.trace,
             matte: t.matte.as_ref().expect("matte targets exist before the chain"),
-            sampler: &self.linear_clamp,
         }
     }
 
     fn glossy_inputs(&self) -> Option<GlossyInputs<'_>> {
-        glossy_inputs(&self.targets, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref(), &self.linear_clamp)
+        glossy_inputs(&self.targets, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref())
     }
 
     /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
@@ -636,8 +626,8 @@ fn shown_buffers<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, display: &'a wgpu:
 }
 
 /// What the glossy chain binds, when its targets exist.
-fn glossy_inputs<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, denoise: &'a wgpu::Buffer, params: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>, sampler: &'a wgpu::Sampler) -> Option<GlossyInputs<'a>> {
-    Some(GlossyInputs { frame, denoise, params, objects, gbuffer: &t.gbuffer, trace: &t.trace, matte: t.matte.as_ref()?, glossy: t.glossy_chain.as_ref()?, sampler })
+fn glossy_inputs<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, denoise: &'a wgpu::Buffer, params: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>) -> Option<GlossyInputs<'a>> {
+    Some(GlossyInputs { frame, denoise, params, objects, gbuffer: &t.gbuffer, trace: &t.trace, matte: t.matte.as_ref()?, glossy: t.glossy_chain.as_ref()? })
 }
 
 /// Halton (2, 3) sub-pixel positions, 64 per cycle: the TAA jitter. A still pixel averages up

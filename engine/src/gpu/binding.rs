@@ -48,11 +48,6 @@ impl<'a> Bindings<'a> {
         self.texture(binding, view, wgpu::TextureSampleType::Float { filterable: false })
     }
 
-    pub fn sampler(mut self, binding: u32, sampler: &'a wgpu::Sampler) -> Self {
-        self.push(binding, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering), wgpu::BindingResource::Sampler(sampler));
-        self
-    }
-
     pub fn storage_texture(mut self, binding: u32, view: &'a wgpu::TextureView, format: wgpu::TextureFormat) -> Self {
         let ty = wgpu::BindingType::StorageTexture { access: wgpu::StorageTextureAccess::WriteOnly, format, view_dimension: wgpu::TextureViewDimension::D2 };
         self.push(binding, ty, wgpu::BindingResource::TextureView(view));

@@ -107,7 +107,7 @@ impl GlossyChainTargets {
             search: t("glossy/search", RGBA16F),
             neighbourhood: t("glossy/neighbourhood", RGBA16F),
             scratch: t("glossy/scratch", RGBA16F),
-            history: [t("glossy/history 0", RGBA16F), t("glossy/history 1", RGBA16F)],
+            history: [t("glossy/history 0", RGBA32F), t("glossy/history 1", RGBA32F)],
             info: t("glossy/info", RGBA16F),
             denoised: t("glossy/denoised", RGBA16F),
         }
@@ -124,7 +124,6 @@ pub struct GlossyInputs<'a> {
     pub trace: &'a TraceTargets,
     pub matte: &'a MatteTargets,
     pub glossy: &'a GlossyChainTargets,
-    pub sampler: &'a wgpu::Sampler,
 }
 
 /// The glossy trace outputs every glossy stage reads (shaders/realtime/glossy_in.wgsl).
@@ -158,7 +157,6 @@ const STAGES: [(Kind, &str, &str, &str); 6] = [
 fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a> {
     let g = i.glossy;
     let f = wgpu::TextureSampleType::Float { filterable: false };
-    let filterable = wgpu::TextureSampleType::Float { filterable: true };
     let light = &i.trace.glossy.as_ref().expect("the glossy chain runs in glossy scenes").light.1;
     let mut b = Bindings::new(wgpu::ShaderStages::COMPUTE).uniform(11, i.frame).uniform(40, i.denoise).uniform(60, i.params);
     b = glossy_trace_inputs(gbuffer_inputs(b, i.gbuffer, i.trace, &i.trace.matte.1), i.trace, light);
@@ -175,11 +173,10 @@ fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a>
         Kind::Temporal => {
             b = b
                 .texture(41, &i.matte.prev_depth.1, depth)
-                .texture(42, &g.history[parity].1, filterable)
-                .sampler(43, i.sampler)
+                .texture(42, &g.history[parity].1, f)
                 .texture(61, &g.hit[parity].1, f)
                 .texture(65, &g.neighbourhood.1, f)
-                .storage_texture(66, &g.history[1 - parity].1, RGBA16F)
+                .storage_texture(66, &g.history[1 - parity].1, RGBA32F)
                 .texture(67, &g.motion.1, f)
                 .storage_texture(68, &g.info.1, RGBA16F);
             if let Some(o) = i.objects {

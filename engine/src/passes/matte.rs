@@ -13,6 +13,9 @@ use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 
 const RGBA16F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Histories: a blend that weighs the new frame 1 / 64 cannot move a half float by less than
+/// 32 of its steps (1.5% of the value), so a 16-bit history stalls once it is close.
+const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 const R32F: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 const R32U: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
@@ -120,14 +123,14 @@ impl MatteTargets {
         let d = &gpu.device;
         let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
         let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
-        let history = [t("matte/history 0", RGBA16F), t("matte/history 1", RGBA16F)];
-        let temporal = t("matte/temporal", RGBA16F);
+        let history = [t("matte/history 0", RGBA32F), t("matte/history 1", RGBA32F)];
+        let temporal = t("matte/temporal", RGBA32F);
         let reason = t("matte/reason", R32U);
         let min = t("matte/disocclusion min", R32F);
         let radius = t("matte/radius", R32F);
         let median = t("matte/firefly", RGBA16F);
         let denoised = t("matte/bilateral", RGBA16F);
-        let taa_history = [t("taa/history 0", RGBA16F), t("taa/history 1", RGBA16F)];
+        let taa_history = [t("taa/history 0", RGBA32F), t("taa/history 1", RGBA32F)];
         let prev_depth = mem.texture(d, "matte/previous depth", size, super::gbuffer::DEPTH_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let final_image = mem.buffer(d, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
@@ -144,7 +147,6 @@ pub struct ChainInputs<'a> {
     pub gbuffer: &'a GBufferTargets,
     pub trace: &'a TraceTargets,
     pub matte: &'a MatteTargets,
-    pub sampler: &'a wgpu::Sampler,
 }
 
 /// The G-buffer and trace textures every stage binds (shaders/realtime/gbuffer_in.wgsl).
@@ -184,23 +186,21 @@ const STAGES: [(Kind, &str); 7] = [
 
 fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> {
     let m = i.matte;
-    let filterable = wgpu::TextureSampleType::Float { filterable: true };
     let f = wgpu::TextureSampleType::Float { filterable: false };
     let mut b = gbuffer_inputs(Bindings::new(wgpu::ShaderStages::COMPUTE).uniform(11, i.frame).uniform(40, i.params), i.gbuffer, i.trace, &i.trace.matte.1);
     match kind {
         Kind::Temporal => {
             b = b
                 .texture(41, &m.prev_depth.1, wgpu::TextureSampleType::Depth)
-                .texture(42, &m.history[parity].1, filterable)
-                .sampler(43, i.sampler)
-                .storage_texture(50, &m.temporal.1, RGBA16F)
+                .texture(42, &m.history[parity].1, f)
+                .storage_texture(50, &m.temporal.1, RGBA32F)
                 .storage_texture(51, &m.reason.1, R32U);
             if let Some(o) = i.objects {
                 b = b.storage(17, o, true);
             }
         }
         Kind::HistoryBilateral => {
-            b = b.texture(44, &m.temporal.1, f).texture(51, &m.reason.1, wgpu::TextureSampleType::Uint).storage_texture(50, &m.history[1 - parity].1, RGBA16F)
+            b = b.texture(44, &m.temporal.1, f).texture(51, &m.reason.1, wgpu::TextureSampleType::Uint).storage_texture(50, &m.history[1 - parity].1, RGBA32F)
         }
         Kind::MinH => b = b.texture(44, &m.temporal.1, f).texture(52, &m.radius.1, f).storage_texture(53, &m.min.1, R32F),
         Kind::MinV => b = b.texture(44, &m.temporal.1, f).texture(52, &m.min.1, f).storage_texture(53, &m.radius.1, R32F),
@@ -209,9 +209,8 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> 
         Kind::Taa => {
             b = b
                 .storage(32, i.hdr, true)
-                .texture(42, &m.taa_history[parity].1, filterable)
-                .sampler(43, i.sampler)
-                .storage_texture(50, &m.taa_history[1 - parity].1, RGBA16F)
+                .texture(42, &m.taa_history[parity].1, f)
+                .storage_texture(50, &m.taa_history[1 - parity].1, RGBA32F)
                 .storage(54, &m.final_image, false)
         }
     }
