@@ -50,6 +50,8 @@ struct DenoiseParams {
     min_radius_px: f32,
     // Its luminance edge-stop, in standard deviations of the history's noise (0: none).
     edge_stop_sigmas: f32,
+    // 1 when neither the camera nor any object moved since the last frame (ChainView::static_view).
+    static_view: u32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;

@@ -1,7 +1,8 @@
 // Temporal anti-aliasing of the composited image (the raster is jittered over a Halton(2, 3)
 // sequence). History is fetched bilinearly at pixel + motion and clamped to the min/max box of
 // the current 3x3 neighbourhood in YCoCg (Karis 2014), which bounds ghosting to colours present
-// now; then blended with weight taa_alpha for the current frame. Without a history (first frame,
+// now (not in a static view, where nothing can ghost); then blended with weight taa_alpha for
+// the current frame. Without a history (first frame,
 // off screen, no surface) the current colour is used as is.
 //
 // The history's alpha carries n, its length in frames, and the current frame weighs 2 / (n + 1):
@@ -48,9 +49,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let texel = load_bilinear(history, prev);
         let hist = half_safe(texel.rgb);
         let y = to_ycocg(hist);
-        let yc = clamp(y, lo, hi);
-        let clamped = from_ycocg(yc);
         let still = dot(prev - vec2f(p) - 0.5, prev - vec2f(p) - 0.5) < 1e-4;
+        // In a static view (no camera or object motion) the history shows what the pixel shows,
+        // and the clamp can only take from it: a feature thinner than a pixel (a highlight on a
+        // stair nosing, a lantern's lit glass) lies between the jittered samples of most frames,
+        // the current 3x3 box then misses it, and the clamp darkened it every such frame.
+        var yc = y;
+        if dn.static_view == 0u || !still {
+            yc = clamp(y, lo, hi);
+        }
+        let clamped = from_ycocg(yc);
         // A clamp by more than half-precision rounding.
         let held = any(abs(yc - y) > vec3f(1e-3 * max(abs(y.x), 1e-2)));
         let weight_floor = select(dn.taa_alpha, min(dn.taa_alpha, 1.0 / max(dn.taa_still_frames, 1.0)), still && !held);

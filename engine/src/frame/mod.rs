@@ -322,12 +322,10 @@ impl Renderer {
         if denoise {
             let history_valid = self.denoised_last && self.prev_jittered.is_some();
             let (prev_jittered, prev_jitter) = self.prev_jittered.unwrap_or((jittered, jitter));
-            let view = ChainView { inv_view_proj: jittered.inverse(), prev_inv_view_proj: prev_jittered.inverse(), jitter_shift: prev_jitter - jitter, history_valid };
+            let static_view = !moved && self.prev_view_proj == Some(cam.view_proj);
+            let view = ChainView { inv_view_proj: jittered.inverse(), prev_inv_view_proj: prev_jittered.inverse(), jitter_shift: prev_jitter - jitter, history_valid, static_view };
             let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, &view);
             gpu.queue.write_buffer(&self.denoise_buf, 0, bytemuck::bytes_of(&dp));
-            // Neither the camera nor any object moved since the last frame: nothing seen in a
-            // reflection moved either.
-            let static_view = !moved && self.prev_view_proj == Some(cam.view_proj);
             let gp = GlossyParams::new(&settings.glossy, self.prepared.extent as f32, static_view);
             gpu.queue.write_buffer(&self.glossy_buf, 0, bytemuck::bytes_of(&gp));
         }

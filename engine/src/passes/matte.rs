@@ -53,7 +53,8 @@ pub struct DenoiseParams {
     pub min_radius_px: f32,
     /// [`MatteSettings::edge_stop_sigmas`].
     pub edge_stop_sigmas: f32,
-    pub _pad: f32,
+    /// [`ChainView::static_view`].
+    pub static_view: u32,
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -67,6 +68,9 @@ pub struct ChainView {
     pub jitter_shift: glam::Vec2,
     /// False when there is no usable history (first denoised frame, resize, denoiser paused).
     pub history_valid: bool,
+    /// Neither the camera nor any object moved since the last frame: every surface, and
+    /// everything seen in a reflection, stands where it stood.
+    pub static_view: bool,
 }
 
 impl DenoiseParams {
@@ -98,7 +102,7 @@ impl DenoiseParams {
             taa_still_frames: s.taa_still_frames.clamp(0.0, 1024.0),
             min_radius_px: (s.min_radius_fraction * w).clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
             edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
-            _pad: 0.0,
+            static_view: view.static_view as u32,
         }
     }
 }

@@ -138,7 +138,8 @@ pub struct MatteSettings {
     /// 160x90, 60 frames, 256-frame references: level FLIP 0.0601 and temporal error 0.00270
     /// (the plain mean 1 / n: 0.0623 and 0.00186; taa_alpha alone: 0.0599 and 0.00449);
     /// FlightHelmet 0.0113 and 0.00036 (1 / n: 0.0112 and 0.00024; taa_alpha alone: 0.0116 and
-    /// 0.00063). 0: taa_alpha always.
+    /// 0.00063). 0: taa_alpha always. In a static view (no camera or object motion) the history
+    /// is not clamped at all (shaders/taa/taa.wgsl), so a still pixel always reaches this blend.
     pub taa_still_frames: f32,
     /// Fault injection for tests: the temporal stage reads NaN, +Inf and -Inf in place of the
     /// matte light on a sparse pixel pattern (1 in 7).
