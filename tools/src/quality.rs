@@ -173,10 +173,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
             references.push(references[k - 1].clone());
             continue;
         }
-        let cached = match &a.reference_cache {
-            Some(dir) => Some(dir.join(format!("reference_{:016x}.exr", reference_key(&a, &s, input, &acc)))),
-            None => None,
-        };
+        let cached = a.reference_cache.as_ref().map(|dir| dir.join(format!("reference_{:016x}.exr", reference_key(&a, &s, input, &acc))));
         if let Some(path) = cached.as_ref().filter(|p| p.exists()) {
             let img = Image::load(path).with_context(|| format!("reading the cached reference {}", path.display()))?;
             if (img.width, img.height) != s.size {
