@@ -234,6 +234,37 @@ fn matte_input(p: vec2i) -> vec3f {
     return v;
 }
 
+// Running first and second moments of matte input samples: per channel in xyz, of luminance
+// in w (the luminance's variance needs its own square, not the channels').
+struct Moments {
+    m1: vec4f,
+    m2: vec4f,
+    count: f32,
+}
+
+fn moments_add(m: Moments, s: vec3f) -> Moments {
+    let v = vec4f(s, luminance(s));
+    return Moments(m.m1 + v, m.m2 + v * v, m.count + 1.0);
+}
+
+// Adds the matte input at `taps` spiral taps within `radius` pixels of p that lie on p's
+// surface (bilateral weight of at least 0.3) to `m`: the neighbourhood statistics of the
+// temporal clamp and of stage 7's noise estimate.
+fn surface_moments(m: Moments, p: vec2i, x: vec3f, nc: vec3f, fc: f32, taps: u32, radius: f32) -> Moments {
+    var r = m;
+    for (var i = 0u; i < taps; i++) {
+        let t = p + vec2i(round(spiral_tap(i, taps, radius, p)));
+        if !in_bounds(t) || !has_surface(t) {
+            continue;
+        }
+        if bilateral_weight(x, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
+            continue;
+        }
+        r = moments_add(r, half_safe(matte_input(t)));
+    }
+    return r;
+}
+
 // YCoCg, where TAA's box and the glossy chain's neighbourhood clip are drawn (Karis 2014).
 fn to_ycocg(c: vec3f) -> vec3f {
     return vec3f(

@@ -6,25 +6,11 @@
 // Standard deviation of the n-frame mean at p: the raw input's spread over 16 taps on p's
 // surface within 3 pixels, over sqrt(n).
 fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32) -> f32 {
-    var m1 = luminance(half_safe(matte_input(p)));
-    var m2 = m1 * m1;
-    var count = 1.0;
-    for (var i = 0u; i < 16u; i++) {
-        let q = p + vec2i(round(spiral_tap(i, 16u, 3.0, p)));
-        if !in_bounds(q) || !has_surface(q) {
-            continue;
-        }
-        if bilateral_weight(xc, nc, fc, position_at(q), oct_decode(textureLoad(gb_normal, q, 0).xy)) < 0.3 {
-            continue;
-        }
-        let s = luminance(half_safe(matte_input(q)));
-        m1 += s;
-        m2 += s * s;
-        count += 1.0;
-    }
-    m1 /= count;
+    let own = moments_add(Moments(vec4f(0.0), vec4f(0.0), 0.0), half_safe(matte_input(p)));
+    let m = surface_moments(own, p, xc, nc, fc, 16u, 3.0);
+    let m1 = m.m1.w / m.count;
     let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
-    return sqrt(max(m2 / count - m1 * m1, 0.0) / n);
+    return sqrt(max(m.m2.w / m.count - m1 * m1, 0.0) / n);
 }
 
 fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {

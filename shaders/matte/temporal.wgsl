@@ -62,34 +62,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             // lit region is mostly zeros with rare bright samples; nine samples are then often all
             // zero (sigma = 0), and clamping to them would erase a correct history every frame (the
             // living room's interior came out 3x too dark). 33 samples rarely miss every bright one.
-            var m1 = vec3f(0.0);
-            var m2 = vec3f(0.0);
-            var count = 0.0;
+            var m = Moments(vec4f(0.0), vec4f(0.0), 0.0);
             for (var dy = -1; dy <= 1; dy++) {
                 for (var dx = -1; dx <= 1; dx++) {
-                    let s = half_safe(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1)));
-                    m1 += s;
-                    m2 += s * s;
-                    count += 1.0;
+                    m = moments_add(m, half_safe(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1))));
                 }
             }
-            let nc = oct_decode(textureLoad(gb_normal, p, 0).xy);
-            let fc = footprint(x);
-            for (var i = 0u; i < 24u; i++) {
-                let t = p + vec2i(round(spiral_tap(i, 24u, 4.0, p)));
-                if !in_bounds(t) || !has_surface(t) {
-                    continue;
-                }
-                if bilateral_weight(x, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
-                    continue;
-                }
-                let s = half_safe(matte_input(t));
-                m1 += s;
-                m2 += s * s;
-                count += 1.0;
-            }
-            m1 /= count;
-            let sigma = sqrt(max(m2 / count - m1 * m1, vec3f(0.0)));
+            m = surface_moments(m, p, x, oct_decode(textureLoad(gb_normal, p, 0).xy), footprint(x), 24u, 4.0);
+            let m1 = m.m1.xyz / m.count;
+            let sigma = sqrt(max(m.m2.xyz / m.count - m1 * m1, vec3f(0.0)));
             let lo = m1 - dn.clamp_sigma * sigma;
             let hi = m1 + dn.clamp_sigma * sigma;
             clamped = clamp(hist, lo, hi);

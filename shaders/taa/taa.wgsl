@@ -2,8 +2,8 @@
 // sequence). History is fetched bilinearly at pixel + motion and clamped to the min/max box of
 // the current 3x3 neighbourhood in YCoCg (Karis 2014), which bounds ghosting to colours present
 // now (not in a static view, where nothing can ghost); then blended with weight taa_alpha for
-// the current frame. Without a history (first frame,
-// off screen, no surface) the current colour is used as is.
+// the current frame. Without a history (first frame, off screen, no surface) the current
+// colour is used as is.
 //
 // The history's alpha carries n, its length in frames, and the current frame weighs 2 / (n + 1):
 // the exponential blend whose samples are as old on average as an n-frame mean's, so that the
