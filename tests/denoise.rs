@@ -6,7 +6,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::quality::{Image, compare, luminance};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
-use hush_tests::half;
+use hush_tests::{half, oct_normal};
 
 const SIZE: (u32, u32) = (96, 54);
 
@@ -146,14 +146,6 @@ fn still_view_flickers_at_a_tenth_of_raw() {
     assert!(settled < 0.75 * exponential, "temporal error {settled} against {exponential} with the exponential TAA blend");
 }
 
-/// The G-buffer's octahedral normal (shaders/realtime/frame.wgsl: oct_decode).
-fn oct_decode(x: f32, y: f32) -> glam::Vec3 {
-    let mut n = glam::Vec3::new(x, y, 1.0 - x.abs() - y.abs());
-    if n.z < 0.0 {
-        n = glam::Vec3::new((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum(), n.z);
-    }
-    n.normalize()
-}
 
 /// History resets where the surface was not visible in the previous frame. After a sideways
 /// step past the arcade's pillars, the test recomputes eq. (11)'s distance on the CPU for every
@@ -195,7 +187,7 @@ fn history_resets_on_disocclusion() {
                 continue;
             }
             let p = world(&inv1, x, y, d);
-            let n = oct_decode(half(&normal[i * 4..]), half(&normal[i * 4 + 2..]));
+            let n = oct_normal(&normal[i * 4..]);
             let stretch = 1.0 / n.dot((setup1.pos - p).normalize()).abs().max(0.1);
             let foot = 2.0 * (p - setup1.pos).dot(setup1.fwd) * setup1.up.length() / h as f32;
             let q = (x as f32 + 0.5 + half(&motion[i * 4..]), y as f32 + 0.5 + half(&motion[i * 4 + 2..]));

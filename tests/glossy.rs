@@ -1,6 +1,6 @@
 //! The glossy chain (Mara et al. 2017 §3.4 stages 8-10, Voorhuis §4): the diamond search on a
-//! synthetic motion, the virtual-position reprojection of a plane mirror against geometry, and
-//! the bilateral's sigma.
+//! synthetic motion, the virtual-position reprojection of a plane mirror against geometry, the
+//! surface reprojection's normal test, and the bilateral's sigma.
 
 use glam::{DVec3, Vec2, Vec4};
 use hush_engine::accel::BvhKind;
@@ -8,7 +8,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, GpuRequirements};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, ReflectionMv};
-use hush_tests::half;
+use hush_tests::{half, oct_normal};
 
 /// The search of shaders/glossy/diamond.wgsl over a synthetic previous frame whose world
 /// position is (pixel centre, 0): the pixel p of this frame shows the point at p + motion.
@@ -238,3 +238,80 @@ fn glossy_bilateral_sigma() {
     }
     assert!(seen.iter().all(|&k| k > 20), "rough, glossy, mirror pixels: {seen:?}");
 }
+
+/// The glossy history of a pixel comes from its own face. In a still view every frame samples
+/// another sub-pixel position, so a pixel on a crease or a ledge thinner than a pixel shows one
+/// face in one frame and the other face in the next, and eq. (11)'s position test passes
+/// both (they are within a footprint of each other). The two faces reflect different things
+/// under different Fresnel weights, and the chain filters glossy light divided by F: a history
+/// that mixes them came out ten times too bright on the staircase's table edge (row 177 at
+/// 160x284: 4.3 against a reference of 0.46). The reprojection's normal test
+/// (GlossySettings::reprojection_normal_degrees) rejects such texels. The test recomputes the
+/// 3x3 reprojection on the CPU (positions through both frames' jittered cameras, distances in
+/// footprints as tests/denoise.rs does) and finds the pixels where a texel passes the position
+/// test but none of them is on a face within the angle: their confidence must be 0.
+#[test]
+fn glossy_history_stays_on_its_face() {
+    use hush_engine::frame::halton_jitter;
+    use hush_engine::settings::MatteSettings;
+    let size = (96u32, 54u32);
+    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, size).unwrap();
+    let cam = Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0);
+    let s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let warm = 7;
+    for _ in 0..warm {
+        r.render(&gpu, &FrameInput { camera: cam, time: 0.0 }, &s, None).unwrap();
+    }
+    let read = |r: &Renderer, n: &str| r.read_texture(&gpu, n).unwrap().0;
+    let (depth0, normal0) = (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"));
+    r.render(&gpu, &FrameInput { camera: cam, time: 0.0 }, &s, None).unwrap();
+    let (depth1, normal1, info) = (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"), read(&r, "glossy/info"));
+    let setup = r.camera_setup(&cam);
+    let (inv0, inv1) = (setup.jittered(halton_jitter(warm - 1), size).inverse(), setup.jittered(halton_jitter(warm), size).inverse());
+    let f32_at = |b: &[u8], i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
+    let (w, h) = (size.0 as i64, size.1 as i64);
+    let world = |inv: &glam::Mat4, x: i64, y: i64, d: f32| {
+        let ndc = glam::Vec4::new((x as f32 + 0.5) / w as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h as f32 * 2.0, d, 1.0);
+        let p = *inv * ndc;
+        p.truncate() / p.w
+    };
+    let (m, cos_max) = (MatteSettings::default(), GlossySettings::default().reprojection_normal_degrees.to_radians().cos());
+    let (mut creases, mut kept) = (0, Vec::new());
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let d = f32_at(&depth1, i);
+            if d <= 0.0 {
+                continue;
+            }
+            let p = world(&inv1, x, y, d);
+            let n = oct_normal(&normal1[i * 4..]);
+            let stretch = 1.0 / n.dot((setup.pos - p).normalize()).abs().max(0.1);
+            let foot = 2.0 * (p - setup.pos).dot(setup.fwd) * setup.up.length() / h as f32;
+            let texels: Vec<(f32, f32)> = (-1..=1)
+                .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+                .filter(|&(tx, ty)| tx >= 0 && ty >= 0 && tx < w && ty < h && f32_at(&depth0, (ty * w + tx) as usize) > 0.0)
+                .map(|(tx, ty)| {
+                    let t = (ty * w + tx) as usize;
+                    let delta = world(&inv0, tx, ty, f32_at(&depth0, t)) - p;
+                    let off_plane = n.dot(delta);
+                    (off_plane.abs().max((delta - n * off_plane).length() / stretch) / foot, n.dot(oct_normal(&normal0[t * 4..])))
+                })
+                .collect();
+            // Margins around d0, d1 and the angle keep float rounding from deciding a pixel.
+            let position_only = texels.iter().any(|&(dist, _)| dist < 0.9 * m.d0_px);
+            let same_face = texels.iter().any(|&(dist, cos)| dist < 1.1 * m.d1_px && cos >= cos_max - 0.02);
+            if position_only && !same_face {
+                creases += 1;
+                let c = half(&info[i * 8..]);
+                if c != 0.0 {
+                    kept.push((x, y, c));
+                }
+            }
+        }
+    }
+    println!("{creases} crease pixels, {} kept another face's glossy history", kept.len());
+    assert!(creases >= 10, "the view has only {creases} crease pixels");
+    assert!(kept.is_empty(), "crease pixels kept another face's glossy history (x, y, confidence): {:?}", &kept[..kept.len().min(20)]);
+}
+

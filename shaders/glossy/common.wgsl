@@ -35,7 +35,8 @@ struct GlossyParams {
     // 1 when neither the camera nor an object moved since the previous frame: every reflection
     // then stands still, and the reflection motion is the surface's (zero) in every mode.
     static_view: u32,
-    _pad0: u32,
+    // The surface reprojection's normal test (DenoiseParams::reprojection_min_cos).
+    reprojection_min_cos: f32,
     _pad1: u32,
     _pad2: u32,
 }

@@ -5,7 +5,11 @@
 //
 // Confidence c, by how the pixel was reprojected:
 // - surface motion vectors (rough surfaces, --reflection-mv primary, or a static view): eq. (11)
-//   on the primary surface, as the matte temporal;
+//   on the primary surface, as the matte temporal, and the previous texel's normal within
+//   gp.reprojection_min_cos of this one's. The jitter puts a crease's two faces, or a ledge
+//   thinner than a pixel and what lies behind it, under one pixel in turn; eq. (11) passes
+//   both (they are within a footprint), but they reflect different things under different
+//   F(w_s), and the chain filters light divided by F, so their mix is biased, not just noisy;
 // - reflection motion vectors on a mirror: eq. (11) on the reflected hit (exact for mirrors),
 //   in pixel footprints at the reflected hit (reflected_footprint: curved mirrors minify);
 // - reflection motion vectors on a glossy surface: h wherever the previous pixel had a glossy
@@ -15,6 +19,7 @@
 
 @group(0) @binding(41) var prev_depth: texture_depth_2d;
 @group(0) @binding(42) var history: texture_2d<f32>;
+@group(0) @binding(43) var prev_normal: texture_2d<f32>;
 @group(0) @binding(61) var prev_hit: texture_2d<f32>;
 @group(0) @binding(65) var neighbourhood: texture_2d<f32>;
 @group(0) @binding(66) var dst: texture_storage_2d<rgba32float, write>;
@@ -86,7 +91,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if dn.history_valid != 0u {
         if !reflected {
             let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
-            r = reproject(prev_depth, prev, expected, surface_frame(p, x));
+            r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), gp.reprojection_min_cos);
         }
         // The previous pixel must have had a glossy lobe (its hit class is set).
         if in_bounds(r.texel) && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {

@@ -52,6 +52,12 @@ struct DenoiseParams {
     edge_stop_sigmas: f32,
     // 1 when neither the camera nor any object moved since the last frame (ChainView::static_view).
     static_view: u32,
+    // Eq. (11)'s reprojection passes a previous texel only where its normal is within this
+    // cosine of the surface's (-2: any normal).
+    reprojection_min_cos: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;
@@ -140,12 +146,12 @@ struct Reprojection {
     distance: f32,
 }
 
-fn previous_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, s: SurfaceFrame) -> f32 {
+fn previous_distance(depth: texture_depth_2d, normals: texture_2d<f32>, t: vec2i, expected: vec3f, s: SurfaceFrame, min_cos: f32) -> f32 {
     if !in_bounds(t) {
         return -1.0;
     }
     let d = textureLoad(depth, t, 0);
-    if d <= 0.0 {
+    if d <= 0.0 || dot(oct_decode(textureLoad(normals, t, 0).xy), s.n) < min_cos {
         return -1.0;
     }
     let delta = world_from_depth(dn.prev_inv_view_proj, t, d) - expected;
@@ -173,12 +179,12 @@ fn neighbour_3x3(k: i32) -> vec2i {
     return vec2i((k + 4) % 3 - 1, (k + 4) / 3 % 3 - 1);
 }
 
-fn reproject(depth: texture_depth_2d, prev: vec2f, expected: vec3f, s: SurfaceFrame) -> Reprojection {
+fn reproject(depth: texture_depth_2d, normals: texture_2d<f32>, prev: vec2f, expected: vec3f, s: SurfaceFrame, min_cos: f32) -> Reprojection {
     let q = vec2i(floor(prev));
     var best = Reprojection(q, true, -1.0);
     for (var k = 0; k < 9; k++) {
         let t = q + neighbour_3x3(k);
-        let d = previous_distance(depth, t, expected, s);
+        let d = previous_distance(depth, normals, t, expected, s, min_cos);
         if d >= 0.0 && (best.distance < 0.0 || d < best.distance) {
             best = Reprojection(t, k == 0, d);
         }

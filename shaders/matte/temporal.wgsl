@@ -12,6 +12,7 @@
 
 @group(0) @binding(41) var prev_depth: texture_depth_2d;
 @group(0) @binding(42) var history: texture_2d<f32>;
+@group(0) @binding(43) var prev_normal: texture_2d<f32>;
 @group(0) @binding(50) var out_temporal: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(51) var out_reason: texture_storage_2d<r32uint, write>;
 
@@ -36,7 +37,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var c = 0.0;
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     if dn.history_valid != 0u {
-        r = reproject(prev_depth, prev, expected, surface_frame(p, x));
+        r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
     }
     if r.distance < 0.0 {
         reason = REASON_DISOCCLUDED;

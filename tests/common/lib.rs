@@ -83,3 +83,14 @@ pub fn trimmed_bias(test: &hush_engine::quality::Image, reference: &hush_engine:
 pub fn half(b: &[u8]) -> f32 {
     half::f16::from_le_bytes([b[0], b[1]]).to_f32()
 }
+
+/// A G-buffer normal texel (Rg16Float, octahedral) as a unit vector, as oct_decode in
+/// shaders/realtime/frame.wgsl reads it.
+pub fn oct_normal(texel: &[u8]) -> glam::Vec3 {
+    let (x, y) = (half(texel), half(&texel[2..]));
+    let mut n = glam::Vec3::new(x, y, 1.0 - x.abs() - y.abs());
+    if n.z < 0.0 {
+        n = glam::Vec3::new((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum(), n.z);
+    }
+    n.normalize()
+}

@@ -416,6 +416,7 @@ impl Renderer {
         if let (true, Some(m)) = (denoise, &t.matte) {
             let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
             enc.copy_texture_to_texture(t.gbuffer.depth.0.as_image_copy(), m.prev_depth.0.as_image_copy(), extent);
+            enc.copy_texture_to_texture(t.gbuffer.color[0].0.as_image_copy(), m.prev_normal.0.as_image_copy(), extent);
         }
         if let Some(timer) = self.timer.as_mut() {
             timer.resolve(&gpu.device, &mut enc, self.async_timings);

@@ -42,7 +42,9 @@ pub struct GlossyParams {
     pub representative_traced: u32,
     pub sigma_full_frames: f32,
     pub static_view: u32,
-    pub _pad: [u32; 3],
+    /// Cosine of [`GlossySettings::reprojection_normal_degrees`].
+    pub reprojection_min_cos: f32,
+    pub _pad: [u32; 2],
 }
 
 impl GlossyParams {
@@ -75,7 +77,8 @@ impl GlossyParams {
             representative_traced: s.trace_representative_ray as u32,
             sigma_full_frames: s.sigma_full_frames,
             static_view: static_view as u32,
-            _pad: [0; 3],
+            reprojection_min_cos: super::matte::normal_test_cos(s.reprojection_normal_degrees),
+            _pad: [0; 2],
         }
     }
 }
@@ -174,6 +177,7 @@ fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a>
             b = b
                 .texture(41, &i.matte.prev_depth.1, depth)
                 .texture(42, &g.history[parity].1, f)
+                .texture(43, &i.matte.prev_normal.1, f)
                 .texture(61, &g.hit[parity].1, f)
                 .texture(65, &g.neighbourhood.1, f)
                 .storage_texture(66, &g.history[1 - parity].1, RGBA32F)

@@ -55,6 +55,9 @@ pub struct DenoiseParams {
     pub edge_stop_sigmas: f32,
     /// [`ChainView::static_view`].
     pub static_view: u32,
+    /// Cosine of [`MatteSettings::reprojection_normal_degrees`].
+    pub reprojection_min_cos: f32,
+    pub _pad: [u32; 3],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -103,13 +106,22 @@ impl DenoiseParams {
             min_radius_px: (s.min_radius_fraction * w).clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
             edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
             static_view: view.static_view as u32,
+            reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
+            _pad: [0; 3],
         }
     }
+}
+
+/// The reprojections' normal test as a cosine: 180 degrees or more passes every normal.
+pub fn normal_test_cos(degrees: f32) -> f32 {
+    if degrees >= 180.0 { -2.0 } else { degrees.max(0.0).to_radians().cos() }
 }
 
 /// Per-pixel textures of the chain (made with the frame's other targets).
 pub struct MatteTargets {
     pub prev_depth: (wgpu::Texture, wgpu::TextureView),
+    /// The previous frame's G-buffer normals (octahedral), for the reprojection's normal test.
+    pub prev_normal: (wgpu::Texture, wgpu::TextureView),
     pub history: [(wgpu::Texture, wgpu::TextureView); 2],
     pub temporal: (wgpu::Texture, wgpu::TextureView),
     pub reason: (wgpu::Texture, wgpu::TextureView),
@@ -136,9 +148,10 @@ impl MatteTargets {
         let denoised = t("matte/bilateral", RGBA16F);
         let taa_history = [t("taa/history 0", RGBA32F), t("taa/history 1", RGBA32F)];
         let prev_depth = mem.texture(d, "matte/previous depth", size, super::gbuffer::DEPTH_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
+        let prev_normal = mem.texture(d, "matte/previous normal", size, super::gbuffer::COLOR_FORMATS[0].1, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let final_image = mem.buffer(d, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
-        MatteTargets { prev_depth, history, temporal, reason, min, radius, median, denoised, taa_history, final_image }
+        MatteTargets { prev_depth, prev_normal, history, temporal, reason, min, radius, median, denoised, taa_history, final_image }
     }
 }
 
@@ -197,6 +210,7 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> 
             b = b
                 .texture(41, &m.prev_depth.1, wgpu::TextureSampleType::Depth)
                 .texture(42, &m.history[parity].1, f)
+                .texture(43, &m.prev_normal.1, f)
                 .storage_texture(50, &m.temporal.1, RGBA32F)
                 .storage_texture(51, &m.reason.1, R32U);
             if let Some(o) = i.objects {
