@@ -6,6 +6,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::quality::{Image, compare, luminance};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings};
+use hush_tests::reproject::{DepthFrame, Surface, neighbours_3x3};
 use hush_tests::{half, oct_normal};
 
 const SIZE: (u32, u32) = (96, 54);
@@ -171,40 +172,21 @@ fn history_resets_on_disocclusion() {
     let read = |n: &str| r.read_texture(&gpu, n).unwrap().0;
     let (depth1, reason, motion, temporal, input, normal) = (read("gbuffer/depth"), read("matte/reason"), read("gbuffer/motion"), read("matte/temporal"), read("trace/matte"), read("gbuffer/normal"));
     let f32_at = |b: &[u8], i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
-    let (w, h) = (SIZE.0 as i64, SIZE.1 as i64);
-    let world = |inv: &glam::Mat4, x: i64, y: i64, d: f32| {
-        let ndc = glam::Vec4::new((x as f32 + 0.5) / w as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h as f32 * 2.0, d, 1.0);
-        let p = *inv * ndc;
-        p.truncate() / p.w
-    };
+    let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size: SIZE };
+    let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
     let d1 = MatteSettings::default().d1_px;
     let (mut rejected, mut flagged, mut exact) = (0, 0, 0);
-    for y in 0..h {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            let d = f32_at(&depth1, i);
-            if d <= 0.0 {
-                continue;
-            }
-            let p = world(&inv1, x, y, d);
-            let n = oct_normal(&normal[i * 4..]);
-            let stretch = 1.0 / n.dot((setup1.pos - p).normalize()).abs().max(0.1);
-            let foot = 2.0 * (p - setup1.pos).dot(setup1.fwd) * setup1.up.length() / h as f32;
+    for y in 0..SIZE.1 as i64 {
+        for x in 0..SIZE.0 as i64 {
+            let Some(p) = now.world(x, y) else { continue };
+            let i = now.index(x, y).unwrap();
+            let surface = Surface::new(p, oct_normal(&normal[i * 4..]), &setup1, SIZE.1);
             let q = (x as f32 + 0.5 + half(&motion[i * 4..]), y as f32 + 0.5 + half(&motion[i * 4 + 2..]));
-            let (qx, qy) = (q.0.floor() as i64, q.1.floor() as i64);
-            let closest = (-1..=1)
-                .flat_map(|dy| (-1..=1).map(move |dx| (qx + dx, qy + dy)))
-                .filter(|&(tx, ty)| tx >= 0 && ty >= 0 && tx < w && ty < h)
-                .filter_map(|(tx, ty)| {
-                    let dq = f32_at(&depth0, (ty * w + tx) as usize);
-                    (dq > 0.0).then(|| {
-                        let delta = world(&inv0, tx, ty, dq) - p;
-                        let off_plane = n.dot(delta);
-                        off_plane.abs().max((delta - n * off_plane).length() / stretch)
-                    })
-                })
+            let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
+                .filter_map(|(tx, ty)| before.world(tx, ty))
+                .map(|prev| surface.distance(prev))
                 .fold(f32::INFINITY, f32::min);
-            if closest <= 1.5 * d1 * foot {
+            if closest <= 1.5 * d1 {
                 continue;
             }
             rejected += 1;

@@ -8,6 +8,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, GpuRequirements};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, ReflectionMv};
+use hush_tests::reproject::{DepthFrame, Surface, neighbours_3x3};
 use hush_tests::{half, oct_normal};
 
 /// The search of shaders/glossy/diamond.wgsl over a synthetic previous frame whose world
@@ -268,35 +269,19 @@ fn glossy_history_stays_on_its_face() {
     let (depth1, normal1, info) = (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"), read(&r, "glossy/info"));
     let setup = r.camera_setup(&cam);
     let (inv0, inv1) = (setup.jittered(halton_jitter(warm - 1), size).inverse(), setup.jittered(halton_jitter(warm), size).inverse());
-    let f32_at = |b: &[u8], i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
-    let (w, h) = (size.0 as i64, size.1 as i64);
-    let world = |inv: &glam::Mat4, x: i64, y: i64, d: f32| {
-        let ndc = glam::Vec4::new((x as f32 + 0.5) / w as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h as f32 * 2.0, d, 1.0);
-        let p = *inv * ndc;
-        p.truncate() / p.w
-    };
+    let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size };
+    let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size };
     let (m, cos_max) = (MatteSettings::default(), GlossySettings::default().reprojection_normal_degrees.to_radians().cos());
     let (mut creases, mut kept) = (0, Vec::new());
-    for y in 0..h {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            let d = f32_at(&depth1, i);
-            if d <= 0.0 {
-                continue;
-            }
-            let p = world(&inv1, x, y, d);
-            let n = oct_normal(&normal1[i * 4..]);
-            let stretch = 1.0 / n.dot((setup.pos - p).normalize()).abs().max(0.1);
-            let foot = 2.0 * (p - setup.pos).dot(setup.fwd) * setup.up.length() / h as f32;
-            let texels: Vec<(f32, f32)> = (-1..=1)
-                .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
-                .filter(|&(tx, ty)| tx >= 0 && ty >= 0 && tx < w && ty < h && f32_at(&depth0, (ty * w + tx) as usize) > 0.0)
-                .map(|(tx, ty)| {
-                    let t = (ty * w + tx) as usize;
-                    let delta = world(&inv0, tx, ty, f32_at(&depth0, t)) - p;
-                    let off_plane = n.dot(delta);
-                    (off_plane.abs().max((delta - n * off_plane).length() / stretch) / foot, n.dot(oct_normal(&normal0[t * 4..])))
-                })
+    for y in 0..size.1 as i64 {
+        for x in 0..size.0 as i64 {
+            let Some(p) = now.world(x, y) else { continue };
+            let i = now.index(x, y).unwrap();
+            let surface = Surface::new(p, oct_normal(&normal1[i * 4..]), &setup, size.1);
+            // (distance in footprints, cosine to this normal) of each previous texel with a surface.
+            let texels: Vec<(f32, f32)> = neighbours_3x3(x, y)
+                .filter_map(|(tx, ty)| Some((before.world(tx, ty)?, before.index(tx, ty)?)))
+                .map(|(prev, t)| (surface.distance(prev), surface.n.dot(oct_normal(&normal0[t * 4..]))))
                 .collect();
             // Margins around d0, d1 and the angle keep float rounding from deciding a pixel.
             let position_only = texels.iter().any(|&(dist, _)| dist < 0.9 * m.d0_px);

@@ -151,7 +151,11 @@ fn previous_distance(depth: texture_depth_2d, normals: texture_2d<f32>, t: vec2i
         return -1.0;
     }
     let d = textureLoad(depth, t, 0);
-    if d <= 0.0 || dot(oct_decode(textureLoad(normals, t, 0).xy), s.n) < min_cos {
+    if d <= 0.0 {
+        return -1.0;
+    }
+    // min_cos <= -1 passes every normal: skip the fetch (the matte default).
+    if min_cos > -1.0 && dot(oct_decode(textureLoad(normals, t, 0).xy), s.n) < min_cos {
         return -1.0;
     }
     let delta = world_from_depth(dn.prev_inv_view_proj, t, d) - expected;

@@ -1,7 +1,9 @@
 //! Helpers shared by the GPU integration tests: paths to `../shared`, rendering a scene with the
-//! reference tracer, and a small glTF writer for synthetic scenes.
+//! reference tracer, a small glTF writer for synthetic scenes, and eq. (11)'s reprojection
+//! distance on the CPU.
 
 pub mod gltf_writer;
+pub mod reproject;
 
 use anyhow::Result;
 use hush_engine::accel::BvhKind;

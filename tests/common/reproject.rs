@@ -1,0 +1,61 @@
+//! Eq. (11)'s reprojection distance on the CPU, as shaders/matte/common.wgsl measures it
+//! (`world_from_depth`, `surface_frame`, `previous_distance`), for tests that check which pixels
+//! the temporal stages keep or reset.
+
+use glam::{Mat4, Vec3, Vec4};
+use hush_engine::frame::CameraSetup;
+
+/// One frame's depth buffer (Depth32Float texels read back) and its jittered inverse view-projection.
+pub struct DepthFrame<'a> {
+    pub depth: &'a [u8],
+    pub inv_view_proj: Mat4,
+    pub size: (u32, u32),
+}
+
+impl DepthFrame<'_> {
+    /// The texel index of (x, y), None outside the frame.
+    pub fn index(&self, x: i64, y: i64) -> Option<usize> {
+        (x >= 0 && y >= 0 && x < self.size.0 as i64 && y < self.size.1 as i64).then(|| (y * self.size.0 as i64 + x) as usize)
+    }
+
+    /// The rebased world position of the sample at (x, y); None outside the frame or without a surface.
+    pub fn world(&self, x: i64, y: i64) -> Option<Vec3> {
+        let i = self.index(x, y)?;
+        let d = f32::from_le_bytes(self.depth[i * 4..i * 4 + 4].try_into().unwrap());
+        if d <= 0.0 {
+            return None;
+        }
+        let (w, h) = (self.size.0 as f32, self.size.1 as f32);
+        let p = self.inv_view_proj * Vec4::new((x as f32 + 0.5) / w * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h * 2.0, d, 1.0);
+        Some(p.truncate() / p.w)
+    }
+}
+
+/// A surface point with the frame eq. (11)'s distance is measured in: its normal, the pixel
+/// footprint at its distance and how far the view's slant stretches it (at most 10x).
+pub struct Surface {
+    pub p: Vec3,
+    pub n: Vec3,
+    footprint: f32,
+    stretch: f32,
+}
+
+impl Surface {
+    pub fn new(p: Vec3, n: Vec3, camera: &CameraSetup, height: u32) -> Surface {
+        let stretch = 1.0 / n.dot((camera.pos - p).normalize()).abs().max(0.1);
+        let footprint = 2.0 * (p - camera.pos).dot(camera.fwd) * camera.up.length() / height as f32;
+        Surface { p, n, footprint, stretch }
+    }
+
+    /// The distance to q in footprints: off the surface's plane as is, along it divided by the stretch.
+    pub fn distance(&self, q: Vec3) -> f32 {
+        let delta = q - self.p;
+        let off_plane = self.n.dot(delta);
+        off_plane.abs().max((delta - self.n * off_plane).length() / self.stretch) / self.footprint
+    }
+}
+
+/// The 3x3 texels around (x, y) (the reprojection's search), in or out of the frame.
+pub fn neighbours_3x3(x: i64, y: i64) -> impl Iterator<Item = (i64, i64)> {
+    (-1..=1).flat_map(move |dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+}
