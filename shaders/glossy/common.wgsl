@@ -37,8 +37,9 @@ struct GlossyParams {
     static_view: u32,
     // The surface reprojection's normal test (DenoiseParams::reprojection_min_cos).
     reprojection_min_cos: f32,
+    // A bilinearly resampled history counts as at most this many frames (0: no cap).
+    resampled_history_frames: f32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 @group(0) @binding(60) var<uniform> gp: GlossyParams;

@@ -116,6 +116,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             hist = half_safe(load_bilinear(history, prev).rgb);
+            n = resampled_length(n, prev, gp.resampled_history_frames);
         }
         var clipped = hist;
         if gstage_on(GSTAGE_CLIPPING) && roughness < gp.clip_roughness {

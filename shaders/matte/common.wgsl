@@ -55,9 +55,11 @@ struct DenoiseParams {
     // Eq. (11)'s reprojection passes a previous texel only where its normal is within this
     // cosine of the surface's (-2: any normal).
     reprojection_min_cos: f32,
+    // A bilinearly resampled history counts as at most this many frames (0: no cap).
+    resampled_history_frames: f32,
+    // TAA: a pixel that stands still again restarts its history length here (0: carries on).
+    taa_resampled_frames: f32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;
@@ -166,6 +168,16 @@ fn previous_distance(depth: texture_depth_2d, normals: texture_2d<f32>, t: vec2i
 
 // Bilinear fetch of a history at pixel coordinates `at` (texel centres at +0.5), edges clamped.
 // The histories are 32-bit floats, which WebGPU does not filter without an optional feature.
+// History length n of a history read bilinearly at `prev`: at most `cap` frames when `prev`
+// falls between texel centres (0: no cap). Reading a texel at its centre is exact.
+fn resampled_length(n: f32, prev: vec2f, cap: f32) -> f32 {
+    let off = prev - floor(prev) - 0.5;
+    if cap > 0.0 && dot(off, off) > 1e-6 {
+        return min(n, cap + 1.0);
+    }
+    return n;
+}
+
 fn load_bilinear(t: texture_2d<f32>, at: vec2f) -> vec4f {
     let f = at - 0.5;
     let base = vec2i(floor(f));

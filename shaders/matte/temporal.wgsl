@@ -8,7 +8,9 @@
 // its alpha), and the new sample's weight is max(1 - c, 1 / (n + 1)). A fresh history then
 // averages its first frames equally instead of keeping 0.98^k of its first, noisy sample (after
 // 60 frames that sample would still weigh 30%); once n passes 1 / (1 - h) it is the paper's
-// exponential blend. The reason texture carries n above its 8 flag bits.
+// exponential blend. The reason texture carries n above its 8 flag bits. A history resampled
+// between texels (the surface moved on screen) is a little blurred each time, and counts as at
+// most resampled_history_frames, so that motion's blur fades within a few frames of a stop.
 
 @group(0) @binding(41) var prev_depth: texture_depth_2d;
 @group(0) @binding(42) var history: texture_2d<f32>;
@@ -55,6 +57,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             hist = half_safe(load_bilinear(history, prev).rgb);
+            n = resampled_length(n, prev, dn.resampled_history_frames);
         }
         var clamped = hist;
         if dn.clamp_sigma > 0.0 {

@@ -13,7 +13,10 @@
 // converges to the box-filtered pixel, where taa_alpha weighs the latest offsets most and keeps
 // an edge pixel off by a fraction of the edge's contrast. Moving or clamped, the weight is held
 // at taa_alpha: bilinear resampling blurs a long history, and a clamp means the history no
-// longer matches what the pixel shows.
+// longer matches what the pixel shows. Such a history is stored with a negative length, and
+// when the pixel stands still again its length restarts at taa_resampled_frames: held at
+// taa_alpha, the blur that resampling left in it would otherwise outlast the stop by tens of
+// frames.
 
 @group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
 @group(0) @binding(42) var history: texture_2d<f32>;
@@ -62,8 +65,18 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // A clamp by more than half-precision rounding.
         let held = any(abs(yc - y) > vec3f(1e-3 * max(abs(y.x), 1e-2)));
         let weight_floor = select(dn.taa_alpha, min(dn.taa_alpha, 1.0 / max(dn.taa_still_frames, 1.0)), still && !held);
-        n = clamp(select(texel.a, 1.0, texel.a != texel.a) + 1.0, 1.0, 2.0 / weight_floor - 1.0);
+        var n_prev = select(texel.a, 1.0, texel.a != texel.a);
+        if n_prev < 0.0 {
+            n_prev = -n_prev;
+            if still && !held && dn.taa_resampled_frames > 0.0 {
+                n_prev = min(n_prev, dn.taa_resampled_frames);
+            }
+        }
+        n = clamp(n_prev + 1.0, 1.0, 2.0 / weight_floor - 1.0);
         result = mix(clamped, current, 2.0 / (n + 1.0));
+        if !(still && !held) {
+            n = -n;
+        }
     }
     result = half_safe(result);
     textureStore(out_history, p, vec4f(result, n));

@@ -44,7 +44,9 @@ pub struct GlossyParams {
     pub static_view: u32,
     /// Cosine of [`GlossySettings::reprojection_normal_degrees`].
     pub reprojection_min_cos: f32,
-    pub _pad: [u32; 2],
+    /// [`GlossySettings::resampled_history_frames`].
+    pub resampled_history_frames: f32,
+    pub _pad: u32,
 }
 
 impl GlossyParams {
@@ -78,7 +80,8 @@ impl GlossyParams {
             sigma_full_frames: s.sigma_full_frames,
             static_view: static_view as u32,
             reprojection_min_cos: super::matte::normal_test_cos(s.reprojection_normal_degrees),
-            _pad: [0; 2],
+            resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
+            _pad: 0,
         }
     }
 }

@@ -57,7 +57,11 @@ pub struct DenoiseParams {
     pub static_view: u32,
     /// Cosine of [`MatteSettings::reprojection_normal_degrees`].
     pub reprojection_min_cos: f32,
-    pub _pad: [u32; 3],
+    /// [`MatteSettings::resampled_history_frames`].
+    pub resampled_history_frames: f32,
+    /// [`MatteSettings::taa_resampled_frames`].
+    pub taa_resampled_frames: f32,
+    pub _pad: u32,
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -107,7 +111,9 @@ impl DenoiseParams {
             edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
             static_view: view.static_view as u32,
             reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
-            _pad: [0; 3],
+            resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
+            taa_resampled_frames: s.taa_resampled_frames.clamp(0.0, 1024.0),
+            _pad: 0,
         }
     }
 }

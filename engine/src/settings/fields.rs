@@ -70,6 +70,7 @@ pub const FIELDS: &[Field] = &[
     f("matte.taps", "matte/history_bilateral", "taps", Int(1, 256), "Taps of both sparse bilaterals (paper 50)."),
     f("matte.history_diameter_fraction", "matte/history_bilateral", "of width", Float(0.0, 0.2, 0.0005), "Disk diameter of the history bilateral (paper 1%)."),
     f("matte.history_full_frames", "matte/history_bilateral", "frames", Float(0.0, 1024.0, 0.1), "Past this history length the disk shrinks as 1/sqrt(length) (0: fixed)."),
+    f("matte.resampled_history_frames", "matte/temporal", "frames", Float(0.0, 1024.0, 1.0), "A bilinearly resampled history counts as at most this many frames (0: no cap)."),
     f("matte.normal_power", "matte/history_bilateral", "exponent", Float(0.0, 512.0, 0.5), "Bilateral normal weight: cos^power (both sparse bilaterals)."),
     f("matte.plane_sigma_px", "matte/history_bilateral", "footprints", Float(0.0, 64.0, 0.05), "Bilateral plane-distance sigma (both sparse bilaterals)."),
     f("matte.disocclusion", "matte/disocclusion", "", Bool, "Stage 5: the disocclusion-driven radius r = (1 - min c) R."),
@@ -82,6 +83,7 @@ pub const FIELDS: &[Field] = &[
     f("matte.edge_stop_sigmas", "matte/bilateral", "sigma", Float(0.0, 256.0, 0.5), "Final bilateral's luminance edge-stop, in standard deviations of the history's noise (0: none)."),
     f("matte.taa", "taa", "", Bool, "Temporal anti-aliasing with a jittered raster and YCoCg clamping."),
     f("matte.taa_alpha", "taa", "", Float(0.0, 1.0, 0.005), "Weight of the current frame in TAA's blend."),
+    f("matte.taa_resampled_frames", "taa", "frames", Float(0.0, 64.0, 1.0), "TAA: history length a pixel restarts at when it stands still after moving (0: carries on)."),
     f("matte.taa_still_frames", "taa", "", Float(0.0, 256.0, 1.0), "TAA in a still view: the current frame's weight falls to 1 / this (0: always taa_alpha)."),
     f("glossy.reflection_mv", "glossy/motion", "", Choice(reflection_mvs), "Reflection motion: surface (primary), virtual position, or diamond search."),
     f("glossy.roughness_threshold", "glossy/motion", "roughness", Float(0.0, 1.0, 0.005), "Reflection motion below this roughness, surface motion above (Voorhuis 0.4)."),
@@ -101,6 +103,7 @@ pub const FIELDS: &[Field] = &[
     f("glossy.sigma_exponent", "glossy/bilateral", "", Float(0.0, 4.0, 0.005), "Roughness exponent of sigma (Mara 0.1)."),
     f("glossy.sigma_epsilon_px", "glossy/bilateral", "px", Float(0.0, 9.0, 0.05), "Sigma at roughness 0."),
     f("glossy.sigma_full_frames", "glossy/bilateral", "frames", Float(0.0, 256.0, 0.1), "Past this history length sigma shrinks as 1/sqrt(length) (0: fixed)."),
+    f("glossy.resampled_history_frames", "glossy/temporal", "frames", Float(0.0, 1024.0, 1.0), "A bilinearly resampled history counts as at most this many frames (0: no cap)."),
     f("glossy.ray_differential_omega", "glossy/bilateral", "footprints", Float(0.001, 1024.0, 0.1), "Voorhuis eq. 6's omega: sigma x exp(-ray differential / omega)."),
     f("glossy.roughness_sigma", "glossy/bilateral", "roughness", Float(0.0, 1.0, 0.001), "Bilateral weight on roughness differences."),
 ];

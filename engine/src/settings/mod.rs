@@ -108,6 +108,17 @@ pub struct MatteSettings {
     /// firefly off): FLIP 0.0644 with the fixed disk, 0.0618 past 4 frames, 0.0605 past 1 (the
     /// default).
     pub history_full_frames: f32,
+    /// A history resampled bilinearly (the surface moved on screen since the last frame) counts
+    /// as at most this many frames, so that its new sample weighs at least 1 / (this + 1). Each
+    /// resampling blurs the history a little, and at the paper's 1 - h = 2% a strafe's blur
+    /// outlived it: when the camera stopped, the level took over 20 frames to reach the FLIP a
+    /// fresh start reached in 10. Texels read exactly (a still view) keep their whole length.
+    /// 0: no cap (the paper's blend). Level at 160x90, 20 still, 20 strafing (1.2 m) and 20
+    /// still frames, 128-frame references, FLIP 10 frames after the stop (fresh start at the
+    /// same view after 10 frames: 0.0774) / moving mean: no cap 0.0830 / 0.1030, 24 frames
+    /// 0.0811 / 0.1028, 8 frames 0.0805 / 0.1014, 4 frames 0.0820 / 0.1020 (TAA restarting as
+    /// MatteSettings::taa_resampled_frames; the glossy chain uncapped).
+    pub resampled_history_frames: f32,
     /// R of the disocclusion radius as a fraction of the screen width (paper: 1/20).
     pub disocclusion_fraction: f32,
     /// Radius multiplier where the confidence c < 1/2 (paper: 6).
@@ -148,6 +159,14 @@ pub struct MatteSettings {
     /// 0.00063). 0: taa_alpha always. In a static view (no camera or object motion) the history
     /// is not clamped at all (shaders/taa/taa.wgsl), so a still pixel always reaches this blend.
     pub taa_still_frames: f32,
+    /// TAA: when a pixel that moved in the last frame stands still again (the camera stopped),
+    /// its history length restarts at this many frames, so that the sharp still frames replace
+    /// a history that bilinear resampling blurred while it moved; held at taa_alpha, that
+    /// history still weighed 44% ten frames after the stop. 0: the length carries on. Strafe as
+    /// MatteSettings::resampled_history_frames (no history caps), FLIP 1, 5, 10 and 19 frames
+    /// after the stop: carrying on 0.1137, 0.1019, 0.0932, 0.0842; restarting at 4 frames
+    /// 0.1097, 0.0903, 0.0837, 0.0783; at 1 0.1128, 0.0897, 0.0830, 0.0778.
+    pub taa_resampled_frames: f32,
     /// Fault injection for tests: the temporal stage reads NaN, +Inf and -Inf in place of the
     /// matte light on a sparse pixel pattern (1 in 7).
     #[serde(skip)]
@@ -171,6 +190,7 @@ impl Default for MatteSettings {
             taps: 50,
             history_diameter_fraction: 0.01,
             history_full_frames: 1.0,
+            resampled_history_frames: 8.0,
             disocclusion_fraction: 0.05,
             low_confidence_multiplier: 6.0,
             max_radius_fraction: 0.1,
@@ -180,6 +200,7 @@ impl Default for MatteSettings {
             plane_sigma_px: 2.0,
             taa_alpha: 0.1,
             taa_still_frames: 64.0,
+            taa_resampled_frames: 1.0,
             inject_nonfinite: false,
         }
     }
@@ -315,6 +336,11 @@ pub struct GlossySettings {
     /// still frames (128-frame references) FLIP still / moving / settled 0.0942 / 0.1085 /
     /// 0.0946 against 0.0970 / 0.1092 / 0.0950 with 1 / sqrt(n).
     pub sigma_full_frames: f32,
+    /// A surface-reprojected history resampled bilinearly counts as at most this many frames,
+    /// as MatteSettings::resampled_history_frames (0: no cap). Strafe as measured there (matte
+    /// capped at 8), FLIP 10 and 19 frames after the stop / moving mean: uncapped 0.0805 /
+    /// 0.0753 / 0.1014, capped at 8 frames 0.0717 / 0.0668 / 0.1000.
+    pub resampled_history_frames: f32,
     /// Voorhuis eq. (6)'s omega, with the ray differential at the secondary hit measured in
     /// pixel footprints of the primary surface (scale-free, unlike the paper's world units):
     /// sigma is multiplied by exp(-footprints / omega) below the roughness threshold.
@@ -354,6 +380,7 @@ impl Default for GlossySettings {
             sigma_exponent: 0.1,
             sigma_epsilon_px: 1.0,
             sigma_full_frames: 1.0,
+            resampled_history_frames: 8.0,
             ray_differential_omega: 16.0,
             roughness_sigma: 0.1,
             trace_representative_ray: true,
