@@ -117,7 +117,8 @@ pub struct MatteSettings {
     /// still frames, 128-frame references, FLIP 10 frames after the stop (fresh start at the
     /// same view after 10 frames: 0.0774) / moving mean: no cap 0.0830 / 0.1030, 24 frames
     /// 0.0811 / 0.1028, 8 frames 0.0805 / 0.1014, 4 frames 0.0820 / 0.1020 (TAA restarting as
-    /// MatteSettings::taa_resampled_frames; the glossy chain uncapped).
+    /// MatteSettings::taa_resampled_frames; the glossy chain uncapped; these caps counted the
+    /// new frame among the 8). As shipped, with the glossy chain's cap too: 0.0720 / 0.1002.
     pub resampled_history_frames: f32,
     /// R of the disocclusion radius as a fraction of the screen width (paper: 1/20).
     pub disocclusion_fraction: f32,
