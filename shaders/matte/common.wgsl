@@ -166,10 +166,9 @@ fn previous_distance(depth: texture_depth_2d, normals: texture_2d<f32>, t: vec2i
     return max(abs(off_plane), along / s.stretch) / s.footprint;
 }
 
-// Bilinear fetch of a history at pixel coordinates `at` (texel centres at +0.5), edges clamped.
-// The histories are 32-bit floats, which WebGPU does not filter without an optional feature.
-// History length n of a history read bilinearly at `prev`: at most `cap` frames when `prev`
-// falls between texel centres (0: no cap). Reading a texel at its centre is exact.
+// History length n (this frame included) of a history read bilinearly at `prev`: at most
+// `cap` frames of history when `prev` falls between texel centres (0: no cap). Reading a texel
+// at its centre is exact.
 fn resampled_length(n: f32, prev: vec2f, cap: f32) -> f32 {
     let off = prev - floor(prev) - 0.5;
     if cap > 0.0 && dot(off, off) > 1e-6 {
@@ -178,6 +177,8 @@ fn resampled_length(n: f32, prev: vec2f, cap: f32) -> f32 {
     return n;
 }
 
+// Bilinear fetch of a history at pixel coordinates `at` (texel centres at +0.5), edges clamped.
+// The histories are 32-bit floats, which WebGPU does not filter without an optional feature.
 fn load_bilinear(t: texture_2d<f32>, at: vec2f) -> vec4f {
     let f = at - 0.5;
     let base = vec2i(floor(f));

@@ -64,17 +64,20 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let clamped = from_ycocg(yc);
         // A clamp by more than half-precision rounding.
         let held = any(abs(yc - y) > vec3f(1e-3 * max(abs(y.x), 1e-2)));
-        let weight_floor = select(dn.taa_alpha, min(dn.taa_alpha, 1.0 / max(dn.taa_still_frames, 1.0)), still && !held);
+        // Read exactly and left alone: the history may grow past 1 / taa_alpha.
+        let settled = still && !held;
+        let weight_floor = select(dn.taa_alpha, min(dn.taa_alpha, 1.0 / max(dn.taa_still_frames, 1.0)), settled);
+        // A negative length marks a history last resampled or clamped.
         var n_prev = select(texel.a, 1.0, texel.a != texel.a);
         if n_prev < 0.0 {
             n_prev = -n_prev;
-            if still && !held && dn.taa_resampled_frames > 0.0 {
+            if settled && dn.taa_resampled_frames > 0.0 {
                 n_prev = min(n_prev, dn.taa_resampled_frames);
             }
         }
         n = clamp(n_prev + 1.0, 1.0, 2.0 / weight_floor - 1.0);
         result = mix(clamped, current, 2.0 / (n + 1.0));
-        if !(still && !held) {
+        if !settled {
             n = -n;
         }
     }
