@@ -149,9 +149,16 @@ fn quality_writes_scores_and_a_plot() {
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 5, "{csv}");
     assert!(rows[0].starts_with("frame,time,flip,relmse,ssim,temporal_error"));
+    assert!(rows[0].ends_with(",uncovered_flip,uncovered_pixels"), "{}", rows[0]);
     for r in &rows[1..] {
-        let v: Vec<f64> = r.split(',').map(|x| x.parse().unwrap()).collect();
+        let fields: Vec<&str> = r.split(',').collect();
+        assert_eq!(fields.len(), 14, "{r}");
+        let v: Vec<f64> = fields[..12].iter().map(|x| x.parse().unwrap()).collect();
         assert!(v.iter().all(|x| x.is_finite()) && v[2] > 0.0 && v[2] < 1.0, "{r}");
+        // FLIP over the pixels the matte temporal flagged lately: blank when there are none.
+        let pixels: usize = fields[13].parse().unwrap();
+        assert_eq!(fields[12].is_empty(), pixels == 0, "{r}");
+        assert!(fields[12].is_empty() || (0.0..=1.0).contains(&fields[12].parse::<f64>().unwrap()), "{r}");
     }
     let ablations = std::fs::read_to_string(dir.join("ablations.csv")).unwrap();
     // Header, the full chain, and each of the 6 matte and 3 glossy stages off.
