@@ -93,8 +93,8 @@ pub struct Scores {
 
 /// Pixels that the matte temporal flagged (disoccluded, or a confidence under h / 2) within the
 /// last UNCOVERED_FRAMES frames, where they were flagged on screen: after a camera stops, the
-/// region a move uncovered, whose FLIP tells how fast it recovers (the issue asks for the static
-/// FLIP within 10 frames; a whole frame's FLIP hides a small region's lag).
+/// region a move uncovered, whose FLIP tells how fast it recovers (it should reach a still
+/// view's FLIP within 10 frames; a whole frame's FLIP hides a small region's lag).
 struct Uncovered {
     /// Frames since each pixel was last flagged.
     age: Vec<u32>,
