@@ -17,6 +17,13 @@
 // when the pixel stands still again its length restarts at taa_resampled_frames: held at
 // taa_alpha, the blur that resampling left in it would otherwise outlast the stop by tens of
 // frames.
+//
+// The image shown is the history, except at a settled pixel, where it is the last image shown
+// blended towards the history by taa_display_ratio x 2 / (n + 1) (at most 1): a second
+// low-pass that damps the flicker of a sub-pixel edge sampled at a new Halton offset every
+// frame (the history moves by 2 / (n + 1) of the edge's contrast each frame) and passes the
+// slower convergence of the denoised light. The history itself is not smoothed; the last image
+// shown is read back from final_image, which nothing else writes.
 
 @group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
 @group(0) @binding(42) var history: texture_2d<f32>;
@@ -37,6 +44,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let current = hdr_at(p);
     var result = current;
     var n = 1.0;
+    var shown_weight = 1.0;
     let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
     let on_screen = all(prev >= vec2f(0.0)) && all(prev < vec2f(frame.size));
     if stage_on(STAGE_TAA) && on_screen && dn.history_valid != 0u {
@@ -79,9 +87,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         result = mix(clamped, current, 2.0 / (n + 1.0));
         if !settled {
             n = -n;
+        } else if dn.taa_display_ratio > 0.0 {
+            // taa_display_ratio times the history's own weight: a fresh history is shown as is.
+            shown_weight = min(dn.taa_display_ratio * 2.0 / (n + 1.0), 1.0);
         }
     }
     result = half_safe(result);
     textureStore(out_history, p, vec4f(result, n));
-    final_image[u32(p.y) * frame.size.x + u32(p.x)] = vec4f(result, 1.0);
+    let i = u32(p.y) * frame.size.x + u32(p.x);
+    var shown = result;
+    if shown_weight < 1.0 {
+        shown = half_safe(mix(half_safe(final_image[i].rgb), result, shown_weight));
+    }
+    final_image[i] = vec4f(shown, 1.0);
 }

@@ -61,7 +61,8 @@ pub struct DenoiseParams {
     pub resampled_history_frames: f32,
     /// [`MatteSettings::taa_resampled_frames`].
     pub taa_resampled_frames: f32,
-    pub _pad: u32,
+    /// [`MatteSettings::taa_display_ratio`].
+    pub taa_display_ratio: f32,
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -113,7 +114,7 @@ impl DenoiseParams {
             reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
             taa_resampled_frames: s.taa_resampled_frames.clamp(0.0, 1024.0),
-            _pad: 0,
+            taa_display_ratio: if s.taa_display_ratio > 0.0 { s.taa_display_ratio.min(1024.0) } else { 0.0 },
         }
     }
 }
