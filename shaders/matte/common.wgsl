@@ -59,7 +59,8 @@ struct DenoiseParams {
     resampled_history_frames: f32,
     // TAA: a pixel that stands still again restarts its history length here (0: carries on).
     taa_resampled_frames: f32,
-    // TAA: the shown image follows a settled pixel's history with at least this weight.
+    // TAA: the shown image follows a settled pixel's history with this many times the history's
+    // own weight (0: the history is shown as is).
     taa_display_ratio: f32,
 }
 

@@ -181,8 +181,11 @@ pub struct MatteSettings {
     /// last; the jump of GlossySettings::resampled_history_frames, its still frames 10-19 and
     /// its uncovered pixels 10 frames after the stop), for 0, 2, 4, 8: Lantern 2.1e-5, 2.3e-6,
     /// 3.9e-6, 7.0e-6; level 0.0481 / 0.0456 at 0 and 0.0484 / 0.0458 at 4; jump 0.0756 /
-    /// 0.1066, 0.0779 / 0.1118, 0.0762 / 0.1079 at 0, 2, 4. A constant weight of 0.25 (5.0e-6 on
-    /// Lantern) lagged the first frames: the jump's still frames 0.0788.
+    /// 0.1066, 0.0779 / 0.1118, 0.0762 / 0.1079 at 0, 2, 4. The lag costs most where the
+    /// history converges slowest, at 0 and 4: the living room 0.1632 / 0.1502 and 0.1673 /
+    /// 0.1544 (its temporal error 0.0209 and 0.0045), the staircase 0.0645 / 0.0615 and 0.0652 /
+    /// 0.0621. A constant weight of 0.25 (5.0e-6 on Lantern) lagged the first frames: the
+    /// jump's still frames 0.0788.
     pub taa_display_ratio: f32,
     /// Fault injection for tests: the temporal stage reads NaN, +Inf and -Inf in place of the
     /// matte light on a sparse pixel pattern (1 in 7).
