@@ -3,7 +3,8 @@
 use glam::DVec3;
 use hush_engine::accel::BvhKind;
 use hush_engine::frame::{FrameInput, Renderer};
-use hush_engine::quality::{Image, compare, luminance};
+use hush_engine::passes::matte::history_rejected;
+use hush_engine::quality::{Image, compare, flip_over, luminance};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MatteSettings};
 use hush_tests::reproject::{DepthFrame, Surface, neighbours_3x3};
@@ -18,6 +19,26 @@ fn level() -> (hush_engine::gpu::Gpu, Renderer) {
 /// The courtyard and the hall's doorway, with the animated cube out of view (a still image).
 fn view() -> Camera {
     Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0)
+}
+
+/// view() moved right by `step` metres a frame for `moving` frames, then held: the camera of
+/// frame k of a strafe that starts after the still frames.
+fn strafe(step: f64, moving: u32) -> impl Fn(u32) -> Camera {
+    move |k| {
+        let dx = step * k.min(moving) as f64;
+        Camera::look_at(DVec3::new(-3.0 + dx, 1.7, 4.0), DVec3::new(-2.0 + dx, 1.2, -6.0), 60.0)
+    }
+}
+
+/// A fresh renderer after 10 still frames at at(0) and one frame at each of at(1)..=at(moving):
+/// the moment the camera stops.
+fn strafed(s: &FrameSettings, at: &impl Fn(u32) -> Camera, moving: u32) -> (hush_engine::gpu::Gpu, Renderer) {
+    let (gpu, mut r) = level();
+    frames(&mut r, &gpu, s, at(0), 10);
+    for k in 1..=moving {
+        frames(&mut r, &gpu, s, at(k), 1);
+    }
+    (gpu, r)
 }
 
 fn frames(r: &mut Renderer, gpu: &hush_engine::gpu::Gpu, s: &FrameSettings, camera: Camera, n: u32) -> Image {
@@ -113,7 +134,8 @@ fn still_view_keeps_its_history() {
     let (pixels, reason) = (SIZE.0 as usize * SIZE.1 as usize, r.read_texture(&gpu, "matte/reason").unwrap().0);
     let (depth, _) = r.read_texture(&gpu, "gbuffer/depth").unwrap();
     let surface = |i: usize| f32::from_le_bytes(depth[i * 4..i * 4 + 4].try_into().unwrap()) > 0.0;
-    let reset: Vec<usize> = (0..pixels).filter(|&i| surface(i) && u32::from_le_bytes(reason[i * 4..i * 4 + 4].try_into().unwrap()) & 3 != 0).collect();
+    let rejected = history_rejected(&reason);
+    let reset: Vec<usize> = (0..pixels).filter(|&i| surface(i) && rejected[i]).collect();
     println!("still view, 8th frame: {} of {pixels} pixels reset their history", reset.len());
     assert!(reset.len() * 1000 <= pixels, "{} pixels reset their history in a still view: {:?}", reset.len(), &reset[..reset.len().min(20)]);
 }
@@ -218,19 +240,12 @@ fn history_resets_on_disocclusion() {
 /// rounding), and 5% under the uncapped stop (measured 19%).
 #[test]
 fn camera_stop_recovers_like_a_fresh_start() {
-    let at = |k: u32| {
-        let dx = 0.06 * k.min(10) as f64;
-        Camera::look_at(DVec3::new(-3.0 + dx, 1.7, 4.0), DVec3::new(-2.0 + dx, 1.2, -6.0), 60.0)
-    };
+    let at = strafe(0.06, 10);
     let (gpu, mut r) = level();
     let converged = frames(&mut r, &gpu, &FrameSettings { accumulate: true, seed: 5, ..Default::default() }, at(10), 128);
     let flip = |img: &Image| compare(img, &converged).unwrap().flip;
     let stopped = |s: &FrameSettings| {
-        let (gpu, mut r) = level();
-        frames(&mut r, &gpu, s, at(0), 10);
-        for k in 1..=10 {
-            frames(&mut r, &gpu, s, at(k), 1);
-        }
+        let (gpu, mut r) = strafed(s, &at, 10);
         flip(&frames(&mut r, &gpu, s, at(10), 10))
     };
     let fresh = {
@@ -261,30 +276,18 @@ fn camera_stop_recovers_like_a_fresh_start() {
 /// glossy caps) prints the region's FLIP for each.
 #[test]
 fn disoccluded_region_recovers_like_a_fresh_start() {
-    let at = |k: u32| {
-        let dx = 0.24 * k.min(5) as f64;
-        Camera::look_at(DVec3::new(-3.0 + dx, 1.7, 4.0), DVec3::new(-2.0 + dx, 1.2, -6.0), 60.0)
-    };
+    let at = strafe(0.24, 5);
     let (gpu, mut r) = level();
     let converged = frames(&mut r, &gpu, &FrameSettings { accumulate: true, seed: 5, ..Default::default() }, at(5), 128);
-    let region_flip = |img: &Image, region: &[bool]| {
-        let map = hush_engine::quality::flip_map(img, &converged);
-        let (sum, n) = map.iter().zip(region).filter(|(_, r)| **r).fold((0.0f64, 0), |(s, n), (e, _)| (s + *e as f64, n + 1));
-        sum / n.max(1) as f64
-    };
+    let region_flip = |img: &Image, region: &[bool]| flip_over(img, &converged, region).map_or(0.0, |(f, _)| f);
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
     let jump = |s: &FrameSettings| {
-        let (gpu, mut r) = level();
-        frames(&mut r, &gpu, s, at(0), 10);
-        for k in 1..=5 {
-            frames(&mut r, &gpu, s, at(k), 1);
-        }
-        let reason = r.read_texture(&gpu, "matte/reason").unwrap().0;
-        let flagged = |i: usize| u32::from_le_bytes(reason[i * 4..i * 4 + 4].try_into().unwrap()) & 3 != 0;
+        let (gpu, mut r) = strafed(s, &at, 5);
+        let flagged = history_rejected(&r.read_texture(&gpu, "matte/reason").unwrap().0);
         let region: Vec<bool> = (0..w * h)
             .map(|i| {
                 let (x, y) = ((i % w) as i64, (i / w) as i64);
-                neighbours_3x3(x, y).any(|(tx, ty)| tx >= 0 && ty >= 0 && (tx as usize) < w && (ty as usize) < h && flagged(ty as usize * w + tx as usize))
+                neighbours_3x3(x, y).any(|(tx, ty)| tx >= 0 && ty >= 0 && (tx as usize) < w && (ty as usize) < h && flagged[ty as usize * w + tx as usize])
             })
             .collect();
         (frames(&mut r, &gpu, s, at(5), 10), region)

@@ -14,7 +14,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
-use hush_engine::quality::{Image, compare, flip_map, luminance, save_flip_heatmap};
+use hush_engine::passes::matte::history_rejected;
+use hush_engine::quality::{Image, compare, flip_over, luminance, save_flip_heatmap};
 use hush_engine::scene::{CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings, stage_names};
 use std::io::Write;
@@ -104,12 +105,11 @@ const UNCOVERED_FRAMES: u32 = 10;
 
 impl Uncovered {
     /// Age the pixels by a frame and restart those the matte temporal flagged in this one
-    /// (the low two bits of matte/reason, shaders/matte/temporal.wgsl).
+    /// (hush_engine::passes::matte::history_rejected).
     fn update(&mut self, r: &Renderer, gpu: &Gpu) -> Result<Vec<bool>> {
         let (reason, _) = r.read_texture(gpu, "matte/reason").context("reading the matte temporal's flags")?;
-        for (age, texel) in self.age.iter_mut().zip(reason.chunks_exact(4)) {
-            let flags = u32::from_le_bytes([texel[0], texel[1], texel[2], texel[3]]) & 3;
-            *age = if flags != 0 { 0 } else { age.saturating_add(1) };
+        for (age, rejected) in self.age.iter_mut().zip(history_rejected(&reason)) {
+            *age = if rejected { 0 } else { age.saturating_add(1) };
         }
         Ok(self.age.iter().map(|a| *a <= UNCOVERED_FRAMES).collect())
     }
@@ -118,14 +118,8 @@ impl Uncovered {
 impl Scores {
     fn push(&mut self, img: &Image, prev: Option<&Image>, reference: &Image, ms: f64, uncovered: Option<&[bool]>) -> Result<()> {
         let m = compare(img, reference)?;
-        let (mut sum, mut n) = (0.0f64, 0usize);
-        if let Some(mask) = uncovered.filter(|m| m.iter().any(|u| *u)) {
-            for (e, _) in flip_map(img, reference).iter().zip(mask).filter(|(_, u)| **u) {
-                sum += *e as f64;
-                n += 1;
-            }
-        }
-        self.uncovered_flip.push(if n > 0 { sum / n as f64 } else { f64::NAN });
+        let (flip, n) = uncovered.and_then(|mask| flip_over(img, reference, mask)).unwrap_or((f64::NAN, 0));
+        self.uncovered_flip.push(flip);
         self.uncovered_pixels.push(n);
         self.flip.push(m.flip as f64);
         self.relmse.push(m.relmse);

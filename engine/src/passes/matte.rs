@@ -114,7 +114,7 @@ impl DenoiseParams {
             reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
             taa_resampled_frames: s.taa_resampled_frames.clamp(0.0, 1024.0),
-            taa_display_ratio: if s.taa_display_ratio > 0.0 { s.taa_display_ratio.min(1024.0) } else { 0.0 },
+            taa_display_ratio: s.taa_display_ratio.clamp(0.0, 1024.0),
         }
     }
 }
@@ -122,6 +122,14 @@ impl DenoiseParams {
 /// The reprojections' normal test as a cosine: 180 degrees or more passes every normal.
 pub fn normal_test_cos(degrees: f32) -> f32 {
     if degrees >= 180.0 { -2.0 } else { degrees.max(0.0).to_radians().cos() }
+}
+
+/// Pixels whose matte history the temporal stage rejected this frame (disoccluded, or a
+/// confidence under h / 2: the low two flag bits of a `matte/reason` texel, as
+/// shaders/matte/temporal.wgsl writes them; the history length sits above the 8 flag bits),
+/// from that texture's bytes as `Renderer::read_texture` returns them.
+pub fn history_rejected(reason: &[u8]) -> Vec<bool> {
+    reason.chunks_exact(4).map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]) & 3 != 0).collect()
 }
 
 /// Per-pixel textures of the chain (made with the frame's other targets).

@@ -69,6 +69,16 @@ pub fn flip_map(x: &Image, y: &Image) -> Vec<f32> {
     flip_error(x, y).to_vec()
 }
 
+/// Mean LDR-FLIP of x against y over the pixels where `region` is true (row-major), and how
+/// many there are; None where the region is empty.
+pub fn flip_over(x: &Image, y: &Image, region: &[bool]) -> Option<(f64, usize)> {
+    if !region.iter().any(|r| *r) {
+        return None;
+    }
+    let (sum, n) = flip_map(x, y).iter().zip(region).filter(|(_, r)| **r).fold((0.0f64, 0usize), |(s, n), (e, _)| (s + *e as f64, n + 1));
+    Some((sum / n as f64, n))
+}
+
 /// The per-pixel LDR-FLIP of `x` against `y` in FLIP's magma colour map (black: no visible
 /// difference), as FLIP's own tool draws it, written as a PNG.
 pub fn save_flip_heatmap(x: &Image, y: &Image, path: &std::path::Path) -> Result<()> {
