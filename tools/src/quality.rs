@@ -15,7 +15,7 @@ use clap::Args;
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::passes::matte::history_rejected;
-use hush_engine::quality::{Image, compare, flip_over, luminance, save_flip_heatmap};
+use hush_engine::quality::{Image, compare, compare_with_flip_map, luminance, region_mean, save_flip_heatmap};
 use hush_engine::scene::{CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings, stage_names};
 use std::io::Write;
@@ -117,8 +117,15 @@ impl Uncovered {
 
 impl Scores {
     fn push(&mut self, img: &Image, prev: Option<&Image>, reference: &Image, ms: f64, uncovered: Option<&[bool]>) -> Result<()> {
-        let m = compare(img, reference)?;
-        let (flip, n) = uncovered.and_then(|mask| flip_over(img, reference, mask)).unwrap_or((f64::NAN, 0));
+        // With a region to score, the frame's FLIP map is kept rather than computed again.
+        let (m, region) = match uncovered {
+            Some(mask) => {
+                let (m, map) = compare_with_flip_map(img, reference)?;
+                (m, region_mean(&map, mask))
+            }
+            None => (compare(img, reference)?, None),
+        };
+        let (flip, n) = region.unwrap_or((f64::NAN, 0));
         self.uncovered_flip.push(flip);
         self.uncovered_pixels.push(n);
         self.flip.push(m.flip as f64);

@@ -75,8 +75,14 @@ pub fn flip_over(x: &Image, y: &Image, region: &[bool]) -> Option<(f64, usize)> 
     if !region.iter().any(|r| *r) {
         return None;
     }
-    let (sum, n) = flip_map(x, y).iter().zip(region).filter(|(_, r)| **r).fold((0.0f64, 0usize), |(s, n), (e, _)| (s + *e as f64, n + 1));
-    Some((sum / n as f64, n))
+    region_mean(&flip_map(x, y), region)
+}
+
+/// Mean of a per-pixel map (as `flip_map` returns) over the pixels where `region` is true, and
+/// how many there are; None where the region is empty.
+pub fn region_mean(map: &[f32], region: &[bool]) -> Option<(f64, usize)> {
+    let (sum, n) = map.iter().zip(region).filter(|(_, r)| **r).fold((0.0f64, 0usize), |(s, n), (e, _)| (s + *e as f64, n + 1));
+    (n > 0).then(|| (sum / n as f64, n))
 }
 
 /// The per-pixel LDR-FLIP of `x` against `y` in FLIP's magma colour map (black: no visible
@@ -104,6 +110,17 @@ fn flip_error(x: &Image, y: &Image) -> nv_flip::FlipImageFloat {
 }
 
 pub fn compare(test: &Image, reference: &Image) -> Result<Metrics> {
+    Ok(metrics(test, reference)?.0)
+}
+
+/// `compare`, and the per-pixel FLIP map it averaged (as `flip_map`), for scoring a region of
+/// the same frame without computing FLIP twice.
+pub fn compare_with_flip_map(test: &Image, reference: &Image) -> Result<(Metrics, Vec<f32>)> {
+    let (m, flip) = metrics(test, reference)?;
+    Ok((m, flip.to_vec()))
+}
+
+fn metrics(test: &Image, reference: &Image) -> Result<(Metrics, nv_flip::FlipImageFloat)> {
     check_sizes(test, reference)?;
     let nonfinite_pixels = test.nonfinite_pixels();
     let x = sanitized(test);
@@ -113,15 +130,17 @@ pub fn compare(test: &Image, reference: &Image) -> Result<Metrics> {
         / (3.0 * n);
     let (mx, my) = (x.mean().as_dvec3(), y.mean().as_dvec3());
     let bias = [0, 1, 2].map(|k| if my[k] != 0.0 { (mx[k] - my[k]) / my[k] } else { 0.0 });
-    Ok(Metrics {
+    let flip = flip_error(&x, &y);
+    let metrics = Metrics {
         rmse: rmse(&x, &y),
         relmse: relmse(&x, &y),
         mae,
         mean_rel_bias: bias,
         ssim: ssim_luma(&x, &y),
-        flip: flip_ldr(&x, &y),
+        flip: nv_flip::FlipPool::from_image(&flip).mean() as f64,
         nonfinite_pixels,
-    })
+    };
+    Ok((metrics, flip))
 }
 
 #[cfg(test)]
