@@ -62,6 +62,8 @@ struct DenoiseParams {
     // TAA: the shown image follows a settled pixel's history with this many times the history's
     // own weight (0: the history is shown as is).
     taa_display_ratio: f32,
+    // TAA: share of a settled pixel's matte-light lag taken out (MatteSettings::taa_current_light).
+    taa_current_light: f32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;
@@ -77,6 +79,9 @@ const STAGE_TAA: u32 = 32u;
 const REASON_DISOCCLUDED: u32 = 1u;
 const REASON_LOW_CONFIDENCE: u32 = 2u;
 const REASON_CLAMPED: u32 = 4u;
+// The history came from a neighbouring texel (the raster's jitter moved the surface off this
+// pixel's last sample): the matte light may jump between frames there.
+const REASON_NEIGHBOUR: u32 = 8u;
 
 fn stage_on(bit: u32) -> bool {
     return (dn.stages & bit) != 0u;

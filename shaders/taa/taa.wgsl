@@ -24,11 +24,41 @@
 // frame (the history moves by 2 / (n + 1) of the edge's contrast each frame) and passes the
 // slower convergence of the denoised light. The history itself is not smoothed; the last image
 // shown is read back from final_image, which nothing else writes.
+//
+// A settled pixel's history averages composites whose matte light was itself a running mean, so
+// it weighs old, little-converged light most. TAA also averages, with the same weights, the
+// matte factor m (1 - F)^2 and the residual (the composite less that factor times the matte
+// temporal's output), and where the matte history continues last frame's (this pixel's own
+// texel, at least as long as TAA's) the history becomes avg(factor) x current light +
+// avg(residual), mixed in by taa_current_light: the same image while the light stands still,
+// and no lag while it converges. Elsewhere (a sample off the surface, a history from a
+// neighbouring texel) the residual is re-set so that the two agree, and the pixel keeps TAA's
+// own average.
 
 @group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
 @group(0) @binding(42) var history: texture_2d<f32>;
 @group(0) @binding(50) var out_history: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(54) var<storage, read_write> final_image: array<vec4f>;
+// The matte temporal's output (stage 3) and its history length (above the reason's 8 flag bits).
+@group(0) @binding(44) var matte_temporal: texture_2d<f32>;
+@group(0) @binding(51) var matte_reason: texture_2d<u32>;
+// Averages, over TAA's history, of the matte factor m (1 - F)^2 and of the composite less that
+// factor times the matte temporal's output (MatteSettings::taa_current_light).
+@group(0) @binding(55) var material_history: texture_2d<f32>;
+@group(0) @binding(56) var out_material: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(57) var residual_history: texture_2d<f32>;
+@group(0) @binding(58) var out_residual: texture_storage_2d<rgba32float, write>;
+
+// What the composite multiplies the matte light by (shaders/realtime/composite.wgsl).
+fn matte_factor(px: vec2u) -> vec3f {
+    let g = gbuffer_at(vec2i(px));
+    if !g.hit {
+        return vec3f(0.0);
+    }
+    let f_s = fresnel_mirror(g, dot(g.n, -camera_ray(px)));
+    let one_minus_f = vec3f(1.0) - f_s;
+    return g.base * (1.0 - g.metallic) * one_minus_f * one_minus_f;
+}
 
 fn hdr_at(p: vec2i) -> vec3f {
     let q = clamp(p, vec2i(0), vec2i(frame.size) - 1);
@@ -42,6 +72,18 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let current = hdr_at(p);
+    let m_k = matte_factor(gid.xy);
+    let light_k = half_safe(textureLoad(matte_temporal, p, 0).rgb);
+    let matte_reason_k = textureLoad(matte_reason, p, 0).x;
+    // The matte light of this pixel continues last frame's: a surface whose history is this
+    // pixel's own texel.
+    let own_light = has_surface(p) && (matte_reason_k & (REASON_DISOCCLUDED | REASON_LOW_CONFIDENCE | REASON_NEIGHBOUR)) == 0u;
+    let matte_n = f32(matte_reason_k >> 8u);
+    var material = m_k;
+    var residual = current - m_k * light_k;
+    // Residual's alpha: 1 where it was kept in step with the matte light (the next frame may
+    // follow the light from it).
+    var in_step = select(0.0, 1.0, own_light);
     var result = current;
     var n = 1.0;
     var shown_weight = 1.0;
@@ -84,7 +126,26 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             }
         }
         n = clamp(n_prev + 1.0, 1.0, 2.0 / weight_floor - 1.0);
-        result = mix(clamped, current, 2.0 / (n + 1.0));
+        let w = 2.0 / (n + 1.0);
+        result = mix(clamped, current, w);
+        material = mix(half_safe(load_bilinear(material_history, prev).rgb), m_k, w);
+        let r_prev = load_bilinear(residual_history, prev);
+        let averaged = mix(half_safe(r_prev.rgb), current - m_k * light_k, w);
+        let followed = material * light_k + averaged;
+        // The matte history at least as long as TAA's, and continuing last frame's.
+        let follows = settled && own_light && matte_n >= n && dn.taa_current_light > 0.0;
+        in_step = select(0.0, 1.0, follows);
+        // Negative where the pixel's material and light changed together (a sub-pixel edge
+        // between a lit and an unlit surface): the product of the averages is not the average of
+        // the products there.
+        if follows && r_prev.a == 1.0 && all(followed >= vec3f(0.0)) {
+            // The history's matte light, replaced by the current one: residual averages what
+            // the composite adds beside m (1 - F)^2 x light.
+            residual = averaged;
+            result = mix(result, followed, dn.taa_current_light);
+        } else {
+            residual = result - material * light_k;
+        }
         if !settled {
             n = -n;
         } else if dn.taa_display_ratio > 0.0 {
@@ -94,6 +155,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     result = half_safe(result);
     textureStore(out_history, p, vec4f(result, n));
+    textureStore(out_material, p, vec4f(half_safe(material), 0.0));
+    textureStore(out_residual, p, vec4f(half_safe(residual), in_step));
     let i = u32(p.y) * frame.size.x + u32(p.x);
     var shown = result;
     if shown_weight < 1.0 {

@@ -63,6 +63,10 @@ pub struct DenoiseParams {
     pub taa_resampled_frames: f32,
     /// [`MatteSettings::taa_display_ratio`].
     pub taa_display_ratio: f32,
+    /// [`MatteSettings::taa_current_light`].
+    pub taa_current_light: f32,
+    /// The uniform's size is a multiple of 16 bytes.
+    pub _pad: [f32; 3],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -115,6 +119,8 @@ impl DenoiseParams {
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
             taa_resampled_frames: s.taa_resampled_frames.clamp(0.0, 1024.0),
             taa_display_ratio: s.taa_display_ratio.clamp(0.0, 1024.0),
+            taa_current_light: s.taa_current_light.clamp(0.0, 1.0),
+            _pad: [0.0; 3],
         }
     }
 }
@@ -145,6 +151,10 @@ pub struct MatteTargets {
     pub median: (wgpu::Texture, wgpu::TextureView),
     pub denoised: (wgpu::Texture, wgpu::TextureView),
     pub taa_history: [(wgpu::Texture, wgpu::TextureView); 2],
+    /// TAA's averages of the matte factor m (1 - F)^2 and of the composite less the matte
+    /// factor times the matte temporal's output ([`MatteSettings::taa_current_light`]).
+    pub taa_material: [(wgpu::Texture, wgpu::TextureView); 2],
+    pub taa_residual: [(wgpu::Texture, wgpu::TextureView); 2],
     /// The image after TAA (what the display shows), 16 bytes per pixel.
     pub final_image: wgpu::Buffer,
 }
@@ -162,11 +172,13 @@ impl MatteTargets {
         let median = t("matte/firefly", RGBA16F);
         let denoised = t("matte/bilateral", RGBA16F);
         let taa_history = [t("taa/history 0", RGBA32F), t("taa/history 1", RGBA32F)];
+        let taa_material = [t("taa/material 0", RGBA32F), t("taa/material 1", RGBA32F)];
+        let taa_residual = [t("taa/residual 0", RGBA32F), t("taa/residual 1", RGBA32F)];
         let prev_depth = mem.texture(d, "matte/previous depth", size, super::gbuffer::DEPTH_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
         let prev_normal = mem.texture(d, "matte/previous normal", size, super::gbuffer::COLOR_FORMATS[0].1, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let final_image = mem.buffer(d, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
-        MatteTargets { prev_depth, prev_normal, history, temporal, reason, min, radius, median, denoised, taa_history, final_image }
+        MatteTargets { prev_depth, prev_normal, history, temporal, reason, min, radius, median, denoised, taa_history, taa_material, taa_residual, final_image }
     }
 }
 
@@ -245,6 +257,12 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> 
                 .texture(42, &m.taa_history[parity].1, f)
                 .storage_texture(50, &m.taa_history[1 - parity].1, RGBA32F)
                 .storage(54, &m.final_image, false)
+                .texture(44, &m.temporal.1, f)
+                .texture(51, &m.reason.1, wgpu::TextureSampleType::Uint)
+                .texture(55, &m.taa_material[parity].1, f)
+                .storage_texture(56, &m.taa_material[1 - parity].1, RGBA32F)
+                .texture(57, &m.taa_residual[parity].1, f)
+                .storage_texture(58, &m.taa_residual[1 - parity].1, RGBA32F)
         }
     }
     b
