@@ -19,9 +19,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if g.hit {
         let rd = camera_ray(px);
         let f_s = fresnel_mirror(g, dot(g.n, -rd));
-        let albedo = g.base * (1.0 - g.metallic);
-        let one_minus_f = vec3f(1.0) - f_s;
-        l += g.emission + textureLoad(tr_matte, p, 0).rgb * albedo * one_minus_f * one_minus_f;
+        l += g.emission + textureLoad(tr_matte, p, 0).rgb * matte_factor(g, f_s);
         l += glossy_light(p) * f_s;
     }
     l = select(vec3f(0.0), l, (l == l) & (abs(l) <= vec3f(3.0e38)));

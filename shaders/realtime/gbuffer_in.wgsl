@@ -45,3 +45,10 @@ fn fresnel_mirror(g: GSample, cos_o: f32) -> vec3f {
     let m2 = m * m;
     return g.f0 + (vec3f(g.f90) - g.f0) * (m2 * m2 * m);
 }
+
+// What the composite multiplies the matte light by: m (1 - F(w_s))^2 with m = base colour x
+// (1 - metallic), Mara et al. eq. (9) and (10).
+fn matte_factor(g: GSample, f_s: vec3f) -> vec3f {
+    let one_minus_f = vec3f(1.0) - f_s;
+    return g.base * (1.0 - g.metallic) * one_minus_f * one_minus_f;
+}

@@ -49,15 +49,13 @@
 @group(0) @binding(57) var residual_history: texture_2d<f32>;
 @group(0) @binding(58) var out_residual: texture_storage_2d<rgba32float, write>;
 
-// What the composite multiplies the matte light by (shaders/realtime/composite.wgsl).
-fn matte_factor(px: vec2u) -> vec3f {
+// The composite's matte factor at this pixel (0 off the surface).
+fn pixel_matte_factor(px: vec2u) -> vec3f {
     let g = gbuffer_at(vec2i(px));
     if !g.hit {
         return vec3f(0.0);
     }
-    let f_s = fresnel_mirror(g, dot(g.n, -camera_ray(px)));
-    let one_minus_f = vec3f(1.0) - f_s;
-    return g.base * (1.0 - g.metallic) * one_minus_f * one_minus_f;
+    return matte_factor(g, fresnel_mirror(g, dot(g.n, -camera_ray(px))));
 }
 
 fn hdr_at(p: vec2i) -> vec3f {
@@ -72,7 +70,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let current = hdr_at(p);
-    let m_k = matte_factor(gid.xy);
+    let m_k = pixel_matte_factor(gid.xy);
     let light_k = half_safe(textureLoad(matte_temporal, p, 0).rgb);
     let matte_reason_k = textureLoad(matte_reason, p, 0).x;
     // The matte light of this pixel continues last frame's: a surface whose history is this
