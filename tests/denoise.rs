@@ -92,8 +92,9 @@ fn denoised_frames_beat_raw_ones() {
     assert!(m_dn.relmse < 0.05 * m_raw.relmse, "denoised relMSE {} vs raw {}", m_dn.relmse, m_raw.relmse);
 }
 
-/// NaN, +Inf and -Inf injected into the chain's input on 1 pixel in 7 never reach the history or
-/// the image, with every stage on and with each one off.
+/// NaN, +Inf and -Inf injected into the chain's input on 1 pixel in 7 never reach the history
+/// (TAA's colour, matte factor and residual averages included) or the image, with every stage on
+/// and with each one off.
 #[test]
 fn nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) = level();
@@ -108,7 +109,10 @@ fn nonfinite_input_never_reaches_history_or_screen() {
         let s = FrameSettings { denoiser: Denoiser::Mara, matte: m.clone(), ..Default::default() };
         let img = frames(&mut r, &gpu, &s, view(), 4);
         assert!(img.data.iter().all(|p| p.is_finite()), "non-finite pixel on screen with {m:?}");
-        for name in ["matte/history 0", "matte/history 1", "matte/temporal", "matte/bilateral", "taa/history 0", "taa/history 1"] {
+        let histories = ["matte/history 0", "matte/history 1", "matte/temporal", "matte/bilateral", "taa/history 0", "taa/history 1"];
+        // TAA's averages of the matte factor and the residual (MatteSettings::taa_current_light).
+        let taa_averages = ["taa/material 0", "taa/material 1", "taa/residual 0", "taa/residual 1"];
+        for name in histories.into_iter().chain(taa_averages) {
             let (bytes, format) = r.read_texture(&gpu, name).unwrap();
             // Histories are 32-bit floats, single-frame outputs halves.
             let bad = match format {

@@ -574,6 +574,10 @@ impl Renderer {
                     "matte/bilateral" => &m.denoised.0,
                     "taa/history 0" => &m.taa_history[0].0,
                     "taa/history 1" => &m.taa_history[1].0,
+                    "taa/material 0" => &m.taa_material[0].0,
+                    "taa/material 1" => &m.taa_material[1].0,
+                    "taa/residual 0" => &m.taa_residual[0].0,
+                    "taa/residual 1" => &m.taa_residual[1].0,
                     _ => bail!("no texture {n}"),
                 }
             }
