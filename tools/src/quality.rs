@@ -249,22 +249,22 @@ pub fn run(a: QualityArgs) -> Result<()> {
     // same run's yardstick came out 0.1388 or 0.1403 (the living room at 160x90) by whether
     // its reference had to be rendered.
     drop(refr);
-    let mut refr = renderer(&s)?;
+    let mut accumulator = renderer(&s)?;
     let mut flips64 = vec![];
     let mut accumulated64 = None;
     for j in 0..a.yardstick_seeds.max(1) {
         let yardstick = FrameSettings { seed: a.seed.wrapping_add(104729).wrapping_add(j.wrapping_mul(7)), ..acc.clone() };
         for _ in 0..64 {
-            refr.render(&s.gpu, &last_input, &yardstick, None)?;
+            accumulator.render(&s.gpu, &last_input, &yardstick, None)?;
         }
-        let img = refr.read_hdr(&s.gpu)?;
+        let img = accumulator.read_hdr(&s.gpu)?;
         flips64.push(compare(&img, &references[references.len() - 1])?.flip);
         accumulated64.get_or_insert(img);
     }
     let accumulated64 = accumulated64.expect("at least one yardstick accumulation");
     let flip64 = flips64.iter().sum::<f64>() / flips64.len() as f64;
     let (lo64, hi64) = flips64.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &f| (l.min(f), h.max(f)));
-    drop(refr);
+    drop(accumulator);
 
     let max_depth = crate::realtime::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
