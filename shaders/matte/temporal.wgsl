@@ -55,12 +55,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let texel = textureLoad(history, r.texel, 0);
         n = min(max(texel.a, 1.0) + 1.0, 1024.0);
         var hist = half_safe(texel.rgb);
-        if !r.bilinear {
-            reason |= REASON_NEIGHBOUR;
-        }
         if r.bilinear {
             hist = half_safe(load_bilinear(history, prev).rgb);
             n = resampled_length(n, prev, dn.resampled_history_frames);
+        } else {
+            reason |= REASON_NEIGHBOUR;
         }
         var clamped = hist;
         if dn.clamp_sigma > 0.0 {

@@ -77,8 +77,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // pixel's own texel.
     let own_light = has_surface(p) && (matte_reason_k & (REASON_DISOCCLUDED | REASON_LOW_CONFIDENCE | REASON_NEIGHBOUR)) == 0u;
     let matte_n = f32(matte_reason_k >> 8u);
+    // What the composite adds beside m (1 - F)^2 x the matte light.
+    let rest_k = current - m_k * light_k;
     var material = m_k;
-    var residual = current - m_k * light_k;
+    var residual = rest_k;
     // Residual's alpha: 1 where it was kept in step with the matte light (the next frame may
     // follow the light from it).
     var in_step = select(0.0, 1.0, own_light);
@@ -128,7 +130,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         result = mix(clamped, current, w);
         material = mix(half_safe(load_bilinear(material_history, prev).rgb), m_k, w);
         let r_prev = load_bilinear(residual_history, prev);
-        let averaged = mix(half_safe(r_prev.rgb), current - m_k * light_k, w);
+        let averaged = mix(half_safe(r_prev.rgb), rest_k, w);
         let followed = material * light_k + averaged;
         // The matte history at least as long as TAA's, and continuing last frame's.
         let follows = settled && own_light && matte_n >= n && dn.taa_current_light > 0.0;
