@@ -110,8 +110,9 @@ fn nonfinite_input_never_reaches_history_or_screen() {
         let img = frames(&mut r, &gpu, &s, view(), 4);
         assert!(img.data.iter().all(|p| p.is_finite()), "non-finite pixel on screen with {m:?}");
         let histories = ["matte/history 0", "matte/history 1", "matte/temporal", "matte/bilateral", "taa/history 0", "taa/history 1"];
-        // TAA's averages of the matte factor and the residual (MatteSettings::taa_current_light).
-        let taa_averages = ["taa/material 0", "taa/material 1", "taa/residual 0", "taa/residual 1"];
+        // TAA's averages of the matte and glossy factors and the residual
+        // (MatteSettings::taa_current_light, taa_current_glossy).
+        let taa_averages = ["taa/material 0", "taa/material 1", "taa/residual 0", "taa/residual 1", "taa/glossy 0", "taa/glossy 1"];
         for name in histories.into_iter().chain(taa_averages) {
             let (bytes, format) = r.read_texture(&gpu, name).unwrap();
             // Histories are 32-bit floats, single-frame outputs halves.

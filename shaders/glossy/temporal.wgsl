@@ -110,6 +110,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var result = current;
     var n = 1.0;
     var clip = 0.0;
+    var own = 0.0;
     if c > 0.0 {
         let texel = textureLoad(history, r.texel, 0);
         n = min(max(texel.a, 1.0) + 1.0, 1024.0);
@@ -118,6 +119,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             hist = half_safe(load_bilinear(history, prev).rgb);
             n = resampled_length(n, prev, gp.resampled_history_frames);
         }
+        own = select(0.0, 1.0, all(r.texel == p) && (!r.bilinear || all(prev == vec2f(p) + 0.5)));
         var clipped = hist;
         if gstage_on(GSTAGE_CLIPPING) && roughness < gp.clip_roughness {
             var lo = vec3f(3.0e38);
@@ -135,5 +137,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         result = mix(clipped, current, max(1.0 - c, 1.0 / n));
     }
     textureStore(dst, p, vec4f(half_safe(result), n));
-    textureStore(out_info, p, vec4f(c, clip, n, 0.0));
+    textureStore(out_info, p, vec4f(c, clip, n, own));
 }

@@ -64,6 +64,8 @@ struct DenoiseParams {
     taa_display_ratio: f32,
     // TAA: share of a settled pixel's matte-light lag taken out (MatteSettings::taa_current_light).
     taa_current_light: f32,
+    // The same for the glossy light (MatteSettings::taa_current_glossy).
+    taa_current_glossy: f32,
 }
 
 @group(0) @binding(40) var<uniform> dn: DenoiseParams;

@@ -25,15 +25,19 @@
 // slower convergence of the denoised light. The history itself is not smoothed; the last image
 // shown is read back from final_image, which nothing else writes.
 //
-// A settled pixel's history averages composites whose matte light was itself a running mean, so
-// it weighs old, little-converged light most. TAA also averages, with the same weights, the
-// matte factor m (1 - F)^2 and the residual (the composite less that factor times the matte
-// temporal's output), and where the matte history continues last frame's (this pixel's own
-// texel, at least as long as TAA's) the history becomes avg(factor) x current light +
-// avg(residual), mixed in by taa_current_light: the same image while the light stands still,
-// and no lag while it converges. Elsewhere (a sample off the surface, a history from a
-// neighbouring texel) the residual is re-set so that the two agree, and the pixel keeps TAA's
-// own average.
+// A settled pixel's history averages composites whose matte and glossy light were themselves
+// running means, so it weighs old, little-converged light most. TAA also averages, with the same
+// weights, the matte factor m (1 - F)^2, the glossy factor F(w_s) x the mirror demodulation, and
+// the residual: the composite less those factors times the two chains' temporal outputs. Where a
+// chain's history continues last frame's (this pixel's own texel, at least as long as TAA's), TAA
+// follows that chain: its term becomes avg(factor) x current light, mixed in by
+// taa_current_light (matte) or taa_current_glossy: the same image while the light stands still,
+// and no lag while it converges. The residual's alpha holds which chains it leaves out (bit 0
+// matte, bit 1 glossy), as they were followed last frame; a chain followed from last frame on
+// needs its term left out of the residual then. Where the glossy chain stops continuing, its
+// term goes back into the residual (last frame's light is its temporal output there, still in
+// its history); where the matte chain does, or the pixel is not settled, TAA keeps its own
+// average and re-sets the residual so that the two agree.
 
 @group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
 @group(0) @binding(42) var history: texture_2d<f32>;
@@ -48,14 +52,34 @@
 @group(0) @binding(56) var out_material: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(57) var residual_history: texture_2d<f32>;
 @group(0) @binding(58) var out_residual: texture_storage_2d<rgba32float, write>;
+// Average of the glossy factor F(w_s) x the mirror demodulation (MatteSettings::taa_current_glossy).
+@group(0) @binding(59) var glossy_factor_history: texture_2d<f32>;
+@group(0) @binding(71) var out_glossy_factor: texture_storage_2d<rgba32float, write>;
 
-// The composite's matte factor at this pixel (0 off the surface).
-fn pixel_matte_factor(px: vec2u) -> vec3f {
+// The residual's alpha: which chains' terms it leaves out.
+const FOLLOW_MATTE: u32 = 1u;
+const FOLLOW_GLOSSY: u32 = 2u;
+
+// The terms of the chains in `chains` (FOLLOW_* bits): factor x light.
+fn followed_terms(chains: u32, matte: vec3f, light: vec3f, glossy: vec3f, glossy_light: vec3f) -> vec3f {
+    var sum = vec3f(0.0);
+    if (chains & FOLLOW_MATTE) != 0u {
+        sum += matte * light;
+    }
+    if (chains & FOLLOW_GLOSSY) != 0u {
+        sum += glossy * glossy_light;
+    }
+    return sum;
+}
+
+// The composite's F(w_s) and matte factor at this pixel (0 off the surface).
+fn pixel_factors(px: vec2u) -> array<vec3f, 2> {
     let g = gbuffer_at(vec2i(px));
     if !g.hit {
-        return vec3f(0.0);
+        return array<vec3f, 2>(vec3f(0.0), vec3f(0.0));
     }
-    return matte_factor(g, fresnel_mirror(g, dot(g.n, -camera_ray(px))));
+    let f_s = fresnel_mirror(g, dot(g.n, -camera_ray(px)));
+    return array<vec3f, 2>(f_s, matte_factor(g, f_s));
 }
 
 fn hdr_at(p: vec2i) -> vec3f {
@@ -70,20 +94,19 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let current = hdr_at(p);
-    let m_k = pixel_matte_factor(gid.xy);
+    let factors = pixel_factors(gid.xy);
+    let m_k = factors[1];
     let light_k = half_safe(textureLoad(matte_temporal, p, 0).rgb);
+    let gl = taa_glossy(p, factors[0]);
     let matte_reason_k = textureLoad(matte_reason, p, 0).x;
     // The matte light of this pixel continues last frame's: a surface whose history is this
     // pixel's own texel.
     let own_light = has_surface(p) && (matte_reason_k & (REASON_DISOCCLUDED | REASON_LOW_CONFIDENCE | REASON_NEIGHBOUR)) == 0u;
     let matte_n = f32(matte_reason_k >> 8u);
-    // What the composite adds beside m (1 - F)^2 x the matte light.
-    let rest_k = current - m_k * light_k;
     var material = m_k;
-    var residual = rest_k;
-    // Residual's alpha: 1 where it was kept in step with the matte light (the next frame may
-    // follow the light from it).
-    var in_step = select(0.0, 1.0, own_light);
+    var glossy = gl.factor;
+    // The chains TAA follows from this frame on.
+    var chains = select(0u, FOLLOW_MATTE, own_light && dn.taa_current_light > 0.0) | select(0u, FOLLOW_GLOSSY, gl.own && dn.taa_current_glossy > 0.0);
     var result = current;
     var n = 1.0;
     var shown_weight = 1.0;
@@ -128,23 +151,39 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         n = clamp(n_prev + 1.0, 1.0, 2.0 / weight_floor - 1.0);
         let w = 2.0 / (n + 1.0);
         result = mix(clamped, current, w);
-        material = mix(half_safe(load_bilinear(material_history, prev).rgb), m_k, w);
-        let r_prev = load_bilinear(residual_history, prev);
-        let averaged = mix(half_safe(r_prev.rgb), rest_k, w);
-        let followed = material * light_k + averaged;
-        // The matte history at least as long as TAA's, and continuing last frame's.
-        let follows = settled && own_light && matte_n >= n && dn.taa_current_light > 0.0;
-        in_step = select(0.0, 1.0, follows);
-        // Negative where the pixel's material and light changed together (a sub-pixel edge
-        // between a lit and an unlit surface): the product of the averages is not the average of
-        // the products there.
-        if follows && r_prev.a == 1.0 && all(followed >= vec3f(0.0)) {
-            // The history's matte light, replaced by the current one: residual averages what
-            // the composite adds beside m (1 - F)^2 x light.
-            residual = averaged;
-            result = mix(result, followed, dn.taa_current_light);
-        } else {
-            residual = result - material * light_k;
+        let material_prev = half_safe(load_bilinear(material_history, prev).rgb);
+        let glossy_prev = half_safe(load_bilinear(glossy_factor_history, prev).rgb);
+        material = mix(material_prev, m_k, w);
+        glossy = mix(glossy_prev, gl.factor, w);
+        // A chain is followed where its history is at least as long as TAA's and continues
+        // last frame's.
+        var follows = 0u;
+        if settled {
+            follows = select(0u, FOLLOW_MATTE, matte_n >= n) | select(0u, FOLLOW_GLOSSY, gl.n >= n);
+        }
+        chains &= follows;
+        if settled {
+            let r_prev = load_bilinear(residual_history, prev);
+            var r = half_safe(r_prev.rgb);
+            var left_out = u32(clamp(r_prev.a, 0.0, 3.0));
+            // The glossy chain stopped continuing: its term of last frame goes back in.
+            if (left_out & FOLLOW_GLOSSY) != 0u && (chains & FOLLOW_GLOSSY) == 0u {
+                r += glossy_prev * taa_glossy_previous(p);
+                left_out &= ~FOLLOW_GLOSSY;
+            }
+            // Follow the chains left out of the residual, if all of them still continue.
+            if left_out != 0u && (left_out & ~chains) == 0u {
+                let rest_k = current - followed_terms(left_out, m_k, light_k, gl.factor, gl.light);
+                let averaged = mix(r, rest_k, w);
+                let followed = followed_terms(left_out, material, light_k, glossy, gl.light) + averaged;
+                // Negative where the pixel's material and light changed together (a sub-pixel
+                // edge between a lit and an unlit surface): the product of the averages is not
+                // the average of the products there.
+                if all(followed >= vec3f(0.0)) {
+                    let share = max(select(0.0, dn.taa_current_light, (left_out & FOLLOW_MATTE) != 0u), select(0.0, dn.taa_current_glossy, (left_out & FOLLOW_GLOSSY) != 0u));
+                    result = mix(result, followed, share);
+                }
+            }
         }
         if !settled {
             n = -n;
@@ -154,9 +193,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
     }
     result = half_safe(result);
+    material = half_safe(material);
+    glossy = half_safe(glossy);
+    // What the composite adds beside the terms of the chains followed from here on.
+    let residual = half_safe(result - followed_terms(chains, material, light_k, glossy, gl.light));
     textureStore(out_history, p, vec4f(result, n));
-    textureStore(out_material, p, vec4f(half_safe(material), 0.0));
-    textureStore(out_residual, p, vec4f(half_safe(residual), in_step));
+    textureStore(out_material, p, vec4f(material, 0.0));
+    textureStore(out_glossy_factor, p, vec4f(glossy, 0.0));
+    textureStore(out_residual, p, vec4f(residual, f32(chains)));
     let i = u32(p.y) * frame.size.x + u32(p.x);
     var shown = result;
     if shown_weight < 1.0 {

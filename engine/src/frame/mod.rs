@@ -382,6 +382,7 @@ impl Renderer {
             gbuffer: &t.gbuffer,
             trace: &t.trace,
             matte: m,
+            glossy: t.glossy_chain.as_ref().map(|g| (g, &self.glossy_buf)),
         });
         let denoised_matte = t.matte.as_ref().filter(|_| denoise).map(|m| &m.denoised.1);
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
@@ -446,6 +447,7 @@ impl Renderer {
             gbuffer: &t.gbuffer,
             trace: &t.trace,
             matte: t.matte.as_ref().expect("matte targets exist before the chain"),
+            glossy: t.glossy_chain.as_ref().map(|g| (g, &self.glossy_buf)),
         }
     }
 
@@ -578,6 +580,8 @@ impl Renderer {
                     "taa/material 1" => &m.taa_material[1].0,
                     "taa/residual 0" => &m.taa_residual[0].0,
                     "taa/residual 1" => &m.taa_residual[1].0,
+                    "taa/glossy 0" => &m.taa_glossy[0].0,
+                    "taa/glossy 1" => &m.taa_glossy[1].0,
                     _ => bail!("no texture {n}"),
                 }
             }

@@ -7,6 +7,7 @@
 use super::gbuffer::GBufferTargets;
 use super::trace::TraceTargets;
 use super::chain::ChainStage;
+use super::glossy::GlossyChainTargets;
 use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
 use crate::settings::MatteSettings;
 use anyhow::Result;
@@ -65,8 +66,10 @@ pub struct DenoiseParams {
     pub taa_display_ratio: f32,
     /// [`MatteSettings::taa_current_light`].
     pub taa_current_light: f32,
+    /// [`MatteSettings::taa_current_glossy`].
+    pub taa_current_glossy: f32,
     /// The uniform's size is a multiple of 16 bytes.
-    pub _pad: [f32; 3],
+    pub _pad: [f32; 2],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -120,7 +123,8 @@ impl DenoiseParams {
             taa_resampled_frames: s.taa_resampled_frames.clamp(0.0, 1024.0),
             taa_display_ratio: s.taa_display_ratio.clamp(0.0, 1024.0),
             taa_current_light: s.taa_current_light.clamp(0.0, 1.0),
-            _pad: [0.0; 3],
+            taa_current_glossy: s.taa_current_glossy.clamp(0.0, 1.0),
+            _pad: [0.0; 2],
         }
     }
 }
@@ -155,6 +159,9 @@ pub struct MatteTargets {
     /// factor times the matte temporal's output ([`MatteSettings::taa_current_light`]).
     pub taa_material: [(wgpu::Texture, wgpu::TextureView); 2],
     pub taa_residual: [(wgpu::Texture, wgpu::TextureView); 2],
+    /// TAA's average of the glossy factor F(w_s) x the mirror demodulation
+    /// ([`MatteSettings::taa_current_glossy`]).
+    pub taa_glossy: [(wgpu::Texture, wgpu::TextureView); 2],
     /// The image after TAA (what the display shows), 16 bytes per pixel.
     pub final_image: wgpu::Buffer,
 }
@@ -174,11 +181,12 @@ impl MatteTargets {
         let taa_history = [t("taa/history 0", RGBA32F), t("taa/history 1", RGBA32F)];
         let taa_material = [t("taa/material 0", RGBA32F), t("taa/material 1", RGBA32F)];
         let taa_residual = [t("taa/residual 0", RGBA32F), t("taa/residual 1", RGBA32F)];
+        let taa_glossy = [t("taa/glossy 0", RGBA32F), t("taa/glossy 1", RGBA32F)];
         let prev_depth = mem.texture(d, "matte/previous depth", size, super::gbuffer::DEPTH_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
         let prev_normal = mem.texture(d, "matte/previous normal", size, super::gbuffer::COLOR_FORMATS[0].1, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let final_image = mem.buffer(d, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
-        MatteTargets { prev_depth, prev_normal, history, temporal, reason, min, radius, median, denoised, taa_history, taa_material, taa_residual, final_image }
+        MatteTargets { prev_depth, prev_normal, history, temporal, reason, min, radius, median, denoised, taa_history, taa_material, taa_residual, taa_glossy, final_image }
     }
 }
 
@@ -191,6 +199,9 @@ pub struct ChainInputs<'a> {
     pub gbuffer: &'a GBufferTargets,
     pub trace: &'a TraceTargets,
     pub matte: &'a MatteTargets,
+    /// The glossy chain's targets and its GlossyParams, where the scene has glossy lobes: TAA
+    /// follows the glossy temporal's output ([`MatteSettings::taa_current_glossy`]).
+    pub glossy: Option<(&'a GlossyChainTargets, &'a wgpu::Buffer)>,
 }
 
 /// The G-buffer and trace textures every stage binds (shaders/realtime/gbuffer_in.wgsl).
@@ -263,14 +274,27 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> 
                 .storage_texture(56, &m.taa_material[1 - parity].1, RGBA32F)
                 .texture(57, &m.taa_residual[parity].1, f)
                 .storage_texture(58, &m.taa_residual[1 - parity].1, RGBA32F)
+                .texture(59, &m.taa_glossy[parity].1, f)
+                .storage_texture(71, &m.taa_glossy[1 - parity].1, RGBA32F);
+            if let Some((g, params)) = i.glossy {
+                // The glossy temporal wrote history[1 - parity] this frame.
+                b = super::glossy::glossy_trace_inputs(b, i.trace, &g.denoised.1)
+                    .uniform(60, params)
+                    .texture(69, &g.history[1 - parity].1, f)
+                    .texture(70, &g.info.1, f)
+                    .texture(77, &g.history[parity].1, f);
+            }
         }
     }
     b
 }
 
-fn modules(kind: Kind, animated: bool) -> Vec<&'static str> {
+fn modules(kind: Kind, animated: bool, glossy: bool) -> Vec<&'static str> {
     let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl"];
     m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    if kind == Kind::Taa {
+        m.extend(if glossy { ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice() } else { ["taa/glossy_none.wgsl"].as_slice() });
+    }
     m.extend(match kind {
         Kind::Temporal => vec!["matte/temporal.wgsl"],
         Kind::HistoryBilateral => vec!["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
@@ -300,7 +324,7 @@ impl MatteChain {
                 Kind::MinV => "min_v",
                 _ => "main",
             };
-            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated), entry, bindings(kind, i, 0))?));
+            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated, i.glossy.is_some()), entry, bindings(kind, i, 0))?));
         }
         Ok(MatteChain { stages })
     }

@@ -85,6 +85,7 @@ pub const FIELDS: &[Field] = &[
     f("matte.taa_alpha", "taa", "", Float(0.0, 1.0, 0.005), "Weight of the current frame in TAA's blend."),
     f("matte.taa_display_ratio", "taa", "", Float(0.0, 64.0, 0.5), "TAA: the shown image follows a settled pixel's history with this many times its weight (0: shows it as is)."),
     f("matte.taa_current_light", "taa", "", Float(0.0, 1.0, 0.05), "TAA: share of a settled pixel's matte-light lag taken out (the matte temporal's current output in place of TAA's average)."),
+    f("matte.taa_current_glossy", "taa", "", Float(0.0, 1.0, 0.05), "TAA: share of a settled pixel's glossy-light lag taken out (the glossy temporal's current output in place of TAA's average)."),
     f("matte.taa_resampled_frames", "taa", "frames", Float(0.0, 64.0, 1.0), "TAA: history length a pixel restarts at when it stands still after moving (0: carries on)."),
     f("matte.taa_still_frames", "taa", "", Float(0.0, 256.0, 1.0), "TAA in a still view: the current frame's weight falls to 1 / this (0: always taa_alpha)."),
     f("glossy.reflection_mv", "glossy/motion", "", Choice(reflection_mvs), "Reflection motion: surface (primary), virtual position, or diamond search."),
