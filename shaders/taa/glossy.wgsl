@@ -6,16 +6,6 @@
 @group(0) @binding(70) var glossy_info: texture_2d<f32>;
 @group(0) @binding(77) var glossy_previous: texture_2d<f32>;
 
-struct TaaGlossy {
-    // What the composite multiplies the glossy chain's light by: F(w_s) x the demodulation.
-    factor: vec3f,
-    light: vec3f,
-    // The temporal's history is this pixel's own texel, read exactly.
-    own: bool,
-    // Its length in frames.
-    n: f32,
-}
-
 fn taa_glossy(p: vec2i, f_s: vec3f) -> TaaGlossy {
     if !has_surface(p) {
         return TaaGlossy(vec3f(0.0), vec3f(0.0), false, 0.0);

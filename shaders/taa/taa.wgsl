@@ -56,6 +56,19 @@
 @group(0) @binding(59) var glossy_factor_history: texture_2d<f32>;
 @group(0) @binding(71) var out_glossy_factor: texture_storage_2d<rgba32float, write>;
 
+// This pixel's glossy term as TAA follows it (taa/glossy.wgsl, or taa/glossy_none.wgsl in a
+// scene without glossy buffers).
+struct TaaGlossy {
+    // What the composite multiplies the glossy chain's light by: F(w_s) x the demodulation.
+    factor: vec3f,
+    // The glossy temporal's output: the light divided by the demodulation.
+    light: vec3f,
+    // The temporal's history is this pixel's own texel, read exactly.
+    own: bool,
+    // Its length in frames.
+    n: f32,
+}
+
 // The residual's alpha: which chains' terms it leaves out.
 const FOLLOW_MATTE: u32 = 1u;
 const FOLLOW_GLOSSY: u32 = 2u;
@@ -155,14 +168,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let glossy_prev = half_safe(load_bilinear(glossy_factor_history, prev).rgb);
         material = mix(material_prev, m_k, w);
         glossy = mix(glossy_prev, gl.factor, w);
-        // A chain is followed where its history is at least as long as TAA's and continues
-        // last frame's.
-        var follows = 0u;
-        if settled {
-            follows = select(0u, FOLLOW_MATTE, matte_n >= n) | select(0u, FOLLOW_GLOSSY, gl.n >= n);
-        }
-        chains &= follows;
-        if settled {
+        if !settled {
+            chains = 0u;
+            n = -n;
+        } else {
+            // A chain is followed where its history continues last frame's and is at least as
+            // long as TAA's.
+            chains &= select(0u, FOLLOW_MATTE, matte_n >= n) | select(0u, FOLLOW_GLOSSY, gl.n >= n);
             let r_prev = load_bilinear(residual_history, prev);
             var r = half_safe(r_prev.rgb);
             var left_out = u32(clamp(r_prev.a, 0.0, 3.0));
@@ -184,12 +196,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                     result = mix(result, followed, share);
                 }
             }
-        }
-        if !settled {
-            n = -n;
-        } else if dn.taa_display_ratio > 0.0 {
-            // taa_display_ratio times the history's own weight: a fresh history is shown as is.
-            shown_weight = min(dn.taa_display_ratio * 2.0 / (n + 1.0), 1.0);
+            if dn.taa_display_ratio > 0.0 {
+                // taa_display_ratio times the history's own weight: a fresh history is shown as
+                // is.
+                shown_weight = min(dn.taa_display_ratio * 2.0 / (n + 1.0), 1.0);
+            }
         }
     }
     result = half_safe(result);
