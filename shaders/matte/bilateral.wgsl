@@ -4,10 +4,14 @@
 // the history loop the blur does not compound, and the normal and plane weights keep it on
 // the surface, so it trades little bias for the residual noise of a history tens of frames
 // long (MatteSettings::min_radius_fraction). Taps are also weighed by their luminance
-// difference against edge_stop_sigmas standard deviations of the history's noise (SVGF's
-// luminance weighting function, Dundr §4.4.3 after Schied et al. 2017, with the variance of the
-// n-frame mean estimated from this frame's input): where the history has converged the
-// filter keeps the shading detail the plane and normal weights cannot see.
+// difference against edge_stop_sigmas standard deviations of the noise (SVGF's luminance
+// weighting function, Dundr §4.4.3 after Schied et al. 2017), measured on a guide rather than
+// on the taps themselves: the luminance of each pixel's 3x3 mean on its surface, which stage
+// (6)'s pass writes into its alpha (matte/firefly.wgsl). The guide's noise is a third of the
+// n-frame mean's, so a contact shadow two pixels wide stands out of it where single taps'
+// noise hid it, while taps that differ by noise alone keep their weight. The n-frame mean's
+// noise comes from this frame's input minus the history's mean, so a shadow's own contrast
+// does not count as noise (matte/sparse_bilateral.wgsl: history_noise).
 @group(0) @binding(44) var filter_in: texture_2d<f32>;
 @group(0) @binding(52) var radius_in: texture_2d<f32>;
 @group(0) @binding(51) var reason_in: texture_2d<u32>;

@@ -1,16 +1,34 @@
 // The sparse cross-bilateral filter of stages (4) and (7): `dn.taps` taps in a disk, weighted by
 // plane distance and normals, and with edge_k > 0 also by luminance (stage 7's edge-stop, see
-// matte/bilateral.wgsl). Reads `filter_in`, the caller's input, and for the edge-stop
-// `reason_in`, the history length.
+// matte/bilateral.wgsl). Reads `filter_in`, the caller's input (for the edge-stop, its alpha
+// holds the guide's luminance), and for the edge-stop `reason_in`, the history length.
 
-// Standard deviation of the n-frame mean at p: the raw input's spread over 16 taps on p's
-// surface within 3 pixels, over sqrt(n).
+// Standard deviation of the n-frame mean at p: the root mean square of the raw input minus the
+// history's mean (filter_in) over p and up to 16 taps on p's surface within 3 pixels, over
+// sqrt(n). The residual holds the noise without the shading's own variation: the input's
+// spread around its local mean counted a contact shadow's contrast as noise, and the edge-stop
+// then blurred the shadow it was there to keep.
 fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32) -> f32 {
-    let own = moments_add(Moments(vec4f(0.0), vec4f(0.0), 0.0), half_safe(matte_input(p)));
-    let m = surface_moments(own, p, xc, nc, fc, 16u, 3.0);
-    let m1 = m.m1.w / m.count;
+    var sum = residual_square(p);
+    var count = 1.0;
+    for (var i = 0u; i < 16u; i++) {
+        let t = p + vec2i(round(spiral_tap(i, 16u, 3.0, p)));
+        if !in_bounds(t) || !has_surface(t) {
+            continue;
+        }
+        if bilateral_weight(xc, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
+            continue;
+        }
+        sum += residual_square(t);
+        count += 1.0;
+    }
     let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
-    return sqrt(max(m.m2.w / m.count - m1 * m1, 0.0) / n);
+    return sqrt(sum / count / n);
+}
+
+fn residual_square(p: vec2i) -> f32 {
+    let d = luminance(half_safe(matte_input(p))) - luminance(textureLoad(filter_in, p, 0).rgb);
+    return d * d;
 }
 
 fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
@@ -23,9 +41,10 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
     let fc = footprint(xc);
     var sigma_l = 0.0;
     if edge_k > 0.0 {
-        sigma_l = edge_k * history_noise(p, xc, nc, fc) + 1e-6;
+        // The guide averages up to 9 samples: a third of the mean's noise.
+        sigma_l = edge_k * history_noise(p, xc, nc, fc) / 3.0 + 1e-6;
     }
-    let lc = luminance(c);
+    let lc = textureLoad(filter_in, p, 0).a;
     var sum = c;
     var wsum = 1.0;
     for (var i = 0u; i < dn.taps; i++) {
@@ -33,10 +52,11 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         if !in_bounds(q) || !has_surface(q) {
             continue;
         }
-        let t = textureLoad(filter_in, q, 0).rgb;
+        let tap = textureLoad(filter_in, q, 0);
+        let t = tap.rgb;
         var w = bilateral_weight(xc, nc, fc, position_at(q), oct_decode(textureLoad(gb_normal, q, 0).xy));
         if sigma_l > 0.0 {
-            w *= exp(-abs(luminance(t) - lc) / sigma_l);
+            w *= exp(-abs(tap.a - lc) / sigma_l);
         }
         sum += t * w;
         wsum += w;

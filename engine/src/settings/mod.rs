@@ -141,6 +141,16 @@ pub struct MatteSettings {
     /// would blur, while a noisy one is still filtered. 0: no edge-stop. FLIP as above (living
     /// room, level, FlightHelmet) for k = 4, 8, 16: 0.1676 / 0.0574 / 0.0116, 0.1664 / 0.0567 /
     /// 0.0119, 0.1657 / 0.0560 / 0.0122; Lantern 0.0023 with 4 and 16, 0.0025 with none.
+    /// The luminance difference is now taken on a guide, each pixel's 3x3 mean on its surface,
+    /// against the guide's noise (sigma / 3), and sigma comes from the input minus the
+    /// history's mean, not the input's spread (shaders/matte/bilateral.wgsl). FLIP at 160x90,
+    /// 60 still frames (second half / last frame; staircase 160x284), taps' own luminance and
+    /// spread against the guide and residual, k = 8: living room 0.1541 / 0.1414 and 0.1467 /
+    /// 0.1358, staircase 0.0642 / 0.0610 and 0.0591 / 0.0562, level 0.0483 / 0.0458 and
+    /// 0.0469 / 0.0444. The residual alone: living room 0.1567 / 0.1441, staircase 0.0634 /
+    /// 0.0602; with k = 2 as well, staircase 0.0609 / 0.0566, but the spread with k = 2 took
+    /// the living room to 0.1566 / 0.1423: a smaller k kept the staircase's contact shadows,
+    /// and the noise differences between single taps cost the living room its filtering.
     pub edge_stop_sigmas: f32,
     /// Bilateral weights: cosine power on normals, plane-distance sigma in pixel footprints.
     pub normal_power: f32,
