@@ -279,20 +279,28 @@ fn moments_add(m: Moments, s: vec3f) -> Moments {
     return Moments(m.m1 + v, m.m2 + v * v, m.count + 1.0);
 }
 
-// Adds the matte input at `taps` spiral taps within `radius` pixels of p that lie on p's
-// surface (bilateral weight of at least 0.3) to `m`: the neighbourhood statistics of the
-// temporal clamp and of stage 7's noise estimate.
+// Spiral tap i of `taps` within `radius` pixels of p, where it lies on p's surface (bilateral
+// weight of at least 0.3); vec2i(-1) where it does not. The neighbourhood statistics of the
+// temporal clamp and of stage 7's noise estimate are drawn from these taps.
+fn surface_tap(p: vec2i, x: vec3f, nc: vec3f, fc: f32, i: u32, taps: u32, radius: f32) -> vec2i {
+    let t = p + vec2i(round(spiral_tap(i, taps, radius, p)));
+    if !in_bounds(t) || !has_surface(t) {
+        return vec2i(-1);
+    }
+    if bilateral_weight(x, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
+        return vec2i(-1);
+    }
+    return t;
+}
+
+// Adds the matte input at the surface taps (surface_tap) to `m`.
 fn surface_moments(m: Moments, p: vec2i, x: vec3f, nc: vec3f, fc: f32, taps: u32, radius: f32) -> Moments {
     var r = m;
     for (var i = 0u; i < taps; i++) {
-        let t = p + vec2i(round(spiral_tap(i, taps, radius, p)));
-        if !in_bounds(t) || !has_surface(t) {
-            continue;
+        let t = surface_tap(p, x, nc, fc, i, taps, radius);
+        if t.x >= 0 {
+            r = moments_add(r, half_safe(matte_input(t)));
         }
-        if bilateral_weight(x, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
-            continue;
-        }
-        r = moments_add(r, half_safe(matte_input(t)));
     }
     return r;
 }

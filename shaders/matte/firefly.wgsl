@@ -52,7 +52,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         textureStore(out_median, p, vec4f(centre.rgb, luminance(centre.rgb)));
         return;
     }
-    let guide = edge_guide(p);
+    // Only stage 7's edge-stop reads the guide.
+    var guide = luminance(centre.rgb);
+    if stage_on(STAGE_BILATERAL) && dn.edge_stop_sigmas > 0.0 {
+        guide = edge_guide(p);
+    }
     if !stage_on(STAGE_FIREFLY) {
         textureStore(out_median, p, vec4f(centre.rgb, guide));
         return;

@@ -12,15 +12,11 @@ fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32) -> f32 {
     var sum = residual_square(p);
     var count = 1.0;
     for (var i = 0u; i < 16u; i++) {
-        let t = p + vec2i(round(spiral_tap(i, 16u, 3.0, p)));
-        if !in_bounds(t) || !has_surface(t) {
-            continue;
+        let t = surface_tap(p, xc, nc, fc, i, 16u, 3.0);
+        if t.x >= 0 {
+            sum += residual_square(t);
+            count += 1.0;
         }
-        if bilateral_weight(xc, nc, fc, position_at(t), oct_decode(textureLoad(gb_normal, t, 0).xy)) < 0.3 {
-            continue;
-        }
-        sum += residual_square(t);
-        count += 1.0;
     }
     let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
     return sqrt(sum / count / n);
@@ -32,7 +28,8 @@ fn residual_square(p: vec2i) -> f32 {
 }
 
 fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
-    let c = textureLoad(filter_in, p, 0).rgb;
+    let centre = textureLoad(filter_in, p, 0);
+    let c = centre.rgb;
     if radius < 0.5 || !has_surface(p) {
         return c;
     }
@@ -44,7 +41,7 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         // The guide averages up to 9 samples: a third of the mean's noise.
         sigma_l = edge_k * history_noise(p, xc, nc, fc) / 3.0 + 1e-6;
     }
-    let lc = textureLoad(filter_in, p, 0).a;
+    let lc = centre.a;
     var sum = c;
     var wsum = 1.0;
     for (var i = 0u; i < dn.taps; i++) {
