@@ -74,6 +74,13 @@ impl GltfWriter {
         self.meshes.len() - 1
     }
 
+    /// A mesh built by the engine's scene helpers (scene::quad, scene::cuboid); its positions,
+    /// normals and indices, with `material` of this file.
+    pub fn engine_mesh(&mut self, m: &hush_engine::scene::Mesh, material: usize) -> usize {
+        let arrays = |v: &[glam::Vec3]| v.iter().map(|p| p.to_array()).collect::<Vec<_>>();
+        self.mesh(Prim { positions: &arrays(&m.positions), normals: Some(&arrays(&m.normals)), indices: Some(&m.indices), material })
+    }
+
     pub fn lambert(&mut self, c: [f32; 3]) -> usize {
         self.materials.push(json!({
             "pbrMetallicRoughness": {"baseColorFactor": [c[0], c[1], c[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},

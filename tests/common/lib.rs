@@ -45,13 +45,18 @@ pub fn render_with(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32, kind: Bvh
 /// Render `frames` real-time frames of `scene` in accumulate mode (still camera) and return
 /// their mean, linear HDR.
 pub fn realtime_accumulate(scene: &Scene, w: u32, h: u32, frames: u32, seed: u32) -> Result<hush_engine::quality::Image> {
+    let settings = hush_engine::settings::FrameSettings { max_depth: scene.max_depth, seed, accumulate: true, ..Default::default() };
+    realtime_frames(scene, (w, h), &settings, frames)
+}
+
+/// Render `frames` real-time frames of `scene` from its camera with `settings` and return the
+/// last one shown, linear HDR.
+pub fn realtime_frames(scene: &Scene, size: (u32, u32), settings: &hush_engine::settings::FrameSettings, frames: u32) -> Result<hush_engine::quality::Image> {
     use hush_engine::frame::{FrameInput, Renderer};
-    use hush_engine::settings::FrameSettings;
-    let (gpu, mut r) = Renderer::headless(scene.clone(), BvhKind::DEFAULT, (w, h))?;
-    let settings = FrameSettings { max_depth: scene.max_depth, seed, accumulate: true, ..Default::default() };
+    let (gpu, mut r) = Renderer::headless(scene.clone(), BvhKind::DEFAULT, size)?;
     let input = FrameInput { camera: scene.camera_or_default(), time: 0.0 };
     for _ in 0..frames {
-        r.render(&gpu, &input, &settings, None)?;
+        r.render(&gpu, &input, settings, None)?;
     }
     r.read_hdr(&gpu)
 }

@@ -20,8 +20,9 @@ pub(super) fn metal(name: &str, c: Vec3, roughness: f32) -> Material {
     Material { name: name.into(), base_color: c.extend(1.0), metallic: 1.0, roughness, ..Default::default() }
 }
 
-/// Axis-aligned quad with CCW winding seen from `normal`'s side.
-pub(super) fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
+/// The quad centre ± u ± v, facing u x v (CCW winding seen from that side). Also for tests'
+/// synthetic scenes.
+pub fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
     let n = u.cross(v).normalize();
     let positions = vec![center - u - v, center + u - v, center + u + v, center - u + v];
     Mesh {
@@ -34,7 +35,8 @@ pub(super) fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
     }
 }
 
-pub(super) fn cuboid(center: Vec3, half: Vec3, material: u32) -> Mesh {
+/// An axis-aligned box: `center` ± `half`, six quads facing out.
+pub fn cuboid(center: Vec3, half: Vec3, material: u32) -> Mesh {
     let mut m = Mesh { material, ..Default::default() };
     let faces = [
         (Vec3::X, Vec3::Z, Vec3::Y),

@@ -15,7 +15,7 @@ mod texture;
 
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
-pub use default_scene::default_scene;
+pub use default_scene::{cuboid, default_scene, quad};
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
 pub use environment::{EnvMap, Environment};
