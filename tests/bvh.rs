@@ -36,6 +36,7 @@ fn barycentrics(t: &Triangle, p: DVec3) -> (f64, f64) {
 }
 
 #[test]
+#[cfg_attr(not(hush_shared_scenes), ignore = "needs ../shared/scenes/living-room, absent beside this checkout")]
 fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
     let path = shared().join("scenes/living-room/living-room.gltf");
     let scene = hush_engine::scene::load_gltf_with(&path, 16).expect("living room loads");

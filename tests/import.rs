@@ -7,6 +7,7 @@ use hush_tests::{render, shared};
 use serde_json::json;
 
 #[test]
+#[cfg_attr(not(hush_shared_scenes), ignore = "needs ../shared/scenes (FlightHelmet, Lantern), absent beside this checkout")]
 fn scenes_with_missing_textures_warn_and_render() {
     for (path, missing) in [
         ("scenes/FlightHelmet/glTF/FlightHelmet.gltf", "LeatherPartsMat"),
@@ -31,6 +32,7 @@ fn scenes_with_missing_textures_warn_and_render() {
 }
 
 #[test]
+#[cfg_attr(not(hush_shared_scenes), ignore = "needs ../shared/scenes (living-room, staircase), absent beside this checkout")]
 fn bitterli_scenes_load_with_their_extras() {
     let lr = load_gltf_with(&shared().join("scenes/living-room/living-room.gltf"), 16).unwrap();
     assert_eq!(lr.resolution, Some((1280, 720)));

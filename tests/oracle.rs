@@ -1,5 +1,6 @@
 //! Mitsuba parity: the reference mode against Mitsuba 3 renders of the same scenes
-//! (`../shared/oracle`), at a box-downsampled resolution small enough for CI.
+//! (`tests/oracle`, copied from `../shared/oracle`), at a box-downsampled resolution small
+//! enough for CI.
 //!
 //! Thresholds come from the noise of both images rather than from a guess:
 //! - relMSE: its expectation for two unbiased estimators is the sum of their per-pixel variances
@@ -130,4 +131,25 @@ fn white_furnace_is_one() {
     // With ~30k pixels x 3 channels, a Gaussian deviation beyond 6 standard errors has a chance
     // of about 2e-4 in the whole image; anything beyond is a real error, not noise.
     assert!(worst_z < 6.0, "a furnace pixel is {worst_z:.2} standard errors from 1");
+}
+
+/// The repository's copies of the oracle scenes (`tests/oracle`, what a bare clone tests against)
+/// are byte for byte the files in `../shared/oracle`, where that is present.
+#[test]
+#[cfg_attr(not(hush_shared_oracle), ignore = "needs ../shared/oracle, absent beside this checkout")]
+fn oracle_copies_match_shared() {
+    let ours = oracle("");
+    let mut checked = 0;
+    for scene in std::fs::read_dir(&ours).unwrap() {
+        let scene = scene.unwrap().path();
+        for file in std::fs::read_dir(&scene).unwrap() {
+            let file = file.unwrap().path();
+            let rel = file.strip_prefix(&ours).unwrap();
+            let theirs = hush_tests::shared().join("oracle").join(rel);
+            let same = std::fs::read(&theirs).is_ok_and(|t| t == std::fs::read(&file).unwrap());
+            assert!(same, "tests/oracle/{} differs from {}", rel.display(), theirs.display());
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "only {checked} oracle files");
 }

@@ -1,6 +1,6 @@
-//! Helpers shared by the GPU integration tests: paths to `../shared`, rendering a scene with the
-//! reference tracer, a small glTF writer for synthetic scenes, and eq. (11)'s reprojection
-//! distance on the CPU.
+//! Helpers shared by the GPU integration tests: paths to the oracle scenes (in the repository) and
+//! to `../shared`, rendering a scene with the reference tracer, a small glTF writer for synthetic
+//! scenes, and eq. (11)'s reprojection distance on the CPU.
 
 pub mod gltf_writer;
 pub mod reproject;
@@ -12,13 +12,17 @@ use hush_engine::passes::{Accumulation, ReferenceTracer, TraceView};
 use hush_engine::scene::Scene;
 use std::path::PathBuf;
 
-/// `../shared` beside the checkout (CI has it there).
+/// `../shared` beside the checkout (CI has it there; a bare clone does not). Tests that read its
+/// real scenes carry `#[cfg_attr(not(hush_shared_scenes), ignore = ...)]` (see `build.rs`).
 pub fn shared() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared")
 }
 
+/// An oracle scene's folder: its glTF, the Mitsuba reference and `render_info.json`, copied
+/// from `../shared/oracle` into `tests/oracle` so that the parity tests run on a bare clone
+/// (`oracle_copies_match_shared` keeps the copies honest).
 pub fn oracle(scene: &str) -> PathBuf {
-    shared().join("oracle").join(scene)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("oracle").join(scene)
 }
 
 /// Render `scene` with the reference tracer: `spp` samples per pixel at `w` x `h`.
