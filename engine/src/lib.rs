@@ -7,6 +7,7 @@
 pub mod accel;
 pub mod frame;
 pub mod gpu;
+pub mod limits;
 pub mod passes;
 pub mod profile;
 pub mod quality;

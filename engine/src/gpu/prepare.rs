@@ -190,6 +190,16 @@ fn rebased(m: DMat4, origin: DVec3) -> glam::Mat4 {
 }
 
 impl PreparedScene {
+    /// Whether a material some object uses has a specular (GGX) lobe: the glossy path, its
+    /// buffers and chain exist. Importers append an unused default material, which does not count.
+    pub fn glossy_materials(scene: &Scene) -> bool {
+        let used: std::collections::HashSet<usize> = scene.objects.iter().map(|o| scene.meshes[o.mesh].material as usize).collect();
+        scene.materials.iter().enumerate().filter(|(i, _)| used.contains(i)).any(|(_, m)| {
+            let g = GpuMaterial::from(m);
+            g.metallic > 0.0 || (g.specular_factor > 0.0 && g.specular_color.iter().any(|c| *c > 0.0))
+        })
+    }
+
     pub fn new(scene: &Scene, kind: BvhKind) -> Result<PreparedScene> {
         let origin = scene.origin();
         let extent = scene.bounds().map(|(lo, hi)| (hi - lo).length()).filter(|e| *e > 0.0).unwrap_or(1.0);
@@ -221,12 +231,7 @@ impl PreparedScene {
         };
         let tex_data = pack_textures(scene);
         let alpha_mask = scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_)));
-        // Only materials some object uses count (importers append an unused default material).
-        let used: std::collections::HashSet<usize> = scene.objects.iter().map(|o| scene.meshes[o.mesh].material as usize).collect();
-        let glossy = scene.materials.iter().enumerate().filter(|(i, _)| used.contains(i)).any(|(_, m)| {
-            let g = GpuMaterial::from(m);
-            g.metallic > 0.0 || (g.specular_factor > 0.0 && g.specular_color.iter().any(|c| *c > 0.0))
-        });
+        let glossy = Self::glossy_materials(scene);
         let mut p = PreparedScene {
             features: SceneFeatures {
                 punctual_lights: !lights.is_empty(),

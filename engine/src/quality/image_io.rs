@@ -19,13 +19,20 @@ impl Image {
         self.data[(y * self.width + x) as usize]
     }
 
+    /// An EXR (linear) or PNG/JPEG (sRGB, linearised) file, read within the default budgets
+    /// ([`crate::limits::Limits`]): a regular file of bounded size whose header's size is checked
+    /// before its pixels are decoded.
     pub fn load(path: &Path) -> Result<Image> {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_lowercase();
+        let limits = crate::limits::Limits::default();
+        let bytes = crate::limits::read_regular_file(path, limits.file_bytes)?;
+        let mut budget = crate::limits::Budget::new(limits);
+        let name = path.display().to_string();
         if ext == "exr" {
-            let (width, height, data) = read_exr(path)?;
+            let (width, height, data) = decode_exr(&name, &bytes, &mut budget)?;
             return Ok(Image { width, height, data });
         }
-        let img = image::open(path).with_context(|| format!("reading {}", path.display()))?.to_rgb32f();
+        let img = crate::scene::decode_image(&name, &bytes, &mut budget)?.to_rgb32f();
         // 8-bit files hold display values: undo the sRGB curve so metrics compare radiance.
         let data = img
             .pixels()
@@ -75,16 +82,40 @@ impl Image {
     }
 }
 
+/// The first RGBA layer of an EXR file as linear RGB, read as [`Image::load`] reads it.
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
+    let limits = crate::limits::Limits::default();
+    let bytes = crate::limits::read_regular_file(path, limits.file_bytes)?;
+    decode_exr(&path.display().to_string(), &bytes, &mut crate::limits::Budget::new(limits))
+}
+
+/// The first RGBA layer of an EXR held in memory, as linear RGB. Every layer's size is read
+/// from the headers and charged to `budget` (12 bytes a pixel) before any pixel is allocated:
+/// a header can declare 100000 x 50000 pixels in a few bytes.
+pub fn decode_exr(name: &str, bytes: &[u8], budget: &mut crate::limits::Budget) -> Result<(u32, u32, Vec<Vec3>)> {
     use exr::prelude::*;
-    let img = read_first_rgba_layer_from_file(
-        path,
-        |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-        |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
-        },
-    )
-    .map_err(|e| anyhow!("reading EXR {}: {e}", path.display()))?;
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| anyhow!("reading EXR {name}: {e}"))?;
+    let largest = meta.headers.iter().map(|h| h.layer_size).max_by_key(|s| s.width().saturating_mul(s.height()));
+    let size = largest.ok_or_else(|| anyhow!("reading EXR {name}: no layers"))?;
+    budget.image(size.width() as u64, size.height() as u64, 12, format_args!("EXR {name}"))?;
+    if size.width() > u32::MAX as usize || size.height() > u32::MAX as usize {
+        bail!("reading EXR {name}: {}x{} pixels", size.width(), size.height());
+    }
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+            |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .non_parallel()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| anyhow!("reading EXR {name}: {e}"))?;
     let size = img.layer_data.size;
     let (_, data) = img.layer_data.channel_data.pixels;
     Ok((size.width() as u32, size.height() as u32, data))

@@ -37,7 +37,7 @@ impl CameraKey {
 impl CameraPath {
     pub fn load(path: &Path) -> Result<CameraPath> {
         let ctx = || format!("reading camera path {}", path.display());
-        let text = std::fs::read_to_string(path).with_context(ctx)?;
+        let text = crate::limits::read_text_file(path).with_context(ctx)?;
         let p: CameraPath = serde_json::from_str(&text).with_context(ctx)?;
         p.validate().with_context(ctx)?;
         Ok(p)

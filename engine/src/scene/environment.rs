@@ -1,6 +1,5 @@
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
-use std::path::Path;
 
 /// Light arriving from infinitely far away.
 #[derive(Clone, Debug, Default)]
@@ -26,11 +25,12 @@ pub struct EnvMap {
 }
 
 impl EnvMap {
-    pub fn load_exr(path: &Path, intensity: f32, rotation_y_degrees: f32) -> Result<EnvMap> {
-        let (width, height, rgb) = crate::quality::read_exr(path)
-            .with_context(|| format!("reading environment map {}", path.display()))?;
+    /// An equirectangular map from EXR bytes, decoded within `budget` (see
+    /// [`crate::quality::decode_exr`]).
+    pub fn from_exr(name: &str, bytes: &[u8], intensity: f32, rotation_y_degrees: f32, budget: &mut crate::limits::Budget) -> Result<EnvMap> {
+        let (width, height, rgb) = crate::quality::decode_exr(name, bytes, budget).with_context(|| format!("reading environment map {name}"))?;
         if width == 0 || height == 0 {
-            bail!("environment map {} is empty", path.display());
+            bail!("environment map {name} is empty");
         }
         let rgb = rgb
             .into_iter()

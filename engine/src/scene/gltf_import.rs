@@ -1,12 +1,17 @@
 //! glTF 2.0 (.gltf, .glb) import through the `gltf` crate, following the scene conventions.
+//!
+//! Files are untrusted: everything the `gltf` crate's validation leaves out is checked before it
+//! is used (`gltf_check`, `accessor`), side files are read through [`SceneFiles`] (inside the
+//! scene's folder, regular files only), and every size is held to a [`Limits`] budget. A problem
+//! is an error that names the JSON path, or a warning and a neutral fallback where a viewer can
+//! live with it (a missing texture, an unsupported optional extension, an orthographic camera).
 
-use super::paths::{read_uri, resolve};
-use super::{
-    Animation, Track, AlphaMode, Camera, EnvMap, Environment, Light, Material, Mesh, Object, Scene, Texture,
-    TextureRef, Wrap, DEFAULT_MAX_DEPTH,
-};
+use super::files::{SceneFiles, SceneFolder, read_uri, short};
+use super::gltf_mesh::{animations, primitive};
+use super::{Camera, EnvMap, Environment, Light, Material, Mesh, Object, Scene, Texture, TextureRef, Wrap, DEFAULT_MAX_DEPTH};
+use crate::limits::{Budget, Limits, is_over_budget, over_budget, read_regular_file};
 use anyhow::{Context, Result, anyhow, bail};
-use glam::{DMat4, Vec2, Vec3, Vec4};
+use glam::{DMat3, DMat4, DQuat, DVec3, Vec3, Vec4};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -21,34 +26,87 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
 /// Largest texture side kept on load (larger ones are halved until they fit).
 pub const DEFAULT_MAX_TEXTURE_SIZE: u32 = 2048;
 
+/// How a scene is loaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Largest texture side kept; larger textures are halved until they fit.
+    pub max_texture_size: u32,
+    pub limits: Limits,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions { max_texture_size: DEFAULT_MAX_TEXTURE_SIZE, limits: Limits::default() }
+    }
+}
+
 pub fn load_gltf(path: &Path) -> Result<Scene> {
-    load_gltf_with(path, DEFAULT_MAX_TEXTURE_SIZE)
+    load_gltf_opts(path, &LoadOptions::default())
 }
 
 pub fn load_gltf_with(path: &Path, max_texture_size: u32) -> Result<Scene> {
-    let ctx = || format!("loading glTF scene {}", path.display());
-    let bytes = std::fs::read(path).with_context(ctx)?;
-    let (document, blob) = parse(&bytes).with_context(ctx)?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    Importer { base, warnings: vec![], max_texture_size }.import(&document, blob.as_deref(), name).with_context(ctx)
+    load_gltf_opts(path, &LoadOptions { max_texture_size, ..LoadOptions::default() })
 }
+
+/// Load a `.gltf`/`.glb` file. Its side files are read from the folder it really lies in
+/// (symlinks resolved), and nothing outside that folder.
+pub fn load_gltf_opts(path: &Path, opts: &LoadOptions) -> Result<Scene> {
+    let ctx = || format!("loading glTF scene {}", path.display());
+    let real = std::fs::canonicalize(path).map_err(|e| anyhow!("{e}")).with_context(ctx)?;
+    let bytes = read_regular_file(&real, opts.limits.file_bytes).with_context(ctx)?;
+    let folder = SceneFolder::new(real.parent().unwrap_or(Path::new("/"))).with_context(ctx)?;
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    load_gltf_from(&bytes, &name, &folder, opts).with_context(ctx)
+}
+
+/// Load a scene from the bytes of its `.gltf`/`.glb` file, reading the files it names from
+/// `files`. A panic inside a dependency comes back as an error: a last line of defence, as
+/// every input known to cause one is refused before it reaches the dependency.
+pub fn load_gltf_from(bytes: &[u8], name: &str, files: &dyn SceneFiles, opts: &LoadOptions) -> Result<Scene> {
+    let run = std::panic::AssertUnwindSafe(|| {
+        let (document, blob) = parse(bytes, &opts.limits)?;
+        super::gltf_check::check(document.as_json(), &opts.limits)?;
+        Importer { files, warnings: vec![], max_texture_size: opts.max_texture_size, budget: Budget::new(opts.limits), triangles: 0 }
+            .import(&document, blob, name.to_string())
+    });
+    std::panic::catch_unwind(run).unwrap_or_else(|p| {
+        let msg = p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned());
+        Err(anyhow::Error::new(ImportPanic(msg.unwrap_or_else(|| "panic".into()))))
+    })
+}
+
+/// A panic caught at the import boundary: a bug in Hush or a library it uses, which the fuzz
+/// targets and the corpus replay treat as the failure it is.
+#[derive(Debug)]
+pub struct ImportPanic(pub String);
+
+impl std::fmt::Display for ImportPanic {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "internal error while importing (a bug in Hush or a library it uses; please report it with the file): {}", self.0)
+    }
+}
+
+impl std::error::Error for ImportPanic {}
 
 /// JSON (from a .gltf or a .glb's JSON chunk) -> validated document, refusing unsupported
 /// required extensions by name (the `gltf` crate's own error only says "Unsupported").
-fn parse(bytes: &[u8]) -> Result<(gltf::Document, Option<Vec<u8>>)> {
+fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8>>)> {
     let (json, blob) = if bytes.starts_with(b"glTF") {
         let glb = gltf::Glb::from_slice(bytes).map_err(|e| anyhow!("reading GLB container: {e}"))?;
-        (glb.json.to_vec(), glb.bin.map(|b| b.to_vec()))
+        (glb.json, glb.bin.map(|b| b.to_vec()))
     } else {
-        (bytes.to_vec(), None)
+        (std::borrow::Cow::Borrowed(bytes), None)
     };
+    if json.len() as u64 > limits.json_bytes {
+        return Err(over_budget("json-bytes", "the file's JSON", json.len() as u64, limits.json_bytes));
+    }
     let mut v: serde_json::Value = serde_json::from_slice(&json).map_err(|e| anyhow!("parsing glTF JSON: {e}"))?;
+    drop(json);
     let mut unsupported = vec![];
     if let Some(req) = v.get("extensionsRequired").and_then(|r| r.as_array()) {
         for e in req.iter().filter_map(|e| e.as_str()) {
             if !SUPPORTED_EXTENSIONS.contains(&e) {
-                unsupported.push(e.to_string());
+                unsupported.push(short(e));
             }
         }
     }
@@ -70,49 +128,51 @@ fn parse(bytes: &[u8]) -> Result<(gltf::Document, Option<Vec<u8>>)> {
     Ok((document, blob))
 }
 
-struct Importer<'a> {
-    base: &'a Path,
-    warnings: Vec<String>,
+pub(super) struct Importer<'a> {
+    files: &'a dyn SceneFiles,
+    pub(super) warnings: Vec<String>,
     max_texture_size: u32,
+    pub(super) budget: Budget,
+    /// Triangles placed so far (instances counted), against `Limits::triangles`.
+    pub(super) triangles: u64,
+}
+
+/// An orthographic camera, rendered through a perspective one once the scene's bounds are known.
+struct Orthographic {
+    index: usize,
+    pose: DMat4,
+    ymag: f64,
 }
 
 impl Importer<'_> {
-    fn warn(&mut self, msg: String) {
+    pub(super) fn warn(&mut self, msg: String) {
         log::warn!("{msg}");
         self.warnings.push(msg);
     }
 
-    fn import(mut self, doc: &gltf::Document, blob: Option<&[u8]>, name: String) -> Result<Scene> {
+    fn import(mut self, doc: &gltf::Document, blob: Option<Vec<u8>>, name: String) -> Result<Scene> {
         for ext in doc.extensions_used() {
             if !SUPPORTED_EXTENSIONS.contains(&ext) {
-                self.warn(format!("optional glTF extension {ext} is not supported; ignored"));
+                self.warn(format!("optional glTF extension {} is not supported; ignored", short(ext)));
             }
         }
         let buffers = self.load_buffers(doc, blob)?;
-        let (textures, tex_map) = self.load_textures(doc, &buffers);
-        let materials: Vec<Material> =
-            doc.materials().map(|m| self.material(&m, &tex_map)).collect();
-        let mut scene = Scene {
-            name,
-            textures,
-            materials,
-            max_depth: DEFAULT_MAX_DEPTH,
-            ..Default::default()
-        };
+        let (textures, tex_map) = self.load_textures(doc, &buffers)?;
+        let materials: Vec<Material> = doc.materials().map(|m| self.material(&m, &tex_map)).collect();
+        let mut scene = Scene { name, textures, materials, max_depth: DEFAULT_MAX_DEPTH, ..Default::default() };
         let default_material = scene.materials.len() as u32;
         scene.materials.push(Material::default());
 
-        let gscene = doc
-            .default_scene()
-            .or_else(|| doc.scenes().next())
-            .ok_or_else(|| anyhow!("the file has no scene"))?;
+        let gscene = doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| anyhow!("the file has no scene"))?;
         self.scene_extras(&gscene, &mut scene)?;
+        let data = super::accessor::Data { root: doc.as_json(), buffers: &buffers };
         let mut mesh_cache: HashMap<usize, Vec<usize>> = HashMap::new();
-        let mut animated = self.animations(doc, &buffers);
-        // (node, parent world transform, whether an ancestor is animated)
-        let mut stack: Vec<(gltf::Node, DMat4, bool)> =
-            gscene.nodes().map(|n| (n, DMat4::IDENTITY, false)).collect();
-        while let Some((node, parent, moving_parent)) = stack.pop() {
+        let mut animated = animations(&mut self, doc, &data)?;
+        let mut ortho: Option<Orthographic> = None;
+        // (node, parent world transform, parent world rotation, whether an ancestor is animated).
+        // The node hierarchy is a forest (gltf_check), so this walk visits each node once.
+        let mut stack: Vec<(gltf::Node, DMat4, DQuat, bool)> = gscene.nodes().map(|n| (n, DMat4::IDENTITY, DQuat::IDENTITY, false)).collect();
+        while let Some((node, parent, parent_rotation, moving_parent)) = stack.pop() {
             let mut animation = animated.remove(&node.index());
             if let Some(a) = animation.as_mut() {
                 if moving_parent {
@@ -122,20 +182,22 @@ impl Importer<'_> {
             }
             let local = node.transform().matrix().map(|c| c.map(|x| x as f64));
             let world = parent * DMat4::from_cols_array_2d(&local);
+            let rotation = parent_rotation * local_rotation(&node);
             if !world.is_finite() {
-                self.warn(format!("node {:?} has a non-finite transform; skipped", node.name()));
+                self.warn(format!("nodes[{}] has a non-finite transform; skipped with its children", node.index()));
                 continue;
             }
             if let Some(mesh) = node.mesh() {
                 let ids = match mesh_cache.get(&mesh.index()) {
                     Some(ids) => ids.clone(),
                     None => {
-                        let ids = self.mesh(&mesh, &buffers, &scene.materials, default_material, &mut scene.meshes)
-                            .with_context(|| format!("mesh {:?} ({})", mesh.name(), mesh.index()))?;
+                        let ids = self.mesh(&mesh, &data, default_material, &mut scene.meshes)?;
                         mesh_cache.insert(mesh.index(), ids.clone());
                         ids
                     }
                 };
+                let placed: u64 = ids.iter().map(|&id| scene.meshes[id].indices.len() as u64 / 3).sum();
+                self.place_triangles(placed, format_args!("nodes[{}] (meshes[{}])", node.index(), mesh.index()))?;
                 for id in ids {
                     scene.objects.push(Object {
                         name: node.name().unwrap_or("").to_string(),
@@ -149,14 +211,15 @@ impl Importer<'_> {
                 scene.lights.push(self.light(&light, &world));
             }
             if let Some(cam) = node.camera() {
-                if scene.camera.is_none() {
-                    match cam.projection() {
-                        gltf::camera::Projection::Perspective(p) => {
-                            scene.camera = Some(Camera { world, yfov: p.yfov() });
-                        }
-                        gltf::camera::Projection::Orthographic(_) => self.warn(
-                            "orthographic cameras are not supported; using a default view".into(),
-                        ),
+                if scene.camera.is_none() && ortho.is_none() {
+                    match camera_pose(world, rotation) {
+                        None => self.warn(format!("nodes[{}] places cameras[{}] with a degenerate transform; using a default view", node.index(), cam.index())),
+                        Some(pose) => match cam.projection() {
+                            gltf::camera::Projection::Perspective(p) => scene.camera = Some(Camera { world: pose, yfov: p.yfov() }),
+                            gltf::camera::Projection::Orthographic(o) => {
+                                ortho = Some(Orthographic { index: cam.index(), pose, ymag: o.ymag().abs() as f64 })
+                            }
+                        },
                     }
                 }
             }
@@ -165,97 +228,76 @@ impl Importer<'_> {
                 self.warn(format!("children of animated node {:?} are placed at its rest pose", node.name()));
             }
             for child in node.children() {
-                stack.push((child, world, moving));
+                stack.push((child, world, rotation, moving));
             }
+        }
+        if let Some(o) = ortho {
+            scene.camera = Some(self.perspective_for(&o, &scene));
+        }
+        if scene.triangle_count() > 0 && scene.bounds().is_none() {
+            bail!("no vertex of the scene's triangles has a finite position");
         }
         scene.warnings = self.warnings;
         Ok(scene)
     }
 
-    /// Node index -> its animation (translation/rotation/scale channels of every glTF animation).
-    fn animations(&mut self, doc: &gltf::Document, buffers: &[Vec<u8>]) -> HashMap<usize, Animation> {
-        use gltf::animation::{Interpolation, Property, util::ReadOutputs};
-        let mut map: HashMap<usize, Animation> = HashMap::new();
-        for anim in doc.animations() {
-            for ch in anim.channels() {
-                let node = ch.target().node();
-                let reader = ch.reader(|b| buffers.get(b.index()).map(|v| v.as_slice()));
-                let Some(times) = reader.read_inputs() else { continue };
-                let times: Vec<f64> = times.map(|t| t as f64).collect();
-                let interp = ch.sampler().interpolation();
-                // CUBICSPLINE stores (in-tangent, value, out-tangent) per key: keep the values.
-                let pick = |i: usize| match interp {
-                    Interpolation::CubicSpline => i % 3 == 1,
-                    _ => true,
-                };
-                if interp == Interpolation::CubicSpline {
-                    self.warn(format!("animation on node {:?}: CUBICSPLINE is sampled linearly between keys", node.name()));
-                }
-                let sorted = times.windows(2).all(|w| w[0] <= w[1]) && times.iter().all(|t| t.is_finite());
-                if !sorted {
-                    self.warn(format!("animation on node {:?} has unsorted or non-finite key times; ignored", node.name()));
-                    continue;
-                }
-                let (t, r, s) = node.transform().decomposed();
-                let a = map.entry(node.index()).or_insert_with(|| Animation {
-                    parent: DMat4::IDENTITY,
-                    translation: glam::DVec3::from_array(t.map(|x| x as f64)),
-                    rotation: glam::DQuat::from_array(r.map(|x| x as f64)),
-                    scale: glam::DVec3::from_array(s.map(|x| x as f64)),
-                    translation_track: None,
-                    rotation_track: None,
-                    scale_track: None,
-                });
-                let step = interp == Interpolation::Step;
-                let v3 = |it: &mut dyn Iterator<Item = [f32; 3]>| -> Vec<glam::DVec3> {
-                    it.enumerate().filter(|(i, _)| pick(*i)).map(|(_, v)| glam::DVec3::from_array(v.map(|x| x as f64))).collect()
-                };
-                match (ch.target().property(), reader.read_outputs()) {
-                    (Property::Translation, Some(ReadOutputs::Translations(mut it))) => {
-                        a.translation_track = Some(Track { times: times.clone(), values: v3(&mut it), step });
-                    }
-                    (Property::Scale, Some(ReadOutputs::Scales(mut it))) => {
-                        a.scale_track = Some(Track { times: times.clone(), values: v3(&mut it), step });
-                    }
-                    (Property::Rotation, Some(ReadOutputs::Rotations(it))) => {
-                        let values = it.into_f32().enumerate().filter(|(i, _)| pick(*i))
-                            .map(|(_, q)| glam::DQuat::from_array(q.map(|x| x as f64)).normalize()).collect();
-                        a.rotation_track = Some(Track { times: times.clone(), values, step });
-                    }
-                    (Property::MorphTargetWeights, _) => self.warn("morph target animation is not supported; ignored".into()),
-                    _ => self.warn(format!("animation channel on node {:?} could not be read; ignored", node.name())),
-                }
-            }
+    /// Count `n` more triangles against the triangles budget.
+    pub(super) fn place_triangles(&mut self, n: u64, what: std::fmt::Arguments) -> Result<()> {
+        let total = self.triangles.saturating_add(n);
+        let limit = self.budget.limits.triangles;
+        if total > limit {
+            return Err(over_budget("triangles", format_args!("the scene, up to {what},"), total, limit));
         }
-        map.retain(|_, a| a.duration() > 0.0 || a.translation_track.is_some() || a.rotation_track.is_some() || a.scale_track.is_some());
-        map
+        self.triangles = total;
+        Ok(())
     }
 
-    fn load_buffers(&mut self, doc: &gltf::Document, blob: Option<&[u8]>) -> Result<Vec<Vec<u8>>> {
-        doc.buffers()
-            .map(|b| {
-                let data = match b.source() {
-                    gltf::buffer::Source::Bin => blob
-                        .map(|b| b.to_vec())
-                        .ok_or_else(|| anyhow!("buffer {} refers to a missing GLB chunk", b.index()))?,
-                    gltf::buffer::Source::Uri(uri) => read_uri(self.base, uri)
-                        .with_context(|| format!("buffer {} ({uri})", b.index()))?,
-                };
-                if data.len() < b.length() {
-                    bail!("buffer {} holds {} bytes, the file says {}", b.index(), data.len(), b.length());
+    /// Hush renders perspective cameras only: an orthographic camera becomes a perspective one
+    /// at its pose whose view, at the distance of the scene's centre, is as tall as the
+    /// orthographic one's (2 ymag).
+    fn perspective_for(&mut self, o: &Orthographic, scene: &Scene) -> Camera {
+        let eye = o.pose.w_axis.truncate();
+        let fwd = -o.pose.z_axis.truncate();
+        let (lo, hi) = scene.bounds().unwrap_or((eye - DVec3::ONE, eye + DVec3::ONE));
+        let extent = (hi - lo).length().max(1e-9);
+        let d = ((lo + hi) * 0.5 - eye).dot(fwd);
+        let d = if d > 1e-6 * extent { d } else { 0.5 * extent };
+        let yfov = (2.0 * (o.ymag / d).atan()).clamp(1f64.to_radians(), 150f64.to_radians()) as f32;
+        self.warn(format!(
+            "cameras[{}] is orthographic; Hush renders it as a perspective camera at its place with a vertical field of view of {:.1} degrees (its height 2 x ymag = {:.3} at the scene's centre, {:.3} away)",
+            o.index,
+            yfov.to_degrees(),
+            2.0 * o.ymag,
+            d
+        ));
+        Camera { world: o.pose, yfov }
+    }
+
+    fn load_buffers(&mut self, doc: &gltf::Document, mut blob: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>> {
+        let limit = self.budget.limits.file_bytes;
+        let mut out = vec![];
+        for b in doc.buffers() {
+            let data = match b.source() {
+                gltf::buffer::Source::Bin => blob
+                    .take()
+                    .ok_or_else(|| anyhow!("buffers[{}] has no uri and there is no (unclaimed) GLB binary chunk", b.index()))?,
+                gltf::buffer::Source::Uri(uri) => {
+                    read_uri(self.files, uri, limit).with_context(|| format!("buffers[{}] ({})", b.index(), short(uri)))?
                 }
-                Ok(data)
-            })
-            .collect()
+            };
+            if (data.len() as u64) < b.length() as u64 {
+                bail!("buffers[{}] holds {} bytes, the file says {}", b.index(), data.len(), b.length());
+            }
+            self.budget.decode(data.len() as u64, format_args!("buffers[{}]", b.index()))?;
+            out.push(data);
+        }
+        Ok(out)
     }
 
-    /// Decode every texture a material uses. A texture that cannot be read is a warning and a
-    /// neutral fallback (the material renders with its factors alone).
-    fn load_textures(
-        &mut self,
-        doc: &gltf::Document,
-        buffers: &[Vec<u8>],
-    ) -> (Vec<Texture>, HashMap<(usize, bool), u32>) {
+    /// Decode every texture a material uses, each image once per colour space. A texture that
+    /// cannot be read is a warning and a neutral fallback (the material renders with its factors
+    /// alone); one over a budget is an error.
+    fn load_textures(&mut self, doc: &gltf::Document, buffers: &[Vec<u8>]) -> Result<(Vec<Texture>, HashMap<(usize, bool), u32>)> {
         // Which textures are colour (sRGB) and which are data.
         let mut uses: Vec<(usize, bool)> = vec![];
         for m in doc.materials() {
@@ -272,52 +314,88 @@ impl Importer<'_> {
             add(m.normal_texture().map(|i| i.texture()), false);
             add(m.emissive_texture().map(|i| i.texture()), true);
         }
-        let mut textures = vec![];
+        let mut textures: Vec<Texture> = vec![];
         let mut map = HashMap::new();
+        // (image, sRGB) -> its first texture: an image shared by textures is decoded once, and
+        // copied only for a texture that samples it with other wrap modes.
+        let mut first: HashMap<(usize, bool), Option<usize>> = HashMap::new();
+        let mut placed: HashMap<(usize, bool, Wrap, Wrap), usize> = HashMap::new();
+        let wrap = |w: gltf::texture::WrappingMode| match w {
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        };
         let all: Vec<gltf::Texture> = doc.textures().collect();
         for (ti, srgb) in uses {
-            let t = &all[ti];
+            let Some(t) = all.get(ti) else { continue };
             let img = t.source();
-            let (label, bytes) = match img.source() {
-                gltf::image::Source::Uri { uri, .. } => {
-                    (uri.to_string(), read_uri(self.base, uri).map_err(|e| e.to_string()))
-                }
-                gltf::image::Source::View { view, .. } => {
-                    let b = &buffers[view.buffer().index()];
-                    let r = b.get(view.offset()..view.offset() + view.length());
-                    (format!("image {}", img.index()), r.map(|s| s.to_vec()).ok_or("view out of range".into()))
+            let key = (img.index(), srgb);
+            let decoded = match first.get(&key) {
+                Some(slot) => *slot,
+                None => {
+                    let slot = self.decode_image(&img, buffers, srgb)?.map(|tex| {
+                        textures.push(tex);
+                        textures.len() - 1
+                    });
+                    first.insert(key, slot);
+                    slot
                 }
             };
-            let decoded = bytes.and_then(|b| {
-                Texture::decode(&label, &b, srgb, self.max_texture_size).map_err(|e| format!("{e:#}"))
-            });
-            match decoded {
-                Ok(mut tex) => {
-                    let wrap = |w: gltf::texture::WrappingMode| match w {
-                        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
-                        gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
-                        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-                    };
-                    tex.wrap_s = wrap(t.sampler().wrap_s());
-                    tex.wrap_t = wrap(t.sampler().wrap_t());
-                    map.insert((ti, srgb), textures.len() as u32);
-                    textures.push(tex);
+            let Some(decoded) = decoded else { continue };
+            let (ws, wt) = (wrap(t.sampler().wrap_s()), wrap(t.sampler().wrap_t()));
+            let index = match placed.get(&(key.0, key.1, ws, wt)) {
+                Some(&i) => i,
+                None if !placed.keys().any(|k| (k.0, k.1) == key) => {
+                    textures[decoded].wrap_s = ws;
+                    textures[decoded].wrap_t = wt;
+                    decoded
                 }
-                Err(e) => self.warn(format!("texture {label}: {e}; rendering without it")),
-            }
+                None => {
+                    let copy = Texture { wrap_s: ws, wrap_t: wt, ..textures[decoded].clone() };
+                    self.budget.decode(copy.rgba8.len() as u64, format_args!("textures[{ti}]"))?;
+                    textures.push(copy);
+                    textures.len() - 1
+                }
+            };
+            placed.insert((key.0, key.1, ws, wt), index);
+            map.insert((ti, srgb), index as u32);
         }
-        (textures, map)
+        Ok((textures, map))
     }
 
-    fn tex(
-        &mut self,
-        map: &HashMap<(usize, bool), u32>,
-        t: Option<(gltf::Texture, u32)>,
-        srgb: bool,
-    ) -> Option<TextureRef> {
+    /// One image decoded, or None with a warning where it cannot be read (a budget overrun is an
+    /// error: the scene would render, but not as its author meant, and the user can raise it).
+    fn decode_image(&mut self, img: &gltf::Image, buffers: &[Vec<u8>], srgb: bool) -> Result<Option<Texture>> {
+        let limit = self.budget.limits.file_bytes;
+        let (label, bytes) = match img.source() {
+            gltf::image::Source::Uri { uri, .. } => (short(uri), read_uri(self.files, uri, limit).map_err(|e| format!("{e:#}"))),
+            gltf::image::Source::View { view, .. } => {
+                let b = buffers.get(view.buffer().index()).map(|b| b.as_slice()).unwrap_or_default();
+                let r = view.offset().checked_add(view.length()).and_then(|end| b.get(view.offset()..end));
+                (format!("images[{}]", img.index()), r.map(|s| s.to_vec()).ok_or("its bufferView runs past its buffer".into()))
+            }
+        };
+        let bytes = match bytes {
+            Ok(b) => b,
+            Err(e) => {
+                self.warn(format!("texture {label}: {e}; rendering without it"));
+                return Ok(None);
+            }
+        };
+        match Texture::decode(&label, &bytes, srgb, self.max_texture_size, &mut self.budget) {
+            Ok(t) => Ok(Some(t)),
+            Err(e) if is_over_budget(&e) => Err(e),
+            Err(e) => {
+                self.warn(format!("texture {label}: {e:#}; rendering without it"));
+                Ok(None)
+            }
+        }
+    }
+
+    fn tex(&mut self, map: &HashMap<(usize, bool), u32>, t: Option<(gltf::Texture, u32)>, srgb: bool) -> Option<TextureRef> {
         let (t, set) = t?;
         if set != 0 {
-            self.warn(format!("texture {} uses TEXCOORD_{set}; only TEXCOORD_0 is supported", t.index()));
+            self.warn(format!("textures[{}] is used with TEXCOORD_{set}; only TEXCOORD_0 is supported", t.index()));
         }
         map.get(&(t.index(), srgb)).map(|&index| TextureRef { index })
     }
@@ -334,31 +412,46 @@ impl Importer<'_> {
             None => (1.0, Vec3::ONE),
         };
         let alpha_mode = match m.alpha_mode() {
-            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Opaque => super::AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => super::AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
             gltf::material::AlphaMode::Blend => {
                 // A path tracer has no draw order; blending is rendered as a 50% cut-out.
                 self.warn(format!("material {:?}: alpha BLEND is rendered as MASK 0.5", m.name()));
-                AlphaMode::Mask(0.5)
+                super::AlphaMode::Mask(0.5)
             }
         };
         let strength = m.emissive_strength().unwrap_or(1.0);
         let clamp01 = |x: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 };
         let fin = |v: Vec3| if v.is_finite() { v.max(Vec3::ZERO) } else { Vec3::ZERO };
+        let base = Vec4::from(pbr.base_color_factor());
+        // glTF bounds these factors; a value outside is clamped, and said so.
+        let in01 = |x: f32| (0.0..=1.0).contains(&x);
+        let emission = Vec3::from(m.emissive_factor()) * strength;
+        let out_of_range: Vec<&str> = [
+            ("baseColorFactor", base.to_array().iter().all(|&x| in01(x))),
+            ("metallicFactor", in01(pbr.metallic_factor())),
+            ("roughnessFactor", in01(pbr.roughness_factor())),
+            ("emission", emission.is_finite() && emission.min_element() >= 0.0),
+            ("specularFactor", in01(specular_factor)),
+            ("specularColorFactor", specular_color.is_finite() && specular_color.min_element() >= 0.0),
+        ]
+        .into_iter()
+        .filter(|(_, ok)| !ok)
+        .map(|(name, _)| name)
+        .collect();
+        if !out_of_range.is_empty() {
+            self.warn(format!("materials[{}] ({:?}): {} out of range; clamped", m.index().unwrap_or(0), m.name().unwrap_or(""), out_of_range.join(", ")));
+        }
         Material {
             name: m.name().unwrap_or("").to_string(),
-            base_color: Vec4::from(pbr.base_color_factor()).clamp(Vec4::ZERO, Vec4::ONE),
+            base_color: if base.is_finite() { base.clamp(Vec4::ZERO, Vec4::ONE) } else { Vec4::ONE },
             base_color_texture: self.tex(tex, pbr.base_color_texture().map(|i| (i.texture(), i.tex_coord())), true),
             metallic: clamp01(pbr.metallic_factor()),
             roughness: clamp01(pbr.roughness_factor()),
-            metallic_roughness_texture: self.tex(
-                tex,
-                pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord())),
-                false,
-            ),
+            metallic_roughness_texture: self.tex(tex, pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord())), false),
             normal_texture: self.tex(tex, m.normal_texture().map(|i| (i.texture(), i.tex_coord())), false),
-            normal_scale: m.normal_texture().map(|n| n.scale()).unwrap_or(1.0),
-            emission: fin(Vec3::from(m.emissive_factor()) * strength),
+            normal_scale: m.normal_texture().map(|n| n.scale()).filter(|s| s.is_finite()).unwrap_or(1.0),
+            emission: fin(emission),
             emissive_texture: self.tex(tex, m.emissive_texture().map(|i| (i.texture(), i.tex_coord())), true),
             specular_factor: clamp01(specular_factor),
             specular_color: fin(specular_color),
@@ -367,58 +460,11 @@ impl Importer<'_> {
         }
     }
 
-    fn mesh(
-        &mut self,
-        mesh: &gltf::Mesh,
-        buffers: &[Vec<u8>],
-        materials: &[Material],
-        default_material: u32,
-        out: &mut Vec<Mesh>,
-    ) -> Result<Vec<usize>> {
+    fn mesh(&mut self, mesh: &gltf::Mesh, data: &super::accessor::Data, default_material: u32, out: &mut Vec<Mesh>) -> Result<Vec<usize>> {
         let mut ids = vec![];
         for prim in mesh.primitives() {
-            use gltf::mesh::Mode;
-            let mode = prim.mode();
-            if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
-                self.warn(format!("mesh {:?}: {mode:?} primitives are not rendered", mesh.name()));
-                continue;
-            }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|v| v.as_slice()));
-            let positions: Vec<Vec3> = match reader.read_positions() {
-                Some(p) => p.map(Vec3::from).collect(),
-                None => {
-                    self.warn(format!("mesh {:?}: a primitive has no POSITION; skipped", mesh.name()));
-                    continue;
-                }
-            };
-            let n = positions.len();
-            let raw: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..n as u32).collect(),
-            };
-            if let Some(bad) = raw.iter().find(|&&i| i as usize >= n) {
-                bail!("index {bad} is out of range for {n} vertices");
-            }
-            let indices = triangulate(mode, &raw);
-            let normals: Option<Vec<Vec3>> = reader.read_normals().map(|r| r.map(Vec3::from).collect());
-            let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
-                Some(t) => t.into_f32().map(Vec2::from).collect(),
-                None => vec![Vec2::ZERO; n],
-            };
-            let material = prim.material().index().map(|i| i as u32).unwrap_or(default_material);
-            let tangents: Option<Vec<Vec4>> = reader.read_tangents().map(|t| t.map(Vec4::from).collect());
-            let mut m = Mesh { positions, normals: normals.unwrap_or_default(), uvs, tangents: vec![], indices, material };
-            if m.normals.len() != n {
-                // glTF: without NORMAL, clients compute flat normals.
-                flatten_with_face_normals(&mut m);
-            }
-            let wants_tangents = materials.get(material as usize).is_some_and(|m| m.normal_texture.is_some());
-            if wants_tangents {
-                match tangents {
-                    Some(t) if t.len() == m.positions.len() => m.tangents = t,
-                    _ => generate_tangents(&mut m),
-                }
-            }
+            let here = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
+            let Some(m) = primitive(self, &prim, data, default_material, &here)? else { continue };
             ids.push(out.len());
             out.push(m);
         }
@@ -428,123 +474,120 @@ impl Importer<'_> {
     fn light(&mut self, l: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Light {
         use gltf::khr_lights_punctual::Kind;
         let c = Vec3::from(l.color()) * l.intensity();
-        let c = if c.is_finite() { c.max(Vec3::ZERO) } else { Vec3::ZERO };
+        let c = if c.is_finite() && c.min_element() >= 0.0 {
+            c
+        } else {
+            self.warn(format!("light {}: colour x intensity {c} is not finite and non-negative; the light is black", l.index()));
+            Vec3::ZERO
+        };
         if l.range().is_some() {
             self.warn("light range is ignored (lights follow the inverse-square law)".into());
         }
         let position = world.w_axis.truncate();
-        let direction = (-world.z_axis.truncate()).normalize_or(glam::DVec3::NEG_Z).as_vec3();
+        let direction = (-world.z_axis.truncate()).normalize_or(DVec3::NEG_Z).as_vec3();
         match l.kind() {
             Kind::Directional => Light::Directional { direction, irradiance: c },
             Kind::Point => Light::Point { position, intensity: c },
-            Kind::Spot { inner_cone_angle, outer_cone_angle } => Light::Spot {
-                position,
-                direction,
-                intensity: c,
-                inner_cone: inner_cone_angle,
-                outer_cone: outer_cone_angle,
-            },
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                Light::Spot { position, direction, intensity: c, inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
+            }
         }
     }
 
     fn scene_extras(&mut self, s: &gltf::Scene, scene: &mut Scene) -> Result<()> {
         let Some(raw) = s.extras() else { return Ok(()) };
         let v: serde_json::Value = serde_json::from_str(raw.get()).context("parsing scene extras")?;
+        let here = format!("scenes[{}].extras", s.index());
         if let Some(r) = v.get("resolution") {
             let wh = r
                 .as_array()
                 .filter(|a| a.len() == 2)
                 .and_then(|a| Some((a[0].as_u64()?, a[1].as_u64()?)))
                 .filter(|&(w, h)| w > 0 && h > 0 && w <= 16384 && h <= 16384)
-                .ok_or_else(|| anyhow!("extras.resolution must be [width, height] in 1..=16384, got {r}"))?;
+                .ok_or_else(|| anyhow!("{here}.resolution must be [width, height] in 1..=16384, got {}", shown(r)))?;
             scene.resolution = Some((wh.0 as u32, wh.1 as u32));
         }
         if let Some(d) = v.get("max_depth") {
             scene.max_depth = d
                 .as_i64()
-                .filter(|&d| d >= -1 && d <= 1 << 16)
-                .ok_or_else(|| anyhow!("extras.max_depth must be an integer >= -1, got {d}"))? as i32;
+                .filter(|&d| (-1..=1 << 16).contains(&d))
+                .ok_or_else(|| anyhow!("{here}.max_depth must be an integer in -1..=65536, got {}", shown(d)))? as i32;
         }
         // Written by Hush's exporter: the environment is the sun's procedural sky.
-        scene.procedural_sky = v.get("procedural_sky").and_then(|b| b.as_bool()).unwrap_or(false);
-        if let Some(env) = v.get("environment") {
-            if let Some(rad) = env.get("radiance") {
-                let c = rad
-                    .as_array()
-                    .filter(|a| a.len() == 3)
-                    .and_then(|a| Some(Vec3::new(a[0].as_f64()? as f32, a[1].as_f64()? as f32, a[2].as_f64()? as f32)))
-                    .filter(|c| c.is_finite() && c.min_element() >= 0.0)
-                    .ok_or_else(|| anyhow!("extras.environment.radiance must be [r, g, b] >= 0, got {rad}"))?;
-                scene.environment = Environment::Constant(c);
-            } else if let Some(map) = env.get("map").and_then(|m| m.as_str()) {
-                let intensity = env.get("intensity").and_then(|x| x.as_f64()).unwrap_or(1.0) as f32;
-                let rot = env.get("rotation_y_degrees").and_then(|x| x.as_f64()).unwrap_or(0.0) as f32;
-                let path = resolve(self.base, map)?;
-                scene.environment = Environment::Map(EnvMap::load_exr(&path, intensity, rot)?);
-            } else {
-                bail!("extras.environment needs `radiance` or `map`, got {env}");
+        if let Some(p) = v.get("procedural_sky") {
+            scene.procedural_sky = p.as_bool().ok_or_else(|| anyhow!("{here}.procedural_sky must be true or false, got {}", shown(p)))?;
+        }
+        let Some(env) = v.get("environment") else { return Ok(()) };
+        if let Some(obj) = env.as_object() {
+            let known: &[&str] = if obj.contains_key("radiance") { &["radiance"] } else { &["map", "intensity", "rotation_y_degrees"] };
+            for k in obj.keys().filter(|k| !known.contains(&k.as_str())) {
+                self.warn(format!("{here}.environment.{}: not used with {}; ignored", short(k), known[0]));
             }
+        }
+        let number = |key: &str, default: f64, ok: &dyn Fn(f64) -> bool, what: &str| -> Result<f64> {
+            match env.get(key) {
+                None => Ok(default),
+                Some(x) => x.as_f64().filter(|x| x.is_finite() && ok(*x)).ok_or_else(|| anyhow!("{here}.environment.{key} must be {what}, got {}", shown(x))),
+            }
+        };
+        if let Some(rad) = env.get("radiance") {
+            let c = rad
+                .as_array()
+                .filter(|a| a.len() == 3)
+                .and_then(|a| Some(Vec3::new(a[0].as_f64()? as f32, a[1].as_f64()? as f32, a[2].as_f64()? as f32)))
+                .filter(|c| c.is_finite() && c.min_element() >= 0.0)
+                .ok_or_else(|| anyhow!("{here}.environment.radiance must be [r, g, b] >= 0, got {}", shown(rad)))?;
+            scene.environment = Environment::Constant(c);
+        } else if let Some(map) = env.get("map") {
+            let map = map.as_str().ok_or_else(|| anyhow!("{here}.environment.map must be a file name, got {}", shown(map)))?;
+            let intensity = number("intensity", 1.0, &|x| x >= 0.0, "a number >= 0")? as f32;
+            let rot = number("rotation_y_degrees", 0.0, &|_| true, "a number (degrees)")? as f32;
+            let bytes = read_uri(self.files, map, self.budget.limits.file_bytes).with_context(|| format!("{here}.environment.map"))?;
+            scene.environment = Environment::Map(EnvMap::from_exr(&short(map), &bytes, intensity, rot, &mut self.budget)?);
+        } else {
+            bail!("{here}.environment needs `radiance` or `map`, got {}", shown(env));
         }
         Ok(())
     }
 }
 
-fn triangulate(mode: gltf::mesh::Mode, idx: &[u32]) -> Vec<u32> {
-    use gltf::mesh::Mode;
-    match mode {
-        Mode::Triangles => idx[..idx.len() / 3 * 3].to_vec(),
-        Mode::TriangleStrip => (2..idx.len())
-            .flat_map(|i| {
-                if i % 2 == 0 { [idx[i - 2], idx[i - 1], idx[i]] } else { [idx[i - 1], idx[i - 2], idx[i]] }
-            })
-            .collect(),
-        Mode::TriangleFan => (2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect(),
-        _ => vec![],
+/// A JSON value for an error message, shortened.
+fn shown(v: &serde_json::Value) -> String {
+    let s = v.to_string();
+    if s.len() > 80 { short(&s) } else { s }
+}
+
+/// A node's own rotation: its `rotation`, or its matrix's rotation part orthonormalised.
+fn local_rotation(node: &gltf::Node) -> DQuat {
+    match node.transform() {
+        gltf::scene::Transform::Decomposed { rotation, .. } => {
+            let q = DQuat::from_array(rotation.map(|x| x as f64));
+            if q.is_finite() && q.length() > 0.0 { q.normalize() } else { DQuat::IDENTITY }
+        }
+        gltf::scene::Transform::Matrix { matrix } => {
+            let m = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(|x| x as f64)));
+            orthonormal(DMat3::from_mat4(m)).map(|r| DQuat::from_mat3(&r)).unwrap_or(DQuat::IDENTITY)
+        }
     }
 }
 
-/// Give every triangle its own three vertices with the face normal.
-fn flatten_with_face_normals(m: &mut Mesh) {
-    let mut out = Mesh { material: m.material, ..Default::default() };
-    for t in m.indices.chunks_exact(3) {
-        let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
-        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-        for k in 0..3 {
-            out.indices.push(out.positions.len() as u32);
-            out.positions.push(p[k]);
-            out.normals.push(n);
-            out.uvs.push(m.uvs.get(t[k] as usize).copied().unwrap_or_default());
-        }
+/// The rotation nearest `m`'s axes (Gram-Schmidt from its z and y), or None where they are
+/// degenerate.
+fn orthonormal(m: DMat3) -> Option<DMat3> {
+    let z = m.z_axis.normalize_or_zero();
+    let x = m.y_axis.cross(m.z_axis).normalize_or_zero();
+    if z == DVec3::ZERO || x == DVec3::ZERO || !x.is_finite() || !z.is_finite() {
+        return None;
     }
-    *m = out;
+    Some(DMat3::from_cols(x, z.cross(x), z))
 }
 
-/// MikkTSpace tangents (the glTF reference) for a mesh with a normal map but no TANGENT.
-fn generate_tangents(m: &mut Mesh) {
-    struct Geo<'a>(&'a mut Mesh);
-    impl mikktspace::Geometry for Geo<'_> {
-        fn num_faces(&self) -> usize {
-            self.0.indices.len() / 3
-        }
-        fn num_vertices_of_face(&self, _: usize) -> usize {
-            3
-        }
-        fn position(&self, f: usize, v: usize) -> [f32; 3] {
-            self.0.positions[self.0.indices[f * 3 + v] as usize].into()
-        }
-        fn normal(&self, f: usize, v: usize) -> [f32; 3] {
-            self.0.normals[self.0.indices[f * 3 + v] as usize].into()
-        }
-        fn tex_coord(&self, f: usize, v: usize) -> [f32; 2] {
-            self.0.uvs[self.0.indices[f * 3 + v] as usize].into()
-        }
-        fn set_tangent_encoded(&mut self, t: [f32; 4], f: usize, v: usize) {
-            let i = self.0.indices[f * 3 + v] as usize;
-            self.0.tangents[i] = Vec4::from(t);
-        }
-    }
-    m.tangents = vec![Vec4::new(1.0, 0.0, 0.0, 1.0); m.positions.len()];
-    // MikkTSpace writes per face-vertex; shared vertices get the last write, which matches for
-    // the usual case of vertices split along UV seams.
-    let _ = mikktspace::generate_tangents(&mut Geo(m));
+/// A camera's pose from its node's world transform. glTF cameras carry no scale, so the axes are
+/// orthonormalised; where the transform has none to give (a zero scale), the chain of the nodes'
+/// rotations stands in. None where neither gives a pose.
+fn camera_pose(world: DMat4, rotation: DQuat) -> Option<DMat4> {
+    let eye = world.w_axis.truncate();
+    let axes = orthonormal(DMat3::from_mat4(world)).or_else(|| rotation.is_finite().then(|| DMat3::from_quat(rotation.normalize())))?;
+    let m = DMat4::from_cols(axes.x_axis.extend(0.0), axes.y_axis.extend(0.0), axes.z_axis.extend(0.0), eye.extend(1.0));
+    m.is_finite().then_some(m)
 }

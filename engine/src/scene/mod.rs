@@ -1,15 +1,18 @@
 //! Scenes on the CPU: what a glTF file (or the built-in default scene) describes, in the units and
 //! conventions of `README.md` ("Scene conventions").
 
+mod accessor;
 mod animation;
 mod camera_path;
 mod default_scene;
+mod environment;
+mod files;
+mod gltf_check;
 mod gltf_export;
+mod gltf_import;
+mod gltf_mesh;
 mod level;
 mod reflections;
-mod environment;
-mod gltf_import;
-mod paths;
 mod sky;
 mod texture;
 
@@ -20,8 +23,9 @@ pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
 pub use environment::{EnvMap, Environment};
 pub use gltf_export::save_gltf;
-pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with};
-pub use texture::{Texture, TextureRef, Wrap};
+pub use files::{MemoryFiles, SceneFiles, SceneFolder};
+pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, ImportPanic, LoadOptions, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_from, load_gltf_opts, load_gltf_with};
+pub use texture::{Texture, TextureRef, Wrap, decode_image};
 
 use anyhow::Result;
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
@@ -177,9 +181,13 @@ pub const DEFAULT_MAX_DEPTH: i32 = 6;
 impl Scene {
     /// Load a `.gltf`/`.glb` file or a built-in scene by name ([`BUILTIN_SCENES`]).
     pub fn load(path_or_default: &str) -> Result<Scene> {
+        Scene::load_with(path_or_default, &LoadOptions::default())
+    }
+
+    pub fn load_with(path_or_default: &str, opts: &LoadOptions) -> Result<Scene> {
         match builtin_scene(path_or_default) {
             Some(s) => Ok(s),
-            None => load_gltf(Path::new(path_or_default)),
+            None => load_gltf_opts(Path::new(path_or_default), opts),
         }
     }
 
@@ -191,15 +199,19 @@ impl Scene {
         self.objects.iter().map(|o| self.meshes[o.mesh].indices.len() / 3).sum()
     }
 
-    /// World-space bounds of all geometry (f64), or None for an empty scene.
+    /// World-space bounds of all geometry (f64), or None for an empty scene. Vertices at
+    /// non-finite positions are left out (their triangles are dropped before rendering): one
+    /// +Inf vertex would otherwise make the bounds, and the rebasing origin, infinite.
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
         for o in &self.objects {
             for p in &self.meshes[o.mesh].positions {
                 let w = o.transform.transform_point3(p.as_dvec3());
-                lo = lo.min(w);
-                hi = hi.max(w);
+                if w.is_finite() {
+                    lo = lo.min(w);
+                    hi = hi.max(w);
+                }
             }
         }
         (lo.x <= hi.x).then_some((lo, hi))

@@ -1,6 +1,7 @@
+use crate::limits::Budget;
 use anyhow::{Context, Result};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Wrap {
     Repeat,
     Clamp,
@@ -36,9 +37,11 @@ impl Texture {
     }
 
     /// Decode a PNG/JPEG, shrinking it (by halving) until neither side exceeds `max_size`, so
-    /// scenes with many 4K textures fit a GPU's storage-buffer limits.
-    pub fn decode(name: &str, bytes: &[u8], srgb: bool, max_size: u32) -> Result<Texture> {
-        let img = image::load_from_memory(bytes).with_context(|| format!("decoding image {name}"))?;
+    /// scenes with many 4K textures fit a GPU's storage-buffer limits. The size comes from the
+    /// image's header and is checked against `budget` (4 bytes a pixel) before anything is
+    /// decoded; the decoder is held to that size.
+    pub fn decode(name: &str, bytes: &[u8], srgb: bool, max_size: u32, budget: &mut Budget) -> Result<Texture> {
+        let img = decode_image(name, bytes, budget)?;
         let mut img = img.to_rgba8();
         while img.width().max(img.height()) > max_size.max(1) {
             let (w, h) = ((img.width() / 2).max(1), (img.height() / 2).max(1));
@@ -54,4 +57,20 @@ impl Texture {
             wrap_t: Wrap::Repeat,
         })
     }
+}
+
+/// A PNG or JPEG decoded within `budget`: its header's size is charged (4 bytes a pixel, what
+/// is kept) before decoding, and the decoder may allocate no more than that image at 16 bytes
+/// a pixel (16-bit RGBA and its conversion), so a header that lies cannot make it allocate more.
+pub fn decode_image(name: &str, bytes: &[u8], budget: &mut Budget) -> Result<image::DynamicImage> {
+    let reader = || image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().with_context(|| format!("reading image {name}"));
+    let (w, h) = reader()?.into_dimensions().with_context(|| format!("decoding image {name}"))?;
+    budget.image(w as u64, h as u64, 4, format_args!("image {name}"))?;
+    let mut r = reader()?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(w);
+    limits.max_image_height = Some(h);
+    limits.max_alloc = Some((w as u64 * h as u64 * 16).max(1 << 20));
+    r.limits(limits);
+    r.decode().with_context(|| format!("decoding image {name}"))
 }

@@ -22,13 +22,13 @@ impl FrameSettings {
     /// The path length a preset file names, if it names one: a preset saved without
     /// `max_depth` keeps the scene's instead of the default's.
     pub fn preset_max_depth(path: &Path) -> Result<Option<i32>> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("reading preset {}", path.display()))?;
+        let text = crate::limits::read_text_file(path).with_context(|| format!("reading preset {}", path.display()))?;
         let v: toml::Value = toml::from_str(&text).with_context(|| format!("reading TOML settings of preset {}", path.display()))?;
         Ok(v.get("max_depth").and_then(|d| d.as_integer()).map(|d| d as i32))
     }
 
     pub fn load_preset(path: &Path) -> Result<FrameSettings> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("reading preset {}", path.display()))?;
+        let text = crate::limits::read_text_file(path).with_context(|| format!("reading preset {}", path.display()))?;
         FrameSettings::from_toml(&text).with_context(|| format!("preset {}", path.display()))
     }
 }

@@ -1,0 +1,215 @@
+//! glTF mesh primitives and node animations, read through the checked accessors of `accessor`.
+
+use super::accessor::{self, Data, Expect};
+use super::gltf_import::Importer;
+use super::{Animation, Mesh, Track};
+use anyhow::{Result, bail};
+use glam::{DQuat, DVec3, Vec2, Vec3, Vec4};
+use std::collections::HashMap;
+
+/// Read one primitive as a triangle mesh, or None (with a warning) for points and lines.
+pub(super) fn primitive(imp: &mut Importer, prim: &gltf::Primitive, data: &Data, default_material: u32, here: &str) -> Result<Option<Mesh>> {
+    use gltf::mesh::Mode;
+    let mode = prim.mode();
+    if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+        imp.warn(format!("{here}: {mode:?} primitives are not rendered"));
+        return Ok(None);
+    }
+    let attribute = |s: gltf::Semantic| prim.get(&s).map(|a| a.index());
+    let Some(pos) = attribute(gltf::Semantic::Positions) else {
+        imp.warn(format!("{here} has no POSITION; skipped"));
+        return Ok(None);
+    };
+    let positions: Vec<Vec3> = vec3s(accessor::read_f32(data, pos, accessor::POSITION, &mut imp.budget, &format!("{here}.attributes.POSITION"))?);
+    let n = positions.len();
+    let raw: Vec<u32> = match prim.indices() {
+        Some(a) => accessor::read_indices(data, a.index(), &mut imp.budget, &format!("{here}.indices"))?,
+        None => (0..n as u32).collect(),
+    };
+    if let Some(bad) = raw.iter().find(|&&i| i as usize >= n) {
+        bail!("{here}: index {bad} is out of range for {n} vertices");
+    }
+    // Counted against the triangles budget before any per-triangle work (triangulation,
+    // flattening, tangents), as if the mesh were placed once more.
+    let triangles = match mode {
+        Mode::Triangles => raw.len() / 3,
+        _ => raw.len().saturating_sub(2),
+    } as u64;
+    let limit = imp.budget.limits.triangles;
+    if imp.triangles.saturating_add(triangles) > limit {
+        return Err(crate::limits::over_budget("triangles", format_args!("the scene, up to {here},"), imp.triangles.saturating_add(triangles), limit));
+    }
+    let indices = triangulate(mode, &raw);
+    drop(raw);
+    // glTF 2.0 §3.7.2.1: all attributes of a primitive have the same count.
+    let same_count = |name: &str, s: gltf::Semantic, expect: Expect, imp: &mut Importer| -> Result<Option<Vec<f32>>> {
+        let Some(i) = attribute(s) else { return Ok(None) };
+        let what = format!("{here}.attributes.{name}");
+        let v = accessor::read_f32(data, i, expect, &mut imp.budget, &what)?;
+        let count = v.len() / expect.ty.multiplicity();
+        if count != n {
+            bail!("{what} has {count} elements and POSITION {n}; a primitive's attributes have one count");
+        }
+        Ok(Some(v))
+    };
+    let normals = same_count("NORMAL", gltf::Semantic::Normals, accessor::NORMAL, imp)?.map(vec3s);
+    let uvs: Vec<Vec2> = match same_count("TEXCOORD_0", gltf::Semantic::TexCoords(0), accessor::TEXCOORD, imp)? {
+        Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
+        None => vec![Vec2::ZERO; n],
+    };
+    let tangents: Option<Vec<Vec4>> = same_count("TANGENT", gltf::Semantic::Tangents, accessor::TANGENT, imp)?
+        .map(|t| t.chunks_exact(4).map(|c| Vec4::new(c[0], c[1], c[2], c[3])).collect());
+    let material = prim.material().index().map(|i| i as u32).unwrap_or(default_material);
+    let mut m = Mesh { positions, normals: normals.unwrap_or_default(), uvs, tangents: vec![], indices, material };
+    if m.normals.len() != n {
+        // glTF: without NORMAL, clients compute flat normals.
+        flatten_with_face_normals(&mut m);
+    }
+    if prim.material().normal_texture().is_some() {
+        match tangents {
+            Some(t) if t.len() == m.positions.len() => m.tangents = t,
+            _ => generate_tangents(&mut m),
+        }
+    }
+    Ok(Some(m))
+}
+
+fn vec3s(v: Vec<f32>) -> Vec<Vec3> {
+    v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect()
+}
+
+fn triangulate(mode: gltf::mesh::Mode, idx: &[u32]) -> Vec<u32> {
+    use gltf::mesh::Mode;
+    match mode {
+        Mode::Triangles => idx[..idx.len() / 3 * 3].to_vec(),
+        Mode::TriangleStrip => (2..idx.len())
+            .flat_map(|i| if i % 2 == 0 { [idx[i - 2], idx[i - 1], idx[i]] } else { [idx[i - 1], idx[i - 2], idx[i]] })
+            .collect(),
+        Mode::TriangleFan => (2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect(),
+        _ => vec![],
+    }
+}
+
+/// Give every triangle its own three vertices with the face normal.
+fn flatten_with_face_normals(m: &mut Mesh) {
+    let mut out = Mesh { material: m.material, ..Default::default() };
+    for t in m.indices.chunks_exact(3) {
+        let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        for k in 0..3 {
+            out.indices.push(out.positions.len() as u32);
+            out.positions.push(p[k]);
+            out.normals.push(n);
+            out.uvs.push(m.uvs.get(t[k] as usize).copied().unwrap_or_default());
+        }
+    }
+    *m = out;
+}
+
+/// MikkTSpace tangents (the glTF reference) for a mesh with a normal map but no TANGENT.
+fn generate_tangents(m: &mut Mesh) {
+    struct Geo<'a>(&'a mut Mesh);
+    impl Geo<'_> {
+        fn vertex(&self, f: usize, v: usize) -> usize {
+            self.0.indices[f * 3 + v] as usize
+        }
+    }
+    impl mikktspace::Geometry for Geo<'_> {
+        fn num_faces(&self) -> usize {
+            self.0.indices.len() / 3
+        }
+        fn num_vertices_of_face(&self, _: usize) -> usize {
+            3
+        }
+        fn position(&self, f: usize, v: usize) -> [f32; 3] {
+            self.0.positions[self.vertex(f, v)].into()
+        }
+        fn normal(&self, f: usize, v: usize) -> [f32; 3] {
+            self.0.normals.get(self.vertex(f, v)).copied().unwrap_or(Vec3::Z).into()
+        }
+        fn tex_coord(&self, f: usize, v: usize) -> [f32; 2] {
+            self.0.uvs.get(self.vertex(f, v)).copied().unwrap_or_default().into()
+        }
+        fn set_tangent_encoded(&mut self, t: [f32; 4], f: usize, v: usize) {
+            let i = self.vertex(f, v);
+            self.0.tangents[i] = Vec4::from(t);
+        }
+    }
+    m.tangents = vec![Vec4::new(1.0, 0.0, 0.0, 1.0); m.positions.len()];
+    // MikkTSpace writes per face-vertex; shared vertices get the last write, which matches for
+    // the usual case of vertices split along UV seams.
+    let _ = mikktspace::generate_tangents(&mut Geo(m));
+}
+
+/// Node index -> its animation (translation/rotation/scale channels of every glTF animation).
+/// A channel that cannot be used (unsorted or non-finite keys, a value count that does not match
+/// the keys) is a warning and is ignored; a malformed accessor is an error.
+pub(super) fn animations(imp: &mut Importer, doc: &gltf::Document, data: &Data) -> Result<HashMap<usize, Animation>> {
+    use gltf::animation::{Interpolation, Property};
+    let mut map: HashMap<usize, Animation> = HashMap::new();
+    for anim in doc.animations() {
+        for ch in anim.channels() {
+            let here = format!("animations[{}].channels[{}]", anim.index(), ch.index());
+            let node = ch.target().node();
+            let sampler = ch.sampler();
+            let interp = sampler.interpolation();
+            let property = ch.target().property();
+            let expect = match property {
+                Property::Translation => accessor::TRANSLATION,
+                Property::Rotation => accessor::ROTATION,
+                Property::Scale => accessor::SCALE,
+                Property::MorphTargetWeights => {
+                    imp.warn(format!("{here}: morph target animation is not supported; ignored"));
+                    continue;
+                }
+            };
+            let times: Vec<f64> = accessor::read_f32(data, sampler.input().index(), accessor::KEY_TIMES, &mut imp.budget, &format!("{here} input"))?
+                .into_iter()
+                .map(|t| t as f64)
+                .collect();
+            let values = accessor::read_f32(data, sampler.output().index(), expect, &mut imp.budget, &format!("{here} output"))?;
+            let k = expect.ty.multiplicity();
+            // CUBICSPLINE stores (in-tangent, value, out-tangent) per key: keep the values.
+            let per_key = if interp == Interpolation::CubicSpline { 3 } else { 1 };
+            let keys: Vec<&[f32]> = values.chunks_exact(k).skip(per_key / 2).step_by(per_key).collect();
+            if keys.len() != times.len() || values.len() != times.len() * k * per_key {
+                imp.warn(format!("{here}: {} keys but {} values; ignored", times.len(), values.len() / k));
+                continue;
+            }
+            let sorted = times.windows(2).all(|w| w[0] <= w[1]) && times.iter().all(|t| t.is_finite());
+            if !sorted || !keys.iter().all(|v| v.iter().all(|x| x.is_finite())) {
+                imp.warn(format!("{here} has unsorted or non-finite keys; ignored"));
+                continue;
+            }
+            if interp == Interpolation::CubicSpline {
+                imp.warn(format!("{here}: CUBICSPLINE is sampled linearly between keys"));
+            }
+            let (t, r, s) = node.transform().decomposed();
+            let a = map.entry(node.index()).or_insert_with(|| Animation {
+                parent: glam::DMat4::IDENTITY,
+                translation: DVec3::from_array(t.map(|x| x as f64)),
+                rotation: DQuat::from_array(r.map(|x| x as f64)),
+                scale: DVec3::from_array(s.map(|x| x as f64)),
+                translation_track: None,
+                rotation_track: None,
+                scale_track: None,
+            });
+            let step = interp == Interpolation::Step;
+            let v3 = || keys.iter().map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect::<Vec<_>>();
+            match property {
+                Property::Translation => a.translation_track = Some(Track { times, values: v3(), step }),
+                Property::Scale => a.scale_track = Some(Track { times, values: v3(), step }),
+                _ => {
+                    let values = keys
+                        .iter()
+                        .map(|v| DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64).normalize())
+                        .map(|q| if q.is_finite() { q } else { DQuat::IDENTITY })
+                        .collect();
+                    a.rotation_track = Some(Track { times, values, step });
+                }
+            }
+        }
+    }
+    map.retain(|_, a| a.duration() > 0.0 || a.translation_track.is_some() || a.rotation_track.is_some() || a.scale_track.is_some());
+    Ok(map)
+}
