@@ -62,12 +62,15 @@ pub struct Accel {
     pub order: Vec<u32>,
     /// Wall time of the build (obvhs core build plus packing).
     pub build_time: Duration,
+    /// The SAH tree came out deeper than the GPU traversal holds and this one was built by
+    /// median splits instead ([`CWBVH_MAX_DEPTH`], [`BVH2_MAX_DEPTH`]).
+    pub median_fallback: bool,
 }
 
 impl Accel {
     /// Placeholder before the first build (no nodes).
     pub fn empty(kind: BvhKind) -> Accel {
-        Accel { kind, nodes: vec![], node_count: 0, order: vec![], build_time: Duration::ZERO }
+        Accel { kind, nodes: vec![], node_count: 0, order: vec![], build_time: Duration::ZERO, median_fallback: false }
     }
 }
 
@@ -79,6 +82,12 @@ fn params() -> BvhBuildParams {
 
 const EMPTY_MIN: [f32; 3] = [f32::MAX; 3];
 const EMPTY_MAX: [f32; 3] = [-f32::MAX; 3];
+
+/// The deepest tree the GPU traversals hold: the CWBVH stack (`CW_STACK` in
+/// shaders/common/cwbvh.wgsl) and the BVH2 stack (`BVH_STACK` in shaders/common/bvh2.wgsl).
+/// A deeper tree would lose the subtrees that overflow the stack: missing geometry, silently.
+pub const CWBVH_MAX_DEPTH: usize = 32;
+pub const BVH2_MAX_DEPTH: usize = 64;
 
 pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
     let start = Instant::now();
@@ -96,33 +105,183 @@ pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
         // An empty scene binds one node no ray can enter, in either layout's size.
         let mut nodes = bytemuck::bytes_of(&node).to_vec();
         nodes.resize(80, 0);
-        return Accel { kind: BvhKind::Bvh2, nodes, node_count: 1, order: vec![], build_time: start.elapsed() };
+        return Accel { kind: BvhKind::Bvh2, nodes, node_count: 1, order: vec![], build_time: start.elapsed(), median_fallback: false };
     }
+    // obvhs's PLOC merges mutual nearest neighbours. Triangles that share one centroid (stacked
+    // or nested copies) are all equally near each other: they merge one pair per pass (quadratic
+    // time: 40,000 coincident triangles took 40 s) into a tree as deep as their count. Such input
+    // goes straight to the median build, as does any tree still too deep for the GPU's stack.
+    let sah = (largest_coincident_group(tris) <= COINCIDENT_LIMIT).then(|| sah_build(tris, kind)).flatten();
+    let median_fallback = sah.is_none();
+    let (nodes, node_count, order) = sah.unwrap_or_else(|| {
+        log::warn!(
+            "the {} BVH over {} triangles is built by median splits, which trace slower: many triangles share one bounding box, and the SAH build would be too deep for the GPU's traversal stack",
+            kind.name(),
+            tris.len()
+        );
+        median_build(tris, kind)
+    });
+    Accel { kind, nodes, node_count, order, build_time: start.elapsed(), median_fallback }
+}
+
+/// Node bytes in the layout's GPU form, node count and triangle order.
+type Built = (Vec<u8>, usize, Vec<u32>);
+
+/// obvhs's PLOC build with its reinsertion optimisation (and, for the binary layout, leaf
+/// collapsing), as its `build_*_from_tris` helpers do it but without their debug-build
+/// validation, which panics on a tree deeper than obvhs's own stack. None where the tree is
+/// deeper than the GPU traversal holds: checked before the reinsertion pass, which is slow on
+/// deep trees, and after it.
+fn sah_build(tris: &[Triangle], kind: BvhKind) -> Option<Built> {
+    let p = params();
+    let boxes: Vec<TieBroken> = tris.iter().enumerate().map(|(i, t)| TieBroken::new(t.aabb(), i)).collect();
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(tris.len()).build(p.ploc_search_distance, &boxes, (0..tris.len() as u32).collect(), p.sort_precision, p.search_depth_threshold);
+    drop(boxes);
+    let reinsert = |bvh: &mut obvhs::bvh2::Bvh2, ratio: f32| obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(bvh, ratio, None);
     match kind {
         BvhKind::Bvh2 => {
-            let mut core = Duration::ZERO;
-            let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(tris, params(), &mut core);
-            let nodes = pack_bvh2(&bvh.nodes);
-            Accel {
-                kind,
-                node_count: nodes.len(),
-                nodes: bytemuck::cast_slice(&nodes).to_vec(),
-                order: bvh.primitive_indices.clone(),
-                build_time: start.elapsed(),
+            if bvh2_depth(&bvh.nodes) > 2 * BVH2_MAX_DEPTH {
+                return None;
             }
+            reinsert(&mut bvh, p.reinsertion_batch_ratio);
+            obvhs::bvh2::leaf_collapser::collapse(&mut bvh, p.max_prims_per_leaf, p.collapse_traversal_cost);
+            reinsert(&mut bvh, p.reinsertion_batch_ratio * p.post_collapse_reinsertion_batch_ratio_multiplier);
+            if bvh2_depth(&bvh.nodes) > BVH2_MAX_DEPTH {
+                return None;
+            }
+            let nodes = pack_bvh2(&bvh.nodes);
+            Some((bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices))
         }
         BvhKind::Cwbvh => {
-            let mut core = Duration::ZERO;
-            let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(tris, params(), &mut core);
-            Accel {
-                kind,
-                node_count: bvh.nodes.len(),
-                nodes: bytemuck::cast_slice(&bvh.nodes).to_vec(),
-                order: bvh.primitive_indices.clone(),
-                build_time: start.elapsed(),
+            // A CWBVH node spans up to three binary levels.
+            if bvh2_depth(&bvh.nodes) > 3 * CWBVH_MAX_DEPTH {
+                return None;
+            }
+            reinsert(&mut bvh, p.reinsertion_batch_ratio);
+            let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&bvh, p.max_prims_per_leaf.clamp(1, 3), true, false);
+            (cwbvh_depth(&cw.nodes) <= CWBVH_MAX_DEPTH).then(|| (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices))
+        }
+    }
+}
+
+fn median_build(tris: &[Triangle], kind: BvhKind) -> Built {
+    let p = params();
+    match kind {
+        BvhKind::Bvh2 => {
+            let bvh = median_bvh2(tris, p.max_prims_per_leaf as usize);
+            let nodes = pack_bvh2(&bvh.nodes);
+            (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices)
+        }
+        BvhKind::Cwbvh => {
+            // obvhs's CWBVH leaves hold at most 3 triangles.
+            let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&median_bvh2(tris, 1), p.max_prims_per_leaf.clamp(1, 3), true, false);
+            (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices)
+        }
+    }
+}
+
+/// Triangles sharing one centroid beyond which PLOC is not tried (see [`build`]); real scenes
+/// stack a few copies at most.
+const COINCIDENT_LIMIT: usize = 32;
+
+/// A triangle's box as PLOC sees it: enlarged by a pseudo-random 0 to 1e-5 of its diagonal.
+/// Where neighbours' merge costs tie exactly (a row of evenly spaced copies), every node picks
+/// the same side and PLOC merges one pair per pass: 20,000 copies in a row took 4.9 s to build,
+/// jittered 0.06 s. An enlarged box only makes the tree's bounds conservative.
+struct TieBroken(obvhs::aabb::Aabb);
+
+impl TieBroken {
+    fn new(b: obvhs::aabb::Aabb, i: usize) -> TieBroken {
+        let r = (i as u32).wrapping_mul(0x9E37_79B9).rotate_left(13).wrapping_mul(0x85EB_CA6B) >> 8;
+        let pad = b.diagonal().length() * 1e-5 * (r as f32 / (1 << 24) as f32);
+        TieBroken(obvhs::aabb::Aabb::new(b.min - pad, b.max + pad))
+    }
+}
+
+impl obvhs::Boundable for TieBroken {
+    fn aabb(&self) -> obvhs::aabb::Aabb {
+        self.0
+    }
+}
+
+/// The most triangles that share one centroid (bit for bit; hashed, so a collision can only
+/// overcount, which costs a slower tree and never a wrong one).
+fn largest_coincident_group(tris: &[Triangle]) -> usize {
+    use std::hash::{Hash, Hasher};
+    let mut keys: Vec<u64> = tris
+        .iter()
+        .map(|t| {
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            t.aabb().center().to_array().map(f32::to_bits).hash(&mut h);
+            h.finish()
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.chunk_by(|a, b| a == b).map(|run| run.len()).max().unwrap_or(0)
+}
+
+/// Depth of an obvhs BVH2 (the root alone is 1).
+fn bvh2_depth(nodes: &[obvhs::bvh2::node::Bvh2Node]) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1usize)];
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        let n = &nodes[i];
+        if n.prim_count == 0 {
+            stack.push((n.first_index as usize, d + 1));
+            stack.push((n.first_index as usize + 1, d + 1));
+        }
+    }
+    deepest
+}
+
+/// Depth of a CWBVH in nodes (the root alone is 1).
+fn cwbvh_depth(nodes: &[obvhs::cwbvh::node::CwBvhNode]) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1usize)];
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        for ch in 0..8 {
+            if !nodes[i].is_child_empty(ch) && !nodes[i].is_leaf(ch) {
+                stack.push((nodes[i].child_node_index(ch) as usize, d + 1));
             }
         }
     }
+    deepest
+}
+
+/// A BVH2 of depth at most ceil(log2(n / leaf)) + 1: each node splits its triangles at the
+/// median centroid along the centroids' longest axis (ties by index, so coincident triangles
+/// split too). Written here because obvhs builds only by PLOC, whose tree has no depth bound;
+/// this one is the fallback where that tree is too deep for the GPU's traversal stack.
+fn median_bvh2(tris: &[Triangle], leaf: usize) -> obvhs::bvh2::Bvh2 {
+    use obvhs::{aabb::Aabb, bvh2::node::Bvh2Node};
+    let boxes: Vec<Aabb> = tris.iter().map(|t| t.aabb()).collect();
+    let centre: Vec<glam::Vec3A> = boxes.iter().map(|b| b.center()).collect();
+    let mut prims: Vec<u32> = (0..tris.len() as u32).collect();
+    let mut nodes = vec![Bvh2Node::default()];
+    let mut stack = vec![(0usize, 0usize, tris.len())];
+    while let Some((ni, s, e)) = stack.pop() {
+        let bounds = prims[s..e].iter().fold(Aabb::empty(), |b, &i| b.union(&boxes[i as usize]));
+        if e - s <= leaf.max(1) {
+            nodes[ni] = Bvh2Node::new(bounds, (e - s) as u32, s as u32);
+            continue;
+        }
+        let mut cb = Aabb::empty();
+        for &i in &prims[s..e] {
+            cb.extend(centre[i as usize]);
+        }
+        let axis = cb.largest_axis();
+        let mid = (s + e) / 2;
+        prims[s..e].select_nth_unstable_by(mid - s, |&a, &b| centre[a as usize][axis].total_cmp(&centre[b as usize][axis]).then(a.cmp(&b)));
+        let first = nodes.len();
+        nodes.push(Bvh2Node::default());
+        nodes.push(Bvh2Node::default());
+        nodes[ni] = Bvh2Node::new(bounds, 0, first as u32);
+        stack.push((first, s, mid));
+        stack.push((first + 1, mid, e));
+    }
+    obvhs::bvh2::Bvh2 { nodes, primitive_indices: prims, ..Default::default() }
 }
 
 /// obvhs's BVH2 (each node its own box, children adjacent) -> nodes holding both child boxes.
@@ -161,4 +320,48 @@ fn pack_bvh2(nodes: &[obvhs::bvh2::node::Bvh2Node]) -> Vec<Bvh2GpuNode> {
             Bvh2GpuNode { lmin, l_index, lmax, l_count, rmin, r_index, rmax, r_count }
         })
         .collect()
+}
+
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A degenerate PLOC tree (coincident triangles chain up) is replaced by one the GPU can
+    /// traverse; an ordinary scene keeps its PLOC tree.
+    #[test]
+    fn degenerate_layouts_build_fast_shallow_trees() {
+        let t = Triangle { v0: glam::Vec3A::new(-1.0, 0.0, -1.0), v1: glam::Vec3A::new(1.0, 0.0, 1.0), v2: glam::Vec3A::new(1.0, 0.0, -1.0) };
+        let stacked = vec![t; 5000];
+        let grid: Vec<Triangle> = (0..5000)
+            .map(|i| {
+                let o = glam::Vec3A::new((i % 71) as f32, (i / 71) as f32, (i % 13) as f32 * 0.1);
+                Triangle { v0: t.v0 + o, v1: t.v1 + o, v2: t.v2 + o }
+            })
+            .collect();
+        for kind in [BvhKind::Bvh2, BvhKind::Cwbvh] {
+            let a = build(&stacked, kind);
+            assert!(a.median_fallback, "{kind:?}");
+            let mut order = a.order.clone();
+            order.sort();
+            assert_eq!(order, (0..5000).collect::<Vec<u32>>(), "{kind:?}: every triangle once");
+            assert!(!build(&grid, kind).median_fallback, "{kind:?}");
+        }
+        // Evenly spaced copies in a row (PLOC's ties) and nested copies (one centroid) build in
+        // well under a second, where obvhs's PLOC alone took 4.9 s and 54 s.
+        let row: Vec<Triangle> = (0..20000).map(|i| {
+            let o = glam::Vec3A::new(i as f32 * 2.0, 0.0, 0.0);
+            Triangle { v0: t.v0 + o, v1: t.v1 + o, v2: t.v2 + o }
+        }).collect();
+        let nested: Vec<Triangle> = (0..20000).map(|i| {
+            let k = 1.0 + i as f32 * 1e-3;
+            Triangle { v0: t.v0 * k, v1: t.v1 * k, v2: t.v2 * k }
+        }).collect();
+        for (name, tris, fallback) in [("row", &row, false), ("nested", &nested, true)] {
+            let a = build(tris, BvhKind::Cwbvh);
+            assert!(a.build_time.as_secs_f64() < 1.0 && a.median_fallback == fallback, "{name}: {:?}, fallback {}", a.build_time, a.median_fallback);
+        }
+        let median = median_bvh2(&stacked, 1);
+        assert_eq!(bvh2_depth(&median.nodes), 14, "ceil(log2(5000)) + 1");
+    }
 }
