@@ -55,7 +55,7 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
         let mut t = std::time::Duration::ZERO;
         let cpu = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut t);
 
-        let gpu = Gpu::headless(&prepared.requirements(0)).unwrap();
+        let gpu = Gpu::headless(&prepared.requirements(0, 0)).unwrap();
         let gscene = prepared.upload(&gpu);
         let caster = Raycaster::new(&gpu, &gscene).unwrap();
         let (lo, hi) = scene.bounds().unwrap();

@@ -132,7 +132,7 @@ fn unusable_input_is_a_clear_error() {
     // Image sizes the tracer cannot make.
     let scene = extreme_scene(None);
     let prepared = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
-    let gpu = Gpu::headless(&prepared.requirements(0)).unwrap();
+    let gpu = Gpu::headless(&prepared.requirements(0, 0)).unwrap();
     let gs = prepared.upload(&gpu);
     for (w, h) in [(0, 10), (10, 0), (20000, 10)] {
         let view = TraceView { camera: scene.camera_or_default(), width: w, height: h, max_depth: 6, seed: 0 };

@@ -27,12 +27,15 @@ without a window use the command-line tool, e.g.\n    hush-cli render level --mo
 
 const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-path PATH.json]
             [--preset SETTINGS.toml] [--shaders DIR] [--profiler] [--puffin-http [PORT]]
+            [--limit NAME=VALUE[,NAME=VALUE...]]
   no scene: the default level. Keys: WASD move, Q/E down/up, right-drag look, wheel speed,
   shift run, F12 screenshot (PNG + EXR), R record a camera path, P play it, F9 profiler,
   F10 capture frames to a .puffin file, Esc quit. Drop a .gltf/.glb on the window to load it.
   Shaders reload when their files change: debug builds read the source tree's shaders/,
   release builds embed them unless --shaders DIR or $HUSH_SHADERS names a folder.
-  --profiler opens the profiler window at start; --puffin-http serves profiles to puffin_viewer on 127.0.0.1 (default port 8585).";
+  --profiler opens the profiler window at start; --puffin-http serves profiles to puffin_viewer on 127.0.0.1 (default port 8585).
+  --limit sets a budget on what a scene file may make Hush read and build (file-bytes, json-bytes,
+  image-pixels, decoded-bytes, nodes, hierarchy-depth, triangles); a file over one is refused.";
 
 struct Args {
     scene: String,
@@ -41,6 +44,8 @@ struct Args {
     shaders: Option<PathBuf>,
     puffin_http: Option<u16>,
     profiler: bool,
+    /// Budgets for every scene loaded, dropped files included.
+    load: hush_engine::scene::LoadOptions,
 }
 
 /// The shader folder: --shaders, else $HUSH_SHADERS, else (debug builds) the source tree's.
@@ -53,8 +58,8 @@ fn shader_library(arg: Option<&Path>) -> Result<ShaderLibrary> {
     ShaderLibrary::from_env_or(fallback.as_deref())
 }
 
-fn load_scene(path: &str) -> Result<Scene> {
-    let mut scene = Scene::load(path)?;
+fn load_scene(path: &str, load: &hush_engine::scene::LoadOptions) -> Result<Scene> {
+    let mut scene = Scene::load_with(path, load)?;
     for w in &scene.warnings {
         log::warn!("{w}");
     }
@@ -88,6 +93,8 @@ struct Running {
     shader_read_errors: Vec<String>,
     render_error: Option<String>,
     profiler: profiler::Profiler,
+    /// Budgets for scenes dropped on the window (`--limit`).
+    load: hush_engine::scene::LoadOptions,
 }
 
 struct Viewer {
@@ -117,7 +124,7 @@ fn panel_for(r: &Renderer, message: String) -> ui::Panel {
 impl Viewer {
     fn start(&mut self, el: &ActiveEventLoop) -> Result<()> {
         let t0 = Instant::now();
-        let scene = load_scene(&self.args.scene)?;
+        let scene = load_scene(&self.args.scene, &self.args.load)?;
         let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
         let load_ms = t0.elapsed().as_secs_f64() * 1e3;
         let attrs = Window::default_attributes().with_title(format!("Hush: {}", scene.name)).with_inner_size(winit::dpi::LogicalSize::new(1280.0, 720.0));
@@ -191,6 +198,7 @@ impl Viewer {
             shader_read_errors: vec![],
             render_error: None,
             profiler,
+            load: self.args.load,
         });
         Ok(())
     }
@@ -212,7 +220,7 @@ impl Running {
     }
 
     fn load(&mut self, path: &Path) {
-        let r = load_scene(&path.to_string_lossy()).and_then(|scene| {
+        let r = load_scene(&path.to_string_lossy(), &self.load).and_then(|scene| {
             let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
             let extent = prepared.extent;
             let size = self.frame_size();
@@ -563,6 +571,7 @@ fn has_display() -> bool {
 fn parse_args() -> Result<Option<Args>> {
     let mut scene = None;
     let (mut camera_path, mut preset, mut shaders, mut puffin_http, mut profiler) = (None, None, None, None, false);
+    let mut load = hush_engine::scene::LoadOptions::default();
     let mut it = std::env::args().skip(1).peekable();
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -571,6 +580,7 @@ fn parse_args() -> Result<Option<Args>> {
             "--preset" => preset = Some(PathBuf::from(it.next().context("--preset needs a file")?)),
             "--shaders" => shaders = Some(PathBuf::from(it.next().context("--shaders needs a folder")?)),
             "--profiler" => profiler = true,
+            "--limit" => load.limits.apply(&it.next().context("--limit needs NAME=VALUE")?)?,
             "--puffin-http" => {
                 let port = match it.peek().and_then(|p| p.parse::<u16>().ok()) {
                     Some(p) => {
@@ -585,7 +595,7 @@ fn parse_args() -> Result<Option<Args>> {
             s => scene = Some(s.to_string()),
         }
     }
-    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path, preset, shaders, puffin_http, profiler }))
+    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path, preset, shaders, puffin_http, profiler, load }))
 }
 
 fn run() -> Result<()> {

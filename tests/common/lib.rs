@@ -32,7 +32,7 @@ pub fn render(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32) -> Result<Accu
 
 pub fn render_with(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32, kind: BvhKind) -> Result<Accumulation> {
     let prepared = PreparedScene::new(scene, kind)?;
-    let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64 * 32))?;
+    let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
     let view = TraceView { camera: scene.camera_or_default(), width: w, height: h, max_depth: scene.max_depth, seed };
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;

@@ -44,6 +44,8 @@ pub struct BenchArgs {
     /// passes) to this `.puffin` file (open it with puffin_viewer).
     #[arg(long)]
     pub profile: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub load: crate::render::LoadArgs,
 }
 
 #[derive(Serialize)]
@@ -88,7 +90,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         "realtime" => return crate::bench_realtime::run(&a),
         m => anyhow::bail!("--mode {m:?}: use reference or realtime"),
     }
-    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let scene = load_scene(&a.scene, &a.load)?;
     let kinds = match &a.bvh {
         Some(s) => vec![BvhKind::parse(s).with_context(|| format!("--bvh {s:?}"))?],
         None => vec![BvhKind::Bvh2, BvhKind::Cwbvh],
@@ -99,7 +101,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     for kind in kinds {
         let prepared = PreparedScene::new(&scene, kind)?;
         triangles = prepared.triangle_count();
-        let gpu = Gpu::headless(&prepared.requirements(a.width as u64 * a.height as u64 * 32))?;
+        let gpu = Gpu::headless(&prepared.requirements(a.width as u64 * a.height as u64, 32))?;
         adapter = gpu.info.name.clone();
         let gscene = prepared.upload(&gpu);
         // Traversal: random rays from inside the bounds in uniformly random directions.

@@ -49,7 +49,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let scene = load_scene(&a.scene, &a.load)?;
     let size = (a.width, a.height);
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
     if !gpu.timestamps {

@@ -74,6 +74,8 @@ pub struct QualityArgs {
     /// FlightHelmet at 160x90 measured 0.0055 to 0.0089 over five seeds.
     #[arg(long, default_value_t = 4)]
     pub yardstick_seeds: u32,
+    #[command(flatten)]
+    pub load: crate::render::LoadArgs,
 }
 
 /// One stream's per-frame scores against the reference.
@@ -192,7 +194,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let denoiser = a.denoiser.as_deref().or(if a.preset.is_none() { Some("mara") } else { None });
     let chains = preset_settings(a.preset.as_deref(), denoiser, &a.disable, a.reflection_mv.as_deref())?;
     let denoiser = chains.denoiser;
-    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, Some(a.width), a.height);
     let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
     let camera = match &a.camera {

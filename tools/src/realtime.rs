@@ -1,6 +1,6 @@
 //! `hush-cli render --mode realtime`: the hybrid frame, headless and deterministic.
 
-use crate::render::{RenderArgs, bvh_kind, image_size, load_scene, parse_camera};
+use crate::render::{RenderArgs, bvh_kind, check_output, check_output_dir, check_sides, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::scene::CameraPath;
@@ -56,24 +56,47 @@ fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[Strin
 
 pub fn run(a: RenderArgs) -> Result<()> {
     let chains = preset_settings(a.preset.as_deref(), a.denoiser.as_deref(), &a.disable, a.reflection_mv.as_deref())?;
-    if a.frames == 0 {
+    let frames = a.frames.unwrap_or(1);
+    if frames == 0 {
         bail!("--frames must be at least 1");
     }
-    if a.out.is_none() && a.out_dir.is_none() {
-        bail!("real-time mode needs --out FILE (last frame) or --out-dir DIR (every frame)");
+    if let Some(spp) = a.spp {
+        bail!("--spp {spp}: real-time mode traces one sample per pixel per frame; use --frames (or --accumulate) for more");
     }
-    if !(a.fps > 0.0 && a.fps.is_finite()) {
+    let fps = a.fps.unwrap_or(60.0);
+    if !(fps > 0.0 && fps.is_finite()) {
         bail!("--fps must be a positive number");
     }
-    let scene = load_scene(&a.scene, a.max_texture_size)?;
-    let size = image_size(&scene, a.width, a.height);
-    let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
-    let camera = match &a.camera {
-        Some(c) => parse_camera(c)?,
-        None => scene.camera_or_default(),
-    };
-    if a.accumulate && path.is_some() {
+    match (&a.out, &a.view) {
+        (None, None) if a.out_dir.is_none() => bail!("real-time mode needs --out FILE (last frame) or --out-dir DIR (every frame)"),
+        (None, Some(_)) => bail!("--view needs --out FILE.png"),
+        (Some(out), Some(_)) => check_output(out, &["png"], "--out (what --view shows)")?,
+        (Some(out), None) => check_output(out, &["exr", "png"], "--out")?,
+        (None, None) => {}
+    }
+    let view = a
+        .view
+        .as_deref()
+        .map(|name| {
+            View::ALL.into_iter().find(|v| v.name() == name).with_context(|| format!("--view {name:?}: use one of {}", View::ALL.map(|v| v.name()).join(", ")))
+        })
+        .transpose()?;
+    if let Some(dir) = &a.out_dir {
+        check_output_dir(dir, "--out-dir")?;
+    }
+    check_sides(a.width, a.height, hush_engine::frame::MAX_SIDE, "real-time mode")?;
+    if a.accumulate && a.camera_path.is_some() {
         bail!("--accumulate needs a still camera; it cannot be combined with --camera-path");
+    }
+    let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
+    let camera = a.camera.as_deref().map(parse_camera).transpose()?;
+    let scene = load_scene(&a.scene, &a.load)?;
+    let size = image_size(&scene, a.width, a.height);
+    let camera = camera.unwrap_or_else(|| scene.camera_or_default());
+    if let Some(v) = view {
+        if v.needs_glossy() && !scene_has_glossy(&scene) {
+            bail!("--view {}: the scene has no glossy buffers", v.name());
+        }
     }
     let max_depth = path_length(a.max_depth, a.preset.as_deref(), scene.max_depth)?;
     let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, ..chains };
@@ -83,47 +106,41 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let Some(dir) = &a.out_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    for k in 0..a.frames {
+    for k in 0..frames {
         let input = match &path {
             Some(p) => {
                 let key = p.frame(k as usize);
                 FrameInput { camera: key.camera(), time: key.time }
             }
             // Accumulation needs a frozen clock; otherwise time advances at --fps.
-            None => FrameInput { camera, time: if a.accumulate { 0.0 } else { k as f64 / a.fps } },
+            None => FrameInput { camera, time: if a.accumulate { 0.0 } else { k as f64 / fps } },
         };
         r.render(&gpu, &input, &settings, None)?;
         if let Some(dir) = &a.out_dir {
             r.read_hdr(&gpu)?.save(&dir.join(format!("frame_{k:05}.exr")))?;
         }
     }
-    let img = r.read_hdr(&gpu)?;
     let secs = start.elapsed().as_secs_f64();
-    match (&a.out, &a.view) {
-        (Some(out), Some(name)) => {
-            let view = View::ALL.into_iter().find(|v| v.name() == name).with_context(|| {
-                format!("--view {name:?}: use one of {}", View::ALL.map(|v| v.name()).join(", "))
-            })?;
-            if view.needs_glossy() && !r.prepared.features.glossy {
-                bail!("--view {name}: the scene has no glossy buffers");
-            }
-            if out.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
-                bail!("--view writes what the display shows: use a .png --out");
-            }
+    match (&a.out, view) {
+        (Some(out), Some(view)) => {
             let shown = r.display_image(&gpu, &FrameSettings { view, ..settings })?;
             shown.save(out).with_context(|| format!("writing {}", out.display()))?;
         }
-        (Some(out), None) => img.save(out)?,
-        (None, Some(_)) => bail!("--view needs --out FILE.png"),
-        (None, None) => {}
+        (Some(out), None) => r.read_hdr(&gpu)?.save(out)?,
+        _ => {}
     }
     eprintln!(
-        "{name}: {}x{} real-time, {} frames{} in {secs:.2} s on {}",
+        "{name}: {}x{} real-time, {frames} frames{} in {secs:.2} s on {}",
         size.0,
         size.1,
-        a.frames,
         if a.accumulate { " accumulated" } else { "" },
         gpu.info.name
     );
     Ok(())
+}
+
+/// Whether the real-time frame will have glossy buffers for `scene` (a material some object
+/// uses has a specular lobe), known before any GPU work.
+fn scene_has_glossy(scene: &hush_engine::scene::Scene) -> bool {
+    hush_engine::gpu::PreparedScene::glossy_materials(scene)
 }

@@ -57,6 +57,8 @@ pub struct ReflectionsArgs {
     pub disable: Vec<String>,
     #[arg(long)]
     pub out_dir: PathBuf,
+    #[command(flatten)]
+    pub load: crate::render::LoadArgs,
 }
 
 /// Per-pixel G-buffer facts the measurements mask with.
@@ -123,7 +125,7 @@ fn strafed(c: Camera, offset: f64) -> Camera {
 
 pub fn run(a: ReflectionsArgs) -> Result<()> {
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
-    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, Some(a.width), a.height);
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
@@ -226,7 +228,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     }
 
     // 3. Motion vector accuracy against a brute-force search.
-    let mv_scene = load_scene(&a.mv_scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let mv_scene = load_scene(&a.mv_scene, &a.load)?;
     let mv_camera = mv_scene.camera_or_default();
     println!("  motion vectors on {} against a brute-force search of {}x{} pixels (strafe {} per frame)", a.mv_scene, 2 * a.search_radius + 1, 2 * a.search_radius + 1, a.step * 3.0);
     for (initial_step, traced) in [(4u32, true), (1, true), (4, false)] {

@@ -3,9 +3,70 @@ use clap::Args;
 use hush_engine::accel::BvhKind;
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::passes::{ReferenceTracer, TraceView};
-use hush_engine::scene::{Camera, Scene};
+use hush_engine::scene::{Camera, LoadOptions, Scene};
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// How a scene file is loaded: flags every command that loads one shares.
+#[derive(Args, Clone, Debug)]
+pub struct LoadArgs {
+    /// Largest texture side kept on load (larger textures are halved until they fit).
+    #[arg(long, default_value_t = hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE, value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_texture_size: u32,
+    /// Set a budget on what a scene file may make Hush read, decode and build, as NAME=VALUE
+    /// (comma-separated or repeated). A file over one is refused with an error naming it.
+    /// Budgets and defaults: file-bytes (any one file, 2 GiB), json-bytes (the glTF JSON,
+    /// 64 MiB), image-pixels (one image, 8192x8192), decoded-bytes (all buffers and images, 4 GiB),
+    /// nodes (1,000,000), hierarchy-depth (1024), triangles (after instancing, 16,777,215).
+    #[arg(long, value_name = "NAME=VALUE")]
+    pub limit: Vec<String>,
+}
+
+impl LoadArgs {
+    pub fn options(&self) -> Result<LoadOptions> {
+        let mut limits = hush_engine::limits::Limits::default();
+        for l in &self.limit {
+            limits.apply(l)?;
+        }
+        Ok(LoadOptions { max_texture_size: self.max_texture_size, limits })
+    }
+}
+
+/// Refuse an output file that could not be written, before any work: `what` names the flag.
+pub fn check_output(path: &Path, extensions: &[&str], what: &str) -> Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    if !extensions.contains(&ext.as_str()) {
+        bail!("{what} {}: the file must end in {}", path.display(), extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or "));
+    }
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        bail!("{what} {}: the folder {} does not exist", path.display(), dir.display());
+    }
+    if path.is_dir() {
+        bail!("{what} {} is a folder", path.display());
+    }
+    Ok(())
+}
+
+/// Refuse a --width or --height over `max_side` before any work (the other side may come from
+/// the scene's aspect ratio, checked once the scene is loaded).
+pub fn check_sides(width: Option<u32>, height: Option<u32>, max_side: u32, mode: &str) -> Result<()> {
+    for (flag, v) in [("--width", width), ("--height", height)] {
+        if let Some(v) = v.filter(|&v| v > max_side) {
+            bail!("{flag} {v}: {mode} renders at most {max_side} pixels a side");
+        }
+    }
+    Ok(())
+}
+
+/// Refuse an output folder that could not be made, before any work.
+pub fn check_output_dir(dir: &Path, what: &str) -> Result<()> {
+    match dir.ancestors().find(|a| a.exists()) {
+        Some(a) if a.is_dir() => Ok(()),
+        Some(a) => bail!("{what} {}: {} is not a folder", dir.display(), a.display()),
+        None => Ok(()),
+    }
+}
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -14,9 +75,9 @@ pub struct RenderArgs {
     /// `reference` (progressive path tracing) or `realtime` (the hybrid frame).
     #[arg(long, default_value = "reference")]
     pub mode: String,
-    /// Real-time mode: frames to render.
-    #[arg(long, default_value_t = 1)]
-    pub frames: u32,
+    /// Real-time mode: frames to render (default 1).
+    #[arg(long)]
+    pub frames: Option<u32>,
     /// Real-time mode: a camera path (JSON, as the viewer records); frame k uses key k.
     #[arg(long)]
     pub camera_path: Option<PathBuf>,
@@ -41,9 +102,10 @@ pub struct RenderArgs {
     /// Real-time mode: sum all frames with a still camera and write their mean.
     #[arg(long)]
     pub accumulate: bool,
-    /// Real-time mode: frames per second of the animation clock when no camera path gives times.
-    #[arg(long, default_value_t = 60.0)]
-    pub fps: f64,
+    /// Real-time mode: frames per second of the animation clock when no camera path gives times
+    /// (default 60).
+    #[arg(long)]
+    pub fps: Option<f64>,
     /// Real-time mode: write what the display shows for this view (final, gbuffer/normal,
     /// trace/matte, ...; see the viewer's list) to the --out PNG instead of the HDR image.
     #[arg(long)]
@@ -51,15 +113,15 @@ pub struct RenderArgs {
     /// Real-time mode: write every frame as linear HDR EXR into this folder (frame_00000.exr, ...).
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
-    /// Reference mode: samples per pixel.
-    #[arg(long, default_value_t = 64)]
-    pub spp: u32,
-    #[arg(long)]
+    /// Reference mode: samples per pixel (default 64).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub width: Option<u32>,
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub height: Option<u32>,
     /// Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(i32).range(-1..=65536))]
     pub max_depth: Option<i32>,
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
@@ -69,9 +131,8 @@ pub struct RenderArgs {
     /// BVH layout: bvh2 or cwbvh.
     #[arg(long)]
     pub bvh: Option<String>,
-    /// Largest texture side kept on load.
-    #[arg(long, default_value_t = hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)]
-    pub max_texture_size: u32,
+    #[command(flatten)]
+    pub load: LoadArgs,
     /// Output: .exr (linear HDR RGB float) or .png (tone-mapped sRGB). In real-time mode, the
     /// last frame.
     #[arg(long)]
@@ -111,11 +172,11 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
     Ok(Camera::look_at(eye, target, fov))
 }
 
-pub fn load_scene(path: &str, max_texture_size: u32) -> Result<Scene> {
-    let mut scene = match hush_engine::scene::builtin_scene(path) {
-        Some(s) => s,
-        None => hush_engine::scene::load_gltf_with(std::path::Path::new(path), max_texture_size)?,
-    };
+pub fn load_scene(path: &str, load: &LoadArgs) -> Result<Scene> {
+    let mut scene = Scene::load_with(path, &load.options()?)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
     scene.add_sun_and_sky_if_unlit();
     Ok(scene)
 }
@@ -139,29 +200,44 @@ pub fn bvh_kind(s: &Option<String>) -> Result<BvhKind> {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
+    a.load.options()?;
     match a.mode.as_str() {
         "reference" => {}
         "realtime" => return crate::realtime::run(a),
         m => bail!("--mode {m:?} is not available; use reference or realtime"),
     }
-    let out = a.out.clone().context("--out is required in reference mode")?;
-    if a.spp == 0 {
-        bail!("--spp must be at least 1");
+    let realtime_only = [
+        ("--frames", a.frames.is_some()),
+        ("--camera-path", a.camera_path.is_some()),
+        ("--denoiser", a.denoiser.is_some()),
+        ("--preset", a.preset.is_some()),
+        ("--disable", !a.disable.is_empty()),
+        ("--reflection-mv", a.reflection_mv.is_some()),
+        ("--accumulate", a.accumulate),
+        ("--fps", a.fps.is_some()),
+        ("--view", a.view.is_some()),
+        ("--out-dir", a.out_dir.is_some()),
+    ];
+    let given: Vec<&str> = realtime_only.iter().filter(|(_, on)| *on).map(|(f, _)| *f).collect();
+    if !given.is_empty() {
+        bail!("{} only apply to --mode realtime; reference mode path-traces --spp samples with no settings to set", given.join(", "));
     }
+    let out = a.out.clone().context("--out is required in reference mode")?;
+    check_output(&out, &["exr", "png"], "--out")?;
+    check_sides(a.width, a.height, hush_engine::passes::reference::MAX_SIDE, "reference mode")?;
+    let spp = a.spp.unwrap_or(64);
     let kind = bvh_kind(&a.bvh)?;
-    let scene = load_scene(&a.scene, a.max_texture_size)?;
+    let camera = a.camera.as_deref().map(parse_camera).transpose()?;
+    let scene = load_scene(&a.scene, &a.load)?;
     let (w, h) = image_size(&scene, a.width, a.height);
-    let camera = match &a.camera {
-        Some(c) => parse_camera(c)?,
-        None => scene.camera_or_default(),
-    };
+    let camera = camera.unwrap_or_else(|| scene.camera_or_default());
     let view = TraceView { camera, width: w, height: h, max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed };
     let prepared = PreparedScene::new(&scene, kind)?;
-    let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64 * 32))?;
+    let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     let bar = if std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new(a.spp as u64);
+        let b = indicatif::ProgressBar::new(spp as u64);
         b.set_style(indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} spp {per_sec} eta {eta}")?.progress_chars("=> "));
         Some(b)
     } else {
@@ -169,8 +245,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     let start = std::time::Instant::now();
     let mut done = 0;
-    while done < a.spp {
-        let n = (a.spp - done).min(4);
+    while done < spp {
+        let n = (spp - done).min(4);
         tracer.dispatch(&gpu, n);
         gpu.wait()?;
         done += n;
@@ -189,7 +265,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     acc.mean.save(&out)?;
     eprintln!(
         "{}: {}x{} {} spp in {:.2} s ({:.3} M samples/s) on {} -> {}",
-        scene.name, w, h, a.spp, secs, (w as f64 * h as f64 * a.spp as f64) / secs / 1e6, gpu.info.name, out.display()
+        scene.name, w, h, spp, secs, (w as f64 * h as f64 * spp as f64) / secs / 1e6, gpu.info.name, out.display()
     );
     Ok(())
 }

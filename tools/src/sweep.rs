@@ -28,6 +28,8 @@ pub struct SweepArgs {
     pub reference_frames: u32,
     #[arg(long)]
     pub out_dir: PathBuf,
+    #[command(flatten)]
+    pub load: crate::render::LoadArgs,
 }
 
 struct Point {
@@ -49,7 +51,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
     if a.frames < 2 || a.reference_frames == 0 {
         bail!("--frames must be at least 2 and --reference-frames at least 1");
     }
-    let scene = load_scene(&a.scene, hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE)?;
+    let scene = load_scene(&a.scene, &a.load)?;
     let full = image_size(&scene, Some(a.width & !1), None);
     let full = (full.0, full.1 & !1);
     let camera = match &a.camera {

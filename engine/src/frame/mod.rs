@@ -109,7 +109,7 @@ pub struct Renderer {
 impl PreparedScene {
     /// Features and limits of the real-time frame on this scene.
     pub fn realtime_requirements(&self, size: (u32, u32)) -> GpuRequirements {
-        let mut r = self.requirements(size.0 as u64 * size.1 as u64 * 16);
+        let mut r = self.requirements(size.0 as u64 * size.1 as u64, 16);
         r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
         // matte, direct, and with a glossy lobe glossy, reflection, mirror and mirror hit.
         r.max_storage_textures_per_shader_stage = if self.features.glossy { 6 } else { 2 };

@@ -13,6 +13,10 @@ pub struct GpuRequirements {
     pub features: wgpu::Features,
     /// Largest storage buffer the scene binds, in bytes.
     pub max_storage_buffer_binding_size: u64,
+    /// Bytes and pixels of the largest per-pixel output buffer (the reference tracer's
+    /// accumulation), so that an image too large for the adapter is named as such.
+    pub output_bytes: u64,
+    pub output_pixels: u64,
     /// Storage buffers bound at once by the busiest compute stage.
     pub max_storage_buffers_per_shader_stage: u32,
     /// Storage textures written at once by the busiest compute stage.
@@ -31,6 +35,8 @@ impl Default for GpuRequirements {
         Self {
             features: wgpu::Features::empty(),
             max_storage_buffer_binding_size: d.max_storage_buffer_binding_size as u64,
+            output_bytes: 0,
+            output_pixels: 0,
             max_storage_buffers_per_shader_stage: d.max_storage_buffers_per_shader_stage,
             max_storage_textures_per_shader_stage: d.max_storage_textures_per_shader_stage,
             max_color_attachment_bytes_per_sample: d.max_color_attachment_bytes_per_sample,
@@ -108,6 +114,19 @@ impl Gpu {
                 req.max_color_attachment_bytes_per_sample,
                 have.max_storage_textures_per_shader_stage,
                 have.max_color_attachment_bytes_per_sample
+            ));
+        }
+        if req.output_bytes > have.max_storage_buffer_binding_size && req.output_pixels > 0 {
+            let per_pixel = req.output_bytes / req.output_pixels;
+            let most = have.max_storage_buffer_binding_size / per_pixel.max(1);
+            return Err(anyhow!(
+                "a {} pixel image needs an output buffer of {} bytes ({per_pixel} a pixel); adapter {:?} allows {} bytes a buffer, \
+                 so at most {most} pixels (about {side}x{side}): use a smaller --width and --height",
+                req.output_pixels,
+                req.output_bytes,
+                info.name,
+                have.max_storage_buffer_binding_size,
+                side = (most as f64).sqrt() as u64
             ));
         }
         if limits.max_storage_buffer_binding_size > have.max_storage_buffer_binding_size

@@ -42,7 +42,9 @@ pub mod binding {
 impl PreparedScene {
     /// Storage buffers the reference tracer binds, and the largest of them (plus `extra` bytes of
     /// per-pixel output), for [`Gpu::headless`].
-    pub fn requirements(&self, output_bytes: u64) -> GpuRequirements {
+    /// What the scene's buffers and an output of `output_pixels` x `bytes_per_pixel` need.
+    pub fn requirements(&self, output_pixels: u64, bytes_per_pixel: u64) -> GpuRequirements {
+        let output_bytes = output_pixels * bytes_per_pixel;
         let f = &self.features;
         let sizes = [
             self.accel.nodes.len() as u64,
@@ -63,6 +65,8 @@ impl PreparedScene {
         GpuRequirements {
             max_storage_buffer_binding_size: sizes.into_iter().max().unwrap_or(0).max(d.max_storage_buffer_binding_size),
             max_storage_buffers_per_shader_stage: count.max(d.max_storage_buffers_per_shader_stage),
+            output_bytes,
+            output_pixels,
             ..d
         }
     }
