@@ -6,6 +6,7 @@
 
 pub mod accel;
 pub mod frame;
+pub mod fuzz;
 pub mod gpu;
 pub mod limits;
 pub mod passes;
