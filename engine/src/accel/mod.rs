@@ -184,7 +184,7 @@ fn median_build(tris: &[Triangle], kind: BvhKind) -> Built {
 /// stack a few copies at most.
 const COINCIDENT_LIMIT: usize = 32;
 
-/// A triangle's box as PLOC sees it: enlarged by a pseudo-random 0 to 1e-5 of its diagonal.
+/// A triangle's box as PLOC sees it: enlarged by a pseudo-random 0 to 1e-5 of its largest side.
 /// Where neighbours' merge costs tie exactly (a row of evenly spaced copies), every node picks
 /// the same side and PLOC merges one pair per pass: 20,000 copies in a row took 4.9 s to build,
 /// jittered 0.06 s. An enlarged box only makes the tree's bounds conservative.
@@ -193,7 +193,9 @@ struct TieBroken(obvhs::aabb::Aabb);
 impl TieBroken {
     fn new(b: obvhs::aabb::Aabb, i: usize) -> TieBroken {
         let r = (i as u32).wrapping_mul(0x9E37_79B9).rotate_left(13).wrapping_mul(0x85EB_CA6B) >> 8;
-        let pad = b.diagonal().length() * 1e-5 * (r as f32 / (1 << 24) as f32);
+        // The largest side rather than the diagonal's length, which overflows f32 for a box
+        // whose sides are finite (and inf x 0 is NaN, which PLOC refuses).
+        let pad = b.diagonal().max_element() * 1e-5 * (r as f32 / (1 << 24) as f32);
         TieBroken(obvhs::aabb::Aabb::new(b.min - pad, b.max + pad))
     }
 }

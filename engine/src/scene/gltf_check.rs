@@ -7,8 +7,28 @@ use crate::limits::{Limits, over_budget};
 use anyhow::{Result, bail};
 use gltf::json::validation::Checked;
 
-/// Everything below, each failure naming the JSON path.
+/// Everything below, each failure naming the JSON path. Runs before the `gltf` crate's own
+/// validation, which indexes the accessor a primitive's POSITION names without checking it.
 pub fn check(root: &gltf::json::Root, limits: &Limits) -> Result<()> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = prim.attributes.get(&Checked::Valid(gltf::json::mesh::Semantic::Positions));
+            if let Some(i) = position.map(|i| i.value()).filter(|&i| i >= root.accessors.len()) {
+                bail!("meshes[{m}].primitives[{p}].attributes.POSITION names accessors[{i}], which does not exist");
+            }
+        }
+    }
+    // The gltf crate validates an animation's samplers but not its channels' targets.
+    for (a, anim) in root.animations.iter().enumerate() {
+        for (c, ch) in anim.channels.iter().enumerate() {
+            if ch.target.node.value() >= root.nodes.len() {
+                bail!("animations[{a}].channels[{c}].target.node names nodes[{}], which does not exist", ch.target.node.value());
+            }
+            if matches!(ch.target.path, Checked::Invalid) {
+                bail!("animations[{a}].channels[{c}].target.path must be translation, rotation, scale or weights");
+            }
+        }
+    }
     check_cameras(root)?;
     check_images(root)?;
     check_lights(root)?;

@@ -65,7 +65,6 @@ pub fn load_gltf_opts(path: &Path, opts: &LoadOptions) -> Result<Scene> {
 pub fn load_gltf_from(bytes: &[u8], name: &str, files: &dyn SceneFiles, opts: &LoadOptions) -> Result<Scene> {
     let run = std::panic::AssertUnwindSafe(|| {
         let (document, blob) = parse(bytes, &opts.limits)?;
-        super::gltf_check::check(document.as_json(), &opts.limits)?;
         Importer { files, warnings: vec![], max_texture_size: opts.max_texture_size, budget: Budget::new(opts.limits), triangles: 0 }
             .import(&document, blob, name.to_string())
     });
@@ -92,6 +91,11 @@ impl std::error::Error for ImportPanic {}
 /// required extensions by name (the `gltf` crate's own error only says "Unsupported").
 fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8>>)> {
     let (json, blob) = if bytes.starts_with(b"glTF") {
+        // The gltf crate subtracts the header's 12 bytes from this length unchecked.
+        let length = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if length.is_some_and(|l| l < 12) {
+            bail!("reading GLB container: its length {} is shorter than its 12-byte header", length.unwrap_or(0));
+        }
         let glb = gltf::Glb::from_slice(bytes).map_err(|e| anyhow!("reading GLB container: {e}"))?;
         (glb.json, glb.bin.map(|b| b.to_vec()))
     } else {
@@ -124,6 +128,7 @@ fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8
         }
     }
     let root: gltf::json::Root = serde_json::from_value(v).map_err(|e| anyhow!("reading glTF JSON: {e}"))?;
+    super::gltf_check::check(&root, limits)?;
     let document = gltf::Document::from_json(root).map_err(|e| anyhow!("invalid glTF: {e}"))?;
     Ok((document, blob))
 }

@@ -121,21 +121,41 @@ fn generate_tangents(m: &mut Mesh) {
         fn num_vertices_of_face(&self, _: usize) -> usize {
             3
         }
+        // mikktspace bins vertices into a grid between the smallest and largest position and
+        // indexes past its table where a non-finite one leaves the last cell empty: such values
+        // reach it as zeros (their triangles are dropped before rendering anyway).
         fn position(&self, f: usize, v: usize) -> [f32; 3] {
-            self.0.positions[self.vertex(f, v)].into()
+            finite3(self.0.positions[self.vertex(f, v)]).into()
         }
         fn normal(&self, f: usize, v: usize) -> [f32; 3] {
-            self.0.normals.get(self.vertex(f, v)).copied().unwrap_or(Vec3::Z).into()
+            finite3(self.0.normals.get(self.vertex(f, v)).copied().unwrap_or(Vec3::Z)).into()
         }
         fn tex_coord(&self, f: usize, v: usize) -> [f32; 2] {
-            self.0.uvs.get(self.vertex(f, v)).copied().unwrap_or_default().into()
+            let uv = self.0.uvs.get(self.vertex(f, v)).copied().unwrap_or_default();
+            if uv.is_finite() { uv.into() } else { [0.0; 2] }
         }
         fn set_tangent_encoded(&mut self, t: [f32; 4], f: usize, v: usize) {
             let i = self.vertex(f, v);
             self.0.tangents[i] = Vec4::from(t);
         }
     }
+    fn finite3(v: Vec3) -> Vec3 {
+        if v.is_finite() { v } else { Vec3::ZERO }
+    }
     m.tangents = vec![Vec4::new(1.0, 0.0, 0.0, 1.0); m.positions.len()];
+    // The grid spans the largest extent of the positions it is given; where that extent is zero
+    // or overflows f32 every vertex lands in the first cell and the same indexing fails. Such a
+    // mesh has no area to map (or no finite one) and keeps the default tangents.
+    // It also counts down from its non-degenerate triangles (no two positions equal) unchecked.
+    let (lo, hi) = m.indices.iter().map(|&i| finite3(m.positions[i as usize])).fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let extent = (hi - lo).max_element();
+    let any_triangle = m.indices.chunks_exact(3).any(|t| {
+        let [a, b, c] = [0, 1, 2].map(|k| finite3(m.positions[t[k] as usize]));
+        a != b && a != c && b != c
+    });
+    if !(extent.is_finite() && extent > 0.0 && any_triangle) {
+        return;
+    }
     // MikkTSpace writes per face-vertex; shared vertices get the last write, which matches for
     // the usual case of vertices split along UV seams.
     let _ = mikktspace::generate_tangents(&mut Geo(m));
@@ -212,4 +232,24 @@ pub(super) fn animations(imp: &mut Importer, doc: &gltf::Document, data: &Data) 
     }
     map.retain(|_, a| a.duration() > 0.0 || a.translation_track.is_some() || a.rotation_track.is_some() || a.scale_track.is_some());
     Ok(map)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// mikktspace indexes past its vertex grid when the positions have no finite, non-zero
+    /// extent, and underflows when every triangle is degenerate; such meshes keep default
+    /// tangents instead of panicking.
+    #[test]
+    fn tangents_of_degenerate_meshes_do_not_panic() {
+        for p in [[Vec3::ONE; 3], [Vec3::splat(-3e38), Vec3::splat(3e38), Vec3::ZERO], [Vec3::NAN, Vec3::X, Vec3::INFINITY]] {
+            let mut m = Mesh { positions: p.to_vec(), normals: vec![Vec3::Y; 3], uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y], indices: vec![0, 1, 2], ..Default::default() };
+            generate_tangents(&mut m);
+            assert_eq!(m.tangents.len(), 3);
+        }
+        let mut m = Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z], normals: vec![Vec3::Y; 3], uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y], indices: vec![0, 2, 1], ..Default::default() };
+        generate_tangents(&mut m);
+        assert!((m.tangents[0].truncate() - Vec3::X).length() < 1e-5, "{:?}", m.tangents);
+    }
 }
