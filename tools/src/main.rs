@@ -69,6 +69,22 @@ fn main() {
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");
+        report_peak_memory();
         std::process::exit(1);
+    }
+    report_peak_memory();
+}
+
+/// With `HUSH_PEAK_MEMORY` set, print the process's peak resident memory (Linux's VmHWM) on
+/// exit: how the hostile-input tests bound what a file can make Hush claim. A parent's rusage
+/// cannot tell it, as a child's maxrss starts from the parent's resident size at spawn.
+fn report_peak_memory() {
+    if std::env::var_os("HUSH_PEAK_MEMORY").is_none() {
+        return;
+    }
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    match status.lines().find_map(|l| l.strip_prefix("VmHWM:")) {
+        Some(kib) => eprintln!("peak memory: {} kB", kib.trim().trim_end_matches("kB").trim()),
+        None => eprintln!("peak memory: unknown"),
     }
 }

@@ -220,7 +220,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     ];
     let given: Vec<&str> = realtime_only.iter().filter(|(_, on)| *on).map(|(f, _)| *f).collect();
     if !given.is_empty() {
-        bail!("{} only apply to --mode realtime; reference mode path-traces --spp samples with no settings to set", given.join(", "));
+        let verb = if given.len() == 1 { "applies" } else { "apply" };
+        bail!("{} only {verb} to --mode realtime; reference mode path-traces --spp samples with no settings to set", given.join(", "));
     }
     let out = a.out.clone().context("--out is required in reference mode")?;
     check_output(&out, &["exr", "png"], "--out")?;
