@@ -53,7 +53,7 @@ impl Default for Limits {
 }
 
 impl Limits {
-    /// The `--limit` names, in the order `help` lists them.
+    /// The `--limit` names.
     pub const NAMES: [&'static str; 7] = ["file-bytes", "json-bytes", "image-pixels", "decoded-bytes", "nodes", "hierarchy-depth", "triangles"];
 
     fn slot(&mut self, name: &str) -> Option<&mut u64> {
@@ -90,12 +90,6 @@ impl Limits {
             bail!("--limit triangles={}: the GPU addresses at most {} triangles", self.triangles, crate::gpu::prepare::MAX_TRIANGLES - 1);
         }
         Ok(())
-    }
-
-    /// One line per budget with its current value, for `--help` texts and errors.
-    pub fn describe(&self) -> String {
-        let mut me = *self;
-        Self::NAMES.iter().map(|n| format!("{n}={}", me.slot(n).map_or(0, |v| *v))).collect::<Vec<_>>().join(", ")
     }
 }
 
@@ -158,10 +152,6 @@ impl Budget {
             return Err(over_budget("image-pixels", format_args!("{what} ({w}x{h})"), px, self.limits.image_pixels));
         }
         self.decode(px * bytes_per_pixel, what)
-    }
-
-    pub fn decoded(&self) -> u64 {
-        self.decoded
     }
 }
 
@@ -230,6 +220,5 @@ mod tests {
         let mut b = Budget::new(l);
         let e = b.image(100, 100, 4, "texture a.png").unwrap_err().to_string();
         assert!(e.contains("image-pixels") && e.contains("--limit image-pixels=10000") && e.contains("100x100"), "{e}");
-        assert!(l.describe().contains("triangles=1000"));
     }
 }

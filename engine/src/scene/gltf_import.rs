@@ -139,7 +139,7 @@ pub(super) struct Importer<'a> {
     max_texture_size: u32,
     pub(super) budget: Budget,
     /// Triangles placed so far (instances counted), against `Limits::triangles`.
-    pub(super) triangles: u64,
+    triangles: u64,
 }
 
 /// An orthographic camera, rendered through a perspective one once the scene's bounds are known.
@@ -246,14 +246,20 @@ impl Importer<'_> {
         Ok(scene)
     }
 
-    /// Count `n` more triangles against the triangles budget.
-    pub(super) fn place_triangles(&mut self, n: u64, what: std::fmt::Arguments) -> Result<()> {
+    /// Refuse `n` more triangles than placed so far where they would exceed the triangles budget.
+    pub(super) fn triangles_fit(&self, n: u64, what: std::fmt::Arguments) -> Result<()> {
         let total = self.triangles.saturating_add(n);
         let limit = self.budget.limits.triangles;
         if total > limit {
             return Err(over_budget("triangles", format_args!("the scene, up to {what},"), total, limit));
         }
-        self.triangles = total;
+        Ok(())
+    }
+
+    /// Count `n` more triangles against the triangles budget.
+    fn place_triangles(&mut self, n: u64, what: std::fmt::Arguments) -> Result<()> {
+        self.triangles_fit(n, what)?;
+        self.triangles += n;
         Ok(())
     }
 

@@ -35,10 +35,7 @@ pub(super) fn primitive(imp: &mut Importer, prim: &gltf::Primitive, data: &Data,
         Mode::Triangles => raw.len() / 3,
         _ => raw.len().saturating_sub(2),
     } as u64;
-    let limit = imp.budget.limits.triangles;
-    if imp.triangles.saturating_add(triangles) > limit {
-        return Err(crate::limits::over_budget("triangles", format_args!("the scene, up to {here},"), imp.triangles.saturating_add(triangles), limit));
-    }
+    imp.triangles_fit(triangles, format_args!("{here}"))?;
     let indices = triangulate(mode, &raw);
     drop(raw);
     // glTF 2.0 §3.7.2.1: all attributes of a primitive have the same count.
