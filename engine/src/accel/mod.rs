@@ -111,7 +111,17 @@ pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
     // or nested copies) are all equally near each other: they merge one pair per pass (quadratic
     // time: 40,000 coincident triangles took 40 s) into a tree as deep as their count. Such input
     // goes straight to the median build, as does any tree still too deep for the GPU's stack.
-    let sah = (largest_coincident_group(tris) <= COINCIDENT_LIMIT).then(|| sah_build(tris, kind)).flatten();
+    // Where neighbours' merge costs only tie (copies evenly spaced in a row) PLOC sees its boxes
+    // jittered ([`TieBroken`]); other scenes build exactly as obvhs builds them.
+    let survey = Survey::of(tris);
+    let sah = match (survey.coincident > COINCIDENT_LIMIT, survey.tied > TIE_LIMIT) {
+        (true, _) => None,
+        (false, true) => {
+            log::info!("{} neighbour pairs of {} triangles share one merge cost: PLOC's boxes are jittered", survey.tied, tris.len());
+            sah_build(&tris.iter().enumerate().map(|(i, t)| TieBroken::new(t.aabb(), i)).collect::<Vec<_>>(), kind)
+        }
+        (false, false) => sah_build(tris, kind),
+    };
     let median_fallback = sah.is_none();
     let (nodes, node_count, order) = sah.unwrap_or_else(|| {
         log::warn!(
@@ -132,11 +142,9 @@ type Built = (Vec<u8>, usize, Vec<u32>);
 /// validation, which panics on a tree deeper than obvhs's own stack. None where the tree is
 /// deeper than the GPU traversal holds: checked before the reinsertion pass, which is slow on
 /// deep trees, and after it.
-fn sah_build(tris: &[Triangle], kind: BvhKind) -> Option<Built> {
+fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind) -> Option<Built> {
     let p = params();
-    let boxes: Vec<TieBroken> = tris.iter().enumerate().map(|(i, t)| TieBroken::new(t.aabb(), i)).collect();
-    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(tris.len()).build(p.ploc_search_distance, &boxes, (0..tris.len() as u32).collect(), p.sort_precision, p.search_depth_threshold);
-    drop(boxes);
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(prims.len()).build(p.ploc_search_distance, prims, (0..prims.len() as u32).collect(), p.sort_precision, p.search_depth_threshold);
     let reinsert = |bvh: &mut obvhs::bvh2::Bvh2, ratio: f32| obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(bvh, ratio, None);
     match kind {
         BvhKind::Bvh2 => {
@@ -184,10 +192,12 @@ fn median_build(tris: &[Triangle], kind: BvhKind) -> Built {
 /// stack a few copies at most.
 const COINCIDENT_LIMIT: usize = 32;
 
-/// A triangle's box as PLOC sees it: enlarged by a pseudo-random 0 to 1e-5 of its largest side.
-/// Where neighbours' merge costs tie exactly (a row of evenly spaced copies), every node picks
-/// the same side and PLOC merges one pair per pass: 20,000 copies in a row took 4.9 s to build,
-/// jittered 0.06 s. An enlarged box only makes the tree's bounds conservative.
+/// A triangle's box as PLOC sees it where merge costs tie ([`Survey`]): enlarged by a pseudo-
+/// random 0 to 1e-5 of its largest side. Where neighbours' costs tie exactly (a row of evenly
+/// spaced copies), every node picks the same side and PLOC merges one pair per pass: 20,000
+/// copies in a row took 4.9 s to build, jittered 0.06 s. An enlarged box only makes the tree's
+/// bounds conservative. Only such input is jittered: any other tree would change which rays a
+/// triangle's edge loses to its neighbour, and so the images.
 struct TieBroken(obvhs::aabb::Aabb);
 
 impl TieBroken {
@@ -206,21 +216,45 @@ impl obvhs::Boundable for TieBroken {
     }
 }
 
-/// The most triangles that share one centroid (bit for bit; hashed, so a collision can only
-/// overcount, which costs a slower tree and never a wrong one).
-fn largest_coincident_group(tris: &[Triangle]) -> usize {
-    use std::hash::{Hash, Hasher};
-    let mut keys: Vec<u64> = tris
-        .iter()
-        .map(|t| {
-            let mut h = std::collections::hash_map::DefaultHasher::new();
-            t.aabb().center().to_array().map(f32::to_bits).hash(&mut h);
-            h.finish()
-        })
-        .collect();
-    keys.sort_unstable();
-    keys.chunk_by(|a, b| a == b).map(|run| run.len()).max().unwrap_or(0)
+/// What PLOC would meet, from the triangles in Morton order (PLOC's own order): the most that
+/// share one centroid, and the most neighbour pairs with one merge cost (the half area of the
+/// union of consecutive boxes, bit for bit). Repeated costs are what copies of a mesh laid out
+/// at even steps produce, and once PLOC has merged each copy into one node they tie along the
+/// whole row.
+struct Survey {
+    coincident: usize,
+    tied: usize,
 }
+
+impl Survey {
+    fn of(tris: &[Triangle]) -> Survey {
+        use obvhs::aabb::Aabb;
+        let boxes: Vec<Aabb> = tris.iter().map(|t| t.aabb()).collect();
+        let total = boxes.iter().fold(Aabb::empty(), |a, b| a.union(b));
+        let span = total.diagonal().as_dvec3().max(glam::DVec3::splat(f64::MIN_POSITIVE));
+        let mut keys: Vec<(u64, [u32; 3], u32)> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let c = b.center();
+                let unit = ((c.as_dvec3() - total.min.as_dvec3()) / span).clamp(glam::DVec3::ZERO, glam::DVec3::ONE);
+                (obvhs::ploc::morton::morton_encode_u64_unorm(unit), c.to_array().map(f32::to_bits), i as u32)
+            })
+            .collect();
+        keys.sort_unstable();
+        let coincident = keys.chunk_by(|a, b| a.1 == b.1).map(|run| run.len()).max().unwrap_or(0);
+        let mut costs: Vec<u32> = keys.windows(2).map(|w| boxes[w[0].2 as usize].union(&boxes[w[1].2 as usize]).half_area().to_bits()).collect();
+        costs.sort_unstable();
+        let tied = costs.chunk_by(|a, b| a == b).map(|run| run.len()).max().unwrap_or(0);
+        Survey { coincident, tied }
+    }
+}
+
+/// Neighbour pairs sharing one merge cost beyond which PLOC's input is jittered (see [`build`]).
+/// PLOC's time grows with the square of a tied row (10,000 copies: 1.1 s, 20,000: 4.9 s), so
+/// rows this short cost at most 0.2 s together; the staircase, the most repetitive scene tested,
+/// has 104 such pairs and keeps obvhs's tree.
+const TIE_LIMIT: usize = 4096;
 
 /// Depth of an obvhs BVH2 (the root alone is 1).
 fn bvh2_depth(nodes: &[obvhs::bvh2::node::Bvh2Node]) -> usize {
@@ -359,6 +393,7 @@ mod tests {
             let k = 1.0 + i as f32 * 1e-3;
             Triangle { v0: t.v0 * k, v1: t.v1 * k, v2: t.v2 * k }
         }).collect();
+        assert!(Survey::of(&row).tied > TIE_LIMIT && Survey::of(&grid).tied <= TIE_LIMIT);
         for (name, tris, fallback) in [("row", &row, false), ("nested", &nested, true)] {
             let a = build(tris, BvhKind::Cwbvh);
             assert!(a.build_time.as_secs_f64() < 1.0 && a.median_fallback == fallback, "{name}: {:?}, fallback {}", a.build_time, a.median_fallback);
