@@ -49,6 +49,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    if let Some(p) = &a.profile {
+        crate::render::check_output(p, &["puffin"], "--profile")?;
+    }
     let scene = load_scene(&a.scene, &a.load)?;
     let size = (a.width, a.height);
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;

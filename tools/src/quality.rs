@@ -188,6 +188,7 @@ fn stream(s: &Setup, settings: &FrameSettings, references: &[Image]) -> Result<(
 }
 
 pub fn run(a: QualityArgs) -> Result<()> {
+    crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
     if a.frames == 0 || a.reference_frames == 0 {
         bail!("--frames and --reference-frames must be at least 1");
     }

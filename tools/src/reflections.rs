@@ -124,6 +124,7 @@ fn strafed(c: Camera, offset: f64) -> Camera {
 }
 
 pub fn run(a: ReflectionsArgs) -> Result<()> {
+    crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, Some(a.width), a.height);

@@ -48,6 +48,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 pub fn run(a: SweepArgs) -> Result<()> {
+    crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
     if a.frames < 2 || a.reference_frames == 0 {
         bail!("--frames must be at least 2 and --reference-frames at least 1");
     }

@@ -337,6 +337,18 @@ fn errors_come_before_the_work_and_say_what_is_wrong() {
     assert!(o.refused("--width 65536: reference mode renders at most 16384 pixels a side"), "{}", tail(&o.stderr));
     let o = run(&["render", missing.to_str().unwrap(), "--mode", "realtime", "--width", "9000", "--out", "x.png"], LIMIT);
     assert!(o.refused("--width 9000: real-time mode renders at most 8192 pixels a side"), "{}", tail(&o.stderr));
+    // The other commands' outputs too, before any rendering.
+    let file = support::dir("outputs").join("a-file");
+    std::fs::write(&file, b"").unwrap();
+    let under_file = file.join("out");
+    for (args, needle) in [
+        (vec!["quality", "level", "--out-dir", under_file.to_str().unwrap()], "a-file is not a folder"),
+        (vec!["sweep", "level", "--out-dir", under_file.to_str().unwrap()], "a-file is not a folder"),
+        (vec!["bench", "level", "--mode", "realtime", "--profile", "/nonexistent/x.puffin"], "the folder /nonexistent does not exist"),
+    ] {
+        let o = run(&args, LIMIT);
+        assert!(o.refused(needle) && o.peak_mib < REFUSED_MIB, "{args:?}: {}", tail(&o.stderr));
+    }
     // An accessor past its view names it (it had said 'a primitive has no POSITION').
     assert_refused("accessor past its view", &case("past_view", |d| d["accessors"][0]["byteOffset"] = json!(40)), &[], "POSITION (accessors[0]): 4 elements of 12 bytes (stride 12) from byte 40 run past bufferViews[0] of 48 bytes");
     // A 21 MB data URI that is not base64: the error quotes its first 64 characters.
