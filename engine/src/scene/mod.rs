@@ -7,6 +7,7 @@ mod camera_path;
 mod default_scene;
 mod environment;
 mod files;
+mod gltf_camera;
 mod gltf_check;
 mod gltf_export;
 mod gltf_import;
