@@ -94,7 +94,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let size = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
     if let Some(v) = view {
-        if v.needs_glossy() && !scene_has_glossy(&scene) {
+        if v.needs_glossy() && !hush_engine::gpu::PreparedScene::glossy_materials(&scene) {
             bail!("--view {}: the scene has no glossy buffers", v.name());
         }
     }
@@ -137,10 +137,4 @@ pub fn run(a: RenderArgs) -> Result<()> {
         gpu.info.name
     );
     Ok(())
-}
-
-/// Whether the real-time frame will have glossy buffers for `scene` (a material some object
-/// uses has a specular lobe), known before any GPU work.
-fn scene_has_glossy(scene: &hush_engine::scene::Scene) -> bool {
-    hush_engine::gpu::PreparedScene::glossy_materials(scene)
 }

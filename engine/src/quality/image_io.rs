@@ -82,13 +82,6 @@ impl Image {
     }
 }
 
-/// The first RGBA layer of an EXR file as linear RGB, read as [`Image::load`] reads it.
-pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
-    let limits = crate::limits::Limits::default();
-    let bytes = crate::limits::read_regular_file(path, limits.file_bytes)?;
-    decode_exr(&path.display().to_string(), &bytes, &mut crate::limits::Budget::new(limits))
-}
-
 /// The first RGBA layer of an EXR held in memory, as linear RGB. Every layer's size is read
 /// from the headers and charged to `budget` (12 bytes a pixel) before any pixel is allocated:
 /// a header can declare 100000 x 50000 pixels in a few bytes.
