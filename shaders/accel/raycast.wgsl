@@ -8,9 +8,9 @@ struct RaycastParams {
     pad1: u32,
 }
 
-@group(0) @binding(0) var<uniform> params: RaycastParams;
-@group(0) @binding(3) var<storage, read> rays: array<vec4f>;
-@group(0) @binding(4) var<storage, read_write> hits: array<vec4f>;
+var<uniform> params: RaycastParams;
+var<storage, read> rays: array<vec4f>;
+var<storage, read_write> hits: array<vec4f>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

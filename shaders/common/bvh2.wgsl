@@ -11,7 +11,7 @@ struct Bvh2Node {
     r_count: u32,
 }
 
-@group(0) @binding(1) var<storage, read> bvh_nodes: array<Bvh2Node>;
+var<storage, read> bvh_nodes: array<Bvh2Node>;
 
 const BVH_STACK: u32 = 64u;
 

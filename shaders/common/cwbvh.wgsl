@@ -5,7 +5,7 @@
 //   [1] child_base_idx, primitive_base_idx, child_meta[0..4], child_meta[4..8]
 //   [2] child_min_x (8 bytes), child_max_x (8 bytes); [3] the same for y; [4] for z.
 
-@group(0) @binding(1) var<storage, read> cw_nodes: array<vec4u>;
+var<storage, read> cw_nodes: array<vec4u>;
 
 fn cw_byte(lo: u32, hi: u32, i: u32) -> u32 {
     let w = select(hi, lo, i < 4u);

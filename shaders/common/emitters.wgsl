@@ -1,6 +1,6 @@
 // Emissive triangles, picked in proportion to area x luminance of the material's emission and
 // then uniformly in area. Entries: (cumulative probability as bits, triangle slot).
-@group(0) @binding(7) var<storage, read> emitters: array<vec2u>;
+var<storage, read> emitters: array<vec2u>;
 
 // Area density of a point on an emissive triangle: luminance(L) / sum(area x luminance(L)).
 // It does not depend on the triangle's area, so a BSDF-sampled hit can compute it from its

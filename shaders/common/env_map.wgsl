@@ -3,7 +3,7 @@
 // PBRT 3rd ed. 13.6.7 and 14.2.4). Mitsuba's mapping: column u from the left, row v from the top,
 // local l = (sin 2πu sin πv, cos πv, -cos 2πu sin πv), world = R_y(a) l.
 // Buffer: W*H RGB texels, then the marginal CDF (H+1), then H conditional CDFs (W+1 each).
-@group(0) @binding(8) var<storage, read> env_data: array<f32>;
+var<storage, read> env_data: array<f32>;
 
 fn env_texel(col: u32, row: u32) -> vec3f {
     let i = (row * params.env_size.x + col) * 3u;

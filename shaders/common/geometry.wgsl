@@ -1,6 +1,6 @@
 // Triangles in BVH leaf order: three vec4 per triangle, xyz = vertex; v0.w = material index,
 // v1.w = index of the triangle in the scene's input order (both as bits).
-@group(0) @binding(2) var<storage, read> tris: array<vec4f>;
+var<storage, read> tris: array<vec4f>;
 
 struct Hit {
     t: f32,

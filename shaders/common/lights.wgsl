@@ -14,7 +14,7 @@ const LIGHT_DIRECTIONAL: u32 = 0u;
 const LIGHT_POINT: u32 = 1u;
 const LIGHT_SPOT: u32 = 2u;
 
-@group(0) @binding(6) var<storage, read> lights: array<Light>;
+var<storage, read> lights: array<Light>;
 
 // A direction towards a light and what arrives along it, divided by the (delta) pdf.
 struct LightSample {

@@ -24,4 +24,4 @@ struct Params {
     emit: vec4f,
 }
 
-@group(0) @binding(0) var<uniform> params: Params;
+var<uniform> params: Params;

@@ -1,7 +1,7 @@
 // Shading data and materials (engine/src/gpu/scene.rs mirrors these layouts).
 
 // Four vec4 per triangle: (n0, uv0.x), (n1, uv1.x), (n2, uv2.x), (uv0.y, uv1.y, uv2.y, 0).
-@group(0) @binding(3) var<storage, read> shading: array<vec4f>;
+var<storage, read> shading: array<vec4f>;
 
 struct Material {
     base_color: vec4f,
@@ -20,7 +20,7 @@ struct Material {
 const MAT_DOUBLE_SIDED: u32 = 1u;
 const MAT_ALPHA_MASK: u32 = 2u;
 
-@group(0) @binding(4) var<storage, read> materials: array<Material>;
+var<storage, read> materials: array<Material>;
 
 fn tri_uv(slot: u32, b: vec2f) -> vec2f {
     let s0 = shading[slot * 4u];

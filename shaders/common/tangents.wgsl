@@ -1,5 +1,5 @@
 // Tangents (xyz, w = handedness), three vec4 per triangle, for tangent-space normal maps.
-@group(0) @binding(10) var<storage, read> tangents: array<vec4f>;
+var<storage, read> tangents: array<vec4f>;
 
 fn apply_normal_map(slot: u32, b: vec2f, ns: vec3f, uv: vec2f, m: Material) -> vec3f {
     if m.tex.z < 0 {

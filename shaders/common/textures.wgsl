@@ -1,7 +1,7 @@
 // All textures in one buffer: four u32 of header per texture (texel offset, width, height,
 // flags: bit 0 sRGB, bits 1-2 wrap S, bits 3-4 wrap T with 0 repeat, 1 clamp, 2 mirror), then
 // RGBA8 texels. One binding serves any number of textures on every backend.
-@group(0) @binding(9) var<storage, read> tex_data: array<u32>;
+var<storage, read> tex_data: array<u32>;
 
 fn srgb_decode(c: vec3f) -> vec3f {
     return select(pow((c + 0.055) / 1.055, vec3f(2.4)), c / 12.92, c <= vec3f(0.04045));

@@ -7,8 +7,8 @@
 // Sigma shrinks as 1 / history length past GlossySettings::sigma_full_frames (a departure from
 // the paper's fixed sigma, measured in settings.rs).
 
-@group(0) @binding(65) var src: texture_2d<f32>;
-@group(0) @binding(66) var dst: texture_storage_2d<rgba16float, write>;
+var src: texture_2d<f32>;
+var dst: texture_storage_2d<rgba16float, write>;
 
 struct Features {
     // Position and normal the weights compare: the primary surface's, or behind a mirror the

@@ -42,7 +42,7 @@ struct GlossyParams {
     _pad1: u32,
 }
 
-@group(0) @binding(60) var<uniform> gp: GlossyParams;
+var<uniform> gp: GlossyParams;
 
 const GSTAGE_TEMPORAL: u32 = 1u;
 const GSTAGE_CLIPPING: u32 = 2u;

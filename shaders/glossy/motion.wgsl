@@ -8,11 +8,11 @@
 //   hit:    xyz = representative hit (eq. 4), w = surface kind and secondary distance
 //           (encode_hit_w).
 
-@group(0) @binding(41) var prev_depth: texture_depth_2d;
-@group(0) @binding(61) var prev_hit: texture_2d<f32>;
-@group(0) @binding(62) var out_motion: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(63) var out_search: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(64) var out_hit: texture_storage_2d<rgba32float, write>;
+var prev_depth: texture_depth_2d;
+var prev_hit: texture_2d<f32>;
+var out_motion: texture_storage_2d<rgba32float, write>;
+var out_search: texture_storage_2d<rgba16float, write>;
+var out_hit: texture_storage_2d<rgba32float, write>;
 
 struct Probe {
     // Primary hit and representative hit of the pixel searched for, and its kind (HIT_*).

@@ -3,8 +3,8 @@
 // pixel the raw neighbourhoods of adjacent pixels differ too much to clip against; blurred ones
 // agree.
 
-@group(0) @binding(65) var src: texture_2d<f32>;
-@group(0) @binding(66) var dst: texture_storage_2d<rgba16float, write>;
+var src: texture_2d<f32>;
+var dst: texture_storage_2d<rgba16float, write>;
 
 // exp(-k^2 / (2 x 1.5^2)) for k = 0..3.
 const PREFILTER_W = array<f32, 4>(1.0, 0.80074, 0.41111, 0.13534);

@@ -17,14 +17,14 @@
 //   the consistency test there and lets the neighbourhood clip remove ghosts.
 // Output: history (rgb, n) and info (c, clip amount, n, 0).
 
-@group(0) @binding(41) var prev_depth: texture_depth_2d;
-@group(0) @binding(42) var history: texture_2d<f32>;
-@group(0) @binding(43) var prev_normal: texture_2d<f32>;
-@group(0) @binding(61) var prev_hit: texture_2d<f32>;
-@group(0) @binding(65) var neighbourhood: texture_2d<f32>;
-@group(0) @binding(66) var dst: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(67) var motion: texture_2d<f32>;
-@group(0) @binding(68) var out_info: texture_storage_2d<rgba16float, write>;
+var prev_depth: texture_depth_2d;
+var history: texture_2d<f32>;
+var prev_normal: texture_2d<f32>;
+var prev_hit: texture_2d<f32>;
+var neighbourhood: texture_2d<f32>;
+var dst: texture_storage_2d<rgba32float, write>;
+var motion: texture_2d<f32>;
+var out_info: texture_storage_2d<rgba16float, write>;
 
 // Clip h towards the box centre along the line between them (Karis 2014), in YCoCg.
 fn clip_to_box(h: vec3f, lo: vec3f, hi: vec3f) -> vec3f {

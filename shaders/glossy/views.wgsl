@@ -1,9 +1,9 @@
 // Debug views of the glossy chain (engine/src/frame/views.rs, 22 and up).
-@group(0) @binding(72) var gv_motion: texture_2d<f32>;
-@group(0) @binding(73) var gv_search: texture_2d<f32>;
-@group(0) @binding(74) var gv_info: texture_2d<f32>;
-@group(0) @binding(75) var gv_sigma: texture_2d<f32>;
-@group(0) @binding(76) var gv_denoised: texture_2d<f32>;
+var gv_motion: texture_2d<f32>;
+var gv_search: texture_2d<f32>;
+var gv_info: texture_2d<f32>;
+var gv_sigma: texture_2d<f32>;
+var gv_denoised: texture_2d<f32>;
 
 // As the surface motion view: hue = direction, brightness = length (1 px = 0.25).
 fn motion_colour(mv: vec2f) -> vec3f {

@@ -12,10 +12,10 @@
 // noise hid it, while taps that differ by noise alone keep their weight. The n-frame mean's
 // noise comes from this frame's input minus the history's mean, so a shadow's own contrast
 // does not count as noise (matte/sparse_bilateral.wgsl: history_noise).
-@group(0) @binding(44) var filter_in: texture_2d<f32>;
-@group(0) @binding(52) var radius_in: texture_2d<f32>;
-@group(0) @binding(51) var reason_in: texture_2d<u32>;
-@group(0) @binding(50) var out_matte: texture_storage_2d<rgba16float, write>;
+var filter_in: texture_2d<f32>;
+var radius_in: texture_2d<f32>;
+var reason_in: texture_2d<u32>;
+var out_matte: texture_storage_2d<rgba16float, write>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

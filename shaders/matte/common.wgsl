@@ -68,7 +68,7 @@ struct DenoiseParams {
     taa_current_glossy: f32,
 }
 
-@group(0) @binding(40) var<uniform> dn: DenoiseParams;
+var<uniform> dn: DenoiseParams;
 
 const STAGE_TEMPORAL: u32 = 1u;
 const STAGE_HISTORY_BILATERAL: u32 = 2u;

@@ -2,9 +2,9 @@
 // vertical), times `low_confidence_multiplier` where the pixel's own c < 1/2 (capped at
 // max_radius_px). Entry points: min_h reads c from the temporal output, min_v writes r.
 
-@group(0) @binding(44) var filter_in: texture_2d<f32>;
-@group(0) @binding(52) var min_in: texture_2d<f32>;
-@group(0) @binding(53) var out_min: texture_storage_2d<r32float, write>;
+var filter_in: texture_2d<f32>;
+var min_in: texture_2d<f32>;
+var out_min: texture_storage_2d<r32float, write>;
 
 fn box_radius() -> i32 {
     return max(i32(dn.disocclusion_radius_px), 1);

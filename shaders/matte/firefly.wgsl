@@ -1,8 +1,8 @@
 // Stage (6): 3x3 median per channel, outside the history loop (fireflies still feed the running
 // average, so the image is not darkened, but never reach the screen). The pass also writes, on
 // or off, the guide of stage 7's edge-stop into the alpha.
-@group(0) @binding(44) var filter_in: texture_2d<f32>;
-@group(0) @binding(50) var out_median: texture_storage_2d<rgba16float, write>;
+var filter_in: texture_2d<f32>;
+var out_median: texture_storage_2d<rgba16float, write>;
 
 fn median9(v: array<f32, 9>) -> f32 {
     var a = v;

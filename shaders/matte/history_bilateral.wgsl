@@ -1,9 +1,9 @@
 // Stage (4): the sparse bilateral applied only to what goes back into the history (Mara et al.
 // §3.4: newly sampled paths are never blurred here; the blur is amortised over frames).
-@group(0) @binding(44) var filter_in: texture_2d<f32>;
+var filter_in: texture_2d<f32>;
 // Reason flags and, above them, the history length n (matte/temporal.wgsl).
-@group(0) @binding(51) var reason_in: texture_2d<u32>;
-@group(0) @binding(50) var out_history: texture_storage_2d<rgba32float, write>;
+var reason_in: texture_2d<u32>;
+var out_history: texture_storage_2d<rgba32float, write>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

@@ -12,11 +12,11 @@
 // between texels (the surface moved on screen) is a little blurred each time, and counts as at
 // most resampled_history_frames, so that motion's blur fades within a few frames of a stop.
 
-@group(0) @binding(41) var prev_depth: texture_depth_2d;
-@group(0) @binding(42) var history: texture_2d<f32>;
-@group(0) @binding(43) var prev_normal: texture_2d<f32>;
-@group(0) @binding(50) var out_temporal: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(51) var out_reason: texture_storage_2d<r32uint, write>;
+var prev_depth: texture_depth_2d;
+var history: texture_2d<f32>;
+var prev_normal: texture_2d<f32>;
+var out_temporal: texture_storage_2d<rgba32float, write>;
+var out_reason: texture_storage_2d<r32uint, write>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

@@ -4,8 +4,8 @@
 // already in the matte light). Writes linear HDR radiance; in accumulate mode also adds it to
 // the running sum (converging to the reference image while the camera is still).
 
-@group(0) @binding(32) var<storage, read_write> hdr: array<vec4f>;
-@group(0) @binding(33) var<storage, read_write> accumulation: array<vec4f>;
+var<storage, read_write> hdr: array<vec4f>;
+var<storage, read_write> accumulation: array<vec4f>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

@@ -1,9 +1,9 @@
 // Debug views of the matte chain's intermediates (when the denoiser has run).
-@group(0) @binding(45) var dv_temporal: texture_2d<f32>;
-@group(0) @binding(46) var dv_reason: texture_2d<u32>;
-@group(0) @binding(47) var dv_radius: texture_2d<f32>;
-@group(0) @binding(48) var dv_firefly: texture_2d<f32>;
-@group(0) @binding(49) var dv_denoised: texture_2d<f32>;
+var dv_temporal: texture_2d<f32>;
+var dv_reason: texture_2d<u32>;
+var dv_radius: texture_2d<f32>;
+var dv_firefly: texture_2d<f32>;
+var dv_denoised: texture_2d<f32>;
 
 // x: colour; w: 1 when it is light (exposed and tone-mapped like the image).
 fn denoise_view(view: u32, p: vec2i) -> vec4f {

@@ -1,8 +1,8 @@
 // Display: exposure, the ACES filmic curve (Narkowicz 2015 fit of the ACES RRT+ODT), sRGB
 // encoding unless the target does it; or one of the debug views (engine/src/frame/views.rs).
 
-@group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
-@group(0) @binding(33) var<storage, read> accumulation: array<vec4f>;
+var<storage, read> hdr: array<vec4f>;
+var<storage, read> accumulation: array<vec4f>;
 
 struct DisplayOptions {
     encode_srgb: u32,
@@ -11,7 +11,7 @@ struct DisplayOptions {
     target_size: vec2u,
 }
 
-@group(0) @binding(34) var<uniform> display: DisplayOptions;
+var<uniform> display: DisplayOptions;
 
 @vertex
 fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {

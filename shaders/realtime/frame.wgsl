@@ -29,7 +29,7 @@ struct Frame {
     _pad2: u32,
 }
 
-@group(0) @binding(11) var<uniform> frame: Frame;
+var<uniform> frame: Frame;
 
 // The camera ray through this frame's sample position in pixel px.
 fn camera_ray(px: vec2u) -> vec3f {

@@ -1,14 +1,14 @@
 // The G-buffer as read by compute and display passes (written by realtime/gbuffer.wgsl).
-@group(0) @binding(20) var gb_depth: texture_depth_2d;
-@group(0) @binding(21) var gb_normal: texture_2d<f32>;
-@group(0) @binding(22) var gb_motion: texture_2d<f32>;
-@group(0) @binding(23) var gb_base_color: texture_2d<f32>;
-@group(0) @binding(24) var gb_specular: texture_2d<f32>;
-@group(0) @binding(25) var gb_emission: texture_2d<f32>;
-@group(0) @binding(26) var gb_object: texture_2d<u32>;
+var gb_depth: texture_depth_2d;
+var gb_normal: texture_2d<f32>;
+var gb_motion: texture_2d<f32>;
+var gb_base_color: texture_2d<f32>;
+var gb_specular: texture_2d<f32>;
+var gb_emission: texture_2d<f32>;
+var gb_object: texture_2d<u32>;
 // Trace outputs every scene has.
-@group(0) @binding(27) var tr_matte: texture_2d<f32>;
-@group(0) @binding(28) var tr_direct: texture_2d<f32>;
+var tr_matte: texture_2d<f32>;
+var tr_direct: texture_2d<f32>;
 
 const NO_SURFACE: u32 = 0xffffffffu;
 

@@ -1,6 +1,6 @@
 // Animated scene: per object, the rebased transform from where a point is now to where it was
 // in the previous frame (PreparedScene::prev_from_current).
-@group(0) @binding(17) var<storage, read> prev_from_current: array<mat4x4f>;
+var<storage, read> prev_from_current: array<mat4x4f>;
 
 fn previous_position(object: u32, p: vec3f) -> vec3f {
     let q = prev_from_current[object] * vec4f(p, 1.0);

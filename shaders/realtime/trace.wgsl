@@ -15,9 +15,9 @@
 // The primary hit is re-derived from the triangle the raster stored and this frame's camera ray,
 // so it is exact (the same point the reference tracer would find for that ray).
 
-@group(0) @binding(12) var gb_ids: texture_2d<u32>;
-@group(0) @binding(13) var out_matte: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(14) var out_direct: texture_storage_2d<rgba16float, write>;
+var gb_ids: texture_2d<u32>;
+var out_matte: texture_storage_2d<rgba16float, write>;
+var out_direct: texture_storage_2d<rgba16float, write>;
 
 fn area_groups() -> u32 {
     return select(0u, 1u, HAS_EMITTERS) + select(0u, 1u, HAS_ENV);

@@ -1,11 +1,11 @@
 // Glossy outputs of the trace pass (only in scenes with a specular lobe).
-@group(0) @binding(15) var out_glossy: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(16) var out_reflection: texture_storage_2d<rgba32float, write>;
+var out_glossy: texture_storage_2d<rgba16float, write>;
+var out_reflection: texture_storage_2d<rgba32float, write>;
 // Octahedral direction as pack2x16snorm (Rg16 is not a core storage format).
-@group(0) @binding(18) var out_mirror: texture_storage_2d<r32uint, write>;
+var out_mirror: texture_storage_2d<r32uint, write>;
 // What the glossy path hit first: reflectance as rgba8 and shading normal as octahedral snorm16
 // (the features and albedo a mirror's chain filters and demodulates with, Voorhuis §4.1).
-@group(0) @binding(19) var out_mirror_hit: texture_storage_2d<rg32uint, write>;
+var out_mirror_hit: texture_storage_2d<rg32uint, write>;
 
 const HAS_GLOSSY: bool = true;
 

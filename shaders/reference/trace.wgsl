@@ -2,7 +2,7 @@
 // (common/path.wgsl has the path loop).
 
 // Per pixel two vec4: (sum of rgb, 0) and (sum of rgb^2, count of discarded non-finite samples).
-@group(0) @binding(5) var<storage, read_write> accum: array<vec4f>;
+var<storage, read_write> accum: array<vec4f>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

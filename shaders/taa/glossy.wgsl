@@ -2,9 +2,9 @@
 // output this frame and last frame (glossy light divided by the mirror demodulation), and
 // whether this frame's continues last frame's at this pixel (glossy/temporal.wgsl, info.w).
 
-@group(0) @binding(69) var glossy_temporal: texture_2d<f32>;
-@group(0) @binding(70) var glossy_info: texture_2d<f32>;
-@group(0) @binding(77) var glossy_previous: texture_2d<f32>;
+var glossy_temporal: texture_2d<f32>;
+var glossy_info: texture_2d<f32>;
+var glossy_previous: texture_2d<f32>;
 
 fn taa_glossy(p: vec2i, f_s: vec3f) -> TaaGlossy {
     if !has_surface(p) {

@@ -39,22 +39,22 @@
 // its history); where the matte chain does, or the pixel is not settled, TAA keeps its own
 // average and re-sets the residual so that the two agree.
 
-@group(0) @binding(32) var<storage, read> hdr: array<vec4f>;
-@group(0) @binding(42) var history: texture_2d<f32>;
-@group(0) @binding(50) var out_history: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(54) var<storage, read_write> final_image: array<vec4f>;
+var<storage, read> hdr: array<vec4f>;
+var history: texture_2d<f32>;
+var out_history: texture_storage_2d<rgba32float, write>;
+var<storage, read_write> final_image: array<vec4f>;
 // The matte temporal's output (stage 3) and its history length (above the reason's 8 flag bits).
-@group(0) @binding(44) var matte_temporal: texture_2d<f32>;
-@group(0) @binding(51) var matte_reason: texture_2d<u32>;
+var matte_temporal: texture_2d<f32>;
+var matte_reason: texture_2d<u32>;
 // Averages, over TAA's history, of the matte factor m (1 - F)^2 and of the composite less that
 // factor times the matte temporal's output (MatteSettings::taa_current_light).
-@group(0) @binding(55) var material_history: texture_2d<f32>;
-@group(0) @binding(56) var out_material: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(57) var residual_history: texture_2d<f32>;
-@group(0) @binding(58) var out_residual: texture_storage_2d<rgba32float, write>;
+var material_history: texture_2d<f32>;
+var out_material: texture_storage_2d<rgba32float, write>;
+var residual_history: texture_2d<f32>;
+var out_residual: texture_storage_2d<rgba32float, write>;
 // Average of the glossy factor F(w_s) x the mirror demodulation (MatteSettings::taa_current_glossy).
-@group(0) @binding(59) var glossy_factor_history: texture_2d<f32>;
-@group(0) @binding(71) var out_glossy_factor: texture_storage_2d<rgba32float, write>;
+var glossy_factor_history: texture_2d<f32>;
+var out_glossy_factor: texture_storage_2d<rgba32float, write>;
 
 // This pixel's glossy term as TAA follows it (taa/glossy.wgsl, or taa/glossy_none.wgsl in a
 // scene without glossy buffers).

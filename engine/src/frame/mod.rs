@@ -366,11 +366,11 @@ impl Renderer {
         let key = (self.gpu_scene.generation, self.targets.generation);
         let parity = (self.frame_index % 2) as usize;
         let pass = crate::profile::scope(gbuffer::LABEL);
-        self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &self.targets.gbuffer, self.timer.as_mut());
+        self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &self.targets.gbuffer, self.timer.as_mut())?;
         drop(pass);
         let t = &self.targets;
         let pass = crate::profile::scope(crate::passes::trace::LABEL);
-        self.trace.record(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut());
+        self.trace.record(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut())?;
         drop(pass);
         // The chain's bind groups depend on the scene only through the object-motion buffer.
         let chain_key = key.0 * 1_000_003 + key.1;
@@ -386,11 +386,11 @@ impl Renderer {
         });
         let denoised_matte = t.matte.as_ref().filter(|_| denoise).map(|m| &m.denoised.1);
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
-            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, false, self.timer.as_mut());
+            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, false, self.timer.as_mut())?;
         }
         let glossy_inputs = glossy_inputs(t, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref()).filter(|_| denoise);
         if let (Some(inputs), Some(chain)) = (&glossy_inputs, self.glossy_chain.as_mut()) {
-            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, &settings.glossy, self.timer.as_mut());
+            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, &settings.glossy, self.timer.as_mut())?;
         }
         let denoised_glossy = t.glossy_chain.as_ref().filter(|_| denoise).map(|g| &g.denoised.1);
         let fb = FrameBuffers {
@@ -404,15 +404,15 @@ impl Renderer {
             glossy_chain: None,
         };
         let pass = crate::profile::scope(crate::passes::composite::COMPOSITE);
-        self.composite.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut());
+        self.composite.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut())?;
         drop(pass);
         if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
-            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, true, self.timer.as_mut());
+            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, true, self.timer.as_mut())?;
         }
         let shown = shown_buffers(t, &self.frame_buf, &self.display_buf, &self.no_accumulation, denoise);
         if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
             let _pass = crate::profile::scope(crate::passes::composite::DISPLAY);
-            d.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &shown, target.view, self.timer.as_mut());
+            d.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &shown, target.view, self.timer.as_mut())?;
         }
         if let (true, Some(m)) = (denoise, &t.matte) {
             let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
@@ -466,7 +466,7 @@ impl Renderer {
             let t = &self.targets;
             let fb = shown_buffers(t, &self.frame_buf, &self.display_buf, &self.no_accumulation, self.denoised_last);
             if let Some(d) = self.display.as_mut() {
-                d.record(gpu, &mut enc, t.generation * 2 + self.denoised_last as u64, &t.gbuffer, &t.trace, &fb, target.view, None);
+                d.record(gpu, &mut enc, t.generation * 2 + self.denoised_last as u64, &t.gbuffer, &t.trace, &fb, target.view, None)?;
             }
             gpu.queue.submit([enc.finish()]);
             Ok(())

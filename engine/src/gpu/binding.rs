@@ -1,64 +1,126 @@
-//! Bind group layouts and bind groups described once, entry by entry.
+//! Resources offered to a program by the name of the WGSL variable that binds them. A program's
+//! bind groups are made from what it declares ([`crate::shader::reflect`]): each of its
+//! resources is looked up here by name, so a stage may offer more than a program uses, and a
+//! program that asks for a name nobody offers is an error that names it.
 
-/// Entries of one bind group: the layout half is fixed when a pass is created, the resource half
-/// is filled whenever its inputs change (resize, a scene whose buffers were reallocated).
+use crate::shader::ProgramBindings;
+use anyhow::Result;
+
+#[derive(Clone, Copy)]
+pub enum Resource<'a> {
+    Buffer(&'a wgpu::Buffer),
+    Texture(&'a wgpu::TextureView),
+}
+
+/// Name -> resource; a later entry of the same name replaces an earlier one.
+#[derive(Clone, Default)]
 pub struct Bindings<'a> {
-    visibility: wgpu::ShaderStages,
-    pub layout: Vec<wgpu::BindGroupLayoutEntry>,
-    pub resources: Vec<wgpu::BindGroupEntry<'a>>,
+    entries: Vec<(&'a str, Resource<'a>)>,
 }
 
 impl<'a> Bindings<'a> {
-    pub fn new(visibility: wgpu::ShaderStages) -> Self {
-        Bindings { visibility, layout: vec![], resources: vec![] }
+    pub fn new() -> Self {
+        Bindings::default()
     }
 
-    fn push(&mut self, binding: u32, ty: wgpu::BindingType, resource: wgpu::BindingResource<'a>) {
-        self.layout.push(wgpu::BindGroupLayoutEntry { binding, visibility: self.visibility, ty, count: None });
-        self.resources.push(wgpu::BindGroupEntry { binding, resource });
-    }
-
-    pub fn uniform(mut self, binding: u32, buf: &'a wgpu::Buffer) -> Self {
-        let ty = wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None };
-        self.push(binding, ty, buf.as_entire_binding());
+    pub fn buffer(mut self, name: &'a str, buf: &'a wgpu::Buffer) -> Self {
+        self.set(name, Resource::Buffer(buf));
         self
     }
 
-    pub fn storage(mut self, binding: u32, buf: &'a wgpu::Buffer, read_only: bool) -> Self {
-        let ty = wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None };
-        self.push(binding, ty, buf.as_entire_binding());
+    pub fn texture(mut self, name: &'a str, view: &'a wgpu::TextureView) -> Self {
+        self.set(name, Resource::Texture(view));
         self
     }
 
-    pub fn storage_all(mut self, buffers: &[(u32, &'a wgpu::Buffer)]) -> Self {
-        for (b, buf) in buffers {
-            self = self.storage(*b, buf, true);
+    /// `buffer` where `buf` exists (a feature of the scene).
+    pub fn buffer_opt(self, name: &'a str, buf: Option<&'a wgpu::Buffer>) -> Self {
+        match buf {
+            Some(b) => self.buffer(name, b),
+            None => self,
+        }
+    }
+
+    /// Everything `other` offers, over what this offers.
+    pub fn with(mut self, other: &Bindings<'a>) -> Self {
+        for (n, r) in &other.entries {
+            self.set(n, *r);
         }
         self
     }
 
-    /// A sampled texture read with textureLoad (no sampler, so no filtering requirement).
-    pub fn texture(mut self, binding: u32, view: &'a wgpu::TextureView, sample_type: wgpu::TextureSampleType) -> Self {
-        let ty = wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false };
-        self.push(binding, ty, wgpu::BindingResource::TextureView(view));
-        self
+    fn set(&mut self, name: &'a str, r: Resource<'a>) {
+        match self.entries.iter_mut().find(|(n, _)| *n == name) {
+            Some(e) => e.1 = r,
+            None => self.entries.push((name, r)),
+        }
     }
 
-    pub fn float_texture(self, binding: u32, view: &'a wgpu::TextureView) -> Self {
-        self.texture(binding, view, wgpu::TextureSampleType::Float { filterable: false })
+    pub fn get(&self, name: &str) -> Option<Resource<'a>> {
+        self.entries.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
     }
 
-    pub fn storage_texture(mut self, binding: u32, view: &'a wgpu::TextureView, format: wgpu::TextureFormat) -> Self {
-        let ty = wgpu::BindingType::StorageTexture { access: wgpu::StorageTextureAccess::WriteOnly, format, view_dimension: wgpu::TextureViewDimension::D2 };
-        self.push(binding, ty, wgpu::BindingResource::TextureView(view));
-        self
+    pub fn names(&self) -> impl Iterator<Item = &'a str> + '_ {
+        self.entries.iter().map(|(n, _)| *n)
     }
 
-    pub fn create_layout(&self, device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
-        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &self.layout })
+    /// An error naming every resource of `program` that is not offered here.
+    pub fn check(&self, label: &str, program: &ProgramBindings) -> Result<()> {
+        program.check_offered(label, &self.names().collect::<Vec<_>>())
     }
 
-    pub fn create_group(&self, device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &self.resources })
+    /// The bind groups of `program` (one per layout), each resource found by name.
+    pub fn create_groups(&self, device: &wgpu::Device, label: &str, program: &ProgramBindings, layouts: &[wgpu::BindGroupLayout]) -> Result<Vec<wgpu::BindGroup>> {
+        self.check(label, program)?;
+        Ok(layouts
+            .iter()
+            .enumerate()
+            .map(|(g, layout)| {
+                let entries: Vec<_> = program
+                    .slots
+                    .iter()
+                    .filter(|s| s.group == g as u32)
+                    .map(|s| {
+                        let resource = match self.get(&s.name).expect("checked above") {
+                            Resource::Buffer(b) => b.as_entire_binding(),
+                            Resource::Texture(v) => wgpu::BindingResource::TextureView(v),
+                        };
+                        wgpu::BindGroupEntry { binding: s.binding, resource }
+                    })
+                    .collect();
+                device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+            })
+            .collect())
+    }
+}
+
+/// Bind `groups` from group 0 on.
+pub fn set_compute_groups(pass: &mut wgpu::ComputePass, groups: &[wgpu::BindGroup]) {
+    for (i, g) in groups.iter().enumerate() {
+        pass.set_bind_group(i as u32, g, &[]);
+    }
+}
+
+pub fn set_render_groups(pass: &mut wgpu::RenderPass, groups: &[wgpu::BindGroup]) {
+    for (i, g) in groups.iter().enumerate() {
+        pass.set_bind_group(i as u32, g, &[]);
+    }
+}
+
+/// A pass's bind groups for each of its variants (history parity 0 and 1, or one), remade
+/// when the key of what they bind or the pipeline's build changes.
+#[derive(Default)]
+pub struct BindCache {
+    cached: Option<(u64, u32, Vec<Vec<wgpu::BindGroup>>)>,
+}
+
+impl BindCache {
+    /// The groups of variant `v`, making all variants with `make(v)` if `key` or `builds` changed.
+    pub fn get(&mut self, key: u64, builds: u32, variants: usize, v: usize, make: impl Fn(usize) -> Result<Vec<wgpu::BindGroup>>) -> Result<&[wgpu::BindGroup]> {
+        if self.cached.as_ref().is_none_or(|(k, b, _)| *k != key || *b != builds) {
+            let groups = (0..variants).map(&make).collect::<Result<Vec<_>>>()?;
+            self.cached = Some((key, builds, groups));
+        }
+        Ok(&self.cached.as_ref().unwrap().2[v])
     }
 }

@@ -13,4 +13,4 @@ pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use prepare::{EnvKind, PreparedScene, SceneFeatures};
 pub use scene::GpuScene;
 pub use timestamps::GpuTimer;
-pub use binding::Bindings;
+pub use binding::{BindCache, Bindings, Resource, set_compute_groups, set_render_groups};

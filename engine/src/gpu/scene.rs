@@ -1,7 +1,7 @@
 //! A scene on the GPU: the buffers of a [`PreparedScene`] and what they cost.
 
 use super::prepare::{EnvKind, PreparedScene, SceneFeatures};
-use super::{Gpu, GpuMemory, GpuRequirements};
+use super::{Bindings, Gpu, GpuMemory, GpuRequirements};
 use crate::accel::BvhKind;
 
 pub struct GpuScene {
@@ -22,21 +22,6 @@ pub struct GpuScene {
     pub triangle_count: u32,
     /// Bumped whenever a buffer is replaced, so passes know to rebuild their bind groups.
     pub generation: u64,
-}
-
-/// Binding numbers shared by every program that reads the scene (`shaders/common`).
-pub mod binding {
-    pub const PARAMS: u32 = 0;
-    pub const NODES: u32 = 1;
-    pub const TRIS: u32 = 2;
-    pub const SHADING: u32 = 3;
-    pub const MATERIALS: u32 = 4;
-    pub const LIGHTS: u32 = 6;
-    pub const EMITTERS: u32 = 7;
-    pub const ENV: u32 = 8;
-    pub const TEXTURES: u32 = 9;
-    pub const TANGENTS: u32 = 10;
-    pub const OBJECTS: u32 = 17;
 }
 
 impl PreparedScene {
@@ -121,32 +106,6 @@ impl PreparedScene {
     }
 }
 
-pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl GpuScene {
     /// After [`PreparedScene::repack_lighting`].
     pub fn update_lighting(&self, gpu: &Gpu, p: &PreparedScene) {
@@ -202,17 +161,23 @@ impl GpuScene {
         }
     }
 
-    /// (binding, buffer) of the whole scene, for programs that shade (the tracer).
-    pub fn shading_bindings(&self) -> Vec<(u32, &wgpu::Buffer)> {
-        use binding::*;
-        let mut v = vec![(NODES, &self.nodes), (TRIS, &self.tris), (SHADING, &self.shading), (MATERIALS, &self.materials)];
-        let opt = [(LIGHTS, &self.lights), (EMITTERS, &self.emitters), (ENV, &self.env), (TEXTURES, &self.textures), (TANGENTS, &self.tangents)];
-        for (b, buf) in opt {
-            if let Some(buf) = buf {
-                v.push((b, buf));
-            }
-        }
-        v
+    /// The scene's buffers by the names `shaders/common` binds them by.
+    pub fn bindings(&self) -> Bindings<'_> {
+        let nodes = match self.bvh_kind {
+            BvhKind::Bvh2 => "bvh_nodes",
+            BvhKind::Cwbvh => "cw_nodes",
+        };
+        Bindings::new()
+            .buffer(nodes, &self.nodes)
+            .buffer("tris", &self.tris)
+            .buffer("shading", &self.shading)
+            .buffer("materials", &self.materials)
+            .buffer_opt("lights", self.lights.as_ref())
+            .buffer_opt("emitters", self.emitters.as_ref())
+            .buffer_opt("env_data", self.env.as_ref())
+            .buffer_opt("tex_data", self.textures.as_ref())
+            .buffer_opt("tangents", self.tangents.as_ref())
+            .buffer_opt("prev_from_current", self.objects.as_ref())
     }
 
     /// Program modules that match this scene's features, for a program that shades.
@@ -250,32 +215,11 @@ impl GpuScene {
     }
 }
 
-/// A compute pipeline with one bind group layout and entry point `main`.
-pub fn compute_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::BindGroupLayout,
-) -> wgpu::ComputePipeline {
-    compute_pipeline_at(device, label, module, layout, "main")
-}
-
-/// A compute pipeline with one bind group layout and the given entry point.
-pub fn compute_pipeline_at(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::BindGroupLayout,
-    entry: &str,
-) -> wgpu::ComputePipeline {
-    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(layout)],
-        immediate_size: 0,
-    });
+/// A compute pipeline with entry point `entry`.
+pub fn compute_pipeline(device: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, entry: &str) -> wgpu::ComputePipeline {
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
-        layout: Some(&pl),
+        layout: Some(layout),
         module,
         entry_point: Some(entry),
         compilation_options: Default::default(),

@@ -5,8 +5,8 @@
 use super::gbuffer::GBufferTargets;
 use super::trace::TraceTargets;
 use crate::gpu::scene::compute_pipeline;
-use crate::gpu::{Bindings, Gpu, GpuTimer};
-use crate::shader::Reloadable;
+use crate::gpu::{BindCache, Bindings, Gpu, GpuTimer, set_compute_groups, set_render_groups};
+use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
 pub const COMPOSITE: &str = "composite";
@@ -28,21 +28,18 @@ pub struct FrameBuffers<'a> {
     pub glossy_chain: Option<&'a super::glossy::GlossyChainTargets>,
 }
 
-fn inputs<'a>(stages: wgpu::ShaderStages, g: &'a GBufferTargets, t: &'a TraceTargets, b: &FrameBuffers<'a>, read_only: bool) -> Bindings<'a> {
-    let f = || wgpu::TextureSampleType::Float { filterable: false };
-    let mut s = super::matte::gbuffer_inputs(Bindings::new(stages).uniform(11, b.frame), g, t, b.matte);
+/// What the composite and the display bind (the display also the chains' intermediates).
+fn inputs<'a>(g: &'a GBufferTargets, t: &'a TraceTargets, b: &FrameBuffers<'a>) -> Bindings<'a> {
+    let mut s = super::matte::gbuffer_inputs(Bindings::new().buffer("frame", b.frame), g, t, b.matte);
     if let Some(gl) = &t.glossy {
         s = super::glossy::glossy_trace_inputs(s, t, b.glossy.unwrap_or(&gl.light.1));
     }
-    s = s.storage(32, b.hdr, read_only).storage(33, b.accumulation, read_only);
-    if read_only {
-        s = s.uniform(34, b.display);
-        if let Some(m) = b.denoise {
-            s = s.texture(45, &m.temporal.1, f()).texture(46, &m.reason.1, wgpu::TextureSampleType::Uint).texture(47, &m.radius.1, f()).texture(48, &m.median.1, f()).texture(49, &m.denoised.1, f());
-        }
-        if let Some(g) = b.glossy_chain {
-            s = s.texture(72, &g.motion.1, f()).texture(73, &g.search.1, f()).texture(74, &g.info.1, f()).texture(75, &g.scratch.1, f()).texture(76, &g.denoised.1, f());
-        }
+    s = s.buffer("hdr", b.hdr).buffer("accumulation", b.accumulation).buffer("display", b.display);
+    if let Some(m) = b.denoise {
+        s = s.texture("dv_temporal", &m.temporal.1).texture("dv_reason", &m.reason.1).texture("dv_radius", &m.radius.1).texture("dv_firefly", &m.median.1).texture("dv_denoised", &m.denoised.1);
+    }
+    if let Some(g) = b.glossy_chain {
+        s = s.texture("gv_motion", &g.motion.1).texture("gv_search", &g.search.1).texture("gv_info", &g.info.1).texture("gv_sigma", &g.scratch.1).texture("gv_denoised", &g.denoised.1);
     }
     s
 }
@@ -67,34 +64,31 @@ fn modules(glossy: bool, denoise: bool, glossy_chain: bool, last: &'static str) 
 
 pub struct CompositePass {
     pub pipeline: Reloadable<wgpu::ComputePipeline>,
-    layout: wgpu::BindGroupLayout,
-    bind_group: Option<(u64, wgpu::BindGroup)>,
+    groups: BindCache,
 }
 
 impl CompositePass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers) -> Result<CompositePass> {
-        let layout = inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_layout(&gpu.device, COMPOSITE);
-        let l = layout.clone();
-        let pipeline = Reloadable::new(gpu, COMPOSITE, "", &modules(t.glossy.is_some(), false, false, "realtime/composite.wgsl"), move |d, m| compute_pipeline(d, COMPOSITE, m, &l))?;
-        Ok(CompositePass { pipeline, layout, bind_group: None })
+        let modules = modules(t.glossy.is_some(), false, false, "realtime/composite.wgsl");
+        let pipeline = Reloadable::new(gpu, COMPOSITE, "", &modules, wgpu::ShaderStages::COMPUTE, &inputs(g, t, b), |d, m, l| compute_pipeline(d, COMPOSITE, m, l, "main"))?;
+        Ok(CompositePass { pipeline, groups: BindCache::default() })
     }
 
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, size: (u32, u32), timer: Option<&mut GpuTimer>) {
-        if self.bind_group.as_ref().is_none_or(|(k, _)| *k != key) {
-            self.bind_group = Some((key, inputs(wgpu::ShaderStages::COMPUTE, g, t, b, false).create_group(&gpu.device, COMPOSITE, &self.layout)));
-        }
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, size: (u32, u32), timer: Option<&mut GpuTimer>) -> Result<()> {
+        let p = &self.pipeline;
+        let groups = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &inputs(g, t, b)))?;
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(COMPOSITE), timestamp_writes: timer.and_then(|t| t.compute(COMPOSITE)) });
-        pass.set_pipeline(self.pipeline.get());
-        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.set_pipeline(p.get());
+        set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        Ok(())
     }
 }
 
 pub struct DisplayPass {
     pub pipeline: Reloadable<wgpu::RenderPipeline>,
-    layout: wgpu::BindGroupLayout,
-    bind_group: Option<(u64, wgpu::BindGroup)>,
+    groups: BindCache,
     pub format: wgpu::TextureFormat,
     /// Whether it shows the denoiser's views (its layout binds their textures).
     pub with_denoise: bool,
@@ -102,13 +96,11 @@ pub struct DisplayPass {
 
 impl DisplayPass {
     pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
-        let layout = inputs(wgpu::ShaderStages::FRAGMENT, g, t, b, true).create_layout(&gpu.device, DISPLAY);
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(DISPLAY), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
         let modules = modules(t.glossy.is_some(), b.denoise.is_some(), b.glossy_chain.is_some(), "realtime/display.wgsl");
-        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, move |d, module| {
+        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, wgpu::ShaderStages::FRAGMENT, &inputs(g, t, b), move |d, module, pl| {
             d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(DISPLAY),
-                layout: Some(&pl),
+                layout: Some(pl),
                 vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
                 primitive: Default::default(),
                 depth_stencil: None,
@@ -118,14 +110,13 @@ impl DisplayPass {
                 cache: None,
             })
         })?;
-        Ok(DisplayPass { pipeline, layout, bind_group: None, format, with_denoise: b.denoise.is_some() })
+        Ok(DisplayPass { pipeline, groups: BindCache::default(), format, with_denoise: b.denoise.is_some() })
     }
 
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) {
-        if self.bind_group.as_ref().is_none_or(|(k, _)| *k != key) {
-            self.bind_group = Some((key, inputs(wgpu::ShaderStages::FRAGMENT, g, t, b, true).create_group(&gpu.device, DISPLAY, &self.layout)));
-        }
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) -> Result<()> {
+        let p = &self.pipeline;
+        let groups = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &inputs(g, t, b)))?;
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(DISPLAY),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: target, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store } })],
@@ -134,8 +125,9 @@ impl DisplayPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(self.pipeline.get());
-        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.set_pipeline(p.get());
+        set_render_groups(&mut pass, groups);
         pass.draw(0..3, 0..1);
+        Ok(())
     }
 }

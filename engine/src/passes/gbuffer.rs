@@ -16,8 +16,8 @@
 //! WebGPU's render-target accounting (8-bit RGBA counts 8), over its default of 32: the device
 //! asks for 40, which every native backend grants.
 
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuScene, GpuTimer};
-use crate::shader::Reloadable;
+use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_render_groups};
+use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
 pub const LABEL: &str = "gbuffer";
@@ -55,23 +55,11 @@ impl GBufferTargets {
 
 pub struct GBufferPass {
     pub pipeline: Reloadable<wgpu::RenderPipeline>,
-    layout: wgpu::BindGroupLayout,
-    bind_group: Option<(u64, wgpu::BindGroup)>,
+    groups: BindCache,
 }
 
 fn bindings<'a>(scene: &'a GpuScene, frame: &'a wgpu::Buffer) -> Bindings<'a> {
-    use crate::gpu::scene::binding::*;
-    let mut b = Bindings::new(wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT)
-        .storage(TRIS, &scene.tris, true)
-        .storage(SHADING, &scene.shading, true)
-        .storage(MATERIALS, &scene.materials, true)
-        .uniform(11, frame);
-    for (n, buf) in [(TEXTURES, &scene.textures), (TANGENTS, &scene.tangents), (OBJECTS, &scene.objects)] {
-        if let Some(buf) = buf {
-            b = b.storage(n, buf, true);
-        }
-    }
-    b
+    scene.bindings().buffer("frame", frame)
 }
 
 impl GBufferPass {
@@ -89,12 +77,11 @@ impl GBufferPass {
             if f.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" },
             "realtime/gbuffer.wgsl",
         ];
-        let layout = bindings(scene, frame).create_layout(&gpu.device, LABEL);
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(LABEL), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
         let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
-        let pipeline = Reloadable::new(gpu, LABEL, "", &modules, move |d, module| d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let pipeline = Reloadable::new(gpu, LABEL, "", &modules, visibility, &bindings(scene, frame), move |d, module, pl| d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(LABEL),
-            layout: Some(&pl),
+            layout: Some(pl),
             vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
             primitive: wgpu::PrimitiveState { cull_mode: None, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
@@ -110,13 +97,12 @@ impl GBufferPass {
             multiview_mask: None,
             cache: None,
         }))?;
-        Ok(GBufferPass { pipeline, layout, bind_group: None })
+        Ok(GBufferPass { pipeline, groups: BindCache::default() })
     }
 
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &wgpu::Buffer, t: &GBufferTargets, timer: Option<&mut GpuTimer>) {
-        if self.bind_group.as_ref().is_none_or(|(g, _)| *g != scene.generation) {
-            self.bind_group = Some((scene.generation, bindings(scene, frame).create_group(&gpu.device, LABEL, &self.layout)));
-        }
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &wgpu::Buffer, t: &GBufferTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
+        let p = &self.pipeline;
+        let groups = self.groups.get(scene.generation, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, frame)))?;
         let clear_ids = wgpu::Color { r: u32::MAX as f64, g: u32::MAX as f64, b: 0.0, a: 0.0 };
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = t
             .color
@@ -139,8 +125,9 @@ impl GBufferPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(self.pipeline.get());
-        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.set_pipeline(p.get());
+        set_render_groups(&mut pass, groups);
         pass.draw(0..scene.triangle_count * 3, 0..1);
+        Ok(())
     }
 }

@@ -132,11 +132,11 @@ pub struct GlossyInputs<'a> {
     pub glossy: &'a GlossyChainTargets,
 }
 
-/// The glossy trace outputs every glossy stage reads (shaders/realtime/glossy_in.wgsl).
+/// The glossy trace outputs every glossy stage reads (shaders/realtime/glossy_in.wgsl), with
+/// `light` as the glossy light.
 pub fn glossy_trace_inputs<'a>(b: Bindings<'a>, t: &'a TraceTargets, light: &'a wgpu::TextureView) -> Bindings<'a> {
-    let f = || wgpu::TextureSampleType::Float { filterable: false };
     match &t.glossy {
-        Some(gl) => b.texture(29, light, f()).texture(30, &gl.reflection.1, f()).texture(31, &gl.mirror.1, wgpu::TextureSampleType::Uint).texture(35, &gl.mirror_hit.1, wgpu::TextureSampleType::Uint),
+        Some(gl) => b.texture("tr_glossy", light).texture("tr_reflection", &gl.reflection.1).texture("tr_mirror", &gl.mirror.1).texture("tr_mirror_hit", &gl.mirror_hit.1),
         None => b,
     }
 }
@@ -162,37 +162,29 @@ const STAGES: [(Kind, &str, &str, &str); 6] = [
 
 fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a> {
     let g = i.glossy;
-    let f = wgpu::TextureSampleType::Float { filterable: false };
     let light = &i.trace.glossy.as_ref().expect("the glossy chain runs in glossy scenes").light.1;
-    let mut b = Bindings::new(wgpu::ShaderStages::COMPUTE).uniform(11, i.frame).uniform(40, i.denoise).uniform(60, i.params);
-    b = glossy_trace_inputs(gbuffer_inputs(b, i.gbuffer, i.trace, &i.trace.matte.1), i.trace, light);
-    let depth = wgpu::TextureSampleType::Depth;
+    let b = Bindings::new().buffer("frame", i.frame).buffer("dn", i.denoise).buffer("gp", i.params).buffer_opt("prev_from_current", i.objects);
+    let b = glossy_trace_inputs(gbuffer_inputs(b, i.gbuffer, i.trace, &i.trace.matte.1), i.trace, light);
     match kind {
         Kind::Motion => b
-            .texture(41, &i.matte.prev_depth.1, depth)
-            .texture(61, &g.hit[parity].1, f)
-            .storage_texture(62, &g.motion.1, RGBA32F)
-            .storage_texture(63, &g.search.1, RGBA16F)
-            .storage_texture(64, &g.hit[1 - parity].1, RGBA32F),
-        Kind::PrefilterH => b.texture(65, &g.neighbourhood.1, f).storage_texture(66, &g.scratch.1, RGBA16F),
-        Kind::PrefilterV => b.texture(65, &g.scratch.1, f).storage_texture(66, &g.neighbourhood.1, RGBA16F),
-        Kind::Temporal => {
-            b = b
-                .texture(41, &i.matte.prev_depth.1, depth)
-                .texture(42, &g.history[parity].1, f)
-                .texture(43, &i.matte.prev_normal.1, f)
-                .texture(61, &g.hit[parity].1, f)
-                .texture(65, &g.neighbourhood.1, f)
-                .storage_texture(66, &g.history[1 - parity].1, RGBA32F)
-                .texture(67, &g.motion.1, f)
-                .storage_texture(68, &g.info.1, RGBA16F);
-            if let Some(o) = i.objects {
-                b = b.storage(17, o, true);
-            }
-            b
-        }
-        Kind::BilateralH => b.texture(65, &g.history[1 - parity].1, f).storage_texture(66, &g.scratch.1, RGBA16F),
-        Kind::BilateralV => b.texture(65, &g.scratch.1, f).storage_texture(66, &g.denoised.1, RGBA16F),
+            .texture("prev_depth", &i.matte.prev_depth.1)
+            .texture("prev_hit", &g.hit[parity].1)
+            .texture("out_motion", &g.motion.1)
+            .texture("out_search", &g.search.1)
+            .texture("out_hit", &g.hit[1 - parity].1),
+        Kind::PrefilterH => b.texture("src", &g.neighbourhood.1).texture("dst", &g.scratch.1),
+        Kind::PrefilterV => b.texture("src", &g.scratch.1).texture("dst", &g.neighbourhood.1),
+        Kind::Temporal => b
+            .texture("prev_depth", &i.matte.prev_depth.1)
+            .texture("history", &g.history[parity].1)
+            .texture("prev_normal", &i.matte.prev_normal.1)
+            .texture("prev_hit", &g.hit[parity].1)
+            .texture("neighbourhood", &g.neighbourhood.1)
+            .texture("dst", &g.history[1 - parity].1)
+            .texture("motion", &g.motion.1)
+            .texture("out_info", &g.info.1),
+        Kind::BilateralH => b.texture("src", &g.history[1 - parity].1).texture("dst", &g.scratch.1),
+        Kind::BilateralV => b.texture("src", &g.scratch.1).texture("dst", &g.denoised.1),
     }
 }
 
@@ -220,17 +212,18 @@ impl GlossyChain {
     pub fn new(gpu: &Gpu, i: &GlossyInputs, animated: bool) -> Result<GlossyChain> {
         let mut stages = vec![];
         for (kind, label, file, entry) in STAGES {
-            stages.push((kind, ChainStage::new(gpu, label, &modules(file, animated), entry, bindings(kind, i, 0))?));
+            stages.push((kind, ChainStage::new(gpu, label, &modules(file, animated), entry, &bindings(kind, i, 0))?));
         }
         Ok(GlossyChain { stages })
     }
 
     /// Record the chain. The prefilter runs only when the clip uses it.
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &GlossyInputs, parity: usize, size: (u32, u32), settings: &GlossySettings, mut timer: Option<&mut GpuTimer>) {
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &GlossyInputs, parity: usize, size: (u32, u32), settings: &GlossySettings, mut timer: Option<&mut GpuTimer>) -> Result<()> {
         let clip = settings.temporal && settings.clipping;
         for (kind, s) in self.stages.iter_mut().filter(|(k, _)| clip || !matches!(k, Kind::PrefilterH | Kind::PrefilterV)) {
-            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p));
+            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;
         }
+        Ok(())
     }
 }

@@ -204,18 +204,18 @@ pub struct ChainInputs<'a> {
     pub glossy: Option<(&'a GlossyChainTargets, &'a wgpu::Buffer)>,
 }
 
-/// The G-buffer and trace textures every stage binds (shaders/realtime/gbuffer_in.wgsl).
+/// The G-buffer and trace textures every stage binds (shaders/realtime/gbuffer_in.wgsl), with
+/// `matte` as the matte light.
 pub fn gbuffer_inputs<'a>(b: Bindings<'a>, g: &'a GBufferTargets, t: &'a TraceTargets, matte: &'a wgpu::TextureView) -> Bindings<'a> {
-    let f = || wgpu::TextureSampleType::Float { filterable: false };
-    b.texture(20, &g.depth.1, wgpu::TextureSampleType::Depth)
-        .texture(21, g.view("normal"), f())
-        .texture(22, g.view("motion"), f())
-        .texture(23, g.view("base_color"), f())
-        .texture(24, g.view("specular"), f())
-        .texture(25, g.view("emission"), f())
-        .texture(26, g.view("ids"), wgpu::TextureSampleType::Uint)
-        .texture(27, matte, f())
-        .texture(28, &t.direct.1, f())
+    b.texture("gb_depth", &g.depth.1)
+        .texture("gb_normal", g.view("normal"))
+        .texture("gb_motion", g.view("motion"))
+        .texture("gb_base_color", g.view("base_color"))
+        .texture("gb_specular", g.view("specular"))
+        .texture("gb_emission", g.view("emission"))
+        .texture("gb_object", g.view("ids"))
+        .texture("tr_matte", matte)
+        .texture("tr_direct", &t.direct.1)
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -241,52 +241,44 @@ const STAGES: [(Kind, &str); 7] = [
 
 fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> {
     let m = i.matte;
-    let f = wgpu::TextureSampleType::Float { filterable: false };
-    let mut b = gbuffer_inputs(Bindings::new(wgpu::ShaderStages::COMPUTE).uniform(11, i.frame).uniform(40, i.params), i.gbuffer, i.trace, &i.trace.matte.1);
+    let b = gbuffer_inputs(Bindings::new().buffer("frame", i.frame).buffer("dn", i.params).buffer_opt("prev_from_current", i.objects), i.gbuffer, i.trace, &i.trace.matte.1);
     match kind {
-        Kind::Temporal => {
-            b = b
-                .texture(41, &m.prev_depth.1, wgpu::TextureSampleType::Depth)
-                .texture(42, &m.history[parity].1, f)
-                .texture(43, &m.prev_normal.1, f)
-                .storage_texture(50, &m.temporal.1, RGBA32F)
-                .storage_texture(51, &m.reason.1, R32U);
-            if let Some(o) = i.objects {
-                b = b.storage(17, o, true);
-            }
-        }
-        Kind::HistoryBilateral => {
-            b = b.texture(44, &m.temporal.1, f).texture(51, &m.reason.1, wgpu::TextureSampleType::Uint).storage_texture(50, &m.history[1 - parity].1, RGBA32F)
-        }
-        Kind::MinH => b = b.texture(44, &m.temporal.1, f).texture(52, &m.radius.1, f).storage_texture(53, &m.min.1, R32F),
-        Kind::MinV => b = b.texture(44, &m.temporal.1, f).texture(52, &m.min.1, f).storage_texture(53, &m.radius.1, R32F),
-        Kind::Firefly => b = b.texture(44, &m.temporal.1, f).storage_texture(50, &m.median.1, RGBA16F),
-        Kind::Bilateral => b = b.texture(44, &m.median.1, f).texture(52, &m.radius.1, f).texture(51, &m.reason.1, wgpu::TextureSampleType::Uint).storage_texture(50, &m.denoised.1, RGBA16F),
+        Kind::Temporal => b
+            .texture("prev_depth", &m.prev_depth.1)
+            .texture("history", &m.history[parity].1)
+            .texture("prev_normal", &m.prev_normal.1)
+            .texture("out_temporal", &m.temporal.1)
+            .texture("out_reason", &m.reason.1),
+        Kind::HistoryBilateral => b.texture("filter_in", &m.temporal.1).texture("reason_in", &m.reason.1).texture("out_history", &m.history[1 - parity].1),
+        Kind::MinH => b.texture("filter_in", &m.temporal.1).texture("min_in", &m.radius.1).texture("out_min", &m.min.1),
+        Kind::MinV => b.texture("filter_in", &m.temporal.1).texture("min_in", &m.min.1).texture("out_min", &m.radius.1),
+        Kind::Firefly => b.texture("filter_in", &m.temporal.1).texture("out_median", &m.median.1),
+        Kind::Bilateral => b.texture("filter_in", &m.median.1).texture("radius_in", &m.radius.1).texture("reason_in", &m.reason.1).texture("out_matte", &m.denoised.1),
         Kind::Taa => {
-            b = b
-                .storage(32, i.hdr, true)
-                .texture(42, &m.taa_history[parity].1, f)
-                .storage_texture(50, &m.taa_history[1 - parity].1, RGBA32F)
-                .storage(54, &m.final_image, false)
-                .texture(44, &m.temporal.1, f)
-                .texture(51, &m.reason.1, wgpu::TextureSampleType::Uint)
-                .texture(55, &m.taa_material[parity].1, f)
-                .storage_texture(56, &m.taa_material[1 - parity].1, RGBA32F)
-                .texture(57, &m.taa_residual[parity].1, f)
-                .storage_texture(58, &m.taa_residual[1 - parity].1, RGBA32F)
-                .texture(59, &m.taa_glossy[parity].1, f)
-                .storage_texture(71, &m.taa_glossy[1 - parity].1, RGBA32F);
+            let mut b = b
+                .buffer("hdr", i.hdr)
+                .texture("history", &m.taa_history[parity].1)
+                .texture("out_history", &m.taa_history[1 - parity].1)
+                .buffer("final_image", &m.final_image)
+                .texture("matte_temporal", &m.temporal.1)
+                .texture("matte_reason", &m.reason.1)
+                .texture("material_history", &m.taa_material[parity].1)
+                .texture("out_material", &m.taa_material[1 - parity].1)
+                .texture("residual_history", &m.taa_residual[parity].1)
+                .texture("out_residual", &m.taa_residual[1 - parity].1)
+                .texture("glossy_factor_history", &m.taa_glossy[parity].1)
+                .texture("out_glossy_factor", &m.taa_glossy[1 - parity].1);
             if let Some((g, params)) = i.glossy {
                 // The glossy temporal wrote history[1 - parity] this frame.
                 b = super::glossy::glossy_trace_inputs(b, i.trace, &g.denoised.1)
-                    .uniform(60, params)
-                    .texture(69, &g.history[1 - parity].1, f)
-                    .texture(70, &g.info.1, f)
-                    .texture(77, &g.history[parity].1, f);
+                    .buffer("gp", params)
+                    .texture("glossy_temporal", &g.history[1 - parity].1)
+                    .texture("glossy_info", &g.info.1)
+                    .texture("glossy_previous", &g.history[parity].1);
             }
+            b
         }
     }
-    b
 }
 
 fn modules(kind: Kind, animated: bool, glossy: bool) -> Vec<&'static str> {
@@ -324,16 +316,17 @@ impl MatteChain {
                 Kind::MinV => "min_v",
                 _ => "main",
             };
-            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated, i.glossy.is_some()), entry, bindings(kind, i, 0))?));
+            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated, i.glossy.is_some()), entry, &bindings(kind, i, 0))?));
         }
         Ok(MatteChain { stages })
     }
 
     /// Record stages 3-7 (before the composite) or TAA (after it).
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &ChainInputs, parity: usize, size: (u32, u32), taa: bool, mut timer: Option<&mut GpuTimer>) {
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &ChainInputs, parity: usize, size: (u32, u32), taa: bool, mut timer: Option<&mut GpuTimer>) -> Result<()> {
         for (kind, s) in self.stages.iter_mut().filter(|(k, _)| (*k == Kind::Taa) == taa) {
-            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p));
+            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;
         }
+        Ok(())
     }
 }

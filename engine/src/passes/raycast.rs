@@ -1,8 +1,8 @@
 //! `accel/raycast`: closest (or any) hits for a batch of rays; checks the GPU BVH against the
 //! CPU and measures rays per second.
 
-use crate::gpu::scene::{binding, compute_pipeline, storage_entry, uniform_entry};
-use crate::gpu::{Gpu, GpuMemory, GpuScene, readback_buffer};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuScene, readback_buffer};
+use crate::shader::FixedCompute;
 use anyhow::Result;
 use glam::Vec3;
 
@@ -19,8 +19,7 @@ pub struct RayHit {
 }
 
 pub struct Raycaster {
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    compute: FixedCompute,
 }
 
 impl Raycaster {
@@ -32,18 +31,10 @@ impl Raycaster {
             "common/alpha_none.wgsl",
             "accel/raycast.wgsl",
         ];
-        let program = gpu.shaders.compose(LABEL, "", &modules)?;
-        let module = program.create(&gpu.device)?;
-        let entries = [
-            uniform_entry(0),
-            storage_entry(binding::NODES, true),
-            storage_entry(binding::TRIS, true),
-            storage_entry(3, true),
-            storage_entry(4, false),
-        ];
-        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(LABEL), entries: &entries });
-        let pipeline = compute_pipeline(&gpu.device, LABEL, &module, &layout);
-        Ok(Raycaster { pipeline, layout })
+        // The per-cast buffers are made by each cast: offer the scene's and their names.
+        let mut offered: Vec<&str> = scene.bindings().names().collect();
+        offered.extend(CAST_BUFFERS);
+        Ok(Raycaster { compute: FixedCompute::new(gpu, LABEL, "", &modules, &offered)? })
     }
 
     /// Trace `rays` (origin, direction, tmax) in scene-relative coordinates. Returns the hits
@@ -63,24 +54,14 @@ impl Raycaster {
         let pbuf = mem.buffer_init(d, "raycast/params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
         let rbuf = mem.buffer_init(d, "raycast/rays", bytemuck::cast_slice(&ray_data), wgpu::BufferUsages::STORAGE);
         let hbuf = mem.buffer(d, "raycast/hits", n as u64 * 16, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(LABEL),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: pbuf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: binding::NODES, resource: scene.nodes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: binding::TRIS, resource: scene.tris.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: rbuf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: hbuf.as_entire_binding() },
-            ],
-        });
+        let groups = self.compute.bind_groups(d, &cast_bindings(scene, &pbuf, &rbuf, &hbuf))?;
         gpu.wait()?;
         let start = std::time::Instant::now();
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: None });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
+            pass.set_pipeline(&self.compute.pipeline);
+            crate::gpu::set_compute_groups(&mut pass, &groups);
             let groups = n.div_ceil(64);
             pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
         }
@@ -97,4 +78,12 @@ impl Raycaster {
             .collect();
         Ok((hits, elapsed))
     }
+}
+
+/// What each cast binds beside the scene (accel/raycast.wgsl).
+const CAST_BUFFERS: [&str; 3] = ["params", "rays", "hits"];
+
+fn cast_bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, rays: &'a wgpu::Buffer, hits: &'a wgpu::Buffer) -> Bindings<'a> {
+    let [p, r, h] = CAST_BUFFERS;
+    scene.bindings().buffer(p, params).buffer(r, rays).buffer(h, hits)
 }

@@ -1,6 +1,5 @@
 //! `reference/trace`: the progressive reference path tracer (shaders/reference/trace.wgsl).
 
-use crate::gpu::scene::{compute_pipeline, storage_entry, uniform_entry};
 use crate::gpu::{Gpu, GpuMemory, GpuScene, PreparedScene, readback_buffer};
 use crate::quality::Image;
 use crate::scene::Camera;
@@ -58,7 +57,7 @@ pub struct Accumulation {
 
 pub struct ReferenceTracer {
     pipeline: wgpu::ComputePipeline,
-    bind_group: wgpu::BindGroup,
+    bind_groups: Vec<wgpu::BindGroup>,
     params_buf: wgpu::Buffer,
     accum: wgpu::Buffer,
     params: TraceParams,
@@ -77,8 +76,6 @@ impl ReferenceTracer {
         }
         let mut modules = scene.shading_modules();
         modules.push("reference/trace.wgsl");
-        let program = gpu.shaders.compose(LABEL, &scene.prelude(), &modules)?;
-        let module = program.create(&gpu.device)?;
         let mut memory = GpuMemory::default();
         let accum = memory.buffer(
             &gpu.device,
@@ -92,19 +89,12 @@ impl ReferenceTracer {
             std::mem::size_of::<TraceParams>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let scene_bindings = scene.shading_bindings();
-        let mut entries = vec![uniform_entry(0), storage_entry(5, false)];
-        entries.extend(scene_bindings.iter().map(|(b, _)| storage_entry(*b, true)));
-        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(LABEL), entries: &entries });
-        let mut bg = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: params_buf.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 5, resource: accum.as_entire_binding() },
-        ];
-        bg.extend(scene_bindings.iter().map(|(b, buf)| wgpu::BindGroupEntry { binding: *b, resource: buf.as_entire_binding() }));
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(LABEL), layout: &layout, entries: &bg });
-        let pipeline = compute_pipeline(&gpu.device, LABEL, &module, &layout);
+        let resources = scene.bindings().buffer("params", &params_buf).buffer("accum", &accum);
+        let fixed = crate::shader::FixedCompute::new(gpu, LABEL, &scene.prelude(), &modules, &resources.names().collect::<Vec<_>>())?;
+        let bind_groups = fixed.bind_groups(&gpu.device, &resources)?;
+        let pipeline = fixed.pipeline;
         let params = make_params(prepared, view);
-        Ok(ReferenceTracer { pipeline, bind_group, params_buf, accum, params, samples: 0, memory })
+        Ok(ReferenceTracer { pipeline, bind_groups, params_buf, accum, params, samples: 0, memory })
     }
 
     /// Start over (new camera or settings).
@@ -128,7 +118,7 @@ impl ReferenceTracer {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: None });
                 pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &self.bind_group, &[]);
+                crate::gpu::set_compute_groups(&mut pass, &self.bind_groups);
                 pass.dispatch_workgroups(self.params.width.div_ceil(8), self.params.height.div_ceil(8), 1);
             }
             gpu.queue.submit([enc.finish()]);

@@ -9,7 +9,7 @@
 
 use super::gbuffer::GBufferTargets;
 use crate::gpu::scene::compute_pipeline;
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuScene, GpuTimer};
+use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups};
 use anyhow::Result;
 
 pub const LABEL: &str = "trace";
@@ -52,20 +52,13 @@ impl TraceTargets {
 
 pub struct TracePass {
     pub pipeline: crate::shader::Reloadable<wgpu::ComputePipeline>,
-    layout: wgpu::BindGroupLayout,
-    bind_group: Option<((u64, u64), wgpu::BindGroup)>,
+    groups: BindCache,
 }
 
 fn bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::Buffer, g: &'a GBufferTargets, t: &'a TraceTargets) -> Bindings<'a> {
-    let mut b = Bindings::new(wgpu::ShaderStages::COMPUTE)
-        .uniform(0, params)
-        .storage_all(&scene.shading_bindings())
-        .uniform(11, frame)
-        .texture(12, g.view("ids"), wgpu::TextureSampleType::Uint)
-        .storage_texture(13, &t.matte.1, MATTE_FORMAT)
-        .storage_texture(14, &t.direct.1, MATTE_FORMAT);
+    let mut b = scene.bindings().buffer("params", params).buffer("frame", frame).texture("gb_ids", g.view("ids")).texture("out_matte", &t.matte.1).texture("out_direct", &t.direct.1);
     if let Some(gl) = &t.glossy {
-        b = b.storage_texture(15, &gl.light.1, MATTE_FORMAT).storage_texture(16, &gl.reflection.1, REFLECTION_FORMAT).storage_texture(18, &gl.mirror.1, MIRROR_FORMAT).storage_texture(19, &gl.mirror_hit.1, MIRROR_HIT_FORMAT);
+        b = b.texture("out_glossy", &gl.light.1).texture("out_reflection", &gl.reflection.1).texture("out_mirror", &gl.mirror.1).texture("out_mirror_hit", &gl.mirror_hit.1);
     }
     b
 }
@@ -76,21 +69,21 @@ impl TracePass {
         modules.push("realtime/frame.wgsl");
         modules.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
         modules.push("realtime/trace.wgsl");
-        let layout = bindings(scene, params, frame, g, t).create_layout(&gpu.device, LABEL);
-        let l = layout.clone();
-        let pipeline = crate::shader::Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, move |d, m| compute_pipeline(d, LABEL, m, &l))?;
-        Ok(TracePass { pipeline, layout, bind_group: None })
+        let offered = bindings(scene, params, frame, g, t);
+        let pipeline = crate::shader::Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, wgpu::ShaderStages::COMPUTE, &offered, |d, m, l| compute_pipeline(d, LABEL, m, l, "main"))?;
+        Ok(TracePass { pipeline, groups: BindCache::default() })
     }
 
     /// `key`: (scene generation, frame target generation); bind groups are rebuilt when it changes.
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), timer: Option<&mut GpuTimer>) {
-        if self.bind_group.as_ref().is_none_or(|(k, _)| *k != key) {
-            self.bind_group = Some((key, bindings(scene, params, frame, g, t).create_group(&gpu.device, LABEL, &self.layout)));
-        }
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), timer: Option<&mut GpuTimer>) -> Result<()> {
+        use crate::shader::Reload;
+        let p = &self.pipeline;
+        let groups = self.groups.get(key.0 * 1_000_003 + key.1, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t)))?;
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
-        pass.set_pipeline(self.pipeline.get());
-        pass.set_bind_group(0, &self.bind_group.as_ref().unwrap().1, &[]);
+        pass.set_pipeline(p.get());
+        set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        Ok(())
     }
 }

@@ -21,10 +21,12 @@
 //! text comes from (embedded, or a folder on disk that `watch.rs` watches).
 
 mod library;
+mod reflect;
 mod reload;
 mod watch;
 
 pub use library::{SHADER_DIR_VAR, ShaderLibrary, source_tree_dir};
+pub use reflect::{FixedCompute, ProgramBindings, Slot, reflect};
 pub use reload::{Reload, Reloadable, ReloadOutcome};
 pub use watch::ShaderWatcher;
 
@@ -119,13 +121,48 @@ pub fn compose(label: &str, prelude: &str, modules: &[&'static str]) -> Result<P
 }
 
 /// `compose` with the text of each module given by `source`.
+///
+/// Resources are declared without attributes (`var<uniform> frame: Frame;`, `var history:
+/// texture_2d<f32>;`, at the start of a line); composing numbers them, in the order they appear,
+/// in group [`SHARED_GROUP`] when their module is one of [`shared_module`]'s and in
+/// [`STAGE_GROUP`] otherwise. Rust binds them by name ([`reflect`]), so no number is kept by
+/// hand, and the attributes go on the declaration's own line, so that errors keep their lines.
 pub fn compose_with(label: &str, prelude: &str, modules: &[&'static str], source: impl Fn(&str) -> Result<std::sync::Arc<str>>) -> Result<Program> {
     let mut text = String::from(prelude);
+    let mut next = [0u32; 2];
     for m in modules {
         text.push_str(&format!("\n// ---- {m}\n"));
-        text.push_str(&source(m)?);
+        let group = if shared_module(m) { SHARED_GROUP } else { STAGE_GROUP };
+        for line in source(m)?.split_inclusive('\n') {
+            if is_resource_declaration(line) {
+                text.push_str(&format!("@group({group}) @binding({}) ", next[group as usize]));
+                next[group as usize] += 1;
+            }
+            text.push_str(line);
+        }
     }
     Ok(Program { label: label.to_string(), modules: modules.to_vec(), text })
+}
+
+/// The bind group of the scene's buffers and the frame's shared inputs (its uniform, the
+/// G-buffer, the trace's glossy outputs, object motion): the same resources in every stage.
+pub const SHARED_GROUP: u32 = 0;
+/// The bind group of what one stage owns: its parameters, histories and outputs.
+pub const STAGE_GROUP: u32 = 1;
+
+/// Modules whose resources are the scene's or the frame's, shared by every stage.
+pub fn shared_module(path: &str) -> bool {
+    path.starts_with("common/") || matches!(path, "realtime/frame.wgsl" | "realtime/gbuffer_in.wgsl" | "realtime/glossy_in.wgsl" | "realtime/motion_objects.wgsl")
+}
+
+/// A module-scope `var` in the uniform, storage or handle address space (the only ones a
+/// binding can name): `var<private>` and `var<workgroup>` are not resources.
+fn is_resource_declaration(line: &str) -> bool {
+    let Some(rest) = line.strip_prefix("var") else { return false };
+    match rest.strip_prefix('<') {
+        Some(space) => !(space.starts_with("private") || space.starts_with("workgroup")),
+        None => rest.starts_with(' '),
+    }
 }
 
 impl Program {

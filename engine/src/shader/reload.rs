@@ -5,18 +5,32 @@
 //! On failure the last good pipeline keeps rendering and the error (file and line) is kept
 //! until a later reload of the same pipeline succeeds.
 
-use crate::gpu::Gpu;
+use super::ProgramBindings;
+use crate::gpu::{Bindings, Gpu};
 use anyhow::{Context, Result};
 use std::time::Instant;
 
-type Build<P> = Box<dyn Fn(&wgpu::Device, &wgpu::ShaderModule) -> P + Send + Sync>;
+type Build<P> = Box<dyn Fn(&wgpu::Device, &wgpu::ShaderModule, &wgpu::PipelineLayout) -> P + Send + Sync>;
 
+/// A pipeline with the resources its program declares and the bind group layouts made from them.
+struct Built<P> {
+    pipeline: P,
+    bindings: ProgramBindings,
+    layouts: Vec<wgpu::BindGroupLayout>,
+}
+
+/// A pipeline whose layout follows its program: each build reflects the program's resources
+/// (a reload may use any resource the stage offers, in any order), and bind groups are made
+/// from the current build's layouts ([`Reloadable::bind_groups`]).
 pub struct Reloadable<P> {
     label: String,
     prelude: String,
     modules: Vec<&'static str>,
+    visibility: wgpu::ShaderStages,
+    /// The names the stage offers: a program that binds another fails to build.
+    offered: Vec<String>,
     build: Build<P>,
-    current: P,
+    current: Built<P>,
     builds: u32,
     error: Option<String>,
 }
@@ -44,27 +58,53 @@ pub trait Reload {
 }
 
 impl<P> Reloadable<P> {
-    /// Compose and build the pipeline; `build` makes it from a shader module (and is kept to
-    /// make it again).
-    pub fn new(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], build: impl Fn(&wgpu::Device, &wgpu::ShaderModule) -> P + Send + Sync + 'static) -> Result<Reloadable<P>> {
+    /// Compose and build the pipeline; `build` makes it from a shader module and the layout
+    /// reflected from it (and is kept to make it again). `offered`: what the stage can bind
+    /// (only the names count here), seen by `visibility`.
+    pub fn new(
+        gpu: &Gpu,
+        label: &str,
+        prelude: &str,
+        modules: &[&'static str],
+        visibility: wgpu::ShaderStages,
+        offered: &Bindings,
+        build: impl Fn(&wgpu::Device, &wgpu::ShaderModule, &wgpu::PipelineLayout) -> P + Send + Sync + 'static,
+    ) -> Result<Reloadable<P>> {
         let build: Build<P> = Box::new(build);
-        let current = make(gpu, label, prelude, modules, &build)?;
-        Ok(Reloadable { label: label.to_string(), prelude: prelude.to_string(), modules: modules.to_vec(), build, current, builds: 1, error: None })
+        let offered: Vec<String> = offered.names().map(str::to_string).collect();
+        let current = make(gpu, label, prelude, modules, visibility, &offered, &build)?;
+        Ok(Reloadable { label: label.to_string(), prelude: prelude.to_string(), modules: modules.to_vec(), visibility, offered, build, current, builds: 1, error: None })
     }
 
     pub fn get(&self) -> &P {
-        &self.current
+        &self.current.pipeline
+    }
+
+    /// The resources the current build's program declares.
+    pub fn program_bindings(&self) -> &ProgramBindings {
+        &self.current.bindings
+    }
+
+    /// The current build's bind groups, each resource found in `resources` by name.
+    pub fn bind_groups(&self, device: &wgpu::Device, resources: &Bindings) -> Result<Vec<wgpu::BindGroup>> {
+        resources.create_groups(device, &self.label, &self.current.bindings, &self.current.layouts)
     }
 }
 
-fn make<P>(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], build: &Build<P>) -> Result<P> {
+fn make<P>(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], visibility: wgpu::ShaderStages, offered: &[String], build: &Build<P>) -> Result<Built<P>> {
     let program = gpu.shaders.compose(label, prelude, modules)?;
-    program.validate()?;
-    // naga accepts some programs the pipeline still rejects (a binding the layout lacks, an
-    // entry point that is gone); the error scope turns those into errors too.
+    let module = program.validate()?;
+    let bindings = super::reflect(label, &module)?;
+    bindings.check_offered(label, &offered.iter().map(String::as_str).collect::<Vec<_>>())?;
+    // naga accepts some programs the pipeline still rejects (an entry point that is gone); the
+    // error scope turns those into errors too.
     gpu.validated(&format!("creating pipeline {label}"), || {
+        let layouts = bindings.layouts(&gpu.device, label, visibility);
+        let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
+        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &refs, immediate_size: 0 });
         let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(program.text.as_str().into()) });
-        Ok(build(&gpu.device, &module))
+        let pipeline = build(&gpu.device, &module, &pl);
+        Ok(Built { pipeline, bindings, layouts })
     })
     .with_context(|| format!("pipeline {label} ({})", modules.join(", ")))
 }
@@ -92,7 +132,7 @@ impl<P> Reload for Reloadable<P> {
 
     fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome {
         let start = Instant::now();
-        let result = make(gpu, &self.label, &self.prelude, &self.modules, &self.build);
+        let result = make(gpu, &self.label, &self.prelude, &self.modules, self.visibility, &self.offered, &self.build);
         let ms = start.elapsed().as_secs_f64() * 1e3;
         self.error = match result {
             Ok(p) => {
