@@ -72,7 +72,7 @@ fn final_bilateral_keeps_a_contact_shadow() {
         let mean = |ys: &[usize]| ys.iter().map(|&y| rows[y]).sum::<f32>() / ys.len() as f32;
         mean(&below) - mean(&shadow)
     };
-    let mara = |k: f32| FrameSettings { denoiser: Denoiser::Mara, matte: MatteSettings { edge_stop_sigmas: k, ..Default::default() }, ..Default::default() };
+    let mara = |k: f32| FrameSettings { denoiser: Denoiser::MARA, matte: MatteSettings { edge_stop_sigmas: k, ..Default::default() }, ..Default::default() };
     let kept = |k: f32| depth(&row_means(&realtime_frames(&scene, SIZE, &mara(k), 30).unwrap())) / depth(&reference);
     let (with_stop, without) = (kept(MatteSettings::default().edge_stop_sigmas), kept(0.0));
     println!("shadow depth kept: with the edge-stop {with_stop:.3}, without {without:.3}");

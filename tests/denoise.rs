@@ -49,7 +49,7 @@ fn frames(r: &mut Renderer, gpu: &hush_engine::gpu::Gpu, s: &FrameSettings, came
 }
 
 fn mara() -> FrameSettings {
-    FrameSettings { denoiser: Denoiser::Mara, ..Default::default() }
+    FrameSettings { denoiser: Denoiser::MARA, ..Default::default() }
 }
 
 /// After 30 frames of a still camera (cornell_diffuse, 256²), the denoised frame is much closer
@@ -106,7 +106,7 @@ fn nonfinite_input_never_reaches_history_or_screen() {
     }
     for mut m in cases {
         m.inject_nonfinite = true;
-        let s = FrameSettings { denoiser: Denoiser::Mara, matte: m.clone(), ..Default::default() };
+        let s = FrameSettings { denoiser: Denoiser::MARA, matte: m.clone(), ..Default::default() };
         let img = frames(&mut r, &gpu, &s, view(), 4);
         assert!(img.data.iter().all(|p| p.is_finite()), "non-finite pixel on screen with {m:?}");
         let histories = ["matte/history 0", "matte/history 1", "matte/temporal", "matte/bilateral", "taa/history 0", "taa/history 1"];

@@ -120,7 +120,7 @@ fn camera(x: f64) -> Camera {
 fn virtual_position_of_a_plane_mirror_is_analytic() {
     let size = (96u32, 54u32);
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
-    let mut s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let mut s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     s.matte.taa = false; // samples at pixel centres
     s.glossy.reflection_mv = ReflectionMv::Diamond;
     let (before, now) = (camera(-0.15), camera(0.15));
@@ -187,7 +187,7 @@ fn virtual_position_of_a_plane_mirror_is_analytic() {
 fn a_static_view_keeps_its_reflections_still() {
     let size = (96u32, 54u32);
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
-    let mut s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let mut s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     s.glossy.reflection_mv = ReflectionMv::Diamond;
     for _ in 0..4 {
         r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0 }, &s, None).unwrap();
@@ -213,7 +213,7 @@ fn glossy_bilateral_sigma() {
 
     let size = (96u32, 54u32);
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
-    let s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0 }, &s, None).unwrap();
     let (scratch, _) = r.read_texture(&gpu, "glossy/scratch").unwrap();
     let (specular, _) = r.read_texture(&gpu, "gbuffer/specular").unwrap();
@@ -258,7 +258,7 @@ fn glossy_history_stays_on_its_face() {
     let size = (96u32, 54u32);
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, size).unwrap();
     let cam = Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0);
-    let s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     let warm = 7;
     for _ in 0..warm {
         r.render(&gpu, &FrameInput { camera: cam, time: 0.0 }, &s, None).unwrap();

@@ -189,7 +189,7 @@ fn the_default_level_renders_without_nan() {
     let gpu = hush_engine::gpu::Gpu::headless(&prepared.realtime_requirements((80, 45))).unwrap();
     let mut r = Renderer::new(&gpu, scene, prepared, (80, 45)).unwrap();
     assert!(r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures);
-    let mut denoised = FrameSettings { denoiser: hush_engine::settings::Denoiser::Mara, ..Default::default() };
+    let mut denoised = FrameSettings { denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() };
     // Off by default; on here so that the glossy/clipping view has something to show.
     denoised.glossy.clipping = true;
     for k in 0..3 {

@@ -40,7 +40,7 @@ fn renderer(shaders: &Path) -> (Gpu, Renderer) {
 }
 
 fn frame(gpu: &Gpu, r: &mut Renderer) -> image::RgbaImage {
-    let s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     let camera = Camera::look_at(DVec3::new(0.0, 1.5, 4.0), DVec3::new(0.0, 0.5, 0.0), 60.0);
     r.render(gpu, &FrameInput { camera, time: 0.0 }, &s, None).unwrap();
     r.display_image(gpu, &s).unwrap()
@@ -179,7 +179,7 @@ fn pass_times_arrive_without_waiting() {
         return;
     }
     r.set_async_timings(true);
-    let s = FrameSettings { denoiser: Denoiser::Mara, ..Default::default() };
+    let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     let camera = r.scene.camera_or_default();
     let mut got = vec![];
     for k in 0..6 {

@@ -105,7 +105,7 @@ struct Viewer {
 
 fn panel_for(r: &Renderer, message: String) -> ui::Panel {
     ui::Panel {
-        settings: hush_engine::settings::FrameSettings { max_depth: r.scene.max_depth.max(2), denoiser: hush_engine::settings::Denoiser::Mara, ..Default::default() },
+        settings: hush_engine::settings::FrameSettings { max_depth: r.scene.max_depth.max(2), denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() },
         resolution_scale: 1.0,
         sun: r.scene.sun_direction().map(ui::sun_angles),
         paused: false,

@@ -5,6 +5,7 @@
 //! ([`quality`] for metrics and files).
 
 pub mod accel;
+pub mod denoise;
 pub mod frame;
 pub mod fuzz;
 pub mod gpu;

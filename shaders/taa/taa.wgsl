@@ -43,9 +43,6 @@ var<storage, read> hdr: array<vec4f>;
 var history: texture_2d<f32>;
 var out_history: texture_storage_2d<rgba32float, write>;
 var<storage, read_write> final_image: array<vec4f>;
-// The matte temporal's output (stage 3) and its history length (above the reason's 8 flag bits).
-var matte_temporal: texture_2d<f32>;
-var matte_reason: texture_2d<u32>;
 // Averages, over TAA's history, of the matte factor m (1 - F)^2 and of the composite less that
 // factor times the matte temporal's output (MatteSettings::taa_current_light).
 var material_history: texture_2d<f32>;
@@ -56,8 +53,11 @@ var out_residual: texture_storage_2d<rgba32float, write>;
 var glossy_factor_history: texture_2d<f32>;
 var out_glossy_factor: texture_storage_2d<rgba32float, write>;
 
-// This pixel's glossy term as TAA follows it (taa/glossy.wgsl, or taa/glossy_none.wgsl in a
-// scene without glossy buffers).
+// What TAA follows of the denoiser's matte light: taa/matte.wgsl where the denoiser offers it
+// (the matte temporal's output and its reason flags and history length), taa/matte_none.wgsl
+// where it does not. This pixel's glossy term as TAA follows it: taa/glossy.wgsl, or
+// taa/glossy_none.wgsl in a scene without glossy buffers or a denoiser that offers no glossy
+// light to follow.
 struct TaaGlossy {
     // What the composite multiplies the glossy chain's light by: F(w_s) x the demodulation.
     factor: vec3f,
@@ -109,9 +109,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let current = hdr_at(p);
     let factors = pixel_factors(gid.xy);
     let m_k = factors[1];
-    let light_k = half_safe(textureLoad(matte_temporal, p, 0).rgb);
+    let light_k = half_safe(taa_matte_light(p));
     let gl = taa_glossy(p, factors[0]);
-    let matte_reason_k = textureLoad(matte_reason, p, 0).x;
+    let matte_reason_k = taa_matte_state(p);
     // The matte light of this pixel continues last frame's: a surface whose history is this
     // pixel's own texel.
     let own_light = has_surface(p) && (matte_reason_k & (REASON_DISOCCLUDED | REASON_LOW_CONFIDENCE | REASON_NEIGHBOUR)) == 0u;

@@ -177,7 +177,7 @@ fn stream(s: &Setup, settings: &FrameSettings, references: &[Image]) -> Result<(
         r.render(&s.gpu, input, settings, None)?;
         let ms: f64 = r.pass_times(&s.gpu)?.iter().map(|p| p.1).sum();
         let img = r.read_hdr(&s.gpu)?;
-        let mask = if settings.denoiser == Denoiser::Mara && settings.matte.temporal { Some(uncovered.update(&r, &s.gpu)?) } else { None };
+        let mask = if settings.denoiser == Denoiser::MARA && settings.matte.temporal { Some(uncovered.update(&r, &s.gpu)?) } else { None };
         scores.push(&img, prev.as_ref(), &references[k], ms, mask.as_deref())?;
         if k + 1 == s.inputs.len() {
             last.push(img.clone());
@@ -194,7 +194,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     }
     let denoiser = a.denoiser.as_deref().or(if a.preset.is_none() { Some("mara") } else { None });
     let chains = preset_settings(a.preset.as_deref(), denoiser, &a.disable, a.reflection_mv.as_deref())?;
-    let denoiser = chains.denoiser;
+    let denoiser = chains.denoiser.clone();
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, Some(a.width), a.height);
     let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
@@ -272,7 +272,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let max_depth = crate::realtime::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
     let (den, last) = stream(&s, &base, &references)?;
-    let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::None, ..base.clone() }, &references)?;
+    let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::NONE, ..base.clone() }, &references)?;
     if let (Some(d), Some(r), Some(f)) = (last.first(), last_raw.first(), references.last()) {
         // The last frame as seen and in linear HDR, and where FLIP sees the error (denoised and
         // the 64-spp yardstick side by side show whether the denoiser's error is noise or bias).
@@ -307,7 +307,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let per_seed: Vec<String> = flips64.iter().map(|f| format!("{f:.5}")).collect();
     std::fs::write(a.out_dir.join("accumulated64_flip.txt"), format!("{flip64:.5}\n{}\n", per_seed.join(",")))?;
 
-    if a.ablations && denoiser == Denoiser::Mara {
+    if a.ablations && denoiser == Denoiser::MARA {
         let mut f = std::fs::File::create(a.out_dir.join("ablations.csv"))?;
         writeln!(f, "disabled,flip,relmse,ssim,temporal_error,gpu_ms")?;
         let mut row = |name: &str, sc: &Scores| -> Result<()> {

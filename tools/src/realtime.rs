@@ -7,10 +7,9 @@ use hush_engine::scene::CameraPath;
 use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv, disable_stage, stage_names};
 
 pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
-    match s {
-        "none" => Ok(Denoiser::None),
-        "mara" => Ok(Denoiser::Mara),
-        _ => bail!("--denoiser {s:?}: use none or mara"),
+    match hush_engine::denoise::find(s) {
+        Ok(e) => Ok(Denoiser::named(e.name)),
+        Err(e) => bail!("--denoiser {s:?}: {e}"),
     }
 }
 

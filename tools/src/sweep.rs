@@ -78,10 +78,10 @@ pub fn run(a: SweepArgs) -> Result<()> {
         let mut r = Renderer::new(&gpu, scene.clone(), PreparedScene::new(&scene, bvh_kind(&None)?)?, size)?;
         // A lower resolution is scored against the reference box-filtered to its size.
         let target = if size == full { reference.clone() } else { reference.box_downsample(full.0 / size.0)? };
-        for denoiser in [Denoiser::None, Denoiser::Mara] {
+        for denoiser in [Denoiser::NONE, Denoiser::MARA] {
             for paths in [1u32, 2, 4] {
                 for max_depth in [3, depth] {
-                    let s = FrameSettings { denoiser, paths_per_pixel: paths, max_depth, ..Default::default() };
+                    let s = FrameSettings { denoiser: denoiser.clone(), paths_per_pixel: paths, max_depth, ..Default::default() };
                     // One raw frame between points: the denoiser's history starts over.
                     r.render(&gpu, &input, &FrameSettings::default(), None)?;
                     let mut ms = vec![];
@@ -93,7 +93,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
                         }
                     }
                     let flip = compare(&r.read_hdr(&gpu)?, &target)?.flip as f64;
-                    points.push(Point { scale, paths, max_depth, denoiser, ms: median(ms), flip, pareto: false });
+                    points.push(Point { scale, paths, max_depth, denoiser: denoiser.clone(), ms: median(ms), flip, pareto: false });
                 }
             }
         }
@@ -108,7 +108,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
     println!("  scale  paths  depth  denoiser   GPU ms   FLIP    Pareto");
     points.sort_by(|p, q| p.ms.total_cmp(&q.ms));
     for p in &points {
-        let d = if p.denoiser == Denoiser::Mara { "mara" } else { "none" };
+        let d = if p.denoiser == Denoiser::MARA { "mara" } else { "none" };
         writeln!(f, "{},{},{},{d},{:.3},{:.5},{}", p.scale, p.paths, p.max_depth, p.ms, p.flip, p.pareto)?;
         println!("  {:5.2}  {:5}  {:5}  {d:8} {:8.2}  {:.4}  {}", p.scale, p.paths, p.max_depth, p.ms, p.flip, if p.pareto { "*" } else { "" });
     }
@@ -131,8 +131,8 @@ fn plot(path: &std::path::Path, points: &[Point], title: &str) -> Result<()> {
         .build_cartesian_2d(0.0..xmax, 0.0..ymax)
         .map_err(|x| e(&x))?;
     chart.configure_mesh().x_desc("GPU ms per frame").y_desc("FLIP against the converged image").draw().map_err(|x| e(&x))?;
-    for (den, color) in [(Denoiser::None, RED), (Denoiser::Mara, BLUE)] {
-        let name = if den == Denoiser::Mara { "denoiser: mara" } else { "denoiser: none" };
+    for (den, color) in [(Denoiser::NONE, RED), (Denoiser::MARA, BLUE)] {
+        let name = if den == Denoiser::MARA { "denoiser: mara" } else { "denoiser: none" };
         chart
             .draw_series(points.iter().filter(|p| p.denoiser == den).map(|p| Circle::new((p.ms, p.flip), 4 + 2 * (p.scale >= 1.0) as i32, color.filled())))
             .map_err(|x| e(&x))?

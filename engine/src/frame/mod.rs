@@ -1,24 +1,26 @@
-//! The real-time frame: G-buffer raster -> factored trace -> composite -> display, on one scene.
-//! Which passes, bindings and buffers exist follows the scene's features (no glossy lobe: no
-//! glossy path and no glossy buffers; no animation: no object motion buffer and no BVH rebuilds).
+//! The real-time frame, as Figure 2 of Mara et al. 2017 draws it: gbuffer (raster) -> trace ->
+//! denoise (any [`crate::denoise::Denoiser`], or none) -> composite -> TAA -> display, on one
+//! scene. Which passes, bindings and buffers exist follows the scene's features (no glossy
+//! lobe: no glossy path and no glossy buffers; no animation: no object motion buffer and no
+//! BVH rebuilds) and the denoiser chosen (its textures are made on its first frame).
 
 mod params;
+mod readback;
 mod reload;
-mod views;
 
 pub use params::{CameraSetup, FrameParams, random_jitter};
-pub use views::View;
+pub use crate::settings::View;
 
 use crate::accel::BvhKind;
+use crate::denoise::{Denoiser, DenoiserScene, FrameContext};
 use crate::gpu::{Gpu, GpuMemory, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
 use crate::passes::composite::{CompositePass, DisplayPass, FrameBuffers};
-use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
-use crate::passes::matte::{ChainInputs, ChainView, DenoiseParams, MatteChain, MatteTargets};
-use crate::settings::Denoiser;
 use crate::passes::gbuffer::{self, GBufferPass, GBufferTargets};
+use crate::passes::io::{FrameIo, PreviousGBuffer};
+use crate::passes::matte::{ChainView, DenoiseParams};
 use crate::passes::reference::{TraceParams, TraceView, make_params};
+use crate::passes::taa::TaaStage;
 use crate::passes::trace::{TracePass, TraceTargets};
-use crate::quality::Image;
 use crate::scene::{Camera, Scene};
 use crate::settings::FrameSettings;
 use anyhow::{Context, Result, bail};
@@ -53,23 +55,37 @@ struct Targets {
     trace: TraceTargets,
     hdr: wgpu::Buffer,
     accumulation: Option<wgpu::Buffer>,
-    /// The denoiser's textures, made on its first use.
-    matte: Option<MatteTargets>,
-    /// The glossy chain's textures, made with the matte ones in scenes with a specular lobe.
-    glossy_chain: Option<GlossyChainTargets>,
+    /// Made when a denoiser that reads the previous frame's G-buffer first runs.
+    previous: Option<PreviousGBuffer>,
+    /// Every per-pixel allocation, the denoisers' and TAA's included: bytes per pixel, and
+    /// textures by label for readback.
     memory: GpuMemory,
+    /// Which set of targets this is (one per size): stages allocate again when it changes.
+    epoch: u64,
+    /// Bumped whenever a target is added or replaced, so bind groups are remade.
     generation: u64,
 }
 
 impl Targets {
-    fn new(gpu: &Gpu, size: (u32, u32), glossy: bool, generation: u64) -> Targets {
+    fn new(gpu: &Gpu, size: (u32, u32), glossy: bool, epoch: u64, generation: u64) -> Targets {
         let mut memory = GpuMemory::default();
         let gbuffer = GBufferTargets::new(gpu, &mut memory, size);
         let trace = TraceTargets::new(gpu, &mut memory, size, glossy);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let hdr = memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
-        Targets { size, gbuffer, trace, hdr, accumulation: None, matte: None, glossy_chain: None, memory, generation }
+        Targets { size, gbuffer, trace, hdr, accumulation: None, previous: None, memory, epoch, generation }
     }
+
+    fn io<'a>(&'a self, frame: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>) -> FrameIo<'a> {
+        FrameIo { size: self.size, frame, objects, gbuffer: &self.gbuffer, previous: self.previous.as_ref(), trace: &self.trace, hdr: &self.hdr, memory: &self.memory }
+    }
+}
+
+/// A denoiser the frame made, with the targets epoch it allocated its textures for.
+struct MadeDenoiser {
+    name: String,
+    epoch: Option<u64>,
+    denoiser: Box<dyn Denoiser>,
 }
 
 pub struct Renderer {
@@ -86,12 +102,11 @@ pub struct Renderer {
     trace: TracePass,
     composite: CompositePass,
     display: Option<DisplayPass>,
-    chain: Option<MatteChain>,
-    glossy_chain: Option<GlossyChain>,
-    denoise_buf: wgpu::Buffer,
-    glossy_buf: wgpu::Buffer,
-    /// Whether the last frame went through the denoiser (its image is then TAA's output).
-    denoised_last: bool,
+    /// Every denoiser chosen so far (switching back keeps its pipelines and textures).
+    denoisers: Vec<MadeDenoiser>,
+    taa: TaaStage,
+    /// The index in `denoisers` of the one that ran last frame (its image is then TAA's).
+    denoised_last: Option<usize>,
     timer: Option<GpuTimer>,
     /// Pass times are picked up by [`Renderer::poll_pass_spans`] frames later, not read back.
     async_timings: bool,
@@ -145,8 +160,7 @@ impl Renderer {
 
     fn create(gpu: &Gpu, scene: Scene, prepared: PreparedScene, size: (u32, u32)) -> Result<Renderer> {
         let gpu_scene = prepared.upload(gpu);
-        let glossy = prepared.features.glossy;
-        let targets = Targets::new(gpu, size, glossy, 0);
+        let targets = Targets::new(gpu, size, prepared.features.glossy, 0, 0);
         let mut memory = GpuMemory::default();
         let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let d = &gpu.device;
@@ -154,12 +168,12 @@ impl Renderer {
         let frame_buf = memory.buffer(d, "frame/params", size_of::<FrameParams>() as u64, u);
         let display_buf = memory.buffer(d, "display/options", 16, u);
         let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
-        let denoise_buf = memory.buffer(d, "matte/params", size_of::<DenoiseParams>() as u64, u);
-        let glossy_buf = memory.buffer(d, "glossy/params", size_of::<GlossyParams>() as u64, u);
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
         let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
-        let fb = FrameBuffers { frame: &frame_buf, hdr: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: &targets.trace.matte.1, glossy: None, denoise: None, glossy_chain: None };
-        let composite = CompositePass::new(gpu, &targets.gbuffer, &targets.trace, &fb).context("creating the composite pass")?;
+        let io = targets.io(&frame_buf, gpu_scene.objects.as_ref());
+        let fb = FrameBuffers { io, shown: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: None, glossy: None, views: Default::default() };
+        let composite = CompositePass::new(gpu, &fb).context("creating the composite pass")?;
+        let taa = TaaStage::new(gpu, &mut memory, prepared.features.animated);
         let timer = GpuTimer::new(gpu, TIMED_PASSES);
         let r = Renderer {
             scene,
@@ -174,11 +188,9 @@ impl Renderer {
             trace,
             composite,
             display: None,
-            chain: None,
-            glossy_chain: None,
-            denoise_buf,
-            glossy_buf,
-            denoised_last: false,
+            denoisers: vec![],
+            taa,
+            denoised_last: None,
             timer,
             async_timings: false,
             prev_view_proj: None,
@@ -241,11 +253,11 @@ impl Renderer {
         if size == self.targets.size {
             return Ok(());
         }
-        let g = self.targets.generation + 1;
-        self.targets = Targets::new(gpu, size, self.prepared.features.glossy, g);
+        let t = &self.targets;
+        self.targets = Targets::new(gpu, size, self.prepared.features.glossy, t.epoch + 1, t.generation + 1);
         self.prev_view_proj = None;
         self.prev_jittered = None;
-        self.denoised_last = false;
+        self.denoised_last = None;
         self.accumulated = 0;
         self.accumulated_state = None;
         Ok(())
@@ -264,6 +276,37 @@ impl Renderer {
     /// Render one frame; with `target`, also tone-map (or show `settings.view`) into it.
     pub fn render(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
         gpu.validated("rendering a frame", || self.record_frame(gpu, input, settings, target))
+    }
+
+    /// The index in `denoisers` of the one `settings` asks for (made and allocated on first
+    /// use), or None for the raw frame; None also in accumulate mode.
+    fn denoiser_for(&mut self, gpu: &Gpu, settings: &FrameSettings) -> Result<Option<usize>> {
+        if settings.accumulate {
+            return Ok(None);
+        }
+        let name = settings.denoiser.name();
+        let i = match self.denoisers.iter().position(|d| d.name == name) {
+            Some(i) => i,
+            None => {
+                let Some(make) = crate::denoise::find(name)?.make else { return Ok(None) };
+                let scene = DenoiserScene { glossy: self.prepared.features.glossy, animated: self.prepared.features.animated, extent: self.prepared.extent as f32 };
+                let denoiser = make(gpu, &scene).with_context(|| format!("creating the {name} denoiser"))?;
+                self.denoisers.push(MadeDenoiser { name: name.to_string(), epoch: None, denoiser });
+                self.denoisers.len() - 1
+            }
+        };
+        let t = &mut self.targets;
+        let d = &mut self.denoisers[i];
+        if d.epoch != Some(t.epoch) {
+            d.denoiser.allocate(gpu, &mut t.memory, t.size);
+            d.epoch = Some(t.epoch);
+            t.generation += 1;
+        }
+        if d.denoiser.needs_previous_gbuffer() && t.previous.is_none() {
+            t.previous = Some(PreviousGBuffer::new(&gpu.device, &mut t.memory, t.size));
+            t.generation += 1;
+        }
+        Ok(Some(i))
     }
 
     fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
@@ -291,44 +334,27 @@ impl Renderer {
             self.accumulated = 0;
             self.accumulated_state = None;
         }
-        let denoise = settings.denoiser == Denoiser::Mara && !settings.accumulate;
-        if denoise && self.targets.matte.is_none() {
-            self.targets.matte = Some(MatteTargets::new(gpu, &mut self.targets.memory, size));
-            if self.prepared.features.glossy {
-                self.targets.glossy_chain = Some(GlossyChainTargets::new(gpu, &mut self.targets.memory, size));
-            }
-            self.targets.generation += 1;
-        }
         let setup = crate::profile::scope("upload");
-        if denoise && self.chain.is_none() {
-            let inputs = self.chain_inputs();
-            self.chain = Some(MatteChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the matte chain")?);
-        }
-        if denoise
-            && self.glossy_chain.is_none()
-            && let Some(inputs) = self.glossy_inputs()
-        {
-            self.glossy_chain = Some(GlossyChain::new(gpu, &inputs, self.prepared.features.animated).context("creating the glossy chain")?);
+        let denoiser = self.denoiser_for(gpu, settings)?;
+        if denoiser.is_some() {
+            let t = &mut self.targets;
+            if self.taa.allocate(gpu, &mut t.memory, t.size, t.epoch) {
+                t.generation += 1;
+            }
         }
         let jitter = if settings.accumulate {
             random_jitter(self.frame_index, settings.seed)
-        } else if denoise && settings.matte.taa {
+        } else if denoiser.is_some() && settings.matte.taa {
             halton_jitter(self.frame_index)
         } else {
             Vec2::splat(0.5)
         };
         let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
         let jittered = cam.jittered(jitter, size);
-        if denoise {
-            let history_valid = self.denoised_last && self.prev_jittered.is_some();
-            let (prev_jittered, prev_jitter) = self.prev_jittered.unwrap_or((jittered, jitter));
-            let static_view = !moved && self.prev_view_proj == Some(cam.view_proj);
-            let view = ChainView { inv_view_proj: jittered.inverse(), prev_inv_view_proj: prev_jittered.inverse(), jitter_shift: prev_jitter - jitter, history_valid, static_view };
-            let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, &view);
-            gpu.queue.write_buffer(&self.denoise_buf, 0, bytemuck::bytes_of(&dp));
-            let gp = GlossyParams::new(&settings.glossy, self.prepared.extent as f32, static_view);
-            gpu.queue.write_buffer(&self.glossy_buf, 0, bytemuck::bytes_of(&gp));
-        }
+        let history_valid = denoiser.is_some() && self.denoised_last == denoiser && self.prev_jittered.is_some();
+        let (prev_jittered, prev_jitter) = self.prev_jittered.unwrap_or((jittered, jitter));
+        let static_view = !moved && self.prev_view_proj == Some(cam.view_proj);
+        let view = ChainView { inv_view_proj: jittered.inverse(), prev_inv_view_proj: prev_jittered.inverse(), jitter_shift: prev_jitter - jitter, history_valid, static_view };
         let fp = FrameParams {
             view_proj: jittered.to_cols_array_2d(),
             unjittered_view_proj: cam.view_proj.to_cols_array_2d(),
@@ -344,80 +370,63 @@ impl Renderer {
             exposure: settings.exposure_scale(),
             accumulated: self.accumulated,
             paths: settings.paths_per_pixel.clamp(1, 64),
-            representative_roughness: if denoise && settings.glossy.trace_representative_ray && settings.glossy.reflection_mv != crate::settings::ReflectionMv::Primary { settings.glossy.roughness_threshold } else { 0.0 },
+            representative_roughness: if denoiser.is_some() && settings.glossy.trace_representative_ray && settings.glossy.reflection_mv != crate::settings::ReflectionMv::Primary { settings.glossy.roughness_threshold } else { 0.0 },
             _pad: [0; 2],
         };
-        let view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
-        let tp = make_params(&self.prepared, &view);
+        let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
+        let tp = make_params(&self.prepared, &trace_view);
         gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
         gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
-
-        self.denoised_last = denoise;
+        self.denoised_last = denoiser;
         if let Some(target) = target {
             self.prepare_display(gpu, target)?;
         }
-
         drop(setup);
+
         let encode = crate::profile::scope("encode");
         let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         if let Some(t) = self.timer.as_mut() {
             t.begin_frame();
         }
-        let key = (self.gpu_scene.generation, self.targets.generation);
+        // Bind groups depend on the scene only through its buffers' generation.
+        let key = self.gpu_scene.generation * 1_000_003 + self.targets.generation;
+        // Stages after the denoiser also bind its outputs.
+        let output_key = key * 64 + denoiser.map_or(0, |i| i as u64 + 1);
         let parity = (self.frame_index % 2) as usize;
         let pass = crate::profile::scope(gbuffer::LABEL);
         self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &self.targets.gbuffer, self.timer.as_mut())?;
         drop(pass);
         let t = &self.targets;
         let pass = crate::profile::scope(crate::passes::trace::LABEL);
-        self.trace.record(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut())?;
+        self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut())?;
         drop(pass);
-        // The chain's bind groups depend on the scene only through the object-motion buffer.
-        let chain_key = key.0 * 1_000_003 + key.1;
-        let inputs = t.matte.as_ref().filter(|_| denoise).map(|m| ChainInputs {
-            frame: &self.frame_buf,
-            params: &self.denoise_buf,
-            objects: self.gpu_scene.objects.as_ref(),
-            hdr: &t.hdr,
-            gbuffer: &t.gbuffer,
-            trace: &t.trace,
-            matte: m,
-            glossy: t.glossy_chain.as_ref().map(|g| (g, &self.glossy_buf)),
-        });
-        let denoised_matte = t.matte.as_ref().filter(|_| denoise).map(|m| &m.denoised.1);
-        if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
-            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, false, self.timer.as_mut())?;
+        let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
+        let cx = FrameContext { index: self.frame_index, parity, view, settings, key };
+        let mut denoiser = denoiser.map(|i| &mut self.denoisers[i].denoiser);
+        if let Some(d) = denoiser.as_deref_mut() {
+            d.record(gpu, &mut enc, &io, &cx, self.timer.as_mut())?;
         }
-        let glossy_inputs = glossy_inputs(t, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref()).filter(|_| denoise);
-        if let (Some(inputs), Some(chain)) = (&glossy_inputs, self.glossy_chain.as_mut()) {
-            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, &settings.glossy, self.timer.as_mut())?;
-        }
-        let denoised_glossy = t.glossy_chain.as_ref().filter(|_| denoise).map(|g| &g.denoised.1);
-        let fb = FrameBuffers {
-            frame: &self.frame_buf,
-            hdr: &t.hdr,
-            accumulation: t.accumulation.as_ref().unwrap_or(&self.no_accumulation),
-            display: &self.display_buf,
-            matte: denoised_matte.unwrap_or(&t.trace.matte.1),
-            glossy: denoised_glossy,
-            denoise: None,
-            glossy_chain: None,
+        let denoiser = denoiser.map(|d| &**d);
+        let accumulation = t.accumulation.as_ref().unwrap_or(&self.no_accumulation);
+        let fb = |p: usize| {
+            let out = denoiser.map(|d| d.output(p)).unwrap_or_default();
+            FrameBuffers { io, shown: &t.hdr, accumulation, display: &self.display_buf, matte: out.matte, glossy: out.glossy, views: Default::default() }
         };
         let pass = crate::profile::scope(crate::passes::composite::COMPOSITE);
-        self.composite.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &fb, size, self.timer.as_mut())?;
+        self.composite.record(gpu, &mut enc, output_key, fb, parity, self.timer.as_mut())?;
         drop(pass);
-        if let (Some(inputs), Some(chain)) = (&inputs, self.chain.as_mut()) {
-            chain.record(gpu, &mut enc, chain_key, inputs, parity, size, true, self.timer.as_mut())?;
+        if let Some(d) = denoiser {
+            // TAA runs after any denoiser; with its stage off it passes the composite on.
+            let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, &cx.view);
+            self.taa.record(gpu, &mut enc, output_key, &io, |p| d.taa_follow(p), &dp, parity, self.timer.as_mut())?;
         }
-        let shown = shown_buffers(t, &self.frame_buf, &self.display_buf, &self.no_accumulation, denoise);
+        let shown = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, denoiser, self.taa.output());
         if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
             let _pass = crate::profile::scope(crate::passes::composite::DISPLAY);
-            d.record(gpu, &mut enc, t.generation * 2 + denoise as u64, &t.gbuffer, &t.trace, &shown, target.view, self.timer.as_mut())?;
+            d.record(gpu, &mut enc, output_key, &shown, target.view, self.timer.as_mut())?;
         }
-        if let (true, Some(m)) = (denoise, &t.matte) {
-            let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
-            enc.copy_texture_to_texture(t.gbuffer.depth.0.as_image_copy(), m.prev_depth.0.as_image_copy(), extent);
-            enc.copy_texture_to_texture(t.gbuffer.color[0].0.as_image_copy(), m.prev_normal.0.as_image_copy(), extent);
+        if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
+            p.record_copy(&mut enc, &t.gbuffer, size);
         }
         if let Some(timer) = self.timer.as_mut() {
             timer.resolve(&gpu.device, &mut enc, self.async_timings);
@@ -437,23 +446,6 @@ impl Renderer {
         Ok(())
     }
 
-    fn chain_inputs(&self) -> ChainInputs<'_> {
-        let t = &self.targets;
-        ChainInputs {
-            frame: &self.frame_buf,
-            params: &self.denoise_buf,
-            objects: self.gpu_scene.objects.as_ref(),
-            hdr: &t.hdr,
-            gbuffer: &t.gbuffer,
-            trace: &t.trace,
-            matte: t.matte.as_ref().expect("matte targets exist before the chain"),
-            glossy: t.glossy_chain.as_ref().map(|g| (g, &self.glossy_buf)),
-        }
-    }
-
-    fn glossy_inputs(&self) -> Option<GlossyInputs<'_>> {
-        glossy_inputs(&self.targets, &self.frame_buf, &self.denoise_buf, &self.glossy_buf, self.gpu_scene.objects.as_ref())
-    }
 
     /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
     pub fn redisplay(&mut self, gpu: &Gpu, settings: &FrameSettings, target: &DisplayTarget) -> Result<()> {
@@ -464,177 +456,47 @@ impl Renderer {
             gpu.queue.write_buffer(&self.frame_buf, std::mem::offset_of!(FrameParams, exposure) as u64, bytemuck::bytes_of(&settings.exposure_scale()));
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             let t = &self.targets;
-            let fb = shown_buffers(t, &self.frame_buf, &self.display_buf, &self.no_accumulation, self.denoised_last);
+            let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
+            let last = self.denoised_last.map(|i| &*self.denoisers[i].denoiser);
+            let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, last, self.taa.output());
+            let key = (self.gpu_scene.generation * 1_000_003 + t.generation) * 64 + self.denoised_last.map_or(0, |i| i as u64 + 1);
             if let Some(d) = self.display.as_mut() {
-                d.record(gpu, &mut enc, t.generation * 2 + self.denoised_last as u64, &t.gbuffer, &t.trace, &fb, target.view, None)?;
+                d.record(gpu, &mut enc, key, &fb, target.view, None)?;
             }
             gpu.queue.submit([enc.finish()]);
             Ok(())
         })
     }
 
-    /// The display's image of the last frame (tone-mapped or the chosen debug view) as 8-bit sRGB.
-    pub fn display_image(&mut self, gpu: &Gpu, settings: &FrameSettings) -> Result<image::RgbaImage> {
-        let (w, h) = self.targets.size;
-        let format = wgpu::TextureFormat::Rgba8Unorm;
-        let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("display image"),
-            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let view = tex.create_view(&Default::default());
-        self.redisplay(gpu, settings, &DisplayTarget { view: &view, format, size: (w, h) })?;
-        let bytes = crate::gpu::readback_texture(gpu, &tex)?;
-        image::RgbaImage::from_raw(w, h, bytes).context("display image has the wrong size")
-    }
-
-    /// Make the display pass for `target`'s format (again when the denoiser's views appeared)
-    /// and write its options.
+    /// Make the display pass for `target`'s format (again when the denoiser's views appeared
+    /// or went) and write its options.
     fn prepare_display(&mut self, gpu: &Gpu, target: &DisplayTarget) -> Result<()> {
-        if self.display.as_ref().is_none_or(|d| d.format != target.format || d.with_denoise != self.targets.matte.is_some()) {
-            let fb = shown_buffers(&self.targets, &self.frame_buf, &self.display_buf, &self.no_accumulation, self.denoised_last);
-            self.display = Some(DisplayPass::new(gpu, &self.targets.gbuffer, &self.targets.trace, &fb, target.format).context("creating the display pass")?);
+        let t = &self.targets;
+        let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
+        let last = self.denoised_last.map(|i| &*self.denoisers[i].denoiser);
+        let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, last, self.taa.output());
+        let with_denoise = fb.views.get("dv_temporal").is_some();
+        if self.display.as_ref().is_none_or(|d| d.format != target.format || d.with_denoise != with_denoise) {
+            self.display = Some(DisplayPass::new(gpu, &fb, target.format).context("creating the display pass")?);
         }
         let srgb = !target.format.is_srgb() as u32;
         gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, target.size.0, target.size.1]));
         Ok(())
     }
-
-    /// GPU milliseconds per pass of the last frame (blocks until it finished); empty without
-    /// timestamp queries.
-    pub fn pass_times(&self, gpu: &Gpu) -> Result<Vec<(&'static str, f64)>> {
-        Ok(self.pass_spans(gpu)?.into_iter().map(|s| (s.label, s.ms)).collect())
-    }
-
-    /// Each pass of the last frame with its start and duration (blocks until it finished); when
-    /// puffin's scopes are on, also reported as the frame's GPU timeline.
-    pub fn pass_spans(&self, gpu: &Gpu) -> Result<Vec<crate::profile::PassSpan>> {
-        let Some(t) = &self.timer else { return Ok(vec![]) };
-        let spans = t.read_spans(gpu)?;
-        crate::profile::report_gpu(t.submitted_ns, &spans);
-        Ok(spans)
-    }
-
-    /// Keep per-pass times for [`Renderer::poll_pass_spans`] instead of [`Renderer::pass_spans`]
-    /// (the viewer: reading times back never waits for the GPU).
-    pub fn set_async_timings(&mut self, on: bool) {
-        self.async_timings = on;
-    }
-
-    /// The passes of the oldest frame that finished since the last call, without waiting
-    /// (frames with async timings on); reported to puffin as that frame's GPU timeline.
-    pub fn poll_pass_spans(&mut self, gpu: &Gpu) -> Option<Vec<crate::profile::PassSpan>> {
-        let (submitted, spans) = self.timer.as_mut()?.poll(gpu)?;
-        crate::profile::report_gpu(submitted, &spans);
-        Some(spans)
-    }
-
-    /// Frames summed in accumulate mode (0 when off).
-    pub fn accumulated(&self) -> u32 {
-        self.accumulated
-    }
-
-    /// The last frame's linear HDR image (after composite), or in accumulate mode the mean.
-    pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
-        let (w, h) = self.targets.size;
-        let n = w as u64 * h as u64 * 16;
-        let shown = self.targets.matte.as_ref().filter(|_| self.denoised_last).map_or(&self.targets.hdr, |m| &m.final_image);
-        let (buf, scale) = match (&self.targets.accumulation, self.accumulated) {
-            (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
-            _ => (shown, 1.0),
-        };
-        let bytes = crate::gpu::readback_buffer(&gpu.device, &gpu.queue, buf, n)?;
-        let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
-        let mut img = Image::new(w, h);
-        for (d, s) in img.data.iter_mut().zip(v) {
-            *d = Vec3::new(s[0], s[1], s[2]) * scale;
-        }
-        Ok(img)
-    }
-
-    /// Read a G-buffer or trace texture back as raw bytes, rows tightly packed.
-    pub fn read_texture(&self, gpu: &Gpu, name: &str) -> Result<(Vec<u8>, wgpu::TextureFormat)> {
-        let t = &self.targets;
-        let tex = match name {
-            "gbuffer/depth" => &t.gbuffer.depth.0,
-            "trace/matte" => &t.trace.matte.0,
-            "trace/direct" => &t.trace.direct.0,
-            n if n.starts_with("matte/") || n.starts_with("taa/") => {
-                let m = t.matte.as_ref().with_context(|| format!("no texture {n}: the denoiser has not run"))?;
-                match n {
-                    "matte/history 0" => &m.history[0].0,
-                    "matte/history 1" => &m.history[1].0,
-                    "matte/temporal" => &m.temporal.0,
-                    "matte/reason" => &m.reason.0,
-                    "matte/radius" => &m.radius.0,
-                    "matte/firefly" => &m.median.0,
-                    "matte/bilateral" => &m.denoised.0,
-                    "taa/history 0" => &m.taa_history[0].0,
-                    "taa/history 1" => &m.taa_history[1].0,
-                    "taa/material 0" => &m.taa_material[0].0,
-                    "taa/material 1" => &m.taa_material[1].0,
-                    "taa/residual 0" => &m.taa_residual[0].0,
-                    "taa/residual 1" => &m.taa_residual[1].0,
-                    "taa/glossy 0" => &m.taa_glossy[0].0,
-                    "taa/glossy 1" => &m.taa_glossy[1].0,
-                    _ => bail!("no texture {n}"),
-                }
-            }
-            n if n.starts_with("glossy/") => {
-                let g = t.glossy_chain.as_ref().with_context(|| format!("no texture {n}: the glossy chain has not run"))?;
-                match n {
-                    "glossy/hit 0" => &g.hit[0].0,
-                    "glossy/hit 1" => &g.hit[1].0,
-                    "glossy/motion" => &g.motion.0,
-                    "glossy/search" => &g.search.0,
-                    "glossy/neighbourhood" => &g.neighbourhood.0,
-                    "glossy/scratch" => &g.scratch.0,
-                    "glossy/history 0" => &g.history[0].0,
-                    "glossy/history 1" => &g.history[1].0,
-                    "glossy/info" => &g.info.0,
-                    "glossy/denoised" => &g.denoised.0,
-                    _ => bail!("no texture {n}"),
-                }
-            }
-            n if n.starts_with("gbuffer/") => &t.gbuffer.color[gbuffer::COLOR_FORMATS.iter().position(|(l, _)| *l == n).with_context(|| format!("no texture {n}"))?].0,
-            n => {
-                let g = t.trace.glossy.as_ref().with_context(|| format!("no texture {n}: the scene has no glossy buffers"))?;
-                match n {
-                    "trace/glossy" => &g.light.0,
-                    "trace/reflection" => &g.reflection.0,
-                    "trace/mirror" => &g.mirror.0,
-                    "trace/mirror hit" => &g.mirror_hit.0,
-                    _ => bail!("no texture {n}"),
-                }
-            }
-        };
-        Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
-    }
 }
 
-/// What the display reads: the image after TAA when the denoiser ran, else the composite's;
-/// the raw matte light; the denoiser's intermediates for its views.
-fn shown_buffers<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, display: &'a wgpu::Buffer, no_accumulation: &'a wgpu::Buffer, denoised: bool) -> FrameBuffers<'a> {
+/// What the display reads: the image after TAA when a denoiser ran, else the composite's; the
+/// raw light; the denoiser's intermediates for its views.
+fn shown_buffers<'a>(t: &'a Targets, io: &FrameIo<'a>, display: &'a wgpu::Buffer, no_accumulation: &'a wgpu::Buffer, denoiser: Option<&'a dyn Denoiser>, taa: Option<&'a wgpu::Buffer>) -> FrameBuffers<'a> {
     FrameBuffers {
-        frame,
-        hdr: t.matte.as_ref().filter(|_| denoised).map_or(&t.hdr, |m| &m.final_image),
+        io: *io,
+        shown: denoiser.and(taa).unwrap_or(&t.hdr),
         accumulation: t.accumulation.as_ref().unwrap_or(no_accumulation),
         display,
-        matte: &t.trace.matte.1,
+        matte: None,
         glossy: None,
-        denoise: t.matte.as_ref(),
-        glossy_chain: t.glossy_chain.as_ref(),
+        views: denoiser.map(|d| d.view_bindings()).unwrap_or_default(),
     }
-}
-
-/// What the glossy chain binds, when its targets exist.
-fn glossy_inputs<'a>(t: &'a Targets, frame: &'a wgpu::Buffer, denoise: &'a wgpu::Buffer, params: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>) -> Option<GlossyInputs<'a>> {
-    Some(GlossyInputs { frame, denoise, params, objects, gbuffer: &t.gbuffer, trace: &t.trace, matte: t.matte.as_ref()?, glossy: t.glossy_chain.as_ref()? })
 }
 
 /// Halton (2, 3) sub-pixel positions, 64 per cycle: the TAA jitter. A still pixel averages up

@@ -6,18 +6,16 @@ use crate::gpu::Gpu;
 use crate::shader::{Reload, ReloadOutcome};
 
 impl Renderer {
-    /// Every pipeline of the frame that exists now (the chains and the display are made on
+    /// Every pipeline of the frame that exists now (denoisers, TAA and the display are made on
     /// first use).
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
         let mut v: Vec<&mut dyn Reload> = vec![&mut self.gbuffer.pipeline, &mut self.trace.pipeline, &mut self.composite.pipeline];
         if let Some(d) = self.display.as_mut() {
             v.push(&mut d.pipeline);
         }
-        if let Some(c) = self.chain.as_mut() {
-            v.extend(c.pipelines());
-        }
-        if let Some(c) = self.glossy_chain.as_mut() {
-            v.extend(c.pipelines());
+        v.extend(self.taa.pipelines());
+        for d in &mut self.denoisers {
+            v.extend(d.denoiser.pipelines());
         }
         v
     }

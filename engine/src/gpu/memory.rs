@@ -1,14 +1,23 @@
 use anyhow::{Result, anyhow};
 use wgpu::util::DeviceExt;
 
-/// Creates buffers and remembers what each cost, so the renderer can report what it allocated.
+/// Creates buffers and textures and remembers what each cost, so the renderer can report what
+/// it allocated; its textures can be found again by label (readback, debug views).
 #[derive(Default, Debug, Clone)]
 pub struct GpuMemory {
-    /// (label, bytes) of every buffer made through this tracker.
+    /// (label, bytes) of every buffer and texture made through this tracker.
     pub allocations: Vec<(String, u64)>,
+    /// Every texture made through this tracker, by label (a ping-pong pair is "name 0" and
+    /// "name 1").
+    pub textures: Vec<(String, wgpu::Texture)>,
 }
 
 impl GpuMemory {
+    /// The texture labelled `label`, if this tracker made one.
+    pub fn find_texture(&self, label: &str) -> Option<&wgpu::Texture> {
+        self.textures.iter().find(|(l, _)| l == label).map(|(_, t)| t)
+    }
+
     pub fn total_bytes(&self) -> u64 {
         self.allocations.iter().map(|(_, b)| b).sum()
     }
@@ -54,6 +63,7 @@ impl GpuMemory {
             view_formats: &[],
         });
         let v = t.create_view(&Default::default());
+        self.textures.push((label.to_string(), t.clone()));
         (t, v)
     }
 

@@ -2,8 +2,7 @@
 //! and `display` (exposure, ACES tone map, sRGB, debug views; shaders/realtime/display.wgsl).
 //! Both read the whole G-buffer and the trace outputs through the same bindings.
 
-use super::gbuffer::GBufferTargets;
-use super::trace::TraceTargets;
+use super::io::FrameIo;
 use crate::gpu::scene::compute_pipeline;
 use crate::gpu::{BindCache, Bindings, Gpu, GpuTimer, set_compute_groups, set_render_groups};
 use crate::shader::{Reload, Reloadable};
@@ -12,36 +11,30 @@ use anyhow::Result;
 pub const COMPOSITE: &str = "composite";
 pub const DISPLAY: &str = "display";
 
-/// The HDR image (and the accumulation sum) as storage buffers: one vec4 (16 bytes) per pixel.
+/// What the composite and the display bind beside the frame's I/O.
 pub struct FrameBuffers<'a> {
-    pub frame: &'a wgpu::Buffer,
-    /// The composite's output; for the display, the image after TAA when the denoiser ran.
-    pub hdr: &'a wgpu::Buffer,
+    pub io: FrameIo<'a>,
+    /// For the display: the image after TAA when it ran, else the composite's (`io.hdr`).
+    pub shown: &'a wgpu::Buffer,
     pub accumulation: &'a wgpu::Buffer,
     pub display: &'a wgpu::Buffer,
-    /// The matte light the composite remodulates: raw, or the matte chain's output.
-    pub matte: &'a wgpu::TextureView,
-    /// The glossy light the composite remodulates: the glossy chain's output (None: raw).
+    /// The light the composite remodulates: the denoiser's output (None: the trace's).
+    pub matte: Option<&'a wgpu::TextureView>,
     pub glossy: Option<&'a wgpu::TextureView>,
-    /// The chains' intermediates, for the display's debug views.
-    pub denoise: Option<&'a super::matte::MatteTargets>,
-    pub glossy_chain: Option<&'a super::glossy::GlossyChainTargets>,
+    /// The denoiser's intermediates, for the display's debug views (`dv_*`, `gv_*`).
+    pub views: Bindings<'a>,
 }
 
-/// What the composite and the display bind (the display also the chains' intermediates).
-fn inputs<'a>(g: &'a GBufferTargets, t: &'a TraceTargets, b: &FrameBuffers<'a>) -> Bindings<'a> {
-    let mut s = super::matte::gbuffer_inputs(Bindings::new().buffer("frame", b.frame), g, t, b.matte);
-    if let Some(gl) = &t.glossy {
-        s = super::glossy::glossy_trace_inputs(s, t, b.glossy.unwrap_or(&gl.light.1));
+/// What the composite binds (`shown` as `hdr` for the display, `io.hdr` for the composite).
+fn inputs<'a>(b: &FrameBuffers<'a>, hdr: &'a wgpu::Buffer) -> Bindings<'a> {
+    let mut s = b.io.bindings();
+    if let Some(m) = b.matte {
+        s = s.texture("tr_matte", m);
     }
-    s = s.buffer("hdr", b.hdr).buffer("accumulation", b.accumulation).buffer("display", b.display);
-    if let Some(m) = b.denoise {
-        s = s.texture("dv_temporal", &m.temporal.1).texture("dv_reason", &m.reason.1).texture("dv_radius", &m.radius.1).texture("dv_firefly", &m.median.1).texture("dv_denoised", &m.denoised.1);
+    if let (Some(g), true) = (b.glossy, b.io.trace.glossy.is_some()) {
+        s = s.texture("tr_glossy", g);
     }
-    if let Some(g) = b.glossy_chain {
-        s = s.texture("gv_motion", &g.motion.1).texture("gv_search", &g.search.1).texture("gv_info", &g.info.1).texture("gv_sigma", &g.scratch.1).texture("gv_denoised", &g.denoised.1);
-    }
-    s
+    s.buffer("hdr", hdr).buffer("accumulation", b.accumulation).buffer("display", b.display).with(&b.views)
 }
 
 fn modules(glossy: bool, denoise: bool, glossy_chain: bool, last: &'static str) -> Vec<&'static str> {
@@ -68,16 +61,21 @@ pub struct CompositePass {
 }
 
 impl CompositePass {
-    pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers) -> Result<CompositePass> {
-        let modules = modules(t.glossy.is_some(), false, false, "realtime/composite.wgsl");
-        let pipeline = Reloadable::new(gpu, COMPOSITE, "", &modules, wgpu::ShaderStages::COMPUTE, &inputs(g, t, b), |d, m, l| compute_pipeline(d, COMPOSITE, m, l, "main"))?;
+    pub fn new(gpu: &Gpu, b: &FrameBuffers) -> Result<CompositePass> {
+        let modules = modules(b.io.trace.glossy.is_some(), false, false, "realtime/composite.wgsl");
+        let pipeline = Reloadable::new(gpu, COMPOSITE, "", &modules, wgpu::ShaderStages::COMPUTE, &inputs(b, b.io.hdr), |d, m, l| compute_pipeline(d, COMPOSITE, m, l, "main"))?;
         Ok(CompositePass { pipeline, groups: BindCache::default() })
     }
 
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, size: (u32, u32), timer: Option<&mut GpuTimer>) -> Result<()> {
+    /// `b(p)`: what it binds at history parity p (a denoiser's output may ping-pong).
+    pub fn record<'a>(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, b: impl Fn(usize) -> FrameBuffers<'a>, parity: usize, timer: Option<&mut GpuTimer>) -> Result<()> {
         let p = &self.pipeline;
-        let groups = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &inputs(g, t, b)))?;
+        let size = b(parity).io.size;
+        let groups = self.groups.get(key, p.builds(), 2, parity, |v| {
+            let b = b(v);
+            p.bind_groups(&gpu.device, &inputs(&b, b.io.hdr))
+        })?;
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(COMPOSITE), timestamp_writes: timer.and_then(|t| t.compute(COMPOSITE)) });
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
@@ -95,9 +93,10 @@ pub struct DisplayPass {
 }
 
 impl DisplayPass {
-    pub fn new(gpu: &Gpu, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
-        let modules = modules(t.glossy.is_some(), b.denoise.is_some(), b.glossy_chain.is_some(), "realtime/display.wgsl");
-        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, wgpu::ShaderStages::FRAGMENT, &inputs(g, t, b), move |d, module, pl| {
+    pub fn new(gpu: &Gpu, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
+        let (denoise, glossy_chain) = (b.views.get("dv_temporal").is_some(), b.views.get("gv_motion").is_some());
+        let modules = modules(b.io.trace.glossy.is_some(), denoise, glossy_chain, "realtime/display.wgsl");
+        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, wgpu::ShaderStages::FRAGMENT, &inputs(b, b.shown), move |d, module, pl| {
             d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(DISPLAY),
                 layout: Some(pl),
@@ -110,13 +109,13 @@ impl DisplayPass {
                 cache: None,
             })
         })?;
-        Ok(DisplayPass { pipeline, groups: BindCache::default(), format, with_denoise: b.denoise.is_some() })
+        Ok(DisplayPass { pipeline, groups: BindCache::default(), format, with_denoise: denoise })
     }
 
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, g: &GBufferTargets, t: &TraceTargets, b: &FrameBuffers, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, b: &FrameBuffers, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) -> Result<()> {
         let p = &self.pipeline;
-        let groups = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &inputs(g, t, b)))?;
+        let groups = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &inputs(b, b.shown)))?;
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(DISPLAY),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: target, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store } })],

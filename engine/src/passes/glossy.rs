@@ -5,10 +5,8 @@
 //! `glossy/bilateral_v`. The composite then remodulates the output with F(w_s).
 //! Runs in scenes with a specular lobe when the denoiser is on; [`GlossySettings`] switches it.
 
-use super::gbuffer::GBufferTargets;
-use super::matte::{MatteTargets, gbuffer_inputs};
-use super::trace::TraceTargets;
 use super::chain::ChainStage;
+use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
 use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 use anyhow::Result;
@@ -103,8 +101,7 @@ pub struct GlossyChainTargets {
 }
 
 impl GlossyChainTargets {
-    pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32)) -> GlossyChainTargets {
-        let d = &gpu.device;
+    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> GlossyChainTargets {
         let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
         let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
         GlossyChainTargets {
@@ -120,25 +117,14 @@ impl GlossyChainTargets {
     }
 }
 
+/// Everything a glossy stage may bind.
 pub struct GlossyInputs<'a> {
-    pub frame: &'a wgpu::Buffer,
+    /// The frame's I/O, with the previous G-buffer (the chain asks for it).
+    pub io: FrameIo<'a>,
     /// The matte chain's DenoiseParams (camera matrices, parity, history validity).
     pub denoise: &'a wgpu::Buffer,
     pub params: &'a wgpu::Buffer,
-    pub objects: Option<&'a wgpu::Buffer>,
-    pub gbuffer: &'a GBufferTargets,
-    pub trace: &'a TraceTargets,
-    pub matte: &'a MatteTargets,
     pub glossy: &'a GlossyChainTargets,
-}
-
-/// The glossy trace outputs every glossy stage reads (shaders/realtime/glossy_in.wgsl), with
-/// `light` as the glossy light.
-pub fn glossy_trace_inputs<'a>(b: Bindings<'a>, t: &'a TraceTargets, light: &'a wgpu::TextureView) -> Bindings<'a> {
-    match &t.glossy {
-        Some(gl) => b.texture("tr_glossy", light).texture("tr_reflection", &gl.reflection.1).texture("tr_mirror", &gl.mirror.1).texture("tr_mirror_hit", &gl.mirror_hit.1),
-        None => b,
-    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -162,22 +148,13 @@ const STAGES: [(Kind, &str, &str, &str); 6] = [
 
 fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a> {
     let g = i.glossy;
-    let light = &i.trace.glossy.as_ref().expect("the glossy chain runs in glossy scenes").light.1;
-    let b = Bindings::new().buffer("frame", i.frame).buffer("dn", i.denoise).buffer("gp", i.params).buffer_opt("prev_from_current", i.objects);
-    let b = glossy_trace_inputs(gbuffer_inputs(b, i.gbuffer, i.trace, &i.trace.matte.1), i.trace, light);
+    let b = i.io.bindings().buffer("dn", i.denoise).buffer("gp", i.params);
     match kind {
-        Kind::Motion => b
-            .texture("prev_depth", &i.matte.prev_depth.1)
-            .texture("prev_hit", &g.hit[parity].1)
-            .texture("out_motion", &g.motion.1)
-            .texture("out_search", &g.search.1)
-            .texture("out_hit", &g.hit[1 - parity].1),
+        Kind::Motion => b.texture("prev_hit", &g.hit[parity].1).texture("out_motion", &g.motion.1).texture("out_search", &g.search.1).texture("out_hit", &g.hit[1 - parity].1),
         Kind::PrefilterH => b.texture("src", &g.neighbourhood.1).texture("dst", &g.scratch.1),
         Kind::PrefilterV => b.texture("src", &g.scratch.1).texture("dst", &g.neighbourhood.1),
         Kind::Temporal => b
-            .texture("prev_depth", &i.matte.prev_depth.1)
             .texture("history", &g.history[parity].1)
-            .texture("prev_normal", &i.matte.prev_normal.1)
             .texture("prev_hit", &g.hit[parity].1)
             .texture("neighbourhood", &g.neighbourhood.1)
             .texture("dst", &g.history[1 - parity].1)
@@ -219,7 +196,8 @@ impl GlossyChain {
 
     /// Record the chain. The prefilter runs only when the clip uses it.
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &GlossyInputs, parity: usize, size: (u32, u32), settings: &GlossySettings, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &GlossyInputs, parity: usize, settings: &GlossySettings, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        let size = i.io.size;
         let clip = settings.temporal && settings.clipping;
         for (kind, s) in self.stages.iter_mut().filter(|(k, _)| clip || !matches!(k, Kind::PrefilterH | Kind::PrefilterV)) {
             s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;

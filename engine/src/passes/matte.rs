@@ -1,13 +1,10 @@
-//! The matte denoise chain of Mara et al. 2017 (§3.4, Figure 2 stages 3-7) and TAA, one compute
-//! pass per stage (shaders/matte/*.wgsl, shaders/taa/taa.wgsl):
-//! `matte/temporal` -> `matte/history_bilateral` (into the history only) -> `matte/disocclusion_h`,
-//! `matte/disocclusion_v` -> `matte/firefly` -> `matte/bilateral`; after the composite, `taa`.
+//! The matte denoise chain of Mara et al. 2017 (§3.4, Figure 2 stages 3-7), one compute pass per
+//! stage (shaders/matte/*.wgsl): `matte/temporal` -> `matte/history_bilateral` (into the history
+//! only) -> `matte/disocclusion_h`, `matte/disocclusion_v` -> `matte/firefly` -> `matte/bilateral`.
 //! Each stage can be switched off at run time ([`MatteSettings`]); it then passes its input on.
 
-use super::gbuffer::GBufferTargets;
-use super::trace::TraceTargets;
 use super::chain::ChainStage;
-use super::glossy::GlossyChainTargets;
+use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
 use crate::settings::MatteSettings;
 use anyhow::Result;
@@ -142,11 +139,8 @@ pub fn history_rejected(reason: &[u8]) -> Vec<bool> {
     reason.chunks_exact(4).map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]) & 3 != 0).collect()
 }
 
-/// Per-pixel textures of the chain (made with the frame's other targets).
+/// Per-pixel textures of the chain, 76 bytes per pixel.
 pub struct MatteTargets {
-    pub prev_depth: (wgpu::Texture, wgpu::TextureView),
-    /// The previous frame's G-buffer normals (octahedral), for the reprojection's normal test.
-    pub prev_normal: (wgpu::Texture, wgpu::TextureView),
     pub history: [(wgpu::Texture, wgpu::TextureView); 2],
     pub temporal: (wgpu::Texture, wgpu::TextureView),
     pub reason: (wgpu::Texture, wgpu::TextureView),
@@ -154,23 +148,12 @@ pub struct MatteTargets {
     pub radius: (wgpu::Texture, wgpu::TextureView),
     pub median: (wgpu::Texture, wgpu::TextureView),
     pub denoised: (wgpu::Texture, wgpu::TextureView),
-    pub taa_history: [(wgpu::Texture, wgpu::TextureView); 2],
-    /// TAA's averages of the matte factor m (1 - F)^2 and of the composite less the matte
-    /// factor times the matte temporal's output ([`MatteSettings::taa_current_light`]).
-    pub taa_material: [(wgpu::Texture, wgpu::TextureView); 2],
-    pub taa_residual: [(wgpu::Texture, wgpu::TextureView); 2],
-    /// TAA's average of the glossy factor F(w_s) x the mirror demodulation
-    /// ([`MatteSettings::taa_current_glossy`]).
-    pub taa_glossy: [(wgpu::Texture, wgpu::TextureView); 2],
-    /// The image after TAA (what the display shows), 16 bytes per pixel.
-    pub final_image: wgpu::Buffer,
 }
 
 impl MatteTargets {
-    pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32)) -> MatteTargets {
-        let d = &gpu.device;
+    pub fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> MatteTargets {
         let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
-        let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
+        let mut t = |label: &str, f| mem.texture(device, label, size, f, rw);
         let history = [t("matte/history 0", RGBA32F), t("matte/history 1", RGBA32F)];
         let temporal = t("matte/temporal", RGBA32F);
         let reason = t("matte/reason", R32U);
@@ -178,44 +161,15 @@ impl MatteTargets {
         let radius = t("matte/radius", R32F);
         let median = t("matte/firefly", RGBA16F);
         let denoised = t("matte/bilateral", RGBA16F);
-        let taa_history = [t("taa/history 0", RGBA32F), t("taa/history 1", RGBA32F)];
-        let taa_material = [t("taa/material 0", RGBA32F), t("taa/material 1", RGBA32F)];
-        let taa_residual = [t("taa/residual 0", RGBA32F), t("taa/residual 1", RGBA32F)];
-        let taa_glossy = [t("taa/glossy 0", RGBA32F), t("taa/glossy 1", RGBA32F)];
-        let prev_depth = mem.texture(d, "matte/previous depth", size, super::gbuffer::DEPTH_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
-        let prev_normal = mem.texture(d, "matte/previous normal", size, super::gbuffer::COLOR_FORMATS[0].1, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let final_image = mem.buffer(d, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
-        MatteTargets { prev_depth, prev_normal, history, temporal, reason, min, radius, median, denoised, taa_history, taa_material, taa_residual, taa_glossy, final_image }
+        MatteTargets { history, temporal, reason, min, radius, median, denoised }
     }
 }
 
-/// Everything a stage may bind.
+/// Everything a stage may bind: the frame's I/O, the chain's `DenoiseParams` and textures.
 pub struct ChainInputs<'a> {
-    pub frame: &'a wgpu::Buffer,
+    pub io: FrameIo<'a>,
     pub params: &'a wgpu::Buffer,
-    pub objects: Option<&'a wgpu::Buffer>,
-    pub hdr: &'a wgpu::Buffer,
-    pub gbuffer: &'a GBufferTargets,
-    pub trace: &'a TraceTargets,
     pub matte: &'a MatteTargets,
-    /// The glossy chain's targets and its GlossyParams, where the scene has glossy lobes: TAA
-    /// follows the glossy temporal's output ([`MatteSettings::taa_current_glossy`]).
-    pub glossy: Option<(&'a GlossyChainTargets, &'a wgpu::Buffer)>,
-}
-
-/// The G-buffer and trace textures every stage binds (shaders/realtime/gbuffer_in.wgsl), with
-/// `matte` as the matte light.
-pub fn gbuffer_inputs<'a>(b: Bindings<'a>, g: &'a GBufferTargets, t: &'a TraceTargets, matte: &'a wgpu::TextureView) -> Bindings<'a> {
-    b.texture("gb_depth", &g.depth.1)
-        .texture("gb_normal", g.view("normal"))
-        .texture("gb_motion", g.view("motion"))
-        .texture("gb_base_color", g.view("base_color"))
-        .texture("gb_specular", g.view("specular"))
-        .texture("gb_emission", g.view("emission"))
-        .texture("gb_object", g.view("ids"))
-        .texture("tr_matte", matte)
-        .texture("tr_direct", &t.direct.1)
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -226,74 +180,39 @@ enum Kind {
     MinV,
     Firefly,
     Bilateral,
-    Taa,
 }
 
-const STAGES: [(Kind, &str); 7] = [
+const STAGES: [(Kind, &str); 6] = [
     (Kind::Temporal, "matte/temporal"),
     (Kind::HistoryBilateral, "matte/history_bilateral"),
     (Kind::MinH, "matte/disocclusion_h"),
     (Kind::MinV, "matte/disocclusion_v"),
     (Kind::Firefly, "matte/firefly"),
     (Kind::Bilateral, "matte/bilateral"),
-    (Kind::Taa, "taa"),
 ];
 
 fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> {
     let m = i.matte;
-    let b = gbuffer_inputs(Bindings::new().buffer("frame", i.frame).buffer("dn", i.params).buffer_opt("prev_from_current", i.objects), i.gbuffer, i.trace, &i.trace.matte.1);
+    let b = i.io.bindings().buffer("dn", i.params);
     match kind {
-        Kind::Temporal => b
-            .texture("prev_depth", &m.prev_depth.1)
-            .texture("history", &m.history[parity].1)
-            .texture("prev_normal", &m.prev_normal.1)
-            .texture("out_temporal", &m.temporal.1)
-            .texture("out_reason", &m.reason.1),
+        Kind::Temporal => b.texture("history", &m.history[parity].1).texture("out_temporal", &m.temporal.1).texture("out_reason", &m.reason.1),
         Kind::HistoryBilateral => b.texture("filter_in", &m.temporal.1).texture("reason_in", &m.reason.1).texture("out_history", &m.history[1 - parity].1),
         Kind::MinH => b.texture("filter_in", &m.temporal.1).texture("min_in", &m.radius.1).texture("out_min", &m.min.1),
         Kind::MinV => b.texture("filter_in", &m.temporal.1).texture("min_in", &m.min.1).texture("out_min", &m.radius.1),
         Kind::Firefly => b.texture("filter_in", &m.temporal.1).texture("out_median", &m.median.1),
         Kind::Bilateral => b.texture("filter_in", &m.median.1).texture("radius_in", &m.radius.1).texture("reason_in", &m.reason.1).texture("out_matte", &m.denoised.1),
-        Kind::Taa => {
-            let mut b = b
-                .buffer("hdr", i.hdr)
-                .texture("history", &m.taa_history[parity].1)
-                .texture("out_history", &m.taa_history[1 - parity].1)
-                .buffer("final_image", &m.final_image)
-                .texture("matte_temporal", &m.temporal.1)
-                .texture("matte_reason", &m.reason.1)
-                .texture("material_history", &m.taa_material[parity].1)
-                .texture("out_material", &m.taa_material[1 - parity].1)
-                .texture("residual_history", &m.taa_residual[parity].1)
-                .texture("out_residual", &m.taa_residual[1 - parity].1)
-                .texture("glossy_factor_history", &m.taa_glossy[parity].1)
-                .texture("out_glossy_factor", &m.taa_glossy[1 - parity].1);
-            if let Some((g, params)) = i.glossy {
-                // The glossy temporal wrote history[1 - parity] this frame.
-                b = super::glossy::glossy_trace_inputs(b, i.trace, &g.denoised.1)
-                    .buffer("gp", params)
-                    .texture("glossy_temporal", &g.history[1 - parity].1)
-                    .texture("glossy_info", &g.info.1)
-                    .texture("glossy_previous", &g.history[parity].1);
-            }
-            b
-        }
     }
 }
 
-fn modules(kind: Kind, animated: bool, glossy: bool) -> Vec<&'static str> {
+fn modules(kind: Kind, animated: bool) -> Vec<&'static str> {
     let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl"];
     m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
-    if kind == Kind::Taa {
-        m.extend(if glossy { ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice() } else { ["taa/glossy_none.wgsl"].as_slice() });
-    }
     m.extend(match kind {
         Kind::Temporal => vec!["matte/temporal.wgsl"],
         Kind::HistoryBilateral => vec!["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
         Kind::MinH | Kind::MinV => vec!["matte/disocclusion.wgsl"],
         Kind::Firefly => vec!["matte/firefly.wgsl"],
         Kind::Bilateral => vec!["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"],
-        Kind::Taa => vec!["taa/taa.wgsl"],
     });
     m
 }
@@ -316,16 +235,15 @@ impl MatteChain {
                 Kind::MinV => "min_v",
                 _ => "main",
             };
-            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated, i.glossy.is_some()), entry, &bindings(kind, i, 0))?));
+            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated), entry, &bindings(kind, i, 0))?));
         }
         Ok(MatteChain { stages })
     }
 
-    /// Record stages 3-7 (before the composite) or TAA (after it).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &ChainInputs, parity: usize, size: (u32, u32), taa: bool, mut timer: Option<&mut GpuTimer>) -> Result<()> {
-        for (kind, s) in self.stages.iter_mut().filter(|(k, _)| (*k == Kind::Taa) == taa) {
-            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;
+    /// Record stages 3-7.
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &ChainInputs, parity: usize, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        for (kind, s) in self.stages.iter_mut() {
+            s.record(gpu, enc, key, parity, i.io.size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;
         }
         Ok(())
     }

@@ -7,6 +7,8 @@ pub use raycast::{RayHit, Raycaster};
 pub use reference::{Accumulation, ReferenceTracer, TraceView};
 
 pub mod chain;
+pub mod io;
+pub mod taa;
 pub mod composite;
 pub mod gbuffer;
 pub mod glossy;

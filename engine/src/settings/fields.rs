@@ -4,7 +4,7 @@
 //! test keeps it and the structs in step.
 
 use super::{FrameSettings, ReflectionMv};
-use crate::frame::View;
+use super::View;
 use anyhow::{Result, anyhow};
 use serde_json::Value;
 
@@ -39,7 +39,7 @@ fn views() -> Vec<String> {
     names(&View::ALL)
 }
 fn denoisers() -> Vec<String> {
-    names(&[super::Denoiser::None, super::Denoiser::Mara])
+    super::denoiser_names().into_iter().map(str::to_string).collect()
 }
 fn reflection_mvs() -> Vec<String> {
     names(&ReflectionMv::ALL)
@@ -57,7 +57,7 @@ pub const FIELDS: &[Field] = &[
     f("exposure_ev", "display", "EV", Float(-30.0, 30.0, 0.05), "The image is multiplied by 2^EV before tone mapping."),
     f("accumulate", "frame", "", Bool, "Sum frames while nothing changes and show their mean (the converged image)."),
     f("seed", "frame", "", Int(0, u32::MAX as i64), "Seed of every random sequence."),
-    f("denoiser", "frame", "", Choice(denoisers), "None: the raw 1-sample frame. Mara: the matte and glossy chains and TAA."),
+    f("denoiser", "frame", "", Choice(denoisers), "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. Others: denoisers the application registered."),
     f("max_depth", "trace", "bounces", Int(-1, 64), "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded)."),
     f("paths_per_pixel", "trace", "paths", Int(1, 64), "Indirect paths per pixel per frame (1 is the paper's real-time setting)."),
     f("matte.temporal", "matte/temporal", "", Bool, "Stage 3: reverse reprojection with confidence (Mara eq. 11)."),

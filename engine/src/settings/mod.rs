@@ -3,11 +3,14 @@
 
 mod fields;
 mod preset;
+mod view;
 
 pub use fields::{FIELDS, Field, Kind, get as get_field, get_mut as get_field_mut, leaves};
+pub use view::View;
 
-use crate::frame::View;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
+use std::sync::RwLock;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -41,19 +44,63 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::None, matte: MatteSettings::default(), glossy: GlossySettings::default(), paths_per_pixel: 1 }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::NONE, matte: MatteSettings::default(), glossy: GlossySettings::default(), paths_per_pixel: 1 }
     }
 }
 
-/// Which denoiser filters the 1-sample frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum Denoiser {
+/// Which denoiser filters the 1-sample frame: the name of one in `crate::denoise`'s registry
+/// (`none`, `mara`, or one registered by the application). Written in lower case; presets may
+/// spell it in any case.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(transparent)]
+pub struct Denoiser(Cow<'static, str>);
+
+impl Denoiser {
     /// The raw frame (composite only).
-    None,
-    /// Mara et al. 2017: matte chain (temporal, history bilateral, disocclusion radius, firefly
-    /// median, final bilateral) and TAA.
-    #[default]
-    Mara,
+    pub const NONE: Denoiser = Denoiser(Cow::Borrowed("none"));
+    /// Mara et al. 2017: the matte and glossy chains, then TAA.
+    pub const MARA: Denoiser = Denoiser(Cow::Borrowed("mara"));
+
+    pub fn named(name: &str) -> Denoiser {
+        Denoiser(Cow::Owned(name.to_ascii_lowercase()))
+    }
+
+    pub fn name(&self) -> &str {
+        &self.0
+    }
+}
+
+impl Default for Denoiser {
+    fn default() -> Self {
+        Denoiser::MARA
+    }
+}
+
+impl<'de> Deserialize<'de> for Denoiser {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        let known = denoiser_names();
+        if !known.iter().any(|k| k.eq_ignore_ascii_case(&name)) {
+            return Err(serde::de::Error::custom(format!("no denoiser {name:?} (there are {})", known.join(", "))));
+        }
+        Ok(Denoiser::named(&name))
+    }
+}
+
+/// Names of the denoisers the frame can make: the built-in ones, and those
+/// `crate::denoise::register` added (it keeps this list, which settings read without depending
+/// on the denoisers themselves).
+static DENOISER_NAMES: RwLock<Vec<&'static str>> = RwLock::new(Vec::new());
+
+pub fn denoiser_names() -> Vec<&'static str> {
+    let mut v = vec![Denoiser::NONE.0.as_ref(), "mara"];
+    v.extend(DENOISER_NAMES.read().unwrap().iter());
+    v
+}
+
+/// Called by `crate::denoise::register` only.
+pub(crate) fn add_denoiser_name(name: &'static str) {
+    DENOISER_NAMES.write().unwrap().push(name);
 }
 
 /// The matte chain of Mara et al. 2017, §3.4 (stages 3-7 of Figure 2), and TAA.

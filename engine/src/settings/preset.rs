@@ -40,7 +40,7 @@ mod tests {
 
     #[test]
     fn settings_round_trip_through_a_preset_file() {
-        let mut s = FrameSettings { exposure_ev: -1.25, max_depth: 4, seed: 7, denoiser: Denoiser::Mara, paths_per_pixel: 2, view: crate::frame::View::GlossySigma, ..Default::default() };
+        let mut s = FrameSettings { exposure_ev: -1.25, max_depth: 4, seed: 7, denoiser: Denoiser::MARA, paths_per_pixel: 2, view: crate::settings::View::GlossySigma, ..Default::default() };
         s.matte.hysteresis = 0.9;
         s.matte.firefly = false;
         s.matte.taps = 32;
@@ -57,7 +57,7 @@ mod tests {
     #[test]
     fn a_partial_preset_keeps_the_other_defaults() {
         let s = FrameSettings::from_toml("denoiser = \"Mara\"\n[matte]\nfirefly = false\n").unwrap();
-        assert_eq!(s, FrameSettings { denoiser: Denoiser::Mara, matte: crate::settings::MatteSettings { firefly: false, ..Default::default() }, ..Default::default() });
+        assert_eq!(s, FrameSettings { denoiser: Denoiser::MARA, matte: crate::settings::MatteSettings { firefly: false, ..Default::default() }, ..Default::default() });
         let e = format!("{:#}", FrameSettings::from_toml("[glossy]\nsigma_scael = 3.0\n").unwrap_err());
         assert!(e.contains("glossy.sigma_scael"), "{e}");
     }

@@ -87,6 +87,8 @@ embed!(
     "matte/firefly.wgsl",
     "matte/bilateral.wgsl",
     "taa/taa.wgsl",
+    "taa/matte.wgsl",
+    "taa/matte_none.wgsl",
     "taa/glossy.wgsl",
     "taa/glossy_none.wgsl",
     "glossy/common.wgsl",
@@ -254,7 +256,7 @@ mod tests {
             }
         }
         for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
-            for stage in [&["matte/temporal.wgsl"][..], &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"], &["matte/disocclusion.wgsl"], &["matte/firefly.wgsl"], &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"], &["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl", "taa/taa.wgsl"], &["taa/glossy_none.wgsl", "taa/taa.wgsl"]] {
+            for stage in [&["matte/temporal.wgsl"][..], &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"], &["matte/disocclusion.wgsl"], &["matte/firefly.wgsl"], &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"], &["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl", "taa/matte.wgsl", "taa/taa.wgsl"], &["taa/glossy_none.wgsl", "taa/matte_none.wgsl", "taa/taa.wgsl"]] {
                 let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl", motion];
                 m.extend_from_slice(stage);
                 v.push(compose(stage[stage.len() - 1], "", &m).unwrap());

@@ -1,0 +1,98 @@
+//! The denoiser of Mara et al. 2017 (§3.4, Figure 2): the matte chain (stages 3-7,
+//! `passes/matte.rs`) and, in scenes with a specular lobe, the glossy chain (stages 8-10 with
+//! Voorhuis's reflection reprojection, `passes/glossy.rs`). TAA follows both chains' temporal
+//! outputs ([`TaaFollow`]).
+
+use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
+use crate::passes::io::FrameIo;
+use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
+use crate::passes::taa::{GlossyFollow, TaaFollow};
+use anyhow::{Context, Result};
+
+pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
+    let mut memory = GpuMemory::default();
+    let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+    let d = &gpu.device;
+    let params = memory.buffer(d, "matte/params", size_of::<DenoiseParams>() as u64, u);
+    let glossy_params = memory.buffer(d, "glossy/params", size_of::<GlossyParams>() as u64, u);
+    Ok(Box::new(Mara { scene: *scene, params, glossy_params, targets: None, matte: None, glossy: None }))
+}
+
+struct Mara {
+    scene: DenoiserScene,
+    params: wgpu::Buffer,
+    glossy_params: wgpu::Buffer,
+    targets: Option<(MatteTargets, Option<GlossyChainTargets>)>,
+    matte: Option<MatteChain>,
+    glossy: Option<GlossyChain>,
+}
+
+impl Denoiser for Mara {
+    fn needs_previous_gbuffer(&self) -> bool {
+        true
+    }
+
+    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
+        let d = &gpu.device;
+        let glossy = self.scene.glossy.then(|| GlossyChainTargets::new(d, memory, size));
+        self.targets = Some((MatteTargets::new(d, memory, size), glossy));
+    }
+
+    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        let (m, g) = self.targets.as_ref().context("the Mara denoiser records before its textures exist")?;
+        let s = cx.settings;
+        let dp = DenoiseParams::new(&s.matte, io.size.0, cx.index, &cx.view);
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dp));
+        let gp = GlossyParams::new(&s.glossy, self.scene.extent, cx.view.static_view);
+        gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
+        let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
+        if self.matte.is_none() {
+            self.matte = Some(MatteChain::new(gpu, &inputs, self.scene.animated).context("creating the matte chain")?);
+        }
+        self.matte.as_mut().unwrap().record(gpu, enc, cx.key, &inputs, cx.parity, timer.as_deref_mut())?;
+        if let Some(g) = g {
+            let inputs = GlossyInputs { io: *io, denoise: &self.params, params: &self.glossy_params, glossy: g };
+            if self.glossy.is_none() {
+                self.glossy = Some(GlossyChain::new(gpu, &inputs, self.scene.animated).context("creating the glossy chain")?);
+            }
+            self.glossy.as_mut().unwrap().record(gpu, enc, cx.key, &inputs, cx.parity, &s.glossy, timer)?;
+        }
+        Ok(())
+    }
+
+    fn output(&self, _parity: usize) -> Denoised<'_> {
+        let Some((m, g)) = &self.targets else { return Denoised::default() };
+        Denoised { matte: Some(&m.denoised.1), glossy: g.as_ref().map(|g| &g.denoised.1) }
+    }
+
+    fn taa_follow(&self, parity: usize) -> TaaFollow<'_> {
+        let Some((m, g)) = &self.targets else { return TaaFollow::default() };
+        TaaFollow {
+            matte: Some((&m.temporal.1, &m.reason.1)),
+            // The glossy temporal wrote history[1 - parity] this frame.
+            glossy: g.as_ref().map(|g| GlossyFollow { denoised: &g.denoised.1, temporal: &g.history[1 - parity].1, previous: &g.history[parity].1, info: &g.info.1, params: &self.glossy_params }),
+        }
+    }
+
+    fn view_bindings(&self) -> Bindings<'_> {
+        let Some((m, g)) = &self.targets else { return Bindings::new() };
+        let mut b = Bindings::new().texture("dv_temporal", &m.temporal.1).texture("dv_reason", &m.reason.1).texture("dv_radius", &m.radius.1).texture("dv_firefly", &m.median.1).texture("dv_denoised", &m.denoised.1);
+        if let Some(g) = g {
+            b = b.texture("gv_motion", &g.motion.1).texture("gv_search", &g.search.1).texture("gv_info", &g.info.1).texture("gv_sigma", &g.scratch.1).texture("gv_denoised", &g.denoised.1);
+        }
+        b
+    }
+
+    fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
+        let mut v: Vec<&mut dyn crate::shader::Reload> = vec![];
+        if let Some(c) = self.matte.as_mut() {
+            v.extend(c.pipelines());
+        }
+        if let Some(c) = self.glossy.as_mut() {
+            v.extend(c.pipelines());
+        }
+        v
+    }
+}

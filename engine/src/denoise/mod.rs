@@ -1,0 +1,140 @@
+//! Denoisers: what runs between the trace and the composite, behind one contract.
+//!
+//! The frame (Mara et al. 2017, Figure 2) is gbuffer -> trace -> denoise -> composite -> TAA ->
+//! display. A [`Denoiser`] reads the frame's I/O ([`FrameIo`]: the frame uniform, this and the
+//! previous frame's G-buffer, the trace's signals), allocates its own per-pixel textures in the
+//! frame's labelled memory (so they are read back and reported by label), records its passes,
+//! and returns the denoised matte and glossy light the composite remodulates, plus what TAA may
+//! follow. TAA and the composite belong to the frame and run after any denoiser.
+//!
+//! Adding a denoiser: one module implementing [`Denoiser`] (its WGSL in `shaders/`, or given to
+//! [`crate::shader::ShaderLibrary::add`]) and one [`Entry`] (in [`BUILT_IN`], or passed to
+//! [`register`]). Its name then works in `--denoiser`, presets and the viewer.
+
+pub mod mara;
+
+use crate::gpu::{Gpu, GpuMemory, GpuTimer};
+use crate::passes::io::FrameIo;
+use crate::passes::matte::ChainView;
+use crate::passes::taa::TaaFollow;
+use crate::settings::FrameSettings;
+use anyhow::{Result, bail};
+use std::sync::RwLock;
+
+/// What a denoiser knows about the scene when it is made.
+#[derive(Clone, Copy, Debug)]
+pub struct DenoiserScene {
+    /// The scene has a specular lobe: the trace writes glossy light and reflection data.
+    pub glossy: bool,
+    /// Objects move: `prev_from_current` is bound and motion vectors include object motion.
+    pub animated: bool,
+    /// The scene's bounding-box diagonal (metres).
+    pub extent: f32,
+}
+
+/// This frame beyond its I/O.
+pub struct FrameContext<'a> {
+    /// Frames rendered so far (wraps); histories ping-pong on `parity` = index % 2.
+    pub index: u32,
+    pub parity: usize,
+    /// Cameras of this frame and the last, the jitter between them, history validity.
+    pub view: ChainView,
+    pub settings: &'a FrameSettings,
+    /// Changes whenever a resource the frame offers may have been replaced (resize, a scene
+    /// buffer reallocated): bind groups keyed on it stay valid while it stays.
+    pub key: u64,
+}
+
+/// The denoised light for the composite (None: the trace's raw light passes through).
+#[derive(Clone, Copy, Default)]
+pub struct Denoised<'a> {
+    pub matte: Option<&'a wgpu::TextureView>,
+    pub glossy: Option<&'a wgpu::TextureView>,
+}
+
+pub trait Denoiser {
+    /// Whether it reads the previous frame's depth and normal (`prev_depth`, `prev_normal`);
+    /// the frame then keeps them (8 bytes per pixel).
+    fn needs_previous_gbuffer(&self) -> bool;
+
+    /// Make its per-pixel textures in `memory` (labelled `name/...`), for frame targets of
+    /// `size`; called again after a resize.
+    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32));
+
+    /// Record its passes for this frame.
+    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, timer: Option<&mut GpuTimer>) -> Result<()>;
+
+    /// The light it produced this frame (after [`Denoiser::record`]).
+    fn output(&self, parity: usize) -> Denoised<'_>;
+
+    /// What TAA may follow (the default, nothing: TAA averages the composite alone).
+    fn taa_follow(&self, _parity: usize) -> TaaFollow<'_> {
+        TaaFollow::default()
+    }
+
+    /// Its textures for the display's debug views, by WGSL name.
+    fn view_bindings(&self) -> crate::gpu::Bindings<'_> {
+        crate::gpu::Bindings::new()
+    }
+
+    /// Its pipelines, for hot reload.
+    fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload>;
+}
+
+/// A denoiser the frame can be asked for by name.
+#[derive(Clone, Copy)]
+pub struct Entry {
+    /// As `--denoiser`, presets and the viewer spell it (lower case).
+    pub name: &'static str,
+    /// One line for the viewer and `--help`.
+    pub summary: &'static str,
+    /// Make it for a scene (None: no denoiser, the raw frame).
+    pub make: Option<fn(&Gpu, &DenoiserScene) -> Result<Box<dyn Denoiser>>>,
+}
+
+/// The denoisers built into Hush.
+pub const BUILT_IN: &[Entry] = &[
+    Entry { name: "none", summary: "the raw 1-sample frame (composite only)", make: None },
+    Entry { name: "mara", summary: "Mara et al. 2017: the matte and glossy chains, then TAA", make: Some(mara::make) },
+];
+
+static REGISTERED: RwLock<Vec<Entry>> = RwLock::new(Vec::new());
+
+/// Add a denoiser beside the built-in ones (an application's or a test's own); an error if the
+/// name is taken.
+pub fn register(entry: Entry) -> Result<()> {
+    let mut r = REGISTERED.write().unwrap();
+    if entries_in(&r).iter().any(|e| e.name == entry.name) {
+        bail!("a denoiser named {:?} is already registered", entry.name);
+    }
+    r.push(entry);
+    crate::settings::add_denoiser_name(entry.name);
+    Ok(())
+}
+
+fn entries_in(registered: &[Entry]) -> Vec<Entry> {
+    BUILT_IN.iter().chain(registered).copied().collect()
+}
+
+/// Every denoiser, built-in first.
+pub fn entries() -> Vec<Entry> {
+    entries_in(&REGISTERED.read().unwrap())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn settings_know_every_built_in_name() {
+        let names: Vec<&str> = super::BUILT_IN.iter().map(|e| e.name).collect();
+        assert_eq!(crate::settings::denoiser_names()[..names.len()], names[..]);
+    }
+}
+
+/// The denoiser called `name`.
+pub fn find(name: &str) -> Result<Entry> {
+    let all = entries();
+    match all.iter().find(|e| e.name == name) {
+        Some(e) => Ok(*e),
+        None => bail!("no denoiser {name:?} (there are {})", all.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")),
+    }
+}

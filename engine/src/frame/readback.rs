@@ -1,0 +1,93 @@
+//! What can be read back of the last frame: its image, any labelled texture, pass times.
+
+use super::{DisplayTarget, Renderer};
+use crate::gpu::Gpu;
+use crate::quality::Image;
+use crate::settings::FrameSettings;
+use anyhow::{Context, Result};
+use glam::Vec3;
+
+impl Renderer {
+    /// The display's image of the last frame (tone-mapped or the chosen debug view) as 8-bit sRGB.
+    pub fn display_image(&mut self, gpu: &Gpu, settings: &FrameSettings) -> Result<image::RgbaImage> {
+        let (w, h) = self.targets.size;
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("display image"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = tex.create_view(&Default::default());
+        self.redisplay(gpu, settings, &DisplayTarget { view: &view, format, size: (w, h) })?;
+        let bytes = crate::gpu::readback_texture(gpu, &tex)?;
+        image::RgbaImage::from_raw(w, h, bytes).context("display image has the wrong size")
+    }
+
+    /// GPU milliseconds per pass of the last frame (blocks until it finished); empty without
+    /// timestamp queries.
+    pub fn pass_times(&self, gpu: &Gpu) -> Result<Vec<(&'static str, f64)>> {
+        Ok(self.pass_spans(gpu)?.into_iter().map(|s| (s.label, s.ms)).collect())
+    }
+
+    /// Each pass of the last frame with its start and duration (blocks until it finished); when
+    /// puffin's scopes are on, also reported as the frame's GPU timeline.
+    pub fn pass_spans(&self, gpu: &Gpu) -> Result<Vec<crate::profile::PassSpan>> {
+        let Some(t) = &self.timer else { return Ok(vec![]) };
+        let spans = t.read_spans(gpu)?;
+        crate::profile::report_gpu(t.submitted_ns, &spans);
+        Ok(spans)
+    }
+
+    /// Keep per-pass times for [`Renderer::poll_pass_spans`] instead of [`Renderer::pass_spans`]
+    /// (the viewer: reading times back never waits for the GPU).
+    pub fn set_async_timings(&mut self, on: bool) {
+        self.async_timings = on;
+    }
+
+    /// The passes of the oldest frame that finished since the last call, without waiting
+    /// (frames with async timings on); reported to puffin as that frame's GPU timeline.
+    pub fn poll_pass_spans(&mut self, gpu: &Gpu) -> Option<Vec<crate::profile::PassSpan>> {
+        let (submitted, spans) = self.timer.as_mut()?.poll(gpu)?;
+        crate::profile::report_gpu(submitted, &spans);
+        Some(spans)
+    }
+
+    /// Frames summed in accumulate mode (0 when off).
+    pub fn accumulated(&self) -> u32 {
+        self.accumulated
+    }
+
+    /// The last frame's linear HDR image (after composite), or in accumulate mode the mean.
+    pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
+        let (w, h) = self.targets.size;
+        let n = w as u64 * h as u64 * 16;
+        let shown = self.taa.output().filter(|_| self.denoised_last.is_some()).unwrap_or(&self.targets.hdr);
+        let (buf, scale) = match (&self.targets.accumulation, self.accumulated) {
+            (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
+            _ => (shown, 1.0),
+        };
+        let bytes = crate::gpu::readback_buffer(&gpu.device, &gpu.queue, buf, n)?;
+        let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let mut img = Image::new(w, h);
+        for (d, s) in img.data.iter_mut().zip(v) {
+            *d = Vec3::new(s[0], s[1], s[2]) * scale;
+        }
+        Ok(img)
+    }
+
+    /// Read any texture of the frame back by its label (as the allocation report and debug
+    /// views name it: `gbuffer/depth`, `trace/matte`, `matte/history 0`, `taa/history 1`, ...),
+    /// raw bytes with rows tightly packed.
+    pub fn read_texture(&self, gpu: &Gpu, name: &str) -> Result<(Vec<u8>, wgpu::TextureFormat)> {
+        let tex = self.targets.memory.find_texture(name).with_context(|| {
+            let labels: Vec<&str> = self.targets.memory.textures.iter().map(|(l, _)| l.as_str()).collect();
+            format!("no texture {name:?} in this frame (its textures: {}; a denoiser's appear once it has run)", labels.join(", "))
+        })?;
+        Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
+    }
+}

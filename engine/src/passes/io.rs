@@ -1,0 +1,80 @@
+//! The frame's inputs and outputs as every stage after the trace sees them: the frame uniform,
+//! the G-buffer of this frame and the previous one, the trace's signals and the composite's
+//! image, offered by the names the WGSL binds them by. A stage adds its own resources on top.
+
+use super::gbuffer::GBufferTargets;
+use super::trace::TraceTargets;
+use crate::gpu::{Bindings, GpuMemory};
+
+/// What the frame offers a stage (all borrowed from the frame for one recording).
+#[derive(Clone, Copy)]
+pub struct FrameIo<'a> {
+    pub size: (u32, u32),
+    /// `FrameParams` (shaders/realtime/frame.wgsl).
+    pub frame: &'a wgpu::Buffer,
+    /// Per object, previous-from-current transforms (animated scenes only).
+    pub objects: Option<&'a wgpu::Buffer>,
+    pub gbuffer: &'a GBufferTargets,
+    /// The previous frame's G-buffer depth and normal, where a stage asked for them
+    /// ([`crate::denoise::Denoiser::needs_previous_gbuffer`]).
+    pub previous: Option<&'a PreviousGBuffer>,
+    pub trace: &'a TraceTargets,
+    /// The composite's linear HDR image, one vec4 per pixel.
+    pub hdr: &'a wgpu::Buffer,
+    /// Every per-pixel allocation of the frame, textures findable by label.
+    pub memory: &'a GpuMemory,
+}
+
+impl<'a> FrameIo<'a> {
+    /// The frame's resources by WGSL name: `frame`, the G-buffer (`gb_*`, realtime/gbuffer_in.wgsl),
+    /// the trace's light (`tr_*`, raw; a stage that filters offers its own `tr_matte` on top),
+    /// object motion, and the previous depth and normal where they exist.
+    pub fn bindings(&self) -> Bindings<'a> {
+        let g = self.gbuffer;
+        let t = self.trace;
+        let mut b = Bindings::new()
+            .buffer("frame", self.frame)
+            .buffer_opt("prev_from_current", self.objects)
+            .texture("gb_depth", &g.depth.1)
+            .texture("gb_normal", g.view("normal"))
+            .texture("gb_motion", g.view("motion"))
+            .texture("gb_base_color", g.view("base_color"))
+            .texture("gb_specular", g.view("specular"))
+            .texture("gb_emission", g.view("emission"))
+            .texture("gb_object", g.view("ids"))
+            .texture("tr_matte", &t.matte.1)
+            .texture("tr_direct", &t.direct.1);
+        if let Some(gl) = &t.glossy {
+            b = b.texture("tr_glossy", &gl.light.1).texture("tr_reflection", &gl.reflection.1).texture("tr_mirror", &gl.mirror.1).texture("tr_mirror_hit", &gl.mirror_hit.1);
+        }
+        if let Some(p) = self.previous {
+            b = b.texture("prev_depth", &p.depth.1).texture("prev_normal", &p.normal.1);
+        }
+        b
+    }
+}
+
+/// The previous frame's depth and normal: copied from the G-buffer after each frame that a
+/// stage needing them ran in (8 bytes per pixel), made on first use.
+pub struct PreviousGBuffer {
+    pub depth: (wgpu::Texture, wgpu::TextureView),
+    /// Octahedral normals, for the reprojections' normal test.
+    pub normal: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl PreviousGBuffer {
+    pub fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> PreviousGBuffer {
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
+        PreviousGBuffer {
+            depth: mem.texture(device, "gbuffer/previous depth", size, super::gbuffer::DEPTH_FORMAT, usage),
+            normal: mem.texture(device, "gbuffer/previous normal", size, super::gbuffer::COLOR_FORMATS[0].1, usage),
+        }
+    }
+
+    /// Record the copy of this frame's depth and normal, after every stage read the previous.
+    pub fn record_copy(&self, enc: &mut wgpu::CommandEncoder, g: &GBufferTargets, size: (u32, u32)) {
+        let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
+        enc.copy_texture_to_texture(g.depth.0.as_image_copy(), self.depth.0.as_image_copy(), extent);
+        enc.copy_texture_to_texture(g.color[0].0.as_image_copy(), self.normal.0.as_image_copy(), extent);
+    }
+}

@@ -1,0 +1,142 @@
+//! `taa`: temporal anti-aliasing of the composited image (shaders/taa/taa.wgsl), a stage of its
+//! own after any denoiser's composite. Where the denoiser offers the light it accumulates
+//! ([`TaaFollow`]), a settled pixel follows that light instead of averaging it again
+//! (`MatteSettings::taa_current_light`, `taa_current_glossy`); otherwise it is a plain TAA.
+//! Its settings are `MatteSettings::taa*`; its output, `taa/final`, is the image shown.
+
+use super::chain::ChainStage;
+use super::io::FrameIo;
+use super::matte::DenoiseParams;
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use anyhow::Result;
+
+pub const LABEL: &str = "taa";
+const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// What a denoiser offers TAA to follow (all this frame's, parity resolved).
+#[derive(Clone, Copy, Default)]
+pub struct TaaFollow<'a> {
+    /// The matte light before spatial filtering and its state (`matte/reason`'s format: REASON_*
+    /// flags in the low 8 bits, history length above).
+    pub matte: Option<(&'a wgpu::TextureView, &'a wgpu::TextureView)>,
+    pub glossy: Option<GlossyFollow<'a>>,
+}
+
+/// The glossy light TAA may follow (taa/glossy.wgsl).
+#[derive(Clone, Copy)]
+pub struct GlossyFollow<'a> {
+    /// The glossy light the composite used (remodulated), and the temporal's output this frame
+    /// and last frame (divided by the mirror demodulation).
+    pub denoised: &'a wgpu::TextureView,
+    pub temporal: &'a wgpu::TextureView,
+    pub previous: &'a wgpu::TextureView,
+    /// Continuity and history length (info.z, info.w of shaders/glossy/temporal.wgsl).
+    pub info: &'a wgpu::TextureView,
+    /// `GlossyParams`, for the demodulation.
+    pub params: &'a wgpu::Buffer,
+}
+
+/// TAA's per-pixel textures: its history (with its length), the averaged matte and glossy
+/// factors and residual it follows the chains with, and the image shown. 144 bytes per pixel.
+struct TaaTargets {
+    history: [(wgpu::Texture, wgpu::TextureView); 2],
+    material: [(wgpu::Texture, wgpu::TextureView); 2],
+    residual: [(wgpu::Texture, wgpu::TextureView); 2],
+    glossy: [(wgpu::Texture, wgpu::TextureView); 2],
+    final_image: wgpu::Buffer,
+}
+
+impl TaaTargets {
+    fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> TaaTargets {
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let mut pair = |l: &str| [mem.texture(device, &format!("taa/{l} 0"), size, RGBA32F, rw), mem.texture(device, &format!("taa/{l} 1"), size, RGBA32F, rw)];
+        let (history, material, residual, glossy) = (pair("history"), pair("material"), pair("residual"), pair("glossy"));
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let final_image = mem.buffer(device, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
+        TaaTargets { history, material, residual, glossy, final_image }
+    }
+}
+
+pub struct TaaStage {
+    params: wgpu::Buffer,
+    targets: Option<(u64, TaaTargets)>,
+    /// One program per (follows matte, follows glossy), made on first use.
+    programs: Vec<((bool, bool), ChainStage)>,
+    animated: bool,
+}
+
+impl TaaStage {
+    pub fn new(gpu: &Gpu, memory: &mut GpuMemory, animated: bool) -> TaaStage {
+        let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let params = memory.buffer(&gpu.device, "taa/params", size_of::<DenoiseParams>() as u64, u);
+        TaaStage { params, targets: None, programs: vec![], animated }
+    }
+
+    pub fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
+        self.programs.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
+    }
+
+    /// Make the textures for the frame targets of `epoch` (once per size); true if it did.
+    pub fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32), epoch: u64) -> bool {
+        if self.targets.as_ref().is_some_and(|(e, _)| *e == epoch) {
+            return false;
+        }
+        self.targets = Some((epoch, TaaTargets::new(&gpu.device, memory, size)));
+        true
+    }
+
+    /// The image after TAA (once it ran).
+    pub fn output(&self) -> Option<&wgpu::Buffer> {
+        self.targets.as_ref().map(|(_, t)| &t.final_image)
+    }
+
+    /// Record TAA of `io.hdr`; `params` as the denoisers write them (its `taa*` and `stages`).
+    /// `key` changes whenever a bound resource may have (scene, targets, denoiser).
+    #[allow(clippy::too_many_arguments)]
+    /// `follow(p)`: what TAA follows at history parity p.
+    pub fn record<'a>(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, io: &FrameIo<'a>, follow: impl Fn(usize) -> TaaFollow<'a>, params: &DenoiseParams, parity: usize, timer: Option<&mut GpuTimer>) -> Result<()> {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let (_, t) = self.targets.as_ref().expect("TaaStage::allocate runs before record");
+        let f = follow(parity);
+        let variant = (f.matte.is_some(), f.glossy.is_some());
+        let bindings = |p: usize| taa_bindings(io, t, &self.params, &follow(p), p);
+        if !self.programs.iter().any(|(v, _)| *v == variant) {
+            let stage = ChainStage::new(gpu, LABEL, &modules(variant, self.animated), "main", &bindings(0))?;
+            self.programs.push((variant, stage));
+        }
+        let (_, stage) = self.programs.iter_mut().find(|(v, _)| *v == variant).expect("made above");
+        stage.record(gpu, enc, key, parity, io.size, timer, bindings)
+    }
+}
+
+fn taa_bindings<'a>(io: &FrameIo<'a>, t: &'a TaaTargets, params: &'a wgpu::Buffer, follow: &TaaFollow<'a>, parity: usize) -> Bindings<'a> {
+    let mut b = io
+        .bindings()
+        .buffer("dn", params)
+        .buffer("hdr", io.hdr)
+        .buffer("final_image", &t.final_image)
+        .texture("history", &t.history[parity].1)
+        .texture("out_history", &t.history[1 - parity].1)
+        .texture("material_history", &t.material[parity].1)
+        .texture("out_material", &t.material[1 - parity].1)
+        .texture("residual_history", &t.residual[parity].1)
+        .texture("out_residual", &t.residual[1 - parity].1)
+        .texture("glossy_factor_history", &t.glossy[parity].1)
+        .texture("out_glossy_factor", &t.glossy[1 - parity].1);
+    if let Some((light, state)) = follow.matte {
+        b = b.texture("matte_temporal", light).texture("matte_reason", state);
+    }
+    if let Some(g) = follow.glossy {
+        b = b.texture("tr_glossy", g.denoised).texture("glossy_temporal", g.temporal).texture("glossy_previous", g.previous).texture("glossy_info", g.info).buffer("gp", g.params);
+    }
+    b
+}
+
+fn modules((matte, glossy): (bool, bool), animated: bool) -> Vec<&'static str> {
+    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl"];
+    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.extend(if glossy { ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice() } else { ["taa/glossy_none.wgsl"].as_slice() });
+    m.push(if matte { "taa/matte.wgsl" } else { "taa/matte_none.wgsl" });
+    m.push("taa/taa.wgsl");
+    m
+}
