@@ -90,7 +90,7 @@ impl Panel {
         let glossy = self.glossy;
         let relevant = |g: &str| glossy || !g.starts_with("glossy/");
         // Scenes without a glossy lobe have no glossy buffers to show.
-        let offered = |path: &str, choice: &str| path != "view" || glossy || serde_json::from_value::<View>(serde_json::Value::String(choice.into())).is_ok_and(|v| !v.needs_glossy());
+        let offered = |path: &str, choice: &str| path != "view" || glossy || View::named(choice).spec().is_none_or(|v| !v.needs_glossy());
         let group_of = |pass: &str| groups.iter().copied().find(|g| pass == *g || pass.strip_prefix(*g).is_some_and(|r| r.starts_with('_')));
         let mut shown: Vec<&str> = vec![];
         let mut rows: Vec<(String, f64, Option<&'static str>)> = vec![];

@@ -1,17 +1,28 @@
 // Display: exposure, the ACES filmic curve (Narkowicz 2015 fit of the ACES RRT+ODT), sRGB
-// encoding unless the target does it; or one of the debug views (engine/src/frame/views.rs).
+// encoding unless the target does it; or a debug view: any labelled texture of the frame through
+// a small map (engine/src/settings/view.rs).
 
 var<storage, read> hdr: array<vec4f>;
 var<storage, read> accumulation: array<vec4f>;
 
 struct DisplayOptions {
     encode_srgb: u32,
-    _pad: u32,
+    // 0: the image; else how the view texture is shown (ViewMap::encode in
+    // engine/src/settings/view.rs).
+    map: u32,
     // Size of the render target: the frame is scaled to cover it (resolution scale).
     target_size: vec2u,
+    // The view's channel and its map's parameter.
+    channel: u32,
+    param: f32,
+    _pad: vec2u,
 }
 
 var<uniform> display: DisplayOptions;
+// The texture a debug view shows: float formats in view_float, integer ones in view_uint (the
+// other holds one zero texel).
+var view_float: texture_2d<f32>;
+var view_uint: texture_2d<u32>;
 
 @vertex
 fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
@@ -33,55 +44,67 @@ fn hash_color(id: u32) -> vec3f {
     return vec3f(f32(h & 255u), f32((h >> 8u) & 255u), f32((h >> 16u) & 255u)) / 255.0;
 }
 
-// Light buffers are shown exposed and tone-mapped like the image, G-buffer channels as data.
-fn debug_view(view: u32, p: vec2i) -> vec4f {
-    let g = gbuffer_at(p);
-    switch view {
+// As the surface motion view: hue = direction, brightness = length (1 px = 0.25).
+fn motion_colour(mv: vec2f) -> vec3f {
+    return vec3f(0.5 + mv.x * 0.125, 0.5 - mv.y * 0.125, 0.5 + length(mv) * 0.25);
+}
+
+// A debug view's colour; alpha 1 where it is light (exposed and tone-mapped like the image).
+fn debug_view(p: vec2i) -> vec4f {
+    let t = textureLoad(view_float, p, 0);
+    let u = textureLoad(view_uint, p, 0);
+    let c = display.channel;
+    switch display.map {
         case 1u: {
+            return vec4f(t.rgb, 1.0);
+        }
+        case 2u: {
+            return vec4f(t.rgb, 0.0);
+        }
+        case 3u: {
+            return vec4f(vec3f(t[c] / display.param), 0.0);
+        }
+        case 4u: {
+            return vec4f(motion_colour(vec2f(t[c], t[c + 1u])), 0.0);
+        }
+        case 5u: {
+            let g = gbuffer_at(p);
+            return vec4f(select(vec3f(0.0), g.n * 0.5 + 0.5, g.hit), 0.0);
+        }
+        case 6u: {
             // Reversed Z: near is bright.
             return vec4f(vec3f(pow(textureLoad(gb_depth, p, 0), 0.25)), 0.0);
         }
-        case 2u: {
-            return vec4f(select(vec3f(0.0), g.n * 0.5 + 0.5, g.hit), 0.0);
-        }
-        case 3u: {
-            return vec4f(g.base, 0.0);
-        }
-        case 4u: {
-            return vec4f(vec3f(g.metallic), 0.0);
-        }
-        case 5u: {
-            return vec4f(vec3f(g.roughness), 0.0);
-        }
-        case 6u: {
-            return vec4f(g.f0, 0.0);
-        }
         case 7u: {
-            return vec4f(g.emission, 1.0);
+            return vec4f(select(vec3f(0.0), hash_color(u.x), gbuffer_at(p).hit), 0.0);
         }
         case 8u: {
-            let id = textureLoad(gb_object, p, 0).x;
-            return vec4f(select(vec3f(0.0), hash_color(id), g.hit), 0.0);
+            // Red: disoccluded; yellow: low confidence; blue: history clamped.
+            let r = u.x & 255u;
+            var f = vec3f(0.0);
+            if (r & 1u) != 0u {
+                f = vec3f(1.0, 0.0, 0.0);
+            } else if (r & 2u) != 0u {
+                f = vec3f(1.0, 1.0, 0.0);
+            }
+            if (r & 4u) != 0u {
+                f += vec3f(0.0, 0.3, 1.0);
+            }
+            return vec4f(f, 0.0);
         }
         case 9u: {
-            // Motion in pixels: hue = direction, brightness = length (1 px = 0.25).
-            let mv = textureLoad(gb_motion, p, 0).xy;
-            return vec4f(vec3f(0.5 + mv.x * 0.125, 0.5 - mv.y * 0.125, 0.5 + length(mv) * 0.25), 0.0);
+            return vec4f(oct_decode(unpack2x16snorm(u.x)) * 0.5 + 0.5, 0.0);
         }
         case 10u: {
-            return vec4f(textureLoad(tr_matte, p, 0).rgb, 1.0);
+            // Over the scene's extent (2^17 ray offsets); white: escaped.
+            let d = t[c];
+            return vec4f(vec3f(select(d / (frame.cam_pos.w * 131072.0), 1.0, d >= 65000.0)), 0.0);
         }
         case 11u: {
-            return vec4f(textureLoad(tr_direct, p, 0).rgb, 1.0);
-        }
-        case 12u: {
-            return vec4f(glossy_view(view, p), 1.0);
-        }
-        case 13u, 14u, 15u: {
-            return vec4f(glossy_view(view, p), 0.0);
+            return vec4f(select(fract(t.xyz / (frame.cam_pos.w * 131072.0) * 8.0), vec3f(0.0), t.w >= 3.0e38), 0.0);
         }
         default: {
-            return denoise_view(view, p);
+            return vec4f(0.0);
         }
     }
 }
@@ -92,14 +115,14 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let px = min(q, frame.size - 1u);
     let i = px.y * frame.size.x + px.x;
     var c: vec3f;
-    if frame.view == 0u {
+    if display.map == 0u {
         var l = hdr[i].rgb;
         if frame.accumulated > 0u {
             l = accumulation[i].rgb / f32(frame.accumulated);
         }
         c = aces(max(l * frame.exposure, vec3f(0.0)));
     } else {
-        let d = debug_view(frame.view, vec2i(px));
+        let d = debug_view(vec2i(px));
         c = select(clamp(d.rgb, vec3f(0.0), vec3f(1.0)), aces(max(d.rgb * frame.exposure, vec3f(0.0))), d.a > 0.5);
     }
     if display.encode_srgb != 0u {

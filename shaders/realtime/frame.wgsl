@@ -15,8 +15,6 @@ struct Frame {
     jitter: vec2f,
     size: vec2u,
     index: u32,
-    // Debug view shown by realtime/display.wgsl (engine/src/frame/views.rs: View).
-    view: u32,
     // Exposure multiplier 2^EV.
     exposure: f32,
     // Frames summed in the accumulation buffer (accumulate mode), 0 when off.
@@ -27,6 +25,7 @@ struct Frame {
     representative_roughness: f32,
     _pad1: u32,
     _pad2: u32,
+    _pad3: u32,
 }
 
 var<uniform> frame: Frame;

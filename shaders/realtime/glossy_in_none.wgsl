@@ -2,7 +2,3 @@
 fn glossy_light(p: vec2i) -> vec3f {
     return vec3f(0.0);
 }
-
-fn glossy_view(view: u32, p: vec2i) -> vec3f {
-    return vec3f(0.0);
-}

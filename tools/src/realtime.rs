@@ -77,7 +77,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         .view
         .as_deref()
         .map(|name| {
-            View::ALL.into_iter().find(|v| v.name() == name).with_context(|| format!("--view {name:?}: use one of {}", View::ALL.map(|v| v.name()).join(", ")))
+            let v = View::named(name);
+            if !v.is_final() && v.spec().is_none() {
+                let names: Vec<&str> = std::iter::once(View::FINAL.name()).chain(hush_engine::settings::all_views().iter().map(|v| v.name)).collect();
+                bail!("--view {name:?}: use one of {}", names.join(", "));
+            }
+            Ok(v)
         })
         .transpose()?;
     if let Some(dir) = &a.out_dir {
@@ -92,8 +97,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
-    if let Some(v) = view {
-        if v.needs_glossy() && !hush_engine::gpu::PreparedScene::glossy_materials(&scene) {
+    if let Some(v) = &view {
+        if v.spec().is_some_and(|s| s.needs_glossy()) && !hush_engine::gpu::PreparedScene::glossy_materials(&scene) {
             bail!("--view {}: the scene has no glossy buffers", v.name());
         }
     }

@@ -4,7 +4,7 @@
 //! outputs ([`TaaFollow`]).
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::gpu::{Gpu, GpuMemory, GpuTimer};
 use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
@@ -74,15 +74,6 @@ impl Denoiser for Mara {
             // The glossy temporal wrote history[1 - parity] this frame.
             glossy: g.as_ref().map(|g| GlossyFollow { denoised: &g.denoised.1, temporal: &g.history[1 - parity].1, previous: &g.history[parity].1, info: &g.info.1, params: &self.glossy_params }),
         }
-    }
-
-    fn view_bindings(&self) -> Bindings<'_> {
-        let Some((m, g)) = &self.targets else { return Bindings::new() };
-        let mut b = Bindings::new().texture("dv_temporal", &m.temporal.1).texture("dv_reason", &m.reason.1).texture("dv_radius", &m.radius.1).texture("dv_firefly", &m.median.1).texture("dv_denoised", &m.denoised.1);
-        if let Some(g) = g {
-            b = b.texture("gv_motion", &g.motion.1).texture("gv_search", &g.search.1).texture("gv_info", &g.info.1).texture("gv_sigma", &g.scratch.1).texture("gv_denoised", &g.denoised.1);
-        }
-        b
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {

@@ -17,7 +17,7 @@ use crate::gpu::{Gpu, GpuMemory, GpuTimer};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::ChainView;
 use crate::passes::taa::TaaFollow;
-use crate::settings::FrameSettings;
+use crate::settings::{FrameSettings, ViewSpec};
 use anyhow::{Result, bail};
 use std::sync::RwLock;
 
@@ -72,14 +72,12 @@ pub trait Denoiser {
         TaaFollow::default()
     }
 
-    /// Its textures for the display's debug views, by WGSL name.
-    fn view_bindings(&self) -> crate::gpu::Bindings<'_> {
-        crate::gpu::Bindings::new()
-    }
-
     /// Its pipelines, for hot reload.
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload>;
 }
+
+/// Makes a denoiser for a scene.
+pub type MakeDenoiser = fn(&Gpu, &DenoiserScene) -> Result<Box<dyn Denoiser>>;
 
 /// A denoiser the frame can be asked for by name.
 #[derive(Clone, Copy)]
@@ -89,13 +87,15 @@ pub struct Entry {
     /// One line for the viewer and `--help`.
     pub summary: &'static str,
     /// Make it for a scene (None: no denoiser, the raw frame).
-    pub make: Option<fn(&Gpu, &DenoiserScene) -> Result<Box<dyn Denoiser>>>,
+    pub make: Option<MakeDenoiser>,
+    /// Its debug views: textures it allocates, by label, and how to show them.
+    pub views: &'static [ViewSpec],
 }
 
 /// The denoisers built into Hush.
 pub const BUILT_IN: &[Entry] = &[
-    Entry { name: "none", summary: "the raw 1-sample frame (composite only)", make: None },
-    Entry { name: "mara", summary: "Mara et al. 2017: the matte and glossy chains, then TAA", make: Some(mara::make) },
+    Entry { name: "none", summary: "the raw 1-sample frame (composite only)", make: None, views: &[] },
+    Entry { name: "mara", summary: "Mara et al. 2017: the matte and glossy chains, then TAA", make: Some(mara::make), views: crate::settings::MARA_VIEWS },
 ];
 
 static REGISTERED: RwLock<Vec<Entry>> = RwLock::new(Vec::new());
@@ -109,6 +109,7 @@ pub fn register(entry: Entry) -> Result<()> {
     }
     r.push(entry);
     crate::settings::add_denoiser_name(entry.name);
+    crate::settings::register_views(entry.views);
     Ok(())
 }
 

@@ -128,10 +128,10 @@ impl PreparedScene {
         r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
         // matte, direct, and with a glossy lobe glossy, reflection, mirror and mirror hit.
         r.max_storage_textures_per_shader_stage = if self.features.glossy { 6 } else { 2 };
-        // The display reads the G-buffer (7), trace outputs (2, +4 glossy) and the chains'
-        // intermediates (5 matte, +5 glossy): 23 in a glossy scene (WebGPU's default is 16;
-        // desktop Vulkan, Metal and D3D12 adapters offer far more).
-        r.max_sampled_textures_per_shader_stage = if self.features.glossy { 23 } else { 14 };
+        // TAA reads the most: the G-buffer (7), the trace's outputs (2, +4 glossy), its four
+        // histories and the denoiser's light it follows (2, +3 glossy): 22 in a glossy scene
+        // (WebGPU's default is 16; desktop Vulkan, Metal and D3D12 adapters offer far more).
+        r.max_sampled_textures_per_shader_stage = if self.features.glossy { 22 } else { 15 };
         r
     }
 }
@@ -166,12 +166,12 @@ impl Renderer {
         let d = &gpu.device;
         let params_buf = memory.buffer(d, "frame/scene params", size_of::<TraceParams>() as u64, u);
         let frame_buf = memory.buffer(d, "frame/params", size_of::<FrameParams>() as u64, u);
-        let display_buf = memory.buffer(d, "display/options", 16, u);
+        let display_buf = memory.buffer(d, "display/options", 32, u);
         let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
         let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
         let io = targets.io(&frame_buf, gpu_scene.objects.as_ref());
-        let fb = FrameBuffers { io, shown: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: None, glossy: None, views: Default::default() };
+        let fb = FrameBuffers { io, shown: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: None, glossy: None };
         let composite = CompositePass::new(gpu, &fb).context("creating the composite pass")?;
         let taa = TaaStage::new(gpu, &mut memory, prepared.features.animated);
         let timer = GpuTimer::new(gpu, TIMED_PASSES);
@@ -366,12 +366,11 @@ impl Renderer {
             jitter: jitter.to_array(),
             size: [size.0, size.1],
             index: self.frame_index,
-            view: settings.view as u32,
             exposure: settings.exposure_scale(),
             accumulated: self.accumulated,
             paths: settings.paths_per_pixel.clamp(1, 64),
             representative_roughness: if denoiser.is_some() && settings.glossy.trace_representative_ray && settings.glossy.reflection_mv != crate::settings::ReflectionMv::Primary { settings.glossy.roughness_threshold } else { 0.0 },
-            _pad: [0; 2],
+            _pad: [0; 3],
         };
         let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
         let tp = make_params(&self.prepared, &trace_view);
@@ -379,7 +378,7 @@ impl Renderer {
         gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
         self.denoised_last = denoiser;
         if let Some(target) = target {
-            self.prepare_display(gpu, target)?;
+            self.prepare_display(gpu, target, settings)?;
         }
         drop(setup);
 
@@ -410,7 +409,7 @@ impl Renderer {
         let accumulation = t.accumulation.as_ref().unwrap_or(&self.no_accumulation);
         let fb = |p: usize| {
             let out = denoiser.map(|d| d.output(p)).unwrap_or_default();
-            FrameBuffers { io, shown: &t.hdr, accumulation, display: &self.display_buf, matte: out.matte, glossy: out.glossy, views: Default::default() }
+            FrameBuffers { io, shown: &t.hdr, accumulation, display: &self.display_buf, matte: out.matte, glossy: out.glossy }
         };
         let pass = crate::profile::scope(crate::passes::composite::COMPOSITE);
         self.composite.record(gpu, &mut enc, output_key, fb, parity, self.timer.as_mut())?;
@@ -420,10 +419,11 @@ impl Renderer {
             let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, &cx.view);
             self.taa.record(gpu, &mut enc, output_key, &io, |p| d.taa_follow(p), &dp, parity, self.timer.as_mut())?;
         }
-        let shown = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, denoiser, self.taa.output());
+        let shown = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, denoiser.is_some(), self.taa.output());
         if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
             let _pass = crate::profile::scope(crate::passes::composite::DISPLAY);
-            d.record(gpu, &mut enc, output_key, &shown, target.view, self.timer.as_mut())?;
+            let (view, view_key) = view_texture(t, settings);
+            d.record(gpu, &mut enc, output_key * 1024 + view_key, &shown, view, target.view, self.timer.as_mut())?;
         }
         if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
             p.record_copy(&mut enc, &t.gbuffer, size);
@@ -450,52 +450,63 @@ impl Renderer {
     /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
     pub fn redisplay(&mut self, gpu: &Gpu, settings: &FrameSettings, target: &DisplayTarget) -> Result<()> {
         gpu.validated("displaying the frame", || {
-            self.prepare_display(gpu, target)?;
-            // Only the view and exposure change; the rest of the uniform is the last frame's.
-            gpu.queue.write_buffer(&self.frame_buf, std::mem::offset_of!(FrameParams, view) as u64, bytemuck::bytes_of(&(settings.view as u32)));
+            self.prepare_display(gpu, target, settings)?;
+            // Only the exposure changes; the rest of the uniform is the last frame's.
             gpu.queue.write_buffer(&self.frame_buf, std::mem::offset_of!(FrameParams, exposure) as u64, bytemuck::bytes_of(&settings.exposure_scale()));
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             let t = &self.targets;
             let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
-            let last = self.denoised_last.map(|i| &*self.denoisers[i].denoiser);
-            let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, last, self.taa.output());
+            let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, self.denoised_last.is_some(), self.taa.output());
             let key = (self.gpu_scene.generation * 1_000_003 + t.generation) * 64 + self.denoised_last.map_or(0, |i| i as u64 + 1);
+            let (view, view_key) = view_texture(t, settings);
             if let Some(d) = self.display.as_mut() {
-                d.record(gpu, &mut enc, key, &fb, target.view, None)?;
+                d.record(gpu, &mut enc, key * 1024 + view_key, &fb, view, target.view, None)?;
             }
             gpu.queue.submit([enc.finish()]);
             Ok(())
         })
     }
 
-    /// Make the display pass for `target`'s format (again when the denoiser's views appeared
-    /// or went) and write its options.
-    fn prepare_display(&mut self, gpu: &Gpu, target: &DisplayTarget) -> Result<()> {
-        let t = &self.targets;
-        let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
-        let last = self.denoised_last.map(|i| &*self.denoisers[i].denoiser);
-        let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, last, self.taa.output());
-        let with_denoise = fb.views.get("dv_temporal").is_some();
-        if self.display.as_ref().is_none_or(|d| d.format != target.format || d.with_denoise != with_denoise) {
+    /// Make the display pass for `target`'s format and write its options (the view's map).
+    fn prepare_display(&mut self, gpu: &Gpu, target: &DisplayTarget, settings: &FrameSettings) -> Result<()> {
+        if self.display.as_ref().is_none_or(|d| d.format != target.format) {
+            let t = &self.targets;
+            let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
+            let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, false, None);
             self.display = Some(DisplayPass::new(gpu, &fb, target.format).context("creating the display pass")?);
         }
+        let spec = match settings.view.is_final() {
+            true => None,
+            false => Some(settings.view.spec().with_context(|| format!("no view {:?}", settings.view.name()))?),
+        };
+        let (map, channel, param) = spec.map_or((0, 0, 0.0), |s| s.map.encode(self.targets.size.0));
         let srgb = !target.format.is_srgb() as u32;
-        gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&[srgb, 0, target.size.0, target.size.1]));
+        let options: [u32; 8] = [srgb, map, target.size.0, target.size.1, channel, param.to_bits(), 0, 0];
+        gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&options));
         Ok(())
     }
 }
 
-/// What the display reads: the image after TAA when a denoiser ran, else the composite's; the
-/// raw light; the denoiser's intermediates for its views.
-fn shown_buffers<'a>(t: &'a Targets, io: &FrameIo<'a>, display: &'a wgpu::Buffer, no_accumulation: &'a wgpu::Buffer, denoiser: Option<&'a dyn Denoiser>, taa: Option<&'a wgpu::Buffer>) -> FrameBuffers<'a> {
+/// The texture `settings.view` shows, if this frame has it (a denoiser's view is black until
+/// the denoiser has run), and a key that changes with it.
+fn view_texture<'a>(t: &'a Targets, settings: &FrameSettings) -> (Option<&'a wgpu::Texture>, u64) {
+    let views = crate::settings::all_views();
+    let Some(i) = views.iter().position(|v| v.name == settings.view.name()) else { return (None, 0) };
+    match t.memory.find_texture(views[i].texture) {
+        Some(tex) => (Some(tex), i as u64 + 1),
+        None => (None, 0),
+    }
+}
+
+/// What the display reads: the image after TAA when a denoiser ran, else the composite's.
+fn shown_buffers<'a>(t: &'a Targets, io: &FrameIo<'a>, display: &'a wgpu::Buffer, no_accumulation: &'a wgpu::Buffer, denoised: bool, taa: Option<&'a wgpu::Buffer>) -> FrameBuffers<'a> {
     FrameBuffers {
         io: *io,
-        shown: denoiser.and(taa).unwrap_or(&t.hdr),
+        shown: taa.filter(|_| denoised).unwrap_or(&t.hdr),
         accumulation: t.accumulation.as_ref().unwrap_or(no_accumulation),
         display,
         matte: None,
         glossy: None,
-        views: denoiser.map(|d| d.view_bindings()).unwrap_or_default(),
     }
 }
 

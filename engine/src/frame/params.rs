@@ -18,14 +18,13 @@ pub struct FrameParams {
     pub jitter: [f32; 2],
     pub size: [u32; 2],
     pub index: u32,
-    pub view: u32,
     pub exposure: f32,
     pub accumulated: u32,
     pub paths: u32,
     /// Glossy surfaces below this roughness also trace their representative (mirror) ray for
     /// the glossy chain's reflection motion vectors (0: none do).
     pub representative_roughness: f32,
-    pub _pad: [u32; 2],
+    pub _pad: [u32; 3],
 }
 
 /// A camera in the GPU scene's rebased space, as both the raster and the tracer see it.

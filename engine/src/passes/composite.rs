@@ -21,8 +21,6 @@ pub struct FrameBuffers<'a> {
     /// The light the composite remodulates: the denoiser's output (None: the trace's).
     pub matte: Option<&'a wgpu::TextureView>,
     pub glossy: Option<&'a wgpu::TextureView>,
-    /// The denoiser's intermediates, for the display's debug views (`dv_*`, `gv_*`).
-    pub views: Bindings<'a>,
 }
 
 /// What the composite binds (`shown` as `hdr` for the display, `io.hdr` for the composite).
@@ -34,25 +32,11 @@ fn inputs<'a>(b: &FrameBuffers<'a>, hdr: &'a wgpu::Buffer) -> Bindings<'a> {
     if let (Some(g), true) = (b.glossy, b.io.trace.glossy.is_some()) {
         s = s.texture("tr_glossy", g);
     }
-    s.buffer("hdr", hdr).buffer("accumulation", b.accumulation).buffer("display", b.display).with(&b.views)
+    s.buffer("hdr", hdr).buffer("accumulation", b.accumulation).buffer("display", b.display)
 }
 
-fn modules(glossy: bool, denoise: bool, glossy_chain: bool, last: &'static str) -> Vec<&'static str> {
-    let mut m = vec![
-        "common/math.wgsl",
-        "common/rng.wgsl",
-        "realtime/frame.wgsl",
-        "realtime/gbuffer_in.wgsl",
-        if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" },
-    ];
-    if last == "realtime/display.wgsl" {
-        m.push(if denoise { "realtime/denoise_views.wgsl" } else { "realtime/denoise_views_none.wgsl" });
-        if denoise {
-            m.push(if glossy_chain { "glossy/views.wgsl" } else { "glossy/views_none.wgsl" });
-        }
-    }
-    m.push(last);
-    m
+fn modules(glossy: bool, last: &'static str) -> Vec<&'static str> {
+    vec!["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" }, last]
 }
 
 pub struct CompositePass {
@@ -62,7 +46,7 @@ pub struct CompositePass {
 
 impl CompositePass {
     pub fn new(gpu: &Gpu, b: &FrameBuffers) -> Result<CompositePass> {
-        let modules = modules(b.io.trace.glossy.is_some(), false, false, "realtime/composite.wgsl");
+        let modules = modules(b.io.trace.glossy.is_some(), "realtime/composite.wgsl");
         let pipeline = Reloadable::new(gpu, COMPOSITE, "", &modules, wgpu::ShaderStages::COMPUTE, &inputs(b, b.io.hdr), |d, m, l| compute_pipeline(d, COMPOSITE, m, l, "main"))?;
         Ok(CompositePass { pipeline, groups: BindCache::default() })
     }
@@ -84,19 +68,35 @@ impl CompositePass {
     }
 }
 
+/// Where a debug view's texture is bound (display.wgsl's `view_float` or `view_uint`); depth
+/// is read from the G-buffer's own binding.
+fn view_slot(format: wgpu::TextureFormat) -> Option<&'static str> {
+    match format.sample_type(None, None) {
+        _ if format.is_depth_stencil_format() => None,
+        Some(wgpu::TextureSampleType::Uint) => Some("view_uint"),
+        Some(wgpu::TextureSampleType::Float { .. }) => Some("view_float"),
+        _ => None,
+    }
+}
+
 pub struct DisplayPass {
     pub pipeline: Reloadable<wgpu::RenderPipeline>,
     groups: BindCache,
     pub format: wgpu::TextureFormat,
-    /// Whether it shows the denoiser's views (its layout binds their textures).
-    pub with_denoise: bool,
+    /// One zero texel each, bound in the view slot the shown texture does not use.
+    zero_float: (wgpu::Texture, wgpu::TextureView),
+    zero_uint: (wgpu::Texture, wgpu::TextureView),
 }
 
 impl DisplayPass {
     pub fn new(gpu: &Gpu, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
-        let (denoise, glossy_chain) = (b.views.get("dv_temporal").is_some(), b.views.get("gv_motion").is_some());
-        let modules = modules(b.io.trace.glossy.is_some(), denoise, glossy_chain, "realtime/display.wgsl");
-        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, wgpu::ShaderStages::FRAGMENT, &inputs(b, b.shown), move |d, module, pl| {
+        let mut mem = crate::gpu::GpuMemory::default();
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING;
+        let zero_float = mem.texture(&gpu.device, "display/no float view", (1, 1), wgpu::TextureFormat::Rgba16Float, usage);
+        let zero_uint = mem.texture(&gpu.device, "display/no uint view", (1, 1), wgpu::TextureFormat::R32Uint, usage);
+        let offered = inputs(b, b.shown).texture("view_float", &zero_float.1).texture("view_uint", &zero_uint.1);
+        let modules = modules(b.io.trace.glossy.is_some(), "realtime/display.wgsl");
+        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, wgpu::ShaderStages::FRAGMENT, &offered, move |d, module, pl| {
             d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(DISPLAY),
                 layout: Some(pl),
@@ -109,13 +109,22 @@ impl DisplayPass {
                 cache: None,
             })
         })?;
-        Ok(DisplayPass { pipeline, groups: BindCache::default(), format, with_denoise: denoise })
+        Ok(DisplayPass { pipeline, groups: BindCache::default(), format, zero_float, zero_uint })
     }
 
+    /// `view`: the texture the debug view shows (None for the image); `key` must change with it.
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, b: &FrameBuffers, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, b: &FrameBuffers, view: Option<&wgpu::Texture>, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) -> Result<()> {
         let p = &self.pipeline;
-        let groups = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &inputs(b, b.shown)))?;
+        let (zf, zu) = (&self.zero_float.1, &self.zero_uint.1);
+        let groups = self.groups.get(key, p.builds(), 1, 0, |_| {
+            let shown = view.map(|t| (view_slot(t.format()), t.create_view(&Default::default())));
+            let mut r = inputs(b, b.shown).texture("view_float", zf).texture("view_uint", zu);
+            if let Some((Some(slot), v)) = &shown {
+                r = r.texture(slot, v);
+            }
+            p.bind_groups(&gpu.device, &r)
+        })?;
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(DISPLAY),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: target, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store } })],

@@ -36,7 +36,7 @@ fn names<T: serde::Serialize>(all: &[T]) -> Vec<String> {
 }
 
 fn views() -> Vec<String> {
-    names(&View::ALL)
+    std::iter::once(View::FINAL.name().to_string()).chain(super::all_views().into_iter().map(|v| v.name.to_string())).collect()
 }
 fn denoisers() -> Vec<String> {
     super::denoiser_names().into_iter().map(str::to_string).collect()

@@ -6,7 +6,7 @@ mod preset;
 mod view;
 
 pub use fields::{FIELDS, Field, Kind, get as get_field, get_mut as get_field_mut, leaves};
-pub use view::View;
+pub use view::{FRAME_VIEWS, MARA_VIEWS, View, ViewMap, ViewSpec, all_views, register_views};
 
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -44,13 +44,12 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::Final, denoiser: Denoiser::NONE, matte: MatteSettings::default(), glossy: GlossySettings::default(), paths_per_pixel: 1 }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), glossy: GlossySettings::default(), paths_per_pixel: 1 }
     }
 }
 
 /// Which denoiser filters the 1-sample frame: the name of one in `crate::denoise`'s registry
-/// (`none`, `mara`, or one registered by the application). Written in lower case; presets may
-/// spell it in any case.
+/// (`none`, `mara`, or one registered by the application), as presets and `--denoiser` spell it.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 #[serde(transparent)]
 pub struct Denoiser(Cow<'static, str>);
@@ -62,7 +61,7 @@ impl Denoiser {
     pub const MARA: Denoiser = Denoiser(Cow::Borrowed("mara"));
 
     pub fn named(name: &str) -> Denoiser {
-        Denoiser(Cow::Owned(name.to_ascii_lowercase()))
+        Denoiser(Cow::Owned(name.to_string()))
     }
 
     pub fn name(&self) -> &str {
@@ -80,7 +79,7 @@ impl<'de> Deserialize<'de> for Denoiser {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let name = String::deserialize(d)?;
         let known = denoiser_names();
-        if !known.iter().any(|k| k.eq_ignore_ascii_case(&name)) {
+        if !known.contains(&name.as_str()) {
             return Err(serde::de::Error::custom(format!("no denoiser {name:?} (there are {})", known.join(", "))));
         }
         Ok(Denoiser::named(&name))

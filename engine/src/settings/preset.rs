@@ -40,7 +40,7 @@ mod tests {
 
     #[test]
     fn settings_round_trip_through_a_preset_file() {
-        let mut s = FrameSettings { exposure_ev: -1.25, max_depth: 4, seed: 7, denoiser: Denoiser::MARA, paths_per_pixel: 2, view: crate::settings::View::GlossySigma, ..Default::default() };
+        let mut s = FrameSettings { exposure_ev: -1.25, max_depth: 4, seed: 7, denoiser: Denoiser::MARA, paths_per_pixel: 2, view: crate::settings::View::named("glossy/sigma"), ..Default::default() };
         s.matte.hysteresis = 0.9;
         s.matte.firefly = false;
         s.matte.taps = 32;
@@ -56,7 +56,7 @@ mod tests {
 
     #[test]
     fn a_partial_preset_keeps_the_other_defaults() {
-        let s = FrameSettings::from_toml("denoiser = \"Mara\"\n[matte]\nfirefly = false\n").unwrap();
+        let s = FrameSettings::from_toml("denoiser = \"mara\"\n[matte]\nfirefly = false\n").unwrap();
         assert_eq!(s, FrameSettings { denoiser: Denoiser::MARA, matte: crate::settings::MatteSettings { firefly: false, ..Default::default() }, ..Default::default() });
         let e = format!("{:#}", FrameSettings::from_toml("[glossy]\nsigma_scael = 3.0\n").unwrap_err());
         assert!(e.contains("glossy.sigma_scael"), "{e}");
@@ -65,7 +65,7 @@ mod tests {
     #[test]
     fn a_preset_names_its_path_length_only_when_it_sets_one() {
         let path = std::env::temp_dir().join(format!("hush-preset-depth-{}.toml", std::process::id()));
-        std::fs::write(&path, "denoiser = \"Mara\"\n").unwrap();
+        std::fs::write(&path, "denoiser = \"mara\"\n").unwrap();
         let without = FrameSettings::preset_max_depth(&path).unwrap();
         std::fs::write(&path, "max_depth = 3\n").unwrap();
         let with = FrameSettings::preset_max_depth(&path).unwrap();

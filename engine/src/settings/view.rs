@@ -1,118 +1,181 @@
-//! What the display shows: the image or one buffer of the frame (shaders/realtime/display.wgsl).
+//! What the display shows: the image, or any labelled texture of the frame through a small
+//! mapping (shaders/realtime/display.wgsl). A stage offers a debug view by naming one of its
+//! textures and a [`ViewMap`]: no WGSL and no enum variant per view.
 
-/// Debug views, numbered as the display shader's `frame.view`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-pub enum View {
-    #[default]
-    Final = 0,
-    Depth = 1,
-    Normal = 2,
-    BaseColor = 3,
-    Metallic = 4,
-    Roughness = 5,
-    SpecularF0 = 6,
-    Emission = 7,
-    ObjectId = 8,
-    Motion = 9,
-    MatteLight = 10,
-    DirectLight = 11,
-    GlossyLight = 12,
-    GlossyHitDistance = 13,
-    VirtualPosition = 14,
-    MirrorDirection = 15,
-    MatteTemporal = 16,
-    MatteConfidence = 17,
-    MatteRejection = 18,
-    MatteRadius = 19,
-    MatteFirefly = 20,
-    MatteDenoised = 21,
-    GlossyMotion = 22,
-    GlossyVirtualMotion = 23,
-    GlossyMotionDisagreement = 24,
-    GlossySearchSteps = 25,
-    GlossyConfidence = 26,
-    GlossyClipping = 27,
-    GlossySigma = 28,
-    GlossyDenoised = 29,
-}
+use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
+use std::sync::RwLock;
+
+/// A debug view's name (`gbuffer/normal`, `matte/confidence`, ...), or `final`: the image.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(transparent)]
+pub struct View(Cow<'static, str>);
 
 impl View {
-    pub const ALL: [View; 30] = [
-        View::Final,
-        View::Depth,
-        View::Normal,
-        View::BaseColor,
-        View::Metallic,
-        View::Roughness,
-        View::SpecularF0,
-        View::Emission,
-        View::ObjectId,
-        View::Motion,
-        View::MatteLight,
-        View::DirectLight,
-        View::GlossyLight,
-        View::GlossyHitDistance,
-        View::VirtualPosition,
-        View::MirrorDirection,
-        View::MatteTemporal,
-        View::MatteConfidence,
-        View::MatteRejection,
-        View::MatteRadius,
-        View::MatteFirefly,
-        View::MatteDenoised,
-        View::GlossyMotion,
-        View::GlossyVirtualMotion,
-        View::GlossyMotionDisagreement,
-        View::GlossySearchSteps,
-        View::GlossyConfidence,
-        View::GlossyClipping,
-        View::GlossySigma,
-        View::GlossyDenoised,
-    ];
+    pub const FINAL: View = View(Cow::Borrowed("final"));
 
-    /// The pass output it shows, as named in labels and the profiler.
-    pub fn name(self) -> &'static str {
+    pub fn named(name: &str) -> View {
+        View(Cow::Owned(name.to_string()))
+    }
+
+    pub fn name(&self) -> &str {
+        &self.0
+    }
+
+    pub fn is_final(&self) -> bool {
+        *self == View::FINAL
+    }
+
+    /// The view of this name among the built-in and registered ones.
+    pub fn spec(&self) -> Option<ViewSpec> {
+        all_views().into_iter().find(|v| v.name == self.name())
+    }
+}
+
+impl Default for View {
+    fn default() -> Self {
+        View::FINAL
+    }
+}
+
+impl<'de> Deserialize<'de> for View {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        if name != View::FINAL.name() && !all_views().iter().any(|v| v.name == name) {
+            return Err(serde::de::Error::custom(format!("no view {name:?}")));
+        }
+        Ok(View::named(&name))
+    }
+}
+
+/// How the display turns a texel into a colour (`display.map` in shaders/realtime/display.wgsl;
+/// the numbers are that shader's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewMap {
+    /// Radiance in rgb: exposed and tone-mapped like the image.
+    Light,
+    /// Data in rgb, clamped to [0, 1].
+    Color,
+    /// One channel divided by `divisor`, as grey.
+    Grey { channel: u32, divisor: f32 },
+    /// One channel over this fraction of the frame's width (at least 1), as grey.
+    GreyPerWidth { channel: u32, fraction: f32 },
+    /// Two channels from `channel` as pixels of motion: hue = direction, brightness = length
+    /// (1 px = 0.25).
+    Motion { channel: u32 },
+    /// The G-buffer's octahedral normal, black off the surface.
+    Normal,
+    /// The G-buffer's reversed-Z depth, near bright (depth^0.25).
+    Depth,
+    /// A u32 id (channel 0) hashed to a colour, black off the surface.
+    Id,
+    /// History rejection flags in the low bits of a u32 (`matte/reason`): red disoccluded,
+    /// yellow low confidence, plus blue where clamped.
+    Flags,
+    /// An octahedral direction packed as two snorm16 in a u32.
+    PackedDirection,
+    /// A distance in alpha over 2^17 ray offsets (the scene's extent), white from 65000 on.
+    Distance,
+    /// A position in rgb over the scene's extent, as bands (black where alpha marks a miss).
+    Position,
+}
+
+impl ViewMap {
+    /// (map, channel, parameter) as the display's uniform carries them.
+    pub fn encode(self, width: u32) -> (u32, u32, f32) {
         match self {
-            View::Final => "final",
-            View::Depth => "gbuffer/depth",
-            View::Normal => "gbuffer/normal",
-            View::BaseColor => "gbuffer/base_color",
-            View::Metallic => "gbuffer/metallic",
-            View::Roughness => "gbuffer/roughness",
-            View::SpecularF0 => "gbuffer/specular F0",
-            View::Emission => "gbuffer/emission",
-            View::ObjectId => "gbuffer/object id",
-            View::Motion => "gbuffer/motion",
-            View::MatteLight => "trace/matte",
-            View::DirectLight => "trace/direct",
-            View::GlossyLight => "trace/glossy",
-            View::GlossyHitDistance => "trace/glossy hit distance",
-            View::VirtualPosition => "trace/virtual position",
-            View::MirrorDirection => "trace/mirror direction",
-            View::MatteTemporal => "matte/temporal",
-            View::MatteConfidence => "matte/confidence",
-            View::MatteRejection => "matte/history rejection",
-            View::MatteRadius => "matte/disocclusion radius",
-            View::MatteFirefly => "matte/firefly",
-            View::MatteDenoised => "matte/bilateral",
-            View::GlossyMotion => "glossy/motion",
-            View::GlossyVirtualMotion => "glossy/virtual motion",
-            View::GlossyMotionDisagreement => "glossy/motion disagreement",
-            View::GlossySearchSteps => "glossy/search steps",
-            View::GlossyConfidence => "glossy/confidence",
-            View::GlossyClipping => "glossy/clipping",
-            View::GlossySigma => "glossy/sigma",
-            View::GlossyDenoised => "glossy/bilateral",
+            ViewMap::Light => (1, 0, 0.0),
+            ViewMap::Color => (2, 0, 0.0),
+            ViewMap::Grey { channel, divisor } => (3, channel, divisor),
+            ViewMap::GreyPerWidth { channel, fraction } => (3, channel, (width as f32 * fraction).max(1.0)),
+            ViewMap::Motion { channel } => (4, channel, 0.0),
+            ViewMap::Normal => (5, 0, 0.0),
+            ViewMap::Depth => (6, 0, 0.0),
+            ViewMap::Id => (7, 0, 0.0),
+            ViewMap::Flags => (8, 0, 0.0),
+            ViewMap::PackedDirection => (9, 0, 0.0),
+            ViewMap::Distance => (10, 3, 0.0),
+            ViewMap::Position => (11, 0, 0.0),
         }
     }
+}
 
+/// A debug view: a name, the label of the texture it shows, and how.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewSpec {
+    pub name: &'static str,
+    pub texture: &'static str,
+    pub map: ViewMap,
+}
+
+impl ViewSpec {
     /// Views of buffers that exist only in scenes with a specular lobe.
-    pub fn needs_glossy(self) -> bool {
-        (View::GlossyLight as u32..=View::MirrorDirection as u32).contains(&(self as u32)) || self as u32 >= View::GlossyMotion as u32
+    pub fn needs_glossy(&self) -> bool {
+        self.texture.starts_with("glossy/") || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
     }
+}
 
-    /// Views of the denoiser's intermediates (black until it has run).
-    pub fn needs_denoiser(self) -> bool {
-        (self as u32) >= View::MatteTemporal as u32
+const fn v(name: &'static str, texture: &'static str, map: ViewMap) -> ViewSpec {
+    ViewSpec { name, texture, map }
+}
+
+/// The frame's own views: the G-buffer and the trace's outputs.
+pub const FRAME_VIEWS: &[ViewSpec] = &[
+    v("gbuffer/depth", "gbuffer/depth", ViewMap::Depth),
+    v("gbuffer/normal", "gbuffer/normal", ViewMap::Normal),
+    v("gbuffer/base_color", "gbuffer/base_color", ViewMap::Color),
+    v("gbuffer/metallic", "gbuffer/base_color", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v("gbuffer/roughness", "gbuffer/specular", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v("gbuffer/specular F0", "gbuffer/specular", ViewMap::Color),
+    v("gbuffer/emission", "gbuffer/emission", ViewMap::Light),
+    v("gbuffer/object id", "gbuffer/ids", ViewMap::Id),
+    v("gbuffer/motion", "gbuffer/motion", ViewMap::Motion { channel: 0 }),
+    v("trace/matte", "trace/matte", ViewMap::Light),
+    v("trace/direct", "trace/direct", ViewMap::Light),
+    v("trace/glossy", "trace/glossy", ViewMap::Light),
+    v("trace/glossy hit distance", "trace/glossy", ViewMap::Distance),
+    v("trace/virtual position", "trace/reflection", ViewMap::Position),
+    v("trace/mirror direction", "trace/mirror", ViewMap::PackedDirection),
+];
+
+/// The views of the Mara denoiser's chains (`crate::denoise::mara`), kept here beside their
+/// settings so that presets can name them before any denoiser exists.
+pub const MARA_VIEWS: &[ViewSpec] = &[
+    v("matte/temporal", "matte/temporal", ViewMap::Light),
+    v("matte/confidence", "matte/temporal", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v("matte/history rejection", "matte/reason", ViewMap::Flags),
+    // The radius over R (the disocclusion radius at full strength is white).
+    v("matte/disocclusion radius", "matte/radius", ViewMap::GreyPerWidth { channel: 0, fraction: 0.05 }),
+    v("matte/firefly", "matte/firefly", ViewMap::Light),
+    v("matte/bilateral", "matte/bilateral", ViewMap::Light),
+    v("glossy/motion", "glossy/motion", ViewMap::Motion { channel: 0 }),
+    v("glossy/virtual motion", "glossy/motion", ViewMap::Motion { channel: 2 }),
+    // Pixels between the diamond search and the virtual position (or the brute-force search
+    // when it runs); 4 px is white.
+    v("glossy/motion disagreement", "glossy/search", ViewMap::Grey { channel: 1, divisor: 4.0 }),
+    // Large-pattern iterations; 16 is white.
+    v("glossy/search steps", "glossy/search", ViewMap::Grey { channel: 0, divisor: 16.0 }),
+    v("glossy/confidence", "glossy/info", ViewMap::Grey { channel: 0, divisor: 1.0 }),
+    v("glossy/clipping", "glossy/info", ViewMap::Grey { channel: 1, divisor: 1.0 }),
+    // The bilateral's sigma over 9 px (GlossySettings' largest).
+    v("glossy/sigma", "glossy/scratch", ViewMap::Grey { channel: 3, divisor: 9.0 }),
+    v("glossy/bilateral", "glossy/denoised", ViewMap::Light),
+];
+
+/// Views that denoisers registered beside the built-in ones.
+static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
+
+/// Add a stage's views (names already known are skipped).
+pub fn register_views(views: &[ViewSpec]) {
+    let mut r = REGISTERED.write().unwrap();
+    for v in views {
+        if !FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(r.iter()).any(|k| k.name == v.name) {
+            r.push(*v);
+        }
     }
+}
+
+/// Every view: the frame's, then the denoisers'.
+pub fn all_views() -> Vec<ViewSpec> {
+    FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(REGISTERED.read().unwrap().iter()).copied().collect()
 }

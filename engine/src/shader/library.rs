@@ -59,6 +59,18 @@ impl ShaderLibrary {
         self.dir.as_deref()
     }
 
+    /// A module that is not one of `shaders/` (a denoiser an application or a test brings),
+    /// composed into programs by its path like any other; an error if the path is taken by
+    /// `shaders/` or by another text.
+    pub fn add(&self, module: &'static str, text: &str) -> Result<()> {
+        let mut texts = self.texts.write().unwrap();
+        if SOURCES.iter().any(|(n, _)| *n == module) || texts.get(module).is_some_and(|t| **t != *text) {
+            return Err(anyhow!("shader module {module:?} already exists"));
+        }
+        texts.insert(module, Arc::from(text));
+        Ok(())
+    }
+
     pub fn source(&self, module: &str) -> Result<Arc<str>> {
         if let Some(t) = self.texts.read().unwrap().get(module) {
             return Ok(t.clone());

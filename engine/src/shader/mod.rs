@@ -77,8 +77,6 @@ embed!(
     "realtime/glossy_in_none.wgsl",
     "realtime/composite.wgsl",
     "realtime/display.wgsl",
-    "realtime/denoise_views.wgsl",
-    "realtime/denoise_views_none.wgsl",
     "matte/common.wgsl",
     "matte/sparse_bilateral.wgsl",
     "matte/temporal.wgsl",
@@ -97,8 +95,6 @@ embed!(
     "glossy/prefilter.wgsl",
     "glossy/temporal.wgsl",
     "glossy/bilateral.wgsl",
-    "glossy/views.wgsl",
-    "glossy/views_none.wgsl",
     "accel/raycast.wgsl",
 );
 
@@ -248,12 +244,8 @@ mod tests {
         for glossy in ["realtime/glossy_in.wgsl", "realtime/glossy_in_none.wgsl"] {
             let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/composite.wgsl"];
             v.push(compose("realtime/composite.wgsl", "", &m).unwrap());
-            let display = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/denoise_views_none.wgsl", "realtime/display.wgsl"];
+            let display = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/display.wgsl"];
             v.push(compose("realtime/display.wgsl", "", &display).unwrap());
-            for chain in ["glossy/views.wgsl", "glossy/views_none.wgsl"] {
-                let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/denoise_views.wgsl", chain, "realtime/display.wgsl"];
-                v.push(compose("realtime/display.wgsl", "", &m).unwrap());
-            }
         }
         for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
             for stage in [&["matte/temporal.wgsl"][..], &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"], &["matte/disocclusion.wgsl"], &["matte/firefly.wgsl"], &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"], &["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl", "taa/matte.wgsl", "taa/taa.wgsl"], &["taa/glossy_none.wgsl", "taa/matte_none.wgsl", "taa/taa.wgsl"]] {
@@ -365,8 +357,8 @@ mod tests {
         use crate::frame::FrameParams;
         assert_eq!(size as usize, size_of::<FrameParams>());
         assert_eq!(offs[7] as usize, offset_of!(FrameParams, jitter));
-        assert_eq!(offs[12] as usize, offset_of!(FrameParams, accumulated));
-        assert_eq!(offs[13] as usize, offset_of!(FrameParams, paths));
+        assert_eq!(offs[11] as usize, offset_of!(FrameParams, accumulated));
+        assert_eq!(offs[12] as usize, offset_of!(FrameParams, paths));
         let taa = programs.iter().find(|p| p.label == "taa/taa.wgsl").unwrap();
         let (size, offs) = wgsl_layout(taa, "DenoiseParams");
         use crate::passes::matte::DenoiseParams;
