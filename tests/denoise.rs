@@ -6,7 +6,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::passes::matte::history_rejected;
 use hush_engine::quality::{Image, compare, flip_over, luminance};
 use hush_engine::scene::Camera;
-use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MatteSettings};
+use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MatteSettings, TaaSettings};
 use hush_tests::reproject::{DepthFrame, Surface, neighbours_3x3};
 use hush_tests::{half, oct_normal};
 
@@ -98,20 +98,20 @@ fn denoised_frames_beat_raw_ones() {
 #[test]
 fn nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) = level();
-    let mut cases = vec![MatteSettings::default()];
-    for stage in MatteSettings::STAGES {
-        let mut m = MatteSettings::default();
-        m.disable(stage);
-        cases.push(m);
+    let base = FrameSettings { denoiser: Denoiser::MARA, matte: MatteSettings { inject_nonfinite: true, ..Default::default() }, ..Default::default() };
+    let mut cases = vec![base.clone()];
+    for stage in MatteSettings::STAGES.into_iter().chain([TaaSettings::STAGE]) {
+        let mut s = base.clone();
+        assert!(hush_engine::settings::disable_stage(&mut s, stage));
+        cases.push(s);
     }
-    for mut m in cases {
-        m.inject_nonfinite = true;
-        let s = FrameSettings { denoiser: Denoiser::MARA, matte: m.clone(), ..Default::default() };
+    for s in cases {
+        let m = (&s.matte, &s.taa);
         let img = frames(&mut r, &gpu, &s, view(), 4);
         assert!(img.data.iter().all(|p| p.is_finite()), "non-finite pixel on screen with {m:?}");
         let histories = ["matte/history 0", "matte/history 1", "matte/temporal", "matte/bilateral", "taa/history 0", "taa/history 1"];
         // TAA's averages of the matte and glossy factors and the residual
-        // (MatteSettings::taa_current_light, taa_current_glossy).
+        // (TaaSettings::current_light, current_glossy).
         let taa_averages = ["taa/material 0", "taa/material 1", "taa/residual 0", "taa/residual 1", "taa/glossy 0", "taa/glossy 1"];
         for name in histories.into_iter().chain(taa_averages) {
             let (bytes, format) = r.read_texture(&gpu, name).unwrap();
@@ -147,9 +147,9 @@ fn still_view_keeps_its_history() {
 
 /// Temporal error (Schied et al.: mean absolute luminance change between consecutive frames) of
 /// a still view over frames 40 to 44, against the raw stream's: Hush's target is at most a
-/// tenth. The exponential TAA blend (taa_still_frames = 0) keeps weighing the latest Halton
+/// tenth. The exponential TAA blend (TaaSettings::still_frames = 0) keeps weighing the latest Halton
 /// offsets most, so edges keep flickering; the equal-age blend of a still pixel settles them;
-/// the shown image's second blend (taa_display_ratio) damps what the offsets still move.
+/// the shown image's second blend (TaaSettings::display_ratio) damps what the offsets still move.
 /// Measured at 96x54, 4 frame pairs: raw 0.1132, exponential TAA 0.00385 (1/29), equal-age
 /// 0.00178 (1/64), defaults 0.00047 (1/241). The bounds: a tenth of raw; the equal-age blend
 /// under 0.75x the exponential one (a chain that does not settle edges lands at 1x; measured
@@ -168,10 +168,10 @@ fn still_view_flickers_at_a_tenth_of_raw() {
         }
         sum / PAIRS as f64
     };
-    let shown_as_is = |m: MatteSettings| FrameSettings { matte: MatteSettings { taa_display_ratio: 0.0, ..m }, ..mara() };
+    let shown_as_is = |t: TaaSettings| FrameSettings { taa: TaaSettings { display_ratio: 0.0, ..t }, ..mara() };
     let raw = flicker(&FrameSettings::default());
-    let exponential = flicker(&shown_as_is(MatteSettings { taa_still_frames: 0.0, ..Default::default() }));
-    let equal_age = flicker(&shown_as_is(MatteSettings::default()));
+    let exponential = flicker(&shown_as_is(TaaSettings { still_frames: 0.0, ..Default::default() }));
+    let equal_age = flicker(&shown_as_is(TaaSettings::default()));
     let settled = flicker(&mara());
     println!("temporal error: raw {raw:.5}, exponential TAA {exponential:.5}, equal-age {equal_age:.5}, defaults {settled:.5}");
     assert!(settled <= 0.1 * raw, "temporal error {settled} is over a tenth of raw's {raw}");
@@ -238,7 +238,7 @@ fn history_resets_on_disocclusion() {
 /// After a strafe stops, the picture recovers as fast as a fresh start at the same view: the
 /// histories resampled while moving are blurred, and they count as few frames
 /// (MatteSettings::resampled_history_frames, GlossySettings::resampled_history_frames,
-/// MatteSettings::taa_resampled_frames). 10 still frames, 10 strafing 6 cm each, 10 still
+/// TaaSettings::resampled_frames). 10 still frames, 10 strafing 6 cm each, 10 still
 /// frames, against 10 frames of a fresh start at the end view; FLIP against 128 accumulated
 /// frames of that view. Measured at 96x54: fresh start 0.0842, the stop 0.0799, the stop with
 /// uncapped histories 0.0954. The bounds: within 5% of the fresh start (a different driver's
@@ -258,7 +258,8 @@ fn camera_stop_recovers_like_a_fresh_start() {
         flip(&frames(&mut r, &gpu, &mara(), at(10), 10))
     };
     let uncapped = FrameSettings {
-        matte: MatteSettings { resampled_history_frames: 0.0, taa_resampled_frames: 0.0, ..Default::default() },
+        matte: MatteSettings { resampled_history_frames: 0.0, ..Default::default() },
+        taa: TaaSettings { resampled_frames: 0.0, ..Default::default() },
         glossy: GlossySettings { resampled_history_frames: 0.0, ..Default::default() },
         ..mara()
     };
@@ -278,10 +279,10 @@ fn camera_stop_recovers_like_a_fresh_start() {
 /// Measured at 96x54 over 144 pixels: a fresh start 0.1282; the stop 0.1345 with the glossy
 /// cap at 1 frame (the default), 0.1354 at 2, 0.1562 at 8, 0.1736 uncapped. The bound leaves
 /// 5% for a different driver's rounding and fails at 8 frames. The margin is thin: TAA's
-/// following of the glossy light (MatteSettings::taa_current_glossy) shows the glossy
+/// following of the glossy light (TaaSettings::current_glossy) shows the glossy
 /// temporal's running mean, in which the history blurred while moving still weighs 1 / 11 ten
 /// frames after the stop, where TAA's own average lets a restarted history fade as 1 / n²;
-/// with taa_current_glossy 0 the stop scores 0.1309 against a fresh start's 0.1314.
+/// with current_glossy 0 the stop scores 0.1309 against a fresh start's 0.1314.
 /// HUSH_TEST_CAPS (comma-separated glossy caps) prints the region's FLIP for each.
 #[test]
 fn disoccluded_region_recovers_like_a_fresh_start() {

@@ -121,7 +121,7 @@ fn virtual_position_of_a_plane_mirror_is_analytic() {
     let size = (96u32, 54u32);
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
     let mut s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
-    s.matte.taa = false; // samples at pixel centres
+    s.taa.enabled = false; // samples at pixel centres
     s.glossy.reflection_mv = ReflectionMv::Diamond;
     let (before, now) = (camera(-0.15), camera(0.15));
     r.render(&gpu, &FrameInput { camera: before, time: 0.0 }, &s, None).unwrap();

@@ -1,9 +1,9 @@
 //! Settings panels drawn from the engine's one description of its settings
-//! (`hush_engine::settings::FIELDS`): each field gets the widget its kind calls for, its unit,
+//! (`hush_engine::settings::fields`): each field gets the widget its kind calls for, its unit,
 //! its help and default on hover, and a reset button when it differs from the default. Nothing
 //! here names a particular field, so a new setting appears once it is described.
 
-use hush_engine::settings::{FIELDS, Field, FrameSettings, Kind, get_field, get_field_mut};
+use hush_engine::settings::{Field, FrameSettings, Kind, fields, get_field, get_field_mut};
 use serde_json::Value;
 
 /// Short name of a field: the last part of its path.
@@ -89,7 +89,7 @@ fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value, o
 /// The fields of `group`; returns true when one changed. `v` is the settings' serde form.
 pub fn group(ui: &mut egui::Ui, group: &str, v: &mut Value, defaults: &Value, offered: Offered) -> bool {
     let mut changed = false;
-    for f in FIELDS.iter().filter(|f| f.group == group) {
+    for f in fields().filter(|f| f.group == group) {
         if let (Some(value), Some(default)) = (get_field_mut(v, f.path), get_field(defaults, f.path)) {
             changed |= field_row(ui, f, value, default, offered);
         }
@@ -103,10 +103,10 @@ pub fn defaults() -> &'static Value {
     DEFAULTS.get_or_init(|| FrameSettings::default().to_value())
 }
 
-/// Groups in the order FIELDS lists them.
+/// Groups in the order `fields()` lists them.
 pub fn groups() -> Vec<&'static str> {
     let mut g: Vec<&'static str> = vec![];
-    for f in FIELDS {
+    for f in fields() {
         if !g.contains(&f.group) {
             g.push(f.group);
         }

@@ -147,7 +147,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
         let mut row = vec![];
         for taa in [false, true] {
             let mut s = s.clone();
-            s.matte.taa = taa;
+            s.taa.enabled = taa;
             let mut r = new_renderer(&gpu, &scene, size)?;
             let mut prev: Option<(Vec<f32>, Vec<f32>)> = None;
             let (mut chain_err, mut raw_err) = (vec![], vec![]);

@@ -43,7 +43,7 @@ impl Denoiser for Mara {
     fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
         let (m, g) = self.targets.as_ref().context("the Mara denoiser records before its textures exist")?;
         let s = cx.settings;
-        let dp = DenoiseParams::new(&s.matte, io.size.0, cx.index, &cx.view);
+        let dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dp));
         let gp = GlossyParams::new(&s.glossy, self.scene.extent, cx.view.static_view);
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));

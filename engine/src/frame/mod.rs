@@ -344,7 +344,7 @@ impl Renderer {
         }
         let jitter = if settings.accumulate {
             random_jitter(self.frame_index, settings.seed)
-        } else if denoiser.is_some() && settings.matte.taa {
+        } else if denoiser.is_some() && settings.taa.enabled {
             halton_jitter(self.frame_index)
         } else {
             Vec2::splat(0.5)
@@ -416,7 +416,7 @@ impl Renderer {
         drop(pass);
         if let Some(d) = denoiser {
             // TAA runs after any denoiser; with its stage off it passes the composite on.
-            let dp = DenoiseParams::new(&settings.matte, size.0, self.frame_index, &cx.view);
+            let dp = DenoiseParams::new(&settings.matte, &settings.taa, size.0, self.frame_index, &cx.view);
             self.taa.record(gpu, &mut enc, output_key, &io, |p| d.taa_follow(p), &dp, parity, self.timer.as_mut())?;
         }
         let shown = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, denoiser.is_some(), self.taa.output());
@@ -511,7 +511,7 @@ fn shown_buffers<'a>(t: &'a Targets, io: &FrameIo<'a>, display: &'a wgpu::Buffer
 }
 
 /// Halton (2, 3) sub-pixel positions, 64 per cycle: the TAA jitter. A still pixel averages up
-/// to `taa_still_frames` (64) of them, so the cycle is that long: the first 16 points cover a
+/// to `TaaSettings::still_frames` (64) of them, so the cycle is that long: the first 16 points cover a
 /// horizontal edge at mid-pixel 9 times in 16 (a 6% coverage error); 64 points, within 2%
 /// in x and 4% in y at any edge position, better than 64 random positions (about 10%).
 pub fn halton_jitter(frame: u32) -> Vec2 {

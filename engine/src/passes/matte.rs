@@ -6,7 +6,7 @@
 use super::chain::ChainStage;
 use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
-use crate::settings::MatteSettings;
+use crate::settings::{MatteSettings, TaaSettings};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 
@@ -45,7 +45,7 @@ pub struct DenoiseParams {
     pub history_full_frames: f32,
     /// [`ChainView::jitter_shift`].
     pub jitter_shift: [f32; 2],
-    /// [`MatteSettings::taa_still_frames`].
+    /// [`TaaSettings::still_frames`].
     pub taa_still_frames: f32,
     /// [`MatteSettings::min_radius_fraction`] in pixels.
     pub min_radius_px: f32,
@@ -57,13 +57,13 @@ pub struct DenoiseParams {
     pub reprojection_min_cos: f32,
     /// [`MatteSettings::resampled_history_frames`].
     pub resampled_history_frames: f32,
-    /// [`MatteSettings::taa_resampled_frames`].
+    /// [`TaaSettings::resampled_frames`].
     pub taa_resampled_frames: f32,
-    /// [`MatteSettings::taa_display_ratio`].
+    /// [`TaaSettings::display_ratio`].
     pub taa_display_ratio: f32,
-    /// [`MatteSettings::taa_current_light`].
+    /// [`TaaSettings::current_light`].
     pub taa_current_light: f32,
-    /// [`MatteSettings::taa_current_glossy`].
+    /// [`TaaSettings::current_glossy`].
     pub taa_current_glossy: f32,
     /// The uniform's size is a multiple of 16 bytes.
     pub _pad: [f32; 2],
@@ -86,12 +86,13 @@ pub struct ChainView {
 }
 
 impl DenoiseParams {
-    pub fn new(s: &MatteSettings, width: u32, frame: u32, view: &ChainView) -> DenoiseParams {
+    /// The matte chain's parameters and TAA's (`taa`), which TAA reads from the same struct.
+    pub fn new(s: &MatteSettings, taa: &TaaSettings, width: u32, frame: u32, view: &ChainView) -> DenoiseParams {
         let w = width as f32;
         DenoiseParams {
             inv_view_proj: view.inv_view_proj.to_cols_array_2d(),
             prev_inv_view_proj: view.prev_inv_view_proj.to_cols_array_2d(),
-            stages: s.stage_bits(),
+            stages: s.stage_bits() | taa.stage_bit(),
             taps: s.taps.clamp(1, 256),
             parity: frame % 2,
             max_radius_px: (s.max_radius_fraction * w).max(0.0),
@@ -104,23 +105,23 @@ impl DenoiseParams {
             low_confidence_multiplier: s.low_confidence_multiplier.max(0.0),
             normal_power: s.normal_power.max(0.0),
             plane_sigma_px: s.plane_sigma_px.max(1e-3),
-            taa_alpha: s.taa_alpha.clamp(0.01, 1.0),
+            taa_alpha: taa.alpha.clamp(0.01, 1.0),
             // Golden-ratio steps: consecutive frames' tap patterns interleave.
             rotation: (frame as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU),
             history_valid: view.history_valid as u32,
             inject_nonfinite: s.inject_nonfinite as u32,
             history_full_frames: s.history_full_frames.max(0.0),
             jitter_shift: view.jitter_shift.to_array(),
-            taa_still_frames: s.taa_still_frames.clamp(0.0, 1024.0),
+            taa_still_frames: taa.still_frames.clamp(0.0, 1024.0),
             min_radius_px: (s.min_radius_fraction * w).clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
             edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
             static_view: view.static_view as u32,
             reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
-            taa_resampled_frames: s.taa_resampled_frames.clamp(0.0, 1024.0),
-            taa_display_ratio: s.taa_display_ratio.clamp(0.0, 1024.0),
-            taa_current_light: s.taa_current_light.clamp(0.0, 1.0),
-            taa_current_glossy: s.taa_current_glossy.clamp(0.0, 1.0),
+            taa_resampled_frames: taa.resampled_frames.clamp(0.0, 1024.0),
+            taa_display_ratio: taa.display_ratio.clamp(0.0, 1024.0),
+            taa_current_light: taa.current_light.clamp(0.0, 1.0),
+            taa_current_glossy: taa.current_glossy.clamp(0.0, 1.0),
             _pad: [0.0; 2],
         }
     }

@@ -1,8 +1,8 @@
 //! `taa`: temporal anti-aliasing of the composited image (shaders/taa/taa.wgsl), a stage of its
 //! own after any denoiser's composite. Where the denoiser offers the light it accumulates
 //! ([`TaaFollow`]), a settled pixel follows that light instead of averaging it again
-//! (`MatteSettings::taa_current_light`, `taa_current_glossy`); otherwise it is a plain TAA.
-//! Its settings are `MatteSettings::taa*`; its output, `taa/final`, is the image shown.
+//! (`TaaSettings::current_light`, `current_glossy`); otherwise it is a plain TAA. Its settings
+//! are [`crate::settings::TaaSettings`]; its output, `taa/final`, is the image shown.
 
 use super::chain::ChainStage;
 use super::io::FrameIo;

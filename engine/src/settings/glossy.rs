@@ -1,0 +1,232 @@
+//! The glossy chain's settings (Mara et al. 2017 §3.4 stages 8-10, Voorhuis §4) and their
+//! descriptions.
+
+use super::fields::{Field, Kind::*, f};
+use serde::{Deserialize, Serialize};
+
+/// How the glossy chain finds where a reflection was in the previous frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ReflectionMv {
+    /// Surface motion vectors only (the SVGF baseline: reflections smear under motion).
+    Primary,
+    /// Mara et al. §3.4 after Zimmer et al. 2015: reproject the virtual position of what the
+    /// reflection shows (primary hit + secondary hit distance along the camera ray).
+    Virtual,
+    /// Voorhuis §4.1-4.2.1 and Appendix A: diamond search of the previous frame's reflected hit
+    /// positions.
+    #[default]
+    Diamond,
+}
+
+impl ReflectionMv {
+    pub const ALL: [ReflectionMv; 3] = [ReflectionMv::Primary, ReflectionMv::Virtual, ReflectionMv::Diamond];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ReflectionMv::Primary => "primary",
+            ReflectionMv::Virtual => "virtual",
+            ReflectionMv::Diamond => "diamond",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<ReflectionMv> {
+        Self::ALL.into_iter().find(|m| m.name() == s)
+    }
+}
+
+/// The glossy chain: Mara et al. 2017 §3.4 stages 8-10 with the reflection reprojection and
+/// neighbourhood clipping of Voorhuis §4.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct GlossySettings {
+    /// Stage switches. Without `temporal` nothing is reprojected (Voorhuis's "NoSpecReproj").
+    pub temporal: bool,
+    /// Neighbourhood clipping of the reprojected history (Voorhuis §4.2.3), off by default as
+    /// the matte clamp is: at one sample per pixel the 5x5 box of the blurred current frame
+    /// rarely holds the rare bright paths a converged history averages, so clipping drains
+    /// energy from every glossy surface. Measured with it on and off (jitter-aware
+    /// reprojection): the level at 160x90 (60 still frames, 256-frame reference) 0.0738 and
+    /// 0.0694 FLIP (a mirror in the hall's doorway lost a fifth of its reflection's brightness);
+    /// `hush-cli reflections`, strafe with diamond vectors: reflective FLIP 0.1470 and 0.1371,
+    /// ghost region 0.2576 and 0.2395; still camera, chain-output temporal error 0.00537 and
+    /// 0.00302. Ghosts are left to the confidence tests.
+    pub clipping: bool,
+    /// The separable bilateral (stages 9 and 10).
+    pub bilateral: bool,
+    pub reflection_mv: ReflectionMv,
+    /// Below this roughness reflections are reprojected with reflection motion vectors; above it
+    /// with the surface's (Voorhuis §4.2.1: 0.4).
+    pub roughness_threshold: f32,
+    /// At or below this roughness a surface is a mirror: its chain matches exact reflected hit
+    /// positions (eq. 1), filters with the reflected surface's normal and demodulates by its
+    /// reflectance (§4.1). Above it, the representative-ray distance of eq. (4)-(5).
+    pub mirror_roughness: f32,
+    /// Neighbourhood clipping applies below this roughness (§4.2.3: 0.9).
+    pub clip_roughness: f32,
+    /// Hysteresis h, as the matte temporal's (Mara: the same confidence and clamping).
+    pub hysteresis: f32,
+    /// The surface reprojection (rough surfaces, and every surface in a static view) rejects a
+    /// previous texel whose normal is more than this many degrees from the surface's (180: off).
+    /// With the jitter a crease's two faces, or a ledge thinner than a pixel and the face behind
+    /// it, take turns under one pixel; eq. (11) passes both, but they reflect different things
+    /// under different F(w_s), and the chain filters light divided by F: the staircase's table
+    /// edge came out 10x too bright. FLIP at 160x90, 60 still frames (second half / last frame;
+    /// references of 512 frames for the staircase at 160x284, 2048 for the living room, 1024
+    /// otherwise) with the test off, at 25, 10 and 5 degrees: staircase 0.0726 / 0.0702,
+    /// 0.0655 / 0.0627, 0.0645 / 0.0615, 0.0644 / 0.0614; FlightHelmet 0.0096 / 0.0091,
+    /// 0.0091 / 0.0086, 0.0081 / 0.0072, 0.0080 / 0.0071; Lantern 0.0023 / 0.0023, then
+    /// 0.0019 / 0.0018 at every angle; level 0.0486 / 0.0462, then 0.0481 / 0.0456 at every
+    /// angle; the living room 0.1603 / 0.1479, 0.1632 / 0.1506, 0.1632 / 0.1502 (its shorter
+    /// histories cost more than the mix did).
+    pub reprojection_normal_degrees: f32,
+    /// First step of the diamond search's large pattern, pixels (Appendix A: 4; 1 = no LDSP
+    /// scaling).
+    pub initial_step: u32,
+    /// Most large-pattern iterations per pixel (bounds the search's cost).
+    pub max_search_steps: u32,
+    /// Eq. (11)'s d0, d1 for mirrors, in pixel footprints at the reflected distance.
+    pub d0_px: f32,
+    pub d1_px: f32,
+    /// Bilateral sigma = scale x roughness^exponent + epsilon pixels (Mara: 7, 0.1, epsilon).
+    /// Epsilon is 1 px so that mirrors (roughness 0) are still filtered, across the reflected
+    /// surface's features.
+    pub sigma_scale: f32,
+    pub sigma_exponent: f32,
+    pub sigma_epsilon_px: f32,
+    /// Beyond this many frames of history the bilateral's sigma shrinks as 1 / history length:
+    /// a converged history needs no spatial blur, a fresh one (disocclusion, motion) gets all
+    /// of it, as the matte chain's disocclusion-driven radius. 0: Mara's fixed sigma. FLIP on
+    /// the level (160x90, 40 still frames, 128-frame reference): fixed sigma 0.0994, no glossy
+    /// bilateral 0.0790, 1 / sqrt(n) past 4 frames 0.0864, past 1 frame 0.0816: the fixed blur
+    /// of a converged history costs more than the noise it removes. 1 / n past 1 frame (60
+    /// still frames, 256-frame reference, TAA's still blend): 0.0652 against 0.0673 with
+    /// 1 / sqrt(n) and 0.0651 with no glossy bilateral; on a path of 20 still, 20 strafing and 20
+    /// still frames (128-frame references) FLIP still / moving / settled 0.0942 / 0.1085 /
+    /// 0.0946 against 0.0970 / 0.1092 / 0.0950 with 1 / sqrt(n).
+    pub sigma_full_frames: f32,
+    /// A history resampled bilinearly (by surface or reflection motion) counts as at most this
+    /// many frames, as MatteSettings::resampled_history_frames (0: no cap). A moving glossy
+    /// history holds the reflections seen on the way, and once the camera stops it weighs
+    /// cap / (cap + k) after k still frames: what a fast move uncovered stayed worse than a
+    /// fresh start for over 20 frames with a cap of 8. Level at 160x90, 20 still frames, a
+    /// 1.2 m strafe in 5 frames, 35 still frames, 128-frame reference: FLIP over the 487
+    /// pixels flagged on the last moving frame (grown by one) 10 and 20 frames after the stop,
+    /// against 0.1117 and 0.1018 for a fresh start at that view: uncapped 0.1593 / 0.1406, 8
+    /// frames 0.1367 / 0.1170, 4 frames 0.1226 / 0.1047, 2 frames 0.1124 / 0.0977, 1 frame
+    /// 0.1071 / 0.0943 (whole frame 10 frames after: 0.0807, 0.0749, 0.0717, 0.0701, 0.0695).
+    /// The slow strafe of MatteSettings::resampled_history_frames (matte capped at 8), FLIP 10
+    /// frames after the stop / moving mean: uncapped 0.0805 / 0.1014, 8 frames 0.0720 / 0.1002,
+    /// 2 frames 0.0709 / 0.0999, 1 frame 0.0714 / 0.1013. `hush-cli reflections`, strafe with
+    /// diamond vectors, 8 frames and 1: reflective FLIP 0.1256 and 0.1197, ghost region 0.2234
+    /// and 0.2111 (primary vectors: 0.1622 and 0.1282); the still camera's are unchanged.
+    pub resampled_history_frames: f32,
+    /// Voorhuis eq. (6)'s omega, with the ray differential at the secondary hit measured in
+    /// pixel footprints of the primary surface (scale-free, unlike the paper's world units):
+    /// sigma is multiplied by exp(-footprints / omega) below the roughness threshold.
+    pub ray_differential_omega: f32,
+    /// Bilateral weight on roughness differences: exp(-(dr / sigma)^2).
+    pub roughness_sigma: f32,
+    /// Trace each glossy pixel's representative (mirror) ray below the roughness threshold, and
+    /// search by eq. (1) on its real hit; off, eq. (4) extends the ray by the sample's depth and
+    /// the search uses eq. (5). On the `spheres` strafe (160x90, against a 65x65 brute-force
+    /// search) the glossy sphere's vectors were 8.05 px off on average (42.6% within 1 px) with
+    /// sampled depths, whose jumps between near and far geometry make eq. (5)'s minimum
+    /// ambiguous, and 0.31 px (92.6%) with traced ones, for one closest-hit ray per such pixel.
+    pub trace_representative_ray: bool,
+    /// Measurements only: also run a brute-force search over a window of this radius (pixels)
+    /// and report the diamond search's distance to it in the search view (0: off).
+    #[serde(skip)]
+    pub reference_search_radius: u32,
+}
+
+impl Default for GlossySettings {
+    fn default() -> Self {
+        GlossySettings {
+            temporal: true,
+            clipping: false,
+            bilateral: true,
+            reflection_mv: ReflectionMv::Diamond,
+            roughness_threshold: 0.4,
+            mirror_roughness: 0.01,
+            clip_roughness: 0.9,
+            hysteresis: 0.98,
+            reprojection_normal_degrees: 10.0,
+            initial_step: 4,
+            max_search_steps: 32,
+            d0_px: 2.0,
+            d1_px: 4.0,
+            sigma_scale: 7.0,
+            sigma_exponent: 0.1,
+            sigma_epsilon_px: 1.0,
+            sigma_full_frames: 1.0,
+            resampled_history_frames: 1.0,
+            ray_differential_omega: 16.0,
+            roughness_sigma: 0.1,
+            trace_representative_ray: true,
+            reference_search_radius: 0,
+        }
+    }
+}
+
+impl GlossySettings {
+    pub const STAGES: [&str; 3] = ["glossy.temporal", "glossy.clipping", "glossy.bilateral"];
+
+    pub fn disable(&mut self, name: &str) -> bool {
+        let f = match name {
+            "glossy.temporal" => &mut self.temporal,
+            "glossy.clipping" => &mut self.clipping,
+            "glossy.bilateral" => &mut self.bilateral,
+            _ => return false,
+        };
+        *f = false;
+        true
+    }
+
+    /// Stage bits as shaders/glossy/common.wgsl reads them.
+    pub fn stage_bits(&self) -> u32 {
+        self.temporal as u32 | (self.clipping as u32) << 1 | (self.bilateral as u32) << 2
+    }
+
+    /// The glossy bilateral's Gaussian sigma in pixels: Mara et al. §3.4's 7 r^0.1 + epsilon,
+    /// times Voorhuis eq. (6)'s exp(-dP / omega) below the roughness threshold, where
+    /// `footprints` is the secondary hit's ray differential in primary pixel footprints.
+    /// shaders/glossy/common.wgsl's glossy_sigma is the same function.
+    pub fn sigma_px(&self, roughness: f32, footprints: f32) -> f32 {
+        let base = self.sigma_scale * roughness.clamp(0.0, 1.0).powf(self.sigma_exponent) + self.sigma_epsilon_px;
+        let scale = if roughness < self.roughness_threshold { (-footprints.max(0.0) / self.ray_differential_omega.max(1e-3)).exp() } else { 1.0 };
+        (base * scale).clamp(0.0, MAX_GLOSSY_SIGMA_PX)
+    }
+}
+
+/// Largest glossy bilateral sigma, pixels (the kernel reaches 2.5 sigma).
+pub const MAX_GLOSSY_SIGMA_PX: f32 = 9.0;
+
+
+fn reflection_mvs() -> Vec<String> {
+    super::fields::names(&ReflectionMv::ALL)
+}
+
+/// Its fields, in panel order.
+pub const FIELDS: &[Field] = &[
+    f("glossy.reflection_mv", "glossy/motion", "", Choice(reflection_mvs), "Reflection motion: surface (primary), virtual position, or diamond search."),
+    f("glossy.roughness_threshold", "glossy/motion", "roughness", Float(0.0, 1.0, 0.005), "Reflection motion below this roughness, surface motion above (Voorhuis 0.4)."),
+    f("glossy.mirror_roughness", "glossy/motion", "roughness", Float(0.0, 1.0, 0.001), "At or below this roughness a surface is a mirror (exact reflected hits)."),
+    f("glossy.initial_step", "glossy/motion", "px", Int(1, 64), "First step of the diamond search's large pattern (Appendix A: 4)."),
+    f("glossy.max_search_steps", "glossy/motion", "steps", Int(1, 256), "Most large-pattern iterations per pixel."),
+    f("glossy.trace_representative_ray", "glossy/motion", "", Bool, "Trace the mirror ray of glossy surfaces under the threshold."),
+    f("glossy.temporal", "glossy/temporal", "", Bool, "Stage 8: reprojection of glossy history (off: NoSpecReproj)."),
+    f("glossy.hysteresis", "glossy/temporal", "", Float(0.0, 1.0, 0.001), "h for the glossy history."),
+    f("glossy.reprojection_normal_degrees", "glossy/temporal", "degrees", Float(0.0, 180.0, 0.5), "Surface reprojection rejects a previous texel whose normal differs by more (180: off)."),
+    f("glossy.d0_px", "glossy/temporal", "footprints", Float(0.0, 64.0, 0.05), "Eq. 11's d0 for mirrors, at the reflected distance."),
+    f("glossy.d1_px", "glossy/temporal", "footprints", Float(0.0, 64.0, 0.05), "Eq. 11's d1 for mirrors, at the reflected distance."),
+    f("glossy.clipping", "glossy/temporal", "", Bool, "Neighbourhood clipping of the reprojected history (Voorhuis 4.2.3)."),
+    f("glossy.clip_roughness", "glossy/temporal", "roughness", Float(0.0, 1.0, 0.005), "Clipping applies below this roughness (0.9)."),
+    f("glossy.bilateral", "glossy/bilateral", "", Bool, "Stages 9-10: separable bilateral."),
+    f("glossy.sigma_scale", "glossy/bilateral", "px", Float(0.0, 9.0, 0.05), "Sigma = scale x roughness^exponent + epsilon (Mara 7)."),
+    f("glossy.sigma_exponent", "glossy/bilateral", "", Float(0.0, 4.0, 0.005), "Roughness exponent of sigma (Mara 0.1)."),
+    f("glossy.sigma_epsilon_px", "glossy/bilateral", "px", Float(0.0, 9.0, 0.05), "Sigma at roughness 0."),
+    f("glossy.sigma_full_frames", "glossy/bilateral", "frames", Float(0.0, 256.0, 0.1), "Past this history length sigma shrinks as 1/sqrt(length) (0: fixed)."),
+    f("glossy.resampled_history_frames", "glossy/temporal", "frames", Float(0.0, 1024.0, 1.0), "A bilinearly resampled history counts as at most this many frames (0: no cap)."),
+    f("glossy.ray_differential_omega", "glossy/bilateral", "footprints", Float(0.001, 1024.0, 0.1), "Voorhuis eq. 6's omega: sigma x exp(-ray differential / omega)."),
+    f("glossy.roughness_sigma", "glossy/bilateral", "roughness", Float(0.0, 1.0, 0.001), "Bilateral weight on roughness differences."),
+];
