@@ -309,6 +309,58 @@ impl Renderer {
         Ok(Some(i))
     }
 
+    /// Accumulation restarts whenever anything that changes the image changes.
+    fn update_accumulation(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings) {
+        if !settings.accumulate {
+            self.accumulated = 0;
+            self.accumulated_state = None;
+            return;
+        }
+        let same = self.accumulated_state.as_ref().is_some_and(|(i, s)| i == input && s.max_depth == settings.max_depth && s.seed == settings.seed);
+        self.accumulated = if same { self.accumulated + 1 } else { 1 };
+        self.accumulated_state = Some((*input, settings.clone()));
+        let t = &mut self.targets;
+        if t.accumulation.is_none() {
+            let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+            t.accumulation = Some(t.memory.buffer(&gpu.device, "composite/accumulation", t.size.0 as u64 * t.size.1 as u64 * 16, usage));
+            t.generation += 1;
+        }
+    }
+
+    /// This frame's jitter, its camera against the last frame's, and the frame and trace
+    /// uniforms written; returns what the denoiser and TAA know of the cameras, and the
+    /// jittered view-projection and jitter (the next frame's "previous").
+    fn upload_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, cam: &CameraSetup, moved: bool, denoised: bool) -> (ChainView, Mat4, Vec2) {
+        let size = self.targets.size;
+        let jitter = if settings.accumulate {
+            random_jitter(self.frame_index, settings.seed)
+        } else if denoised && settings.taa.enabled {
+            halton_jitter(self.frame_index)
+        } else {
+            Vec2::splat(0.5)
+        };
+        let jittered = cam.jittered(jitter, size);
+        let (prev_jittered, prev_jitter) = self.prev_jittered.unwrap_or((jittered, jitter));
+        let view = ChainView {
+            inv_view_proj: jittered.inverse(),
+            prev_inv_view_proj: prev_jittered.inverse(),
+            jitter_shift: prev_jitter - jitter,
+            // Set by the caller, which knows whether the same denoiser ran last frame.
+            history_valid: false,
+            static_view: !moved && self.prev_view_proj == Some(cam.view_proj),
+        };
+        let g = &settings.glossy;
+        // The glossy chain's reflection motion wants the representative ray of glossy surfaces.
+        let representative = if denoised && g.trace_representative_ray && g.reflection_mv != crate::settings::ReflectionMv::Primary { g.roughness_threshold } else { 0.0 };
+        let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
+        let fp = FrameParams::new(cam, jittered, prev, jitter, size, self.frame_index, settings, self.accumulated, self.prepared.ray_epsilon(), representative);
+        let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
+        let tp = make_params(&self.prepared, &trace_view);
+        gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
+        gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
+        (view, jittered, jitter)
+    }
+
     fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
         puffin::profile_function!();
         let mut moved = false;
@@ -320,20 +372,7 @@ impl Renderer {
         let size = self.targets.size;
         let cam = self.camera_setup(&input.camera);
 
-        // Accumulation restarts whenever anything that changes the image changes.
-        if settings.accumulate {
-            let same = self.accumulated_state.as_ref().is_some_and(|(i, s)| i == input && s.max_depth == settings.max_depth && s.seed == settings.seed);
-            self.accumulated = if same { self.accumulated + 1 } else { 1 };
-            self.accumulated_state = Some((*input, settings.clone()));
-            if self.targets.accumulation.is_none() {
-                let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-                self.targets.accumulation = Some(self.targets.memory.buffer(&gpu.device, "composite/accumulation", size.0 as u64 * size.1 as u64 * 16, usage));
-                self.targets.generation += 1;
-            }
-        } else {
-            self.accumulated = 0;
-            self.accumulated_state = None;
-        }
+        self.update_accumulation(gpu, input, settings);
         let setup = crate::profile::scope("upload");
         let denoiser = self.denoiser_for(gpu, settings)?;
         if denoiser.is_some() {
@@ -342,40 +381,8 @@ impl Renderer {
                 t.generation += 1;
             }
         }
-        let jitter = if settings.accumulate {
-            random_jitter(self.frame_index, settings.seed)
-        } else if denoiser.is_some() && settings.taa.enabled {
-            halton_jitter(self.frame_index)
-        } else {
-            Vec2::splat(0.5)
-        };
-        let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
-        let jittered = cam.jittered(jitter, size);
-        let history_valid = denoiser.is_some() && self.denoised_last == denoiser && self.prev_jittered.is_some();
-        let (prev_jittered, prev_jitter) = self.prev_jittered.unwrap_or((jittered, jitter));
-        let static_view = !moved && self.prev_view_proj == Some(cam.view_proj);
-        let view = ChainView { inv_view_proj: jittered.inverse(), prev_inv_view_proj: prev_jittered.inverse(), jitter_shift: prev_jitter - jitter, history_valid, static_view };
-        let fp = FrameParams {
-            view_proj: jittered.to_cols_array_2d(),
-            unjittered_view_proj: cam.view_proj.to_cols_array_2d(),
-            prev_view_proj: prev.to_cols_array_2d(),
-            cam_pos: cam.pos.extend(self.prepared.ray_epsilon()).to_array(),
-            cam_right: cam.right.extend(0.0).to_array(),
-            cam_up: cam.up.extend(0.0).to_array(),
-            cam_fwd: cam.fwd.extend(0.0).to_array(),
-            jitter: jitter.to_array(),
-            size: [size.0, size.1],
-            index: self.frame_index,
-            exposure: settings.exposure_scale(),
-            accumulated: self.accumulated,
-            paths: settings.paths_per_pixel.clamp(1, 64),
-            representative_roughness: if denoiser.is_some() && settings.glossy.trace_representative_ray && settings.glossy.reflection_mv != crate::settings::ReflectionMv::Primary { settings.glossy.roughness_threshold } else { 0.0 },
-            _pad: [0; 3],
-        };
-        let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
-        let tp = make_params(&self.prepared, &trace_view);
-        gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
-        gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
+        let (mut view, jittered, jitter) = self.upload_frame(gpu, input, settings, &cam, moved, denoiser.is_some());
+        view.history_valid = denoiser.is_some() && self.denoised_last == denoiser && self.prev_jittered.is_some();
         self.denoised_last = denoiser;
         if let Some(target) = target {
             self.prepare_display(gpu, target, settings)?;
@@ -392,6 +399,7 @@ impl Renderer {
         // Stages after the denoiser also bind its outputs.
         let output_key = key * 64 + denoiser.map_or(0, |i| i as u64 + 1);
         let parity = (self.frame_index % 2) as usize;
+        // gbuffer -> trace -> denoise -> composite -> TAA -> display (Mara et al. 2017, Figure 2).
         let pass = crate::profile::scope(gbuffer::LABEL);
         self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &self.targets.gbuffer, self.timer.as_mut())?;
         drop(pass);

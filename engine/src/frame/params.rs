@@ -27,6 +27,31 @@ pub struct FrameParams {
     pub _pad: [u32; 3],
 }
 
+impl FrameParams {
+    /// `jittered`: this frame's view-projection with `jitter` (the raster's); `prev`: the last
+    /// frame's without jitter (motion vectors compare it with `cam.view_proj`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(cam: &CameraSetup, jittered: Mat4, prev: Mat4, jitter: Vec2, size: (u32, u32), index: u32, settings: &crate::settings::FrameSettings, accumulated: u32, ray_epsilon: f32, representative_roughness: f32) -> FrameParams {
+        FrameParams {
+            view_proj: jittered.to_cols_array_2d(),
+            unjittered_view_proj: cam.view_proj.to_cols_array_2d(),
+            prev_view_proj: prev.to_cols_array_2d(),
+            cam_pos: cam.pos.extend(ray_epsilon).to_array(),
+            cam_right: cam.right.extend(0.0).to_array(),
+            cam_up: cam.up.extend(0.0).to_array(),
+            cam_fwd: cam.fwd.extend(0.0).to_array(),
+            jitter: jitter.to_array(),
+            size: [size.0, size.1],
+            index,
+            exposure: settings.exposure_scale(),
+            accumulated,
+            paths: settings.paths_per_pixel.clamp(1, 64),
+            representative_roughness,
+            _pad: [0; 3],
+        }
+    }
+}
+
 /// A camera in the GPU scene's rebased space, as both the raster and the tracer see it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraSetup {

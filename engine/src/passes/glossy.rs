@@ -84,7 +84,7 @@ impl GlossyParams {
     }
 }
 
-/// Per-pixel textures of the glossy chain (made with the denoiser's other targets), 112 bytes.
+/// Per-pixel textures of the glossy chain (made with the denoiser's other targets), 120 bytes.
 pub struct GlossyChainTargets {
     /// Representative hits (eq. 4) of this frame and the previous one, by parity.
     pub hit: [(wgpu::Texture, wgpu::TextureView); 2],
