@@ -12,6 +12,9 @@ pub struct CompareArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Also write the per-pixel FLIP error as a heat-map PNG (magma), to see where the error is.
+    #[arg(long)]
+    pub flip_map: Option<PathBuf>,
 }
 
 pub fn run(a: CompareArgs) -> Result<()> {
@@ -25,6 +28,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
         y = y.box_downsample(f)?;
     }
     let m = compare(&x, &y)?;
+    if let Some(path) = &a.flip_map {
+        hush_engine::quality::save_flip_heatmap(&x, &y, path).with_context(|| format!("writing {}", path.display()))?;
+    }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&m)?);
     } else {

@@ -32,7 +32,7 @@ pub struct QualityArgs {
     pub camera: Option<String>,
     #[arg(long, default_value_t = 60)]
     pub frames: u32,
-    /// `none` or `mara`; default mara, or the preset's.
+    /// `none`, `mara` or `svgf`; default mara, or the preset's.
     #[arg(long)]
     pub denoiser: Option<String>,
     /// Start from the settings of this preset file (TOML); --denoiser, --disable and
@@ -106,11 +106,19 @@ struct Uncovered {
 const UNCOVERED_FRAMES: u32 = 10;
 
 impl Uncovered {
-    /// Age the pixels by a frame and restart those the matte temporal flagged in this one
-    /// (hush_engine::passes::matte::history_rejected).
-    fn update(&mut self, r: &Renderer, gpu: &Gpu) -> Result<Vec<bool>> {
-        let (reason, _) = r.read_texture(gpu, "matte/reason").context("reading the matte temporal's flags")?;
-        for (age, rejected) in self.age.iter_mut().zip(history_rejected(&reason)) {
+    /// Age the pixels by a frame and restart those whose matte history restarted in this one:
+    /// the Mara matte temporal's flags (hush_engine::passes::matte::history_rejected), or
+    /// SVGF's history length (h = 1 in the moments it wrote this frame, frame `index`).
+    fn update(&mut self, r: &Renderer, gpu: &Gpu, denoiser: &Denoiser, index: usize) -> Result<Vec<bool>> {
+        let rejected: Vec<bool> = if *denoiser == Denoiser::MARA {
+            let (reason, _) = r.read_texture(gpu, "matte/reason").context("reading the matte temporal's flags")?;
+            history_rejected(&reason)
+        } else {
+            let name = format!("svgf/matte moments {}", 1 - index % 2);
+            let (moments, _) = r.read_texture(gpu, &name).with_context(|| format!("reading {name}"))?;
+            moments.chunks_exact(16).map(|m| f32::from_le_bytes(m[8..12].try_into().unwrap()) == 1.0).collect()
+        };
+        for (age, rejected) in self.age.iter_mut().zip(rejected) {
             *age = if rejected { 0 } else { age.saturating_add(1) };
         }
         Ok(self.age.iter().map(|a| *a <= UNCOVERED_FRAMES).collect())
@@ -177,7 +185,8 @@ fn stream(s: &Setup, settings: &FrameSettings, references: &[Image]) -> Result<(
         r.render(&s.gpu, input, settings, None)?;
         let ms: f64 = r.pass_times(&s.gpu)?.iter().map(|p| p.1).sum();
         let img = r.read_hdr(&s.gpu)?;
-        let mask = if settings.denoiser == Denoiser::MARA && settings.matte.temporal { Some(uncovered.update(&r, &s.gpu)?) } else { None };
+        let tracked = (settings.denoiser == Denoiser::MARA && settings.matte.temporal) || (settings.denoiser.name() == "svgf" && settings.svgf.temporal);
+        let mask = if tracked { Some(uncovered.update(&r, &s.gpu, &settings.denoiser, k)?) } else { None };
         scores.push(&img, prev.as_ref(), &references[k], ms, mask.as_deref())?;
         if k + 1 == s.inputs.len() {
             last.push(img.clone());
@@ -307,7 +316,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let per_seed: Vec<String> = flips64.iter().map(|f| format!("{f:.5}")).collect();
     std::fs::write(a.out_dir.join("accumulated64_flip.txt"), format!("{flip64:.5}\n{}\n", per_seed.join(",")))?;
 
-    if a.ablations && denoiser == Denoiser::MARA {
+    if a.ablations && denoiser != Denoiser::NONE {
         let mut f = std::fs::File::create(a.out_dir.join("ablations.csv"))?;
         writeln!(f, "disabled,flip,relmse,ssim,temporal_error,gpu_ms")?;
         let mut row = |name: &str, sc: &Scores| -> Result<()> {
@@ -316,7 +325,10 @@ pub fn run(a: QualityArgs) -> Result<()> {
             Ok(())
         };
         row("nothing", &den)?;
-        for stage in stage_names() {
+        // The stages of the denoiser under test, and TAA.
+        let prefix = format!("{}.", if denoiser == Denoiser::MARA { "" } else { denoiser.name() });
+        let own = |stage: &str| if denoiser == Denoiser::MARA { stage.starts_with("matte.") || stage.starts_with("glossy.") } else { stage.starts_with(&prefix) };
+        for stage in stage_names().into_iter().filter(|s| own(s) || *s == hush_engine::settings::TaaSettings::STAGE) {
             let mut settings = base.clone();
             hush_engine::settings::disable_stage(&mut settings, stage);
             let (sc, _) = stream(&s, &settings, &references)?;

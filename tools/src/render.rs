@@ -81,8 +81,9 @@ pub struct RenderArgs {
     /// Real-time mode: a camera path (JSON, as the viewer records); frame k uses key k.
     #[arg(long)]
     pub camera_path: Option<PathBuf>,
-    /// Real-time mode: the denoiser, `none` or `mara` (Mara et al. 2017 matte chain + TAA);
-    /// default none, or the preset's.
+    /// Real-time mode: the denoiser, `none`, `mara` (Mara et al. 2017: matte and glossy
+    /// chains) or `svgf` (SVGF with Voorhuis's extensions), each followed by TAA; default none,
+    /// or the preset's.
     #[arg(long)]
     pub denoiser: Option<String>,
     /// Real-time mode: start from the settings of this preset file (TOML, as the viewer saves);
@@ -91,7 +92,9 @@ pub struct RenderArgs {
     pub preset: Option<PathBuf>,
     /// Real-time mode: denoiser stages to switch off, comma-separated (matte.temporal,
     /// matte.history_bilateral, matte.disocclusion, matte.firefly, matte.bilateral, taa,
-    /// glossy.temporal, glossy.clipping, glossy.bilateral).
+    /// glossy.temporal, glossy.clipping, glossy.bilateral; svgf.temporal,
+    /// svgf.spatial_variance, svgf.atrous, svgf.accumulated_moments, svgf.bandwidth_boost,
+    /// svgf.firefly, svgf.reflection_reprojection, svgf.clipping, svgf.mirror_features).
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
     /// Real-time mode: how the glossy chain reprojects reflections: diamond (Voorhuis's search),

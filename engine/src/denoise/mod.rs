@@ -12,6 +12,7 @@
 //! [`register`]). Its name then works in `--denoiser`, presets and the viewer.
 
 pub mod mara;
+pub mod svgf;
 
 use crate::gpu::{Gpu, GpuMemory, GpuTimer};
 use crate::passes::io::FrameIo;
@@ -96,6 +97,7 @@ pub struct Entry {
 pub const BUILT_IN: &[Entry] = &[
     Entry { name: "none", summary: "the raw 1-sample frame (composite only)", make: None, views: &[] },
     Entry { name: "mara", summary: "Mara et al. 2017: the matte and glossy chains, then TAA", make: Some(mara::make), views: crate::settings::MARA_VIEWS },
+    Entry { name: "svgf", summary: "SVGF (Schied et al. 2017) with Voorhuis's reflections and robustness, then TAA", make: Some(svgf::make), views: crate::settings::SVGF_VIEWS },
 ];
 
 static REGISTERED: RwLock<Vec<Entry>> = RwLock::new(Vec::new());

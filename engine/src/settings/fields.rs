@@ -55,15 +55,15 @@ const FRAME_FIELDS: &[Field] = &[
     f("exposure_ev", "display", "EV", Float(-30.0, 30.0, 0.05), "The image is multiplied by 2^EV before tone mapping."),
     f("accumulate", "frame", "", Bool, "Sum frames while nothing changes and show their mean (the converged image)."),
     f("seed", "frame", "", Int(0, u32::MAX as i64), "Seed of every random sequence."),
-    f("denoiser", "frame", "", Choice(denoisers), "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. Others: denoisers the application registered."),
+    f("denoiser", "frame", "", Choice(denoisers), "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. svgf: SVGF with Voorhuis's extensions, then TAA. Others: denoisers the application registered."),
     f("max_depth", "trace", "bounces", Int(-1, 64), "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded)."),
     f("paths_per_pixel", "trace", "paths", Int(1, 64), "Indirect paths per pixel per frame (1 is the paper's real-time setting)."),
 ];
 
 /// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then
-/// each technique's own slice (matte chain, TAA, glossy chain).
+/// each technique's own slice (matte chain, TAA, glossy chain, SVGF).
 pub fn fields() -> impl Iterator<Item = &'static Field> {
-    FRAME_FIELDS.iter().chain(super::matte::FIELDS).chain(super::taa::FIELDS).chain(super::glossy::FIELDS)
+    FRAME_FIELDS.iter().chain(super::matte::FIELDS).chain(super::taa::FIELDS).chain(super::glossy::FIELDS).chain(super::svgf::FIELDS)
 }
 
 /// The value at a dotted path of a serde form.

@@ -5,14 +5,16 @@ mod fields;
 mod glossy;
 mod matte;
 mod preset;
+mod svgf;
 mod taa;
 mod view;
 
 pub use fields::{Field, Kind, fields, get as get_field, get_mut as get_field_mut, leaves};
 pub use glossy::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 pub use matte::MatteSettings;
+pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, SvgfSettings};
 pub use taa::TaaSettings;
-pub use view::{FRAME_VIEWS, MARA_VIEWS, View, ViewMap, ViewSpec, all_views, register_views};
+pub use view::{FRAME_VIEWS, MARA_VIEWS, SVGF_VIEWS, View, ViewMap, ViewSpec, all_views, register_views};
 
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -37,6 +39,7 @@ pub struct FrameSettings {
     pub matte: MatteSettings,
     pub taa: TaaSettings,
     pub glossy: GlossySettings,
+    pub svgf: SvgfSettings,
     /// Indirect paths per pixel per frame (each of the matte and glossy estimators, and the
     /// area-light sample, is averaged over them). 1 is the paper's real-time setting.
     pub paths_per_pixel: u32,
@@ -51,7 +54,7 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), paths_per_pixel: 1 }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), paths_per_pixel: 1 }
     }
 }
 
@@ -99,7 +102,7 @@ impl<'de> Deserialize<'de> for Denoiser {
 static DENOISER_NAMES: RwLock<Vec<&'static str>> = RwLock::new(Vec::new());
 
 pub fn denoiser_names() -> Vec<&'static str> {
-    let mut v = vec![Denoiser::NONE.0.as_ref(), "mara"];
+    let mut v = vec![Denoiser::NONE.0.as_ref(), "mara", "svgf"];
     v.extend(DENOISER_NAMES.read().unwrap().iter());
     v
 }
@@ -109,16 +112,16 @@ pub(crate) fn add_denoiser_name(name: &'static str) {
     DENOISER_NAMES.write().unwrap().push(name);
 }
 
-/// Disable a stage of either chain or TAA by its `--disable` name; false for an unknown name.
+/// Disable a stage of any denoiser or TAA by its `--disable` name; false for an unknown name.
 pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
     if name == TaaSettings::STAGE {
         s.taa.enabled = false;
         return true;
     }
-    s.matte.disable(name) || s.glossy.disable(name)
+    s.matte.disable(name) || s.glossy.disable(name) || s.svgf.disable(name)
 }
 
 /// Every stage name `--disable` accepts.
 pub fn stage_names() -> Vec<&'static str> {
-    MatteSettings::STAGES.iter().chain(&[TaaSettings::STAGE]).chain(GlossySettings::STAGES.iter()).copied().collect()
+    MatteSettings::STAGES.iter().chain(&[TaaSettings::STAGE]).chain(GlossySettings::STAGES.iter()).chain(SvgfSettings::STAGES.iter()).copied().collect()
 }

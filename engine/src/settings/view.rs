@@ -111,7 +111,7 @@ pub struct ViewSpec {
 impl ViewSpec {
     /// Views of buffers that exist only in scenes with a specular lobe.
     pub fn needs_glossy(&self) -> bool {
-        self.texture.starts_with("glossy/") || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
+        self.texture.starts_with("glossy/") || self.texture.starts_with("svgf/glossy") || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
     }
 }
 
@@ -162,6 +162,23 @@ pub const MARA_VIEWS: &[ViewSpec] = &[
     v("glossy/bilateral", "glossy/denoised", ViewMap::Light),
 ];
 
+/// The views of SVGF (`crate::denoise::svgf`): every intermediate of both signals.
+pub const SVGF_VIEWS: &[ViewSpec] = &[
+    v("svgf/matte integrated", "svgf/matte integrated", ViewMap::Light),
+    // The luminance variance that steers the first a-trous level; 1 is white.
+    v("svgf/matte variance", "svgf/matte variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v("svgf/matte history length", "svgf/matte moments 0", ViewMap::Grey { channel: 2, divisor: 32.0 }),
+    v("svgf/matte first moment", "svgf/matte moments 0", ViewMap::Grey { channel: 0, divisor: 1.0 }),
+    v("svgf/matte history", "svgf/matte history 0", ViewMap::Light),
+    v("svgf/matte", "svgf/matte out", ViewMap::Light),
+    v("svgf/glossy integrated", "svgf/glossy integrated", ViewMap::Light),
+    v("svgf/glossy variance", "svgf/glossy variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v("svgf/glossy history length", "svgf/glossy moments 0", ViewMap::Grey { channel: 2, divisor: 32.0 }),
+    v("svgf/glossy history", "svgf/glossy history 0", ViewMap::Light),
+    v("svgf/glossy motion", "svgf/glossy motion", ViewMap::Motion { channel: 0 }),
+    v("svgf/glossy", "svgf/glossy out", ViewMap::Light),
+];
+
 /// Views that denoisers registered beside the built-in ones.
 static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
 
@@ -169,7 +186,7 @@ static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
 pub fn register_views(views: &[ViewSpec]) {
     let mut r = REGISTERED.write().unwrap();
     for v in views {
-        if !FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(r.iter()).any(|k| k.name == v.name) {
+        if !FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(r.iter()).any(|k| k.name == v.name) {
             r.push(*v);
         }
     }
@@ -177,5 +194,5 @@ pub fn register_views(views: &[ViewSpec]) {
 
 /// Every view: the frame's, then the denoisers'.
 pub fn all_views() -> Vec<ViewSpec> {
-    FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(REGISTERED.read().unwrap().iter()).copied().collect()
+    FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(REGISTERED.read().unwrap().iter()).copied().collect()
 }

@@ -95,6 +95,14 @@ embed!(
     "glossy/prefilter.wgsl",
     "glossy/temporal.wgsl",
     "glossy/bilateral.wgsl",
+    "svgf/common.wgsl",
+    "svgf/features_matte.wgsl",
+    "svgf/features_glossy.wgsl",
+    "svgf/temporal.wgsl",
+    "svgf/temporal_glossy.wgsl",
+    "svgf/variance.wgsl",
+    "svgf/atrous.wgsl",
+    "svgf/final.wgsl",
     "accel/raycast.wgsl",
 );
 
@@ -259,6 +267,14 @@ mod tests {
                 v.push(compose(stage, "", &crate::passes::glossy::modules(stage, animated)).unwrap());
             }
         }
+        for animated in [false, true] {
+            for glossy in [false, true] {
+                let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
+                for stage in [temporal, "svgf/variance.wgsl", "svgf/atrous.wgsl", "svgf/final.wgsl"] {
+                    v.push(compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated)).unwrap());
+                }
+            }
+        }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             v.push(compose("raycast", "", &["common/math.wgsl", "common/geometry.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
             for (i, set) in FEATURE_SETS.iter().enumerate() {
@@ -371,6 +387,12 @@ mod tests {
         assert_eq!(size as usize, size_of::<GlossyParams>());
         assert_eq!(offs[5] as usize, offset_of!(GlossyParams, roughness_threshold));
         assert_eq!(offs[17] as usize, offset_of!(GlossyParams, max_sigma_px));
+        let atrous = programs.iter().find(|p| p.label == "svgf/atrous.wgsl").unwrap();
+        use crate::denoise::svgf::SvgfParams;
+        let (size, offs) = wgsl_layout(atrous, "SvgfParams");
+        assert_eq!(size as usize, size_of::<SvgfParams>());
+        assert_eq!(offs[7] as usize, offset_of!(SvgfParams, clip_roughness));
+        assert_eq!(wgsl_layout(atrous, "Level").0, 16);
         // obvhs's CWBVH node is read as five vec4u.
         assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
     }

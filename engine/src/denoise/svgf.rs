@@ -1,0 +1,410 @@
+//! SVGF: spatiotemporal variance-guided filtering (Schied et al. 2017) with the extensions of
+//! Voorhuis (§4 reflections, §6 robustness), as a denoiser behind the frame's contract.
+//!
+//! Two signals, the matte and the glossy light (Hush's punctual direct light carries no noise
+//! and bypasses every denoiser), each through its own passes (shaders/svgf/*.wgsl):
+//! `svgf/temporal` (reprojection, moments, features) -> `svgf/variance` -> `svgf/atrous 0..4`
+//! (level 0 also writes the next frame's history) -> `svgf/final` (firefly median on the matte
+//! light, remodulation behind mirrors). In scenes with a specular lobe the glossy signal first
+//! runs the Mara glossy chain's `glossy/motion` (reflection motion vectors by diamond search)
+//! and, for the clip, `glossy/prefilter_h`/`_v`, on SVGF's own textures. The composite and TAA
+//! follow as for every denoiser. [`SvgfSettings`] switches each stage and each of Voorhuis's
+//! changes.
+
+use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::passes::chain::ChainStage;
+use crate::passes::glossy::GlossyParams;
+use crate::passes::io::FrameIo;
+use crate::passes::matte::DenoiseParams;
+use crate::settings::{FrameSettings, SvgfSettings};
+use anyhow::{Context, Result};
+use bytemuck::{Pod, Zeroable};
+
+const RGBA16F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+const RG32F: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+const LEVELS: usize = crate::settings::SVGF_MAX_LEVELS as usize;
+
+/// Mirror of `SvgfParams` in shaders/svgf/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SvgfParams {
+    pub bits: u32,
+    pub alpha: f32,
+    pub alpha_moments: f32,
+    pub sigma_l: f32,
+    pub sigma_n: f32,
+    pub sigma_z: f32,
+    pub roughness_threshold: f32,
+    pub clip_roughness: f32,
+    pub still_frames: f32,
+    pub _pad: [u32; 3],
+}
+
+impl SvgfParams {
+    pub fn new(s: &SvgfSettings) -> SvgfParams {
+        SvgfParams {
+            bits: s.bits(),
+            alpha: s.alpha.clamp(1e-3, 1.0),
+            alpha_moments: s.alpha_moments.clamp(1e-3, 1.0),
+            sigma_l: s.sigma_l.max(0.0),
+            sigma_n: s.sigma_n.max(0.0),
+            sigma_z: s.sigma_z.max(1e-3),
+            roughness_threshold: s.roughness_threshold,
+            clip_roughness: s.clip_roughness,
+            still_frames: s.still_frames.clamp(0.0, 1024.0),
+            _pad: [0; 3],
+        }
+    }
+}
+
+/// Mirror of `Level` in shaders/svgf/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Level {
+    step: i32,
+    write_history: u32,
+    _pad: [u32; 2],
+}
+
+/// The previous frame's surfaces must point the same way within this angle for its light to be
+/// reprojected (SVGF's normal consistency test).
+const NORMAL_TEST_DEGREES: f32 = 25.0;
+
+pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
+    let mut memory = GpuMemory::default();
+    let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+    let d = &gpu.device;
+    let sv = memory.buffer(d, "svgf/params", size_of::<SvgfParams>() as u64, u);
+    let dn = memory.buffer(d, "svgf/denoise params", size_of::<DenoiseParams>() as u64, u);
+    let gp = memory.buffer(d, "svgf/glossy params", size_of::<GlossyParams>() as u64, u);
+    let levels = std::array::from_fn(|i| {
+        let b = memory.buffer(d, &format!("svgf/level {i}"), size_of::<Level>() as u64, u);
+        gpu.queue.write_buffer(&b, 0, bytemuck::bytes_of(&Level { step: 1 << i, write_history: (i == 0) as u32, _pad: [0; 2] }));
+        b
+    });
+    Ok(Box::new(Svgf { scene: *scene, sv, dn, gp, levels, targets: None, matte: None, glossy: None, motion: None }))
+}
+
+type Tex = (wgpu::Texture, wgpu::TextureView);
+
+/// One signal's textures: 104 bytes per pixel.
+pub struct SignalTargets {
+    /// The first a-trous level's output, by parity: what the next frame reprojects.
+    pub history: [Tex; 2],
+    /// Luminance moments and history length (m1, m2, h), by parity.
+    pub moments: [Tex; 2],
+    /// This frame's temporally integrated light (rgb, raw luminance).
+    pub integrated: Tex,
+    /// The variance stage's output (rgb, variance): the first a-trous level's input.
+    pub variance: Tex,
+    /// The a-trous levels' ping-pong (rgb, variance).
+    pub ping: Tex,
+    pub pong: Tex,
+    /// The light for the composite.
+    pub out: Tex,
+}
+
+impl SignalTargets {
+    fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), name: &str) -> SignalTargets {
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST;
+        let mut t = |label: &str, f| mem.texture(d, &format!("svgf/{name} {label}"), size, f, rw);
+        SignalTargets {
+            history: [t("history 0", RGBA16F), t("history 1", RGBA16F)],
+            moments: [t("moments 0", RGBA32F), t("moments 1", RGBA32F)],
+            integrated: t("integrated", RGBA16F),
+            variance: t("variance", RGBA16F),
+            ping: t("ping", RGBA16F),
+            pong: t("pong", RGBA16F),
+            out: t("out", RGBA16F),
+        }
+    }
+}
+
+/// What the reflection motion search and the clip's neighbourhood need (glossy scenes): 64
+/// bytes per pixel.
+pub struct MotionTargets {
+    pub hit: [Tex; 2],
+    pub motion: Tex,
+    pub search: Tex,
+    pub neighbourhood: Tex,
+    pub scratch: Tex,
+}
+
+pub struct SvgfTargets {
+    /// Linear depth and its gradient (8 bytes per pixel).
+    pub features: Tex,
+    pub matte: SignalTargets,
+    pub glossy: Option<(SignalTargets, MotionTargets)>,
+}
+
+impl SvgfTargets {
+    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), glossy: bool) -> SvgfTargets {
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let features = mem.texture(d, "svgf/features", size, RG32F, rw);
+        let matte = SignalTargets::new(d, mem, size, "matte");
+        let glossy = glossy.then(|| {
+            let signal = SignalTargets::new(d, mem, size, "glossy");
+            let mut t = |label: &str, f| mem.texture(d, &format!("svgf/glossy {label}"), size, f, rw);
+            let motion = MotionTargets {
+                hit: [t("hit 0", RGBA32F), t("hit 1", RGBA32F)],
+                motion: t("motion", RGBA32F),
+                search: t("search", RGBA16F),
+                neighbourhood: t("neighbourhood", RGBA16F),
+                scratch: t("scratch", RGBA16F),
+            };
+            (signal, motion)
+        });
+        SvgfTargets { features, matte, glossy }
+    }
+}
+
+/// The modules of an SVGF program: the frame's inputs, the matte (and for the glossy signal,
+/// the glossy) chain's helpers, SVGF's common code, the signal's features (stages after the
+/// temporal) and the stage.
+pub fn modules(stage: &'static str, glossy: bool, animated: bool) -> Vec<&'static str> {
+    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl"];
+    if glossy {
+        m.push("realtime/glossy_in.wgsl");
+    }
+    m.push("matte/common.wgsl");
+    if glossy {
+        m.push("glossy/common.wgsl");
+    }
+    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.push("svgf/common.wgsl");
+    if !stage.starts_with("svgf/temporal") {
+        m.push(if glossy { "svgf/features_glossy.wgsl" } else { "svgf/features_matte.wgsl" });
+    }
+    m.push(stage);
+    m
+}
+
+/// One signal's passes.
+struct SignalStages {
+    temporal: ChainStage,
+    variance: ChainStage,
+    atrous: ChainStage,
+    last: ChainStage,
+}
+
+impl SignalStages {
+    fn new(gpu: &Gpu, glossy: bool, animated: bool, offered: &Bindings) -> Result<SignalStages> {
+        let (prefix, temporal) = if glossy { ("svgf/glossy", "svgf/temporal_glossy.wgsl") } else { ("svgf/matte", "svgf/temporal.wgsl") };
+        // Labels are 'static: the profiler and the pass timings key on them.
+        let labels: [&'static str; 4] = if glossy {
+            ["svgf/glossy temporal", "svgf/glossy variance", "svgf/glossy atrous", "svgf/glossy final"]
+        } else {
+            ["svgf/matte temporal", "svgf/matte variance", "svgf/matte atrous", "svgf/matte final"]
+        };
+        debug_assert!(labels[0].starts_with(prefix));
+        let stage = |label, file, b: &Bindings| ChainStage::new(gpu, label, &modules(file, glossy, animated), "main", b);
+        Ok(SignalStages {
+            temporal: stage(labels[0], temporal, offered)?,
+            variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
+            atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
+            last: stage(labels[3], "svgf/final.wgsl", offered)?,
+        })
+    }
+
+    fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
+        [&mut self.temporal, &mut self.variance, &mut self.atrous, &mut self.last].into_iter().map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload)
+    }
+}
+
+struct MotionStages {
+    motion: ChainStage,
+    prefilter_h: ChainStage,
+    prefilter_v: ChainStage,
+}
+
+struct Svgf {
+    scene: DenoiserScene,
+    sv: wgpu::Buffer,
+    dn: wgpu::Buffer,
+    gp: wgpu::Buffer,
+    levels: [wgpu::Buffer; LEVELS],
+    targets: Option<SvgfTargets>,
+    matte: Option<SignalStages>,
+    glossy: Option<SignalStages>,
+    motion: Option<MotionStages>,
+}
+
+/// Which texture a stage reads and writes, by stage.
+#[derive(Clone, Copy)]
+enum Pass {
+    Temporal,
+    Variance,
+    /// Level i: reads the variance stage's output (level 0), then pong and ping in turn.
+    Atrous(usize),
+    /// Reads the last level's output: 0 the variance stage's (no level ran), 1 ping, 2 pong.
+    Final(usize),
+}
+
+impl Svgf {
+    /// Everything every SVGF program may bind, plus what `pass` of one signal reads and
+    /// writes for history parity `parity`.
+    fn bindings<'a>(&'a self, io: &FrameIo<'a>, glossy: bool, pass: Pass, parity: usize) -> Bindings<'a> {
+        let t = self.targets.as_ref().unwrap();
+        let mut b = io.bindings().buffer("sv", &self.sv).buffer("dn", &self.dn).texture("features", &t.features.1);
+        let s = if glossy {
+            let (s, m) = t.glossy.as_ref().unwrap();
+            b = b.buffer("gp", &self.gp).texture("prev_hit", &m.hit[parity].1).texture("motion", &m.motion.1).texture("neighbourhood", &m.neighbourhood.1);
+            s
+        } else {
+            &t.matte
+        };
+        match pass {
+            Pass::Temporal => b
+                .texture("history", &s.history[parity].1)
+                .texture("moments", &s.moments[parity].1)
+                .texture("out_integrated", &s.integrated.1)
+                .texture("out_moments", &s.moments[1 - parity].1)
+                .texture("out_features", &t.features.1),
+            Pass::Variance => b.texture("integrated", &s.integrated.1).texture("moments", &s.moments[1 - parity].1).texture("dst", &s.variance.1),
+            Pass::Atrous(level) => {
+                let src = match level {
+                    0 => &s.variance,
+                    l if l % 2 == 1 => &s.pong,
+                    _ => &s.ping,
+                };
+                let dst = if level % 2 == 0 { &s.pong } else { &s.ping };
+                b.texture("src", &src.1).texture("dst", &dst.1).texture("moments", &s.moments[1 - parity].1).texture("out_history", &s.history[1 - parity].1).buffer("level", &self.levels[level])
+            }
+            Pass::Final(last) => b.texture("src", &[&s.variance, &s.ping, &s.pong][last].1).texture("dst", &s.out.1),
+        }
+    }
+
+    /// The glossy chain's motion and prefilter stages on SVGF's textures.
+    fn motion_bindings<'a>(&'a self, io: &FrameIo<'a>, prefilter: Option<bool>, parity: usize) -> Bindings<'a> {
+        let (_, m) = self.targets.as_ref().unwrap().glossy.as_ref().unwrap();
+        let b = io.bindings().buffer("dn", &self.dn).buffer("gp", &self.gp);
+        match prefilter {
+            None => b.texture("prev_hit", &m.hit[parity].1).texture("out_motion", &m.motion.1).texture("out_search", &m.search.1).texture("out_hit", &m.hit[1 - parity].1),
+            Some(false) => b.texture("src", &m.neighbourhood.1).texture("dst", &m.scratch.1),
+            Some(true) => b.texture("src", &m.scratch.1).texture("dst", &m.neighbourhood.1),
+        }
+    }
+
+    fn write_params(&self, gpu: &Gpu, io: &FrameIo, cx: &FrameContext) {
+        let s: &FrameSettings = cx.settings;
+        let sv = &s.svgf;
+        gpu.queue.write_buffer(&self.sv, 0, bytemuck::bytes_of(&SvgfParams::new(sv)));
+        let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
+        dp.reprojection_min_cos = crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES);
+        gpu.queue.write_buffer(&self.dn, 0, bytemuck::bytes_of(&dp));
+        let mut gp = GlossyParams::new(&s.glossy, self.scene.extent, cx.view.static_view);
+        gp.roughness_threshold = sv.roughness_threshold;
+        gp.clip_roughness = sv.clip_roughness;
+        gp.mode = if sv.reflection_reprojection { 2 } else { 0 };
+        if !sv.mirror_features {
+            // No surface is a mirror: no demodulation by the reflected surface, no mirror search.
+            gp.mirror_roughness = -1.0;
+        }
+        gpu.queue.write_buffer(&self.gp, 0, bytemuck::bytes_of(&gp));
+    }
+
+    fn record_signal(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, glossy: bool, timer: Option<&mut GpuTimer>) -> Result<()> {
+        let made = if glossy { self.glossy.take() } else { self.matte.take() };
+        let mut stages = match made {
+            Some(s) => s,
+            None => SignalStages::new(gpu, glossy, self.scene.animated, &self.offered(io, glossy)).context("creating SVGF's stages")?,
+        };
+        let result = self.record_stages(gpu, enc, io, cx, glossy, &mut stages, timer);
+        *(if glossy { &mut self.glossy } else { &mut self.matte }) = Some(stages);
+        result
+    }
+
+    /// Every resource any stage of a signal binds (only the names matter: each program's
+    /// layout is checked against them).
+    fn offered<'a>(&'a self, io: &FrameIo<'a>, glossy: bool) -> Bindings<'a> {
+        [Pass::Variance, Pass::Atrous(0), Pass::Final(0)].into_iter().fold(self.bindings(io, glossy, Pass::Temporal, 0), |b, pass| b.with(&self.bindings(io, glossy, pass, 0)))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn record_stages(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, glossy: bool, st: &mut SignalStages, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        let (key, parity, size) = (cx.key, cx.parity, io.size);
+        st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, glossy, Pass::Temporal, p))?;
+        st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, glossy, Pass::Variance, p))?;
+        let levels = cx.settings.svgf.atrous_levels() as usize;
+        for level in 0..levels {
+            st.atrous.record_variant(gpu, enc, key, (2 * LEVELS, parity * LEVELS + level), size, timer.as_deref_mut(), |v| self.bindings(io, glossy, Pass::Atrous(v % LEVELS), v / LEVELS))?;
+        }
+        let t = self.targets.as_ref().unwrap();
+        let s = if glossy { &t.glossy.as_ref().unwrap().0 } else { &t.matte };
+        if levels == 0 || !cx.settings.svgf.filtered_history {
+            // No level wrote the history: it is the integrated light.
+            let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
+            enc.copy_texture_to_texture(s.integrated.0.as_image_copy(), s.history[1 - parity].0.as_image_copy(), extent);
+        }
+        // The last level wrote pong when its index was even.
+        let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
+        st.last.record_variant(gpu, enc, key, (3, last), size, timer, |v| self.bindings(io, glossy, Pass::Final(v), parity))
+    }
+
+    fn record_motion(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        use crate::passes::glossy::modules;
+        if self.motion.is_none() {
+            let a = self.scene.animated;
+            let stage = |label, file, entry, b: &Bindings| ChainStage::new(gpu, label, &modules(file, a), entry, b);
+            self.motion = Some(MotionStages {
+                motion: stage("svgf/glossy motion", "glossy/motion.wgsl", "main", &self.motion_bindings(io, None, 0))?,
+                prefilter_h: stage("svgf/glossy prefilter_h", "glossy/prefilter.wgsl", "pre_h", &self.motion_bindings(io, Some(false), 0))?,
+                prefilter_v: stage("svgf/glossy prefilter_v", "glossy/prefilter.wgsl", "pre_v", &self.motion_bindings(io, Some(true), 0))?,
+            });
+        }
+        let mut m = self.motion.take().unwrap();
+        let (key, parity, size) = (cx.key, cx.parity, io.size);
+        let sv = &cx.settings.svgf;
+        let mut result = m.motion.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.motion_bindings(io, None, p));
+        if result.is_ok() && sv.clipping && sv.temporal {
+            result = m.prefilter_h.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.motion_bindings(io, Some(false), p));
+            if result.is_ok() {
+                result = m.prefilter_v.record(gpu, enc, key, parity, size, timer, |p| self.motion_bindings(io, Some(true), p));
+            }
+        }
+        self.motion = Some(m);
+        result
+    }
+}
+
+impl Denoiser for Svgf {
+    fn needs_previous_gbuffer(&self) -> bool {
+        true
+    }
+
+    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
+        self.targets = Some(SvgfTargets::new(&gpu.device, memory, size, self.scene.glossy));
+    }
+
+    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        self.targets.as_ref().context("SVGF records before its textures exist")?;
+        self.write_params(gpu, io, cx);
+        self.record_signal(gpu, enc, io, cx, false, timer.as_deref_mut())?;
+        if self.scene.glossy {
+            self.record_motion(gpu, enc, io, cx, timer.as_deref_mut())?;
+            self.record_signal(gpu, enc, io, cx, true, timer)?;
+        }
+        Ok(())
+    }
+
+    fn output(&self, _parity: usize) -> Denoised<'_> {
+        let Some(t) = &self.targets else { return Denoised::default() };
+        Denoised { matte: Some(&t.matte.out.1), glossy: t.glossy.as_ref().map(|(s, _)| &s.out.1) }
+    }
+
+    fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
+        let mut v: Vec<&mut dyn crate::shader::Reload> = vec![];
+        if let Some(s) = self.matte.as_mut() {
+            v.extend(s.pipelines());
+        }
+        if let Some(s) = self.glossy.as_mut() {
+            v.extend(s.pipelines());
+        }
+        if let Some(m) = self.motion.as_mut() {
+            v.extend([&mut m.motion, &mut m.prefilter_h, &mut m.prefilter_v].into_iter().map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload));
+        }
+        v
+    }
+}

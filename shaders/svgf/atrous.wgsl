@@ -1,0 +1,82 @@
+// SVGF §4.3: one level of the edge-avoiding a-trous wavelet filter (Dammertz et al. 2010):
+// the 5x5 B3-spline kernel h with taps 2^level pixels apart, weighted by eq. (3)-(5)
+// (common.wgsl: edge_weight) with the luminance bandwidth sigma_l sqrt(g3x3(var)) of the
+// pixel's variance blurred by a 3x3 Gaussian; Voorhuis eq. (8) widens it for young histories.
+// The signal may bound the reach with a Gaussian of its own (signal_sigma: the glossy light's).
+// The variance is filtered with the squared weights (eq. (6)) unless Voorhuis §6 turns that off,
+// when every level uses the first level's. The first level's output is also next frame's
+// history (Schied et al. §4.3: filtered, so the temporal stage accumulates smoother light).
+
+var src: texture_2d<f32>;
+var moments: texture_2d<f32>;
+var dst: texture_storage_2d<rgba16float, write>;
+var out_history: texture_storage_2d<rgba16float, write>;
+var<uniform> level: Level;
+
+const KERNEL = array<f32, 3>(0.375, 0.25, 0.0625);
+
+// The 3x3 Gaussian of the variance around p (SVGF's prefilter of eq. (5)).
+fn blurred_variance(p: vec2i) -> f32 {
+    var sum = 0.0;
+    var wsum = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2i(dx, dy);
+            if in_bounds(q) {
+                let w = select(0.25, 0.5, dx == 0) * select(0.25, 0.5, dy == 0);
+                sum += w * textureLoad(src, q, 0).a;
+                wsum += w;
+            }
+        }
+    }
+    return sum / wsum;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let c = textureLoad(src, p, 0);
+    var out = c;
+    if has_surface(p) {
+        let fc = signal_features(p);
+        let lc = luminance(c.rgb);
+        var sigma_l = sv.sigma_l;
+        if sv_on(SV_BANDWIDTH_BOOST) {
+            // h counts frames; eq. (8) counts successful reprojections, one fewer.
+            let reprojections = max(textureLoad(moments, p, 0).z - 1.0, 0.0);
+            sigma_l *= 8.0 - min(7.0, reprojections);
+        }
+        let phi_l = sigma_l * sqrt(max(blurred_variance(p), 0.0));
+        let sigma = signal_sigma(p);
+        var sum = c.rgb * (KERNEL[0] * KERNEL[0]);
+        var sum_var = c.a * (KERNEL[0] * KERNEL[0] * KERNEL[0] * KERNEL[0]);
+        var wsum = KERNEL[0] * KERNEL[0];
+        for (var dy = -2; dy <= 2; dy++) {
+            for (var dx = -2; dx <= 2; dx++) {
+                let q = p + vec2i(dx, dy) * level.step;
+                if (dx == 0 && dy == 0) || !in_bounds(q) || !has_surface(q) {
+                    continue;
+                }
+                let t = textureLoad(src, q, 0);
+                let offset = f32(level.step) * length(vec2f(f32(dx), f32(dy)));
+                let spatial = exp(-0.5 * offset * offset / (sigma * sigma));
+                let w = KERNEL[abs(dx)] * KERNEL[abs(dy)] * spatial * edge_weight(fc, signal_features(q), offset, lc, luminance(t.rgb), phi_l);
+                sum += w * t.rgb;
+                sum_var += w * w * t.a;
+                wsum += w;
+            }
+        }
+        out = vec4f(sum / wsum, c.a);
+        if sv_on(SV_VARIANCE_FILTERING) {
+            out.a = sum_var / (wsum * wsum);
+        }
+    }
+    out = vec4f(half_safe(out.rgb), clamp(out.a, 0.0, 65000.0));
+    textureStore(dst, p, out);
+    if level.write_history != 0u && sv_on(SV_FILTERED_HISTORY) {
+        textureStore(out_history, p, vec4f(out.rgb, 1.0));
+    }
+}

@@ -1,0 +1,118 @@
+// Shared by SVGF's stages (Schied et al. 2017, with Voorhuis §4 and §6): parameters, the
+// per-signal and per-level uniforms, the edge-stopping weights and the moment integration.
+// engine/src/denoise/svgf.rs mirrors SvgfParams and Level.
+
+struct SvgfParams {
+    // Switches (SV_*), SvgfSettings::bits.
+    bits: u32,
+    // Weights of the current frame in the moving averages of the light and the moments.
+    alpha: f32,
+    alpha_moments: f32,
+    // Edge-stopping: luminance in standard deviations, normal exponent, depth in gradients.
+    sigma_l: f32,
+    sigma_n: f32,
+    sigma_z: f32,
+    // Voorhuis §4.2.1 and §4.2.3.
+    roughness_threshold: f32,
+    clip_roughness: f32,
+    // In a still view the moving averages' weights fall to 1 / this (0: never).
+    still_frames: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// Per dispatch: which a-trous level (step 2^level pixels), whether it writes the history.
+struct Level {
+    step: i32,
+    write_history: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+var<uniform> sv: SvgfParams;
+
+const SV_TEMPORAL: u32 = 1u;
+const SV_SPATIAL_VARIANCE: u32 = 2u;
+const SV_ACCUMULATED_MOMENTS: u32 = 4u;
+const SV_BANDWIDTH_BOOST: u32 = 8u;
+const SV_VARIANCE_FILTERING: u32 = 16u;
+const SV_FIREFLY: u32 = 32u;
+const SV_REFLECTION_REPROJECTION: u32 = 64u;
+const SV_CLIPPING: u32 = 128u;
+const SV_MIRROR_FEATURES: u32 = 256u;
+const SV_VARIANCE_OF_MEAN: u32 = 512u;
+const SV_FILTERED_HISTORY: u32 = 1024u;
+
+fn sv_on(bit: u32) -> bool {
+    return (sv.bits & bit) != 0u;
+}
+
+// A pixel's edge-stopping features: linear view depth, its screen-space gradient (|dz/dx| +
+// |dz/dy|, SVGF's fwidth) and the normal. The signal module (features_matte.wgsl,
+// features_glossy.wgsl) says which surface's features a signal edge-stops on.
+struct Features {
+    z: f32,
+    dz: f32,
+    n: vec3f,
+}
+
+// SVGF eq. (3)-(5): the depth, normal and luminance terms of the a-trous weight of tap q
+// (offset `offset` pixels from p), before the kernel's h(q). phi_l = sigma_l sqrt(g(var)).
+fn edge_weight(c: Features, t: Features, offset: f32, lc: f32, lt: f32, phi_l: f32) -> f32 {
+    let wz = abs(c.z - t.z) / (sv.sigma_z * max(c.dz, 1e-6) * offset + 1e-6);
+    let wn = pow(max(dot(c.n, t.n), 0.0), sv.sigma_n);
+    let wl = abs(lc - lt) / (phi_l + 1e-10);
+    return exp(-wz - wl) * wn;
+}
+
+// Running moments of one signal: first and second moment of luminance, the history length h
+// (frames, this one included) and the sum of the squared weights the light was integrated with
+// (its variance is the samples' times this), as stored in the moments texture (m1, m2, h, s).
+// Schied et al. §4.1: mu'_i = mix(mu_i history, mu_i now, alpha) with alpha = 0.2 once a
+// history exists; Voorhuis §6 averages the first frames truly (alpha = 1 / h up to h = 5, four
+// reprojections). The light follows max(alpha, 1 / h) either way, so that its first frames are
+// a mean and not the first sample's echo. In a still view both fall as 1 / h to
+// 1 / still_frames.
+struct Integrated {
+    light: vec3f,
+    moments: vec4f,
+}
+
+fn integrate(current: vec3f, history: vec3f, moments: vec4f, reprojected: bool) -> Integrated {
+    let l = luminance(current);
+    let now = vec2f(l, l * l);
+    if !reprojected {
+        return Integrated(current, vec4f(now, 1.0, 1.0));
+    }
+    let h = min(moments.z + 1.0, 1024.0);
+    var floor_alpha = sv.alpha;
+    var floor_moments = sv.alpha_moments;
+    if dn.static_view != 0u && sv.still_frames > 0.0 {
+        floor_alpha = min(floor_alpha, 1.0 / sv.still_frames);
+        floor_moments = min(floor_moments, 1.0 / sv.still_frames);
+    }
+    let alpha = max(floor_alpha, 1.0 / h);
+    var alpha_m = floor_moments;
+    if sv_on(SV_ACCUMULATED_MOMENTS) || floor_moments < sv.alpha_moments {
+        alpha_m = max(floor_moments, select(0.0, 1.0 / h, h <= 5.0 || floor_moments < sv.alpha_moments));
+    }
+    let m = mix(moments.xy, now, alpha_m);
+    let s = (1.0 - alpha) * (1.0 - alpha) * clamp(moments.w, 0.0, 1.0) + alpha * alpha;
+    return Integrated(mix(history, current, alpha), vec4f(m, h, s));
+}
+
+// The variance the filter steers by, from the samples' variance and the moments texel: of one
+// sample (Schied et al.) or of the integrated light (SV_VARIANCE_OF_MEAN).
+fn steering_variance(sample_variance: f32, moments: vec4f) -> f32 {
+    var v = max(sample_variance, 0.0);
+    if sv_on(SV_VARIANCE_OF_MEAN) {
+        v *= clamp(moments.w, 0.0, 1.0);
+    }
+    return min(v, 65000.0);
+}
+
+// Feature buffer written by the matte temporal: linear depth and its gradient.
+fn linear_depth(x: vec3f) -> f32 {
+    return dot(x - frame.cam_pos.xyz, frame.cam_fwd.xyz) / length(frame.cam_fwd.xyz);
+}

@@ -1,0 +1,31 @@
+// The glossy light edge-stops on the glossy surface's own features (Voorhuis §4.2.2): its
+// reflections are blurry, and two neighbours on one surface reflect similar distributions.
+// Behind a mirror (§4.1) it edge-stops on what the mirror shows: the reflected surface's normal
+// and the distance along the reflection (primary depth plus secondary distance, its gradient
+// scaled to the reflected footprint), and the light, demodulated by the reflected surface's
+// reflectance in the temporal stage, is multiplied back here. The filter's reach is bounded by
+// a Gaussian (§4.2.2 eq. (6); glossy/common.wgsl: glossy_sigma): Mara's 7 roughness^0.1 pixels,
+// shrunk by the secondary hit's ray differential below the roughness threshold, so that a
+// sharp reflection seen from afar is not blurred across the surface.
+var features: texture_2d<f32>;
+
+const SIGNAL_MATTE: bool = false;
+
+fn signal_features(p: vec2i) -> Features {
+    let f = textureLoad(features, p, 0).xy;
+    var r = Features(f.x, f.y, oct_decode(textureLoad(gb_normal, p, 0).xy));
+    if sv_on(SV_MIRROR_FEATURES) && f.x > 0.0 && is_mirror(roughness_at(p)) {
+        let t = min(secondary_t(p), gp.far);
+        r = Features(f.x + t, f.y * (1.0 + t / f.x), hit_normal(p));
+    }
+    return r;
+}
+
+fn signal_remodulation(p: vec2i) -> vec3f {
+    return demodulation(p);
+}
+
+fn signal_sigma(p: vec2i) -> f32 {
+    let x = position_at(p);
+    return max(glossy_sigma(roughness_at(p), ray_differential(p, x)), 0.5);
+}

@@ -1,0 +1,75 @@
+// SVGF §4.1 for the matte light: reverse-reproject last frame's filtered light and moments with
+// the G-buffer's motion vectors, test the previous depth and normal (matte/common.wgsl's
+// `reproject`: the texel under the vector sampled bilinearly where it passes, else the closest
+// of its 3x3 neighbours), and integrate (common.wgsl). Also writes the features every later
+// stage edge-stops on: linear depth and its gradient.
+// Outputs: integrated (rgb, this frame's raw luminance), moments (m1, m2, h), features (z, dz).
+
+var prev_depth: texture_depth_2d;
+var prev_normal: texture_2d<f32>;
+var history: texture_2d<f32>;
+var moments: texture_2d<f32>;
+var out_integrated: texture_storage_2d<rgba16float, write>;
+var out_moments: texture_storage_2d<rgba32float, write>;
+var out_features: texture_storage_2d<rg32float, write>;
+
+// Linear depth of pixel q (or -1 off the surface).
+fn depth_at(q: vec2i) -> f32 {
+    if !in_bounds(q) || !has_surface(q) {
+        return -1.0;
+    }
+    return linear_depth(position_at(q));
+}
+
+// The smaller one-sided difference along an axis (a silhouette on one side does not count).
+fn gradient(z: f32, a: f32, b: f32) -> f32 {
+    var g = 1e30;
+    if a >= 0.0 {
+        g = abs(a - z);
+    }
+    if b >= 0.0 {
+        g = min(g, abs(b - z));
+    }
+    return select(g, 0.0, g >= 1e30);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let current = half_safe(matte_input(p));
+    if !has_surface(p) {
+        textureStore(out_integrated, p, vec4f(current, luminance(current)));
+        textureStore(out_moments, p, vec4f(0.0));
+        textureStore(out_features, p, vec4f(-1.0, 0.0, 0.0, 0.0));
+        return;
+    }
+    let x = position_at(p);
+    let z = linear_depth(x);
+    let dz = gradient(z, depth_at(p - vec2i(1, 0)), depth_at(p + vec2i(1, 0))) + gradient(z, depth_at(p - vec2i(0, 1)), depth_at(p + vec2i(0, 1)));
+    textureStore(out_features, p, vec4f(z, dz, 0.0, 0.0));
+
+    var reprojected = false;
+    var hist = vec3f(0.0);
+    var mom = vec4f(0.0);
+    if sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
+        let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
+        let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
+        let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
+        if r.distance >= 0.0 && r.distance <= dn.d1_px {
+            mom = textureLoad(moments, r.texel, 0);
+            hist = half_safe(textureLoad(history, r.texel, 0).rgb);
+            if r.bilinear {
+                hist = half_safe(load_bilinear(history, prev).rgb);
+                mom = vec4f(load_bilinear(moments, prev).xy, mom.zw);
+            }
+            // A previous texel without a history (a miss then) does not count.
+            reprojected = mom.z >= 1.0;
+        }
+    }
+    let i = integrate(current, hist, mom, reprojected);
+    textureStore(out_integrated, p, vec4f(half_safe(i.light), luminance(current)));
+    textureStore(out_moments, p, i.moments);
+}

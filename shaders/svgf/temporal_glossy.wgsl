@@ -1,0 +1,92 @@
+// SVGF §4.1 for the glossy light, with Voorhuis §4: below the roughness threshold the history
+// follows the reflection motion vectors of the diamond search (glossy/motion.wgsl) without the
+// surface consistency tests, and below the clip roughness it is clipped to the 5x5 box of the
+// 7x7-blurred current frame (glossy/prefilter.wgsl; §4.2.3); above, it is reprojected as the
+// matte light. Behind mirrors the light is divided by the reflected surface's reflectance
+// (glossy_input, §4.1) and multiplied back by the final stage.
+// Outputs: integrated (rgb, this frame's raw luminance), moments (m1, m2, h).
+
+var prev_depth: texture_depth_2d;
+var prev_normal: texture_2d<f32>;
+var prev_hit: texture_2d<f32>;
+var history: texture_2d<f32>;
+var moments: texture_2d<f32>;
+var motion: texture_2d<f32>;
+var neighbourhood: texture_2d<f32>;
+var out_integrated: texture_storage_2d<rgba16float, write>;
+var out_moments: texture_storage_2d<rgba32float, write>;
+
+// Clip h towards the box centre along the line between them (Karis 2014), in YCoCg.
+fn clip_to_box(h: vec3f, lo: vec3f, hi: vec3f) -> vec3f {
+    let centre = 0.5 * (lo + hi);
+    let extent = max(0.5 * (hi - lo), vec3f(1e-6));
+    let d = h - centre;
+    let t = max3(abs(d) / extent);
+    if t <= 1.0 {
+        return h;
+    }
+    return centre + d / t;
+}
+
+fn clip(p: vec2i, h: vec3f) -> vec3f {
+    var lo = vec3f(3.0e38);
+    var hi = vec3f(-3.0e38);
+    for (var dy = -2; dy <= 2; dy++) {
+        for (var dx = -2; dx <= 2; dx++) {
+            let s = to_ycocg(textureLoad(neighbourhood, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb);
+            lo = min(lo, s);
+            hi = max(hi, s);
+        }
+    }
+    return from_ycocg(clip_to_box(to_ycocg(h), lo, hi));
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let current = glossy_input(p);
+    if !has_surface(p) {
+        textureStore(out_integrated, p, vec4f(current, luminance(current)));
+        textureStore(out_moments, p, vec4f(0.0));
+        return;
+    }
+    let x = position_at(p);
+    let roughness = roughness_at(p);
+    var reprojected = false;
+    var hist = vec3f(0.0);
+    var mom = vec4f(0.0);
+    if sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
+        // In a static view the reflection stood still too: the surface test is exact there.
+        let reflected = sv_on(SV_REFLECTION_REPROJECTION) && roughness < sv.roughness_threshold && gp.static_view == 0u;
+        let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
+        var r = Reprojection(vec2i(floor(prev)), true, -1.0);
+        if reflected {
+            r.distance = select(-1.0, 0.0, in_bounds(r.texel));
+        } else {
+            let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
+            r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
+            if r.distance > dn.d1_px {
+                r.distance = -1.0;
+            }
+        }
+        // The previous pixel must have had a glossy lobe (its hit class is set).
+        if r.distance >= 0.0 && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
+            mom = textureLoad(moments, r.texel, 0);
+            hist = half_safe(textureLoad(history, r.texel, 0).rgb);
+            if r.bilinear {
+                hist = half_safe(load_bilinear(history, prev).rgb);
+                mom = vec4f(load_bilinear(moments, prev).xy, mom.zw);
+            }
+            reprojected = mom.z >= 1.0;
+            if reprojected && sv_on(SV_CLIPPING) && roughness < sv.clip_roughness {
+                hist = clip(p, hist);
+            }
+        }
+    }
+    let i = integrate(current, hist, mom, reprojected);
+    textureStore(out_integrated, p, vec4f(half_safe(i.light), luminance(current)));
+    textureStore(out_moments, p, i.moments);
+}

@@ -1,0 +1,56 @@
+// SVGF §4.2: the luminance variance that steers the a-trous filter. Where the history holds at
+// least 4 frames it is the temporal moments' m2 - m1^2; where fewer, a 7x7 estimate across the
+// surface (depth and normal weights): of this frame's luminance (Schied et al.), or of the
+// neighbours' accumulated moments (Voorhuis §6), and the light is averaged with the same
+// weights. As Falcor's SVGFPass, the young variance is raised by 4 / h, since it is drawn from
+// few samples and underestimates. Output: dst (rgb, variance).
+
+var integrated: texture_2d<f32>;
+var moments: texture_2d<f32>;
+var dst: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let c = textureLoad(integrated, p, 0);
+    let m = textureLoad(moments, p, 0);
+    let h = m.z;
+    if !has_surface(p) {
+        textureStore(dst, p, vec4f(c.rgb, 0.0));
+        return;
+    }
+    if h >= 4.0 || !sv_on(SV_SPATIAL_VARIANCE) {
+        textureStore(dst, p, vec4f(c.rgb, steering_variance(m.y - m.x * m.x, m)));
+        return;
+    }
+    let fc = signal_features(p);
+    var sum_w = 0.0;
+    var sum_light = vec3f(0.0);
+    var sum_m = vec2f(0.0);
+    for (var dy = -3; dy <= 3; dy++) {
+        for (var dx = -3; dx <= 3; dx++) {
+            let q = p + vec2i(dx, dy);
+            if !in_bounds(q) || !has_surface(q) {
+                continue;
+            }
+            let t = textureLoad(integrated, q, 0);
+            var w = 1.0;
+            if dx != 0 || dy != 0 {
+                w = edge_weight(fc, signal_features(q), length(vec2f(f32(dx), f32(dy))), 0.0, 0.0, 1.0);
+            }
+            var mq = vec2f(t.a, t.a * t.a);
+            if sv_on(SV_ACCUMULATED_MOMENTS) {
+                mq = textureLoad(moments, q, 0).xy;
+            }
+            sum_w += w;
+            sum_light += w * t.rgb;
+            sum_m += w * mq;
+        }
+    }
+    let mean = sum_m / sum_w;
+    let variance = max(mean.y - mean.x * mean.x, 0.0) * 4.0 / max(h, 1.0);
+    textureStore(dst, p, vec4f(half_safe(sum_light / sum_w), steering_variance(variance, m)));
+}
