@@ -171,7 +171,8 @@ fn motion_vectors_follow_camera_and_object_motion() {
     assert!(rate >= 0.98, "reprojected object ids match at only {:.2}%", rate * 100.0);
 }
 
-/// The default level: every debug view renders, nothing is NaN, the glossy buffers exist.
+/// The default level: with each denoiser every debug view renders, nothing is NaN, the glossy
+/// buffers exist.
 #[test]
 fn the_default_level_renders_without_nan() {
     let start = std::time::Instant::now();
@@ -189,21 +190,25 @@ fn the_default_level_renders_without_nan() {
     let gpu = hush_engine::gpu::Gpu::headless(&prepared.realtime_requirements((80, 45))).unwrap();
     let mut r = Renderer::new(&gpu, scene, prepared, (80, 45)).unwrap();
     assert!(r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures);
-    let mut denoised = FrameSettings { denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() };
-    // Off by default; on here so that the glossy/clipping view has something to show.
-    denoised.glossy.clipping = true;
-    for k in 0..3 {
-        let input = FrameInput { camera: r.scene.camera_or_default(), time: 1.0 + k as f64 / 60.0 };
-        r.render(&gpu, &input, &denoised, None).unwrap();
-        let img = r.read_hdr(&gpu).unwrap();
-        assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in the default level");
-    }
-    // Emission may be off screen; every other view shows something from the level's camera.
-    let views: Vec<View> = std::iter::once(View::FINAL).chain(hush_engine::settings::all_views().iter().map(|v| View::named(v.name))).collect();
-    for v in views.into_iter().filter(|v| v.name() != "gbuffer/emission") {
-        let settings = FrameSettings { view: v.clone(), ..denoised.clone() };
-        let shown = r.display_image(&gpu, &settings).unwrap();
-        assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "view {} is black", v.name());
+    // Each built-in denoiser in turn: the frame's views and its own.
+    for entry in hush_engine::denoise::BUILT_IN.iter().filter(|e| e.make.is_some()) {
+        let mut denoised = FrameSettings { denoiser: hush_engine::settings::Denoiser::named(entry.name), ..Default::default() };
+        // Off by default; on here so that the glossy/clipping view has something to show.
+        denoised.glossy.clipping = true;
+        for k in 0..3 {
+            let input = FrameInput { camera: r.scene.camera_or_default(), time: 1.0 + k as f64 / 60.0 };
+            r.render(&gpu, &input, &denoised, None).unwrap();
+            let img = r.read_hdr(&gpu).unwrap();
+            assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in the default level with {}", entry.name);
+        }
+        // Emission may be off screen; every other view shows something from the level's camera.
+        let own = hush_engine::settings::FRAME_VIEWS.iter().chain(entry.views);
+        let views: Vec<View> = std::iter::once(View::FINAL).chain(own.map(|v| View::named(v.name))).collect();
+        for v in views.into_iter().filter(|v| v.name() != "gbuffer/emission") {
+            let settings = FrameSettings { view: v.clone(), ..denoised.clone() };
+            let shown = r.display_image(&gpu, &settings).unwrap();
+            assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "view {} is black with {}", v.name(), entry.name);
+        }
     }
 }
 
