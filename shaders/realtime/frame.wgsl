@@ -23,7 +23,8 @@ struct Frame {
     paths: u32,
     // Glossy surfaces below this roughness also trace their representative (mirror) ray.
     representative_roughness: f32,
-    _pad1: u32,
+    // Samples per pixel k (Voorhuis §5): the raster's guide and k - 1 traced samples.
+    samples: u32,
     _pad2: u32,
     _pad3: u32,
 }
@@ -32,9 +33,14 @@ var<uniform> frame: Frame;
 
 // The camera ray through this frame's sample position in pixel px.
 fn camera_ray(px: vec2u) -> vec3f {
+    return camera_ray_at(vec2f(px) + frame.jitter);
+}
+
+// The camera ray through image position x (pixels; pixel (i, j) spans [i, i + 1) x [j, j + 1)).
+fn camera_ray_at(x: vec2f) -> vec3f {
     let ndc = vec2f(
-        (f32(px.x) + frame.jitter.x) / f32(frame.size.x) * 2.0 - 1.0,
-        1.0 - (f32(px.y) + frame.jitter.y) / f32(frame.size.y) * 2.0,
+        x.x / f32(frame.size.x) * 2.0 - 1.0,
+        1.0 - x.y / f32(frame.size.y) * 2.0,
     );
     return normalize(frame.cam_fwd.xyz + ndc.x * frame.cam_right.xyz + ndc.y * frame.cam_up.xyz);
 }

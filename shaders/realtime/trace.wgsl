@@ -13,7 +13,8 @@
 //   with the reference tracer's loop (common/path.wgsl).
 //
 // The primary hit is re-derived from the triangle the raster stored and this frame's camera ray,
-// so it is exact (the same point the reference tracer would find for that ray).
+// so it is exact (the same point the reference tracer would find for that ray). `shade` is also
+// the supersampling's (realtime/samples.wgsl) for the samples it traces beside the raster's.
 
 var gb_ids: texture_2d<u32>;
 var out_matte: texture_storage_2d<rgba16float, write>;
@@ -43,39 +44,30 @@ fn write_all(px: vec2u, matte: vec3f, direct: vec3f) {
     textureStore(out_direct, px, vec4f(half_safe(direct), 1.0));
 }
 
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
-    let px = gid.xy;
-    if px.x >= frame.size.x || px.y >= frame.size.y {
-        return;
-    }
-    var rng = rng_init(px.y * frame.size.x + px.x, frame.index, params.seed);
+// What one sample at a surface carries (the buffers write_all and write_glossy fill).
+struct Shaded {
+    matte: vec3f,
+    direct: vec3f,
+    glossy: vec3f,
+    // The glossy path's secondary hit distance, its first hit's reflectance and normal.
+    glossy_t: f32,
+    hit_reflectance: vec3f,
+    hit_normal: vec3f,
+    mirror: vec3f,
+    representative_t: f32,
+    // The shading normal (the supersampling's guide similarity, Voorhuis §5).
+    n: vec3f,
+    // A back face of a one-sided material: no light, and the glossy outputs of a miss.
+    backface: bool,
+}
+
+// One factored sample at the hit of camera ray direction rd.
+fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
     let eps = params.cam_pos.w;
-    let ro = frame.cam_pos.xyz;
-    let rd = camera_ray(px);
-    let slot = textureLoad(gb_ids, px, 0).y;
-    if slot == NO_HIT {
-        // Background: what the camera sees of the environment goes straight to the screen.
-        write_all(px, vec3f(0.0), env_radiance(rd));
-        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd, INF);
-        return;
-    }
-    // Exact barycentrics of this frame's camera ray on the rasterised triangle (no bounds test:
-    // at a silhouette the sample may sit a hair outside it).
-    let v0 = tris[slot * 3u].xyz;
-    let e1 = tris[slot * 3u + 1u].xyz - v0;
-    let e2 = tris[slot * 3u + 2u].xyz - v0;
-    let pv = cross(rd, e2);
-    let inv = 1.0 / dot(e1, pv);
-    let tv = ro - v0;
-    let qv = cross(tv, e1);
-    let hit = Hit(dot(e2, qv) * inv, slot, vec2f(dot(tv, pv) * inv, dot(rd, qv) * inv));
     let s = surface_at(hit, rd);
     let m = materials[s.material];
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
-        write_all(px, vec3f(0.0), vec3f(0.0));
-        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd, INF);
-        return;
+        return Shaded(vec3f(0.0), vec3f(0.0), vec3f(0.0), INF, vec3f(1.0), -rd, rd, INF, s.ns, true);
     }
     let ms = material_at(m, s.uv);
     let bsdf = material_bsdf(m, ms);
@@ -94,9 +86,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var hit_reflectance = vec3f(1.0);
     var hit_normal = -mirror;
     if !depth_ok(2) || wo.z <= 0.0 {
-        write_all(px, matte, direct);
-        write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal, glossy_t);
-        return;
+        return Shaded(matte, direct, glossy, glossy_t, hit_reflectance, hit_normal, mirror, glossy_t, s.ns, false);
     }
 
     for (var i = 0u; i < params.num_lights; i++) {
@@ -121,7 +111,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let groups = area_groups();
         let nee_select = 1.0 / f32(max(groups, 1u));
         if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
-            let ls = sample_area_light(s.p, &rng);
+            let ls = sample_area_light(s.p, rng);
             let wi = to_local(basis, ls.wi);
             if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
                 let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
@@ -140,15 +130,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 
         if has_matte {
             // Cosine sampling cancels eq. (7)'s cos / pi: the path's throughput starts at 1.
-            let wl = cosine_hemisphere(rand2(&rng));
+            let wl = cosine_hemisphere(rand2(rng));
             let wi = basis * wl;
             if dot(wi, s.ng) > 0.0 {
-                let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select), &rng);
+                let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select), rng);
                 matte += r.radiance;
             }
         } else {
             // Keep the random sequence of the glossy path independent of the material.
-            rand2(&rng);
+            rand2(rng);
         }
 
         if has_glossy {
@@ -159,7 +149,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 wl = vec3f(-wo.xy, wo.z);
                 start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select);
             } else {
-                wl = reflect(-wo, sample_vndf(bsdf.alpha, wo, rand2(&rng)));
+                wl = reflect(-wo, sample_vndf(bsdf.alpha, wo, rand2(rng)));
                 let g = glossy_eval(bsdf, wo, wl);
                 var weight = vec3f(0.0);
                 if g.pdf > 0.0 {
@@ -168,7 +158,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select);
             }
             if wl.z > 0.0 && dot(start.rd, s.ng) > 0.0 && max3(start.beta) > 0.0 {
-                let r = trace_path(start, &rng);
+                let r = trace_path(start, rng);
                 glossy += r.radiance;
                 glossy_t = r.first_t;
                 hit_reflectance = r.first_reflectance;
@@ -186,6 +176,40 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if has_glossy && !bsdf.delta && ms.roughness < frame.representative_roughness && dot(mirror, s.ng) > 0.0 {
         representative_t = traverse(origin, mirror, INF, false).t;
     }
-    write_all(px, matte, direct);
-    write_glossy(px, glossy, glossy_t, rd * hit.t, mirror, hit_reflectance, hit_normal, representative_t);
+    return Shaded(matte, direct, glossy, glossy_t, hit_reflectance, hit_normal, mirror, representative_t, s.ns, false);
+}
+
+// The raster's hit of pixel px's camera ray rd: its triangle (slot), with exact barycentrics of
+// this frame's ray (no bounds test: at a silhouette the sample may sit a hair outside it).
+fn raster_hit(ro: vec3f, rd: vec3f, slot: u32) -> Hit {
+    let v0 = tris[slot * 3u].xyz;
+    let e1 = tris[slot * 3u + 1u].xyz - v0;
+    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    let pv = cross(rd, e2);
+    let inv = 1.0 / dot(e1, pv);
+    let tv = ro - v0;
+    let qv = cross(tv, e1);
+    return Hit(dot(e2, qv) * inv, slot, vec2f(dot(tv, pv) * inv, dot(rd, qv) * inv));
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let px = gid.xy;
+    if px.x >= frame.size.x || px.y >= frame.size.y {
+        return;
+    }
+    var rng = rng_init(px.y * frame.size.x + px.x, frame.index, params.seed);
+    let ro = frame.cam_pos.xyz;
+    let rd = camera_ray(px);
+    let slot = textureLoad(gb_ids, px, 0).y;
+    if slot == NO_HIT {
+        // Background: what the camera sees of the environment goes straight to the screen.
+        write_all(px, vec3f(0.0), env_radiance(rd));
+        write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd, INF);
+        return;
+    }
+    let hit = raster_hit(ro, rd, slot);
+    let sh = shade(rd, hit, &rng);
+    write_all(px, sh.matte, sh.direct);
+    write_glossy(px, sh.glossy, sh.glossy_t, select(rd * hit.t, rd, sh.backface), sh.mirror, sh.hit_reflectance, sh.hit_normal, sh.representative_t);
 }

@@ -59,8 +59,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if frames == 0 {
         bail!("--frames must be at least 1");
     }
-    if let Some(spp) = a.spp {
-        bail!("--spp {spp}: real-time mode traces one sample per pixel per frame; use --frames (or --accumulate) for more");
+    let max_spp = hush_engine::settings::MAX_SAMPLES_PER_PIXEL;
+    if let Some(spp) = a.spp.filter(|s| *s > max_spp) {
+        bail!("--spp {spp}: real-time mode takes at most {max_spp} samples per pixel per frame; use --frames (or --accumulate) for more");
     }
     let fps = a.fps.unwrap_or(60.0);
     if !(fps > 0.0 && fps.is_finite()) {
@@ -103,7 +104,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
     }
     let max_depth = path_length(a.max_depth, a.preset.as_deref(), scene.max_depth)?;
-    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, ..chains };
+    let samples_per_pixel = a.spp.unwrap_or(chains.samples_per_pixel);
+    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, samples_per_pixel, ..chains };
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;

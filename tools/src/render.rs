@@ -116,7 +116,9 @@ pub struct RenderArgs {
     /// Real-time mode: write every frame as linear HDR EXR into this folder (frame_00000.exr, ...).
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
-    /// Reference mode: samples per pixel (default 64).
+    /// Samples per pixel. Reference mode: the progressive tracer's (default 64). Real-time mode:
+    /// per frame, the raster's guide and k - 1 traced samples mixed into their most similar
+    /// guides (Voorhuis §5; default 1, at most 16).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]

@@ -20,6 +20,7 @@ use crate::passes::io::{FrameIo, PreviousGBuffer};
 use crate::passes::matte::{ChainView, DenoiseParams};
 use crate::passes::reference::{TraceParams, TraceView, make_params};
 use crate::passes::taa::TaaStage;
+use crate::passes::supersample::{Supersample, SupersampleTargets};
 use crate::passes::trace::{TracePass, TraceTargets};
 use crate::scene::{Camera, Scene};
 use crate::settings::FrameSettings;
@@ -57,6 +58,8 @@ struct Targets {
     accumulation: Option<wgpu::Buffer>,
     /// Made when a denoiser that reads the previous frame's G-buffer first runs.
     previous: Option<PreviousGBuffer>,
+    /// Made for k > 1 samples per pixel (remade when k changes).
+    supersample: Option<SupersampleTargets>,
     /// Every per-pixel allocation, the denoisers' and TAA's included: bytes per pixel, and
     /// textures by label for readback.
     memory: GpuMemory,
@@ -71,13 +74,14 @@ impl Targets {
         let mut memory = GpuMemory::default();
         let gbuffer = GBufferTargets::new(gpu, &mut memory, size);
         let trace = TraceTargets::new(gpu, &mut memory, size, glossy);
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        // COPY_DST: the supersampling's resolve writes it back.
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let hdr = memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
-        Targets { size, gbuffer, trace, hdr, accumulation: None, previous: None, memory, epoch, generation }
+        Targets { size, gbuffer, trace, hdr, accumulation: None, previous: None, supersample: None, memory, epoch, generation }
     }
 
     fn io<'a>(&'a self, frame: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>) -> FrameIo<'a> {
-        FrameIo { size: self.size, frame, objects, gbuffer: &self.gbuffer, previous: self.previous.as_ref(), trace: &self.trace, hdr: &self.hdr, memory: &self.memory }
+        FrameIo { size: self.size, frame, objects, gbuffer: &self.gbuffer, previous: self.previous.as_ref(), trace: &self.trace, mixed: None, hdr: &self.hdr, memory: &self.memory }
     }
 }
 
@@ -105,6 +109,7 @@ pub struct Renderer {
     /// Every denoiser chosen so far (switching back keeps its pipelines and textures).
     denoisers: Vec<MadeDenoiser>,
     taa: TaaStage,
+    supersample: Supersample,
     /// The index in `denoisers` of the one that ran last frame (its image is then TAA's).
     denoised_last: Option<usize>,
     timer: Option<GpuTimer>,
@@ -125,6 +130,8 @@ impl PreparedScene {
     /// Features and limits of the real-time frame on this scene.
     pub fn realtime_requirements(&self, size: (u32, u32)) -> GpuRequirements {
         let mut r = self.requirements(size.0 as u64 * size.1 as u64, 16);
+        // The supersampling's samples pass binds the trace's buffers and two of its own.
+        r.max_storage_buffers_per_shader_stage += 2;
         r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
         // matte, direct, and with a glossy lobe glossy, reflection, mirror and mirror hit.
         r.max_storage_textures_per_shader_stage = if self.features.glossy { 6 } else { 2 };
@@ -190,6 +197,7 @@ impl Renderer {
             display: None,
             denoisers: vec![],
             taa,
+            supersample: Supersample::new(),
             denoised_last: None,
             timer,
             async_timings: false,
@@ -381,6 +389,14 @@ impl Renderer {
                 t.generation += 1;
             }
         }
+        // Samples per pixel (Voorhuis §5); the accumulate mode box-filters by itself.
+        let samples = if settings.accumulate { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) };
+        if samples > 1 && self.targets.supersample.as_ref().is_none_or(|s| s.k != samples || s.epoch != self.targets.epoch) {
+            let t = &mut self.targets;
+            t.memory.forget(SupersampleTargets::PREFIX);
+            t.supersample = Some(SupersampleTargets::new(&gpu.device, &mut t.memory, t.size, samples, self.prepared.features.glossy, t.epoch));
+            t.generation += 1;
+        }
         let (mut view, jittered, jitter) = self.upload_frame(gpu, input, settings, &cam, moved, denoiser.is_some());
         view.history_valid = denoiser.is_some() && self.denoised_last == denoiser && self.prev_jittered.is_some();
         self.denoised_last = denoiser;
@@ -407,7 +423,13 @@ impl Renderer {
         let pass = crate::profile::scope(crate::passes::trace::LABEL);
         self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut())?;
         drop(pass);
-        let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
+        let mut io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
+        let ss = t.supersample.as_ref().filter(|s| s.k == samples);
+        if let Some(ss) = ss {
+            let trace = crate::passes::trace::bindings(&self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace);
+            self.supersample.record_mix(gpu, &mut enc, key, &self.gpu_scene, trace, &io, ss, self.timer.as_mut())?;
+            io.mixed = Some(&ss.mixed);
+        }
         let cx = FrameContext { index: self.frame_index, parity, view, settings, key };
         let mut denoiser = denoiser.map(|i| &mut self.denoisers[i].denoiser);
         if let Some(d) = denoiser.as_deref_mut() {
@@ -422,6 +444,9 @@ impl Renderer {
         let pass = crate::profile::scope(crate::passes::composite::COMPOSITE);
         self.composite.record(gpu, &mut enc, output_key, fb, parity, self.timer.as_mut())?;
         drop(pass);
+        if let Some(ss) = ss {
+            self.supersample.record_resolve(gpu, &mut enc, key, &io, ss, self.timer.as_mut())?;
+        }
         if let Some(d) = denoiser {
             // TAA runs after any denoiser; with its stage off it passes the composite on.
             let dp = DenoiseParams::new(&settings.matte, &settings.taa, size.0, self.frame_index, &cx.view);

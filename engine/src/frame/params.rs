@@ -24,7 +24,9 @@ pub struct FrameParams {
     /// Glossy surfaces below this roughness also trace their representative (mirror) ray for
     /// the glossy chain's reflection motion vectors (0: none do).
     pub representative_roughness: f32,
-    pub _pad: [u32; 3],
+    /// Samples per pixel k (Voorhuis §5): the raster's guide and k - 1 traced ones.
+    pub samples: u32,
+    pub _pad: [u32; 2],
 }
 
 impl FrameParams {
@@ -47,7 +49,8 @@ impl FrameParams {
             accumulated,
             paths: settings.paths_per_pixel.clamp(1, 64),
             representative_roughness,
-            _pad: [0; 3],
+            samples: if accumulated > 0 { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) },
+            _pad: [0; 2],
         }
     }
 }

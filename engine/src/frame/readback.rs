@@ -90,4 +90,13 @@ impl Renderer {
         })?;
         Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
     }
+
+    /// The bytes of the frame's buffer labelled `name` (`supersample/samples`, ...).
+    pub fn read_buffer(&self, gpu: &Gpu, name: &str) -> Result<Vec<u8>> {
+        let b = self.targets.memory.find_buffer(name).with_context(|| {
+            let labels: Vec<&str> = self.targets.memory.buffers.iter().map(|(l, _)| l.as_str()).collect();
+            format!("no buffer {name:?} in this frame (its buffers: {})", labels.join(", "))
+        })?;
+        crate::gpu::readback_buffer(&gpu.device, &gpu.queue, b, b.size())
+    }
 }

@@ -14,6 +14,7 @@ impl Renderer {
             v.push(&mut d.pipeline);
         }
         v.extend(self.taa.pipelines());
+        v.extend(self.supersample.pipelines());
         for d in &mut self.denoisers {
             v.extend(d.denoiser.pipelines());
         }

@@ -10,12 +10,26 @@ pub struct GpuMemory {
     /// Every texture made through this tracker, by label (a ping-pong pair is "name 0" and
     /// "name 1").
     pub textures: Vec<(String, wgpu::Texture)>,
+    /// Every buffer made through this tracker that can be copied from, by label.
+    pub buffers: Vec<(String, wgpu::Buffer)>,
 }
 
 impl GpuMemory {
     /// The texture labelled `label`, if this tracker made one.
     pub fn find_texture(&self, label: &str) -> Option<&wgpu::Texture> {
         self.textures.iter().find(|(l, _)| l == label).map(|(_, t)| t)
+    }
+
+    /// Forget what was made under labels starting with `prefix` (it was replaced).
+    pub fn forget(&mut self, prefix: &str) {
+        self.allocations.retain(|(l, _)| !l.starts_with(prefix));
+        self.textures.retain(|(l, _)| !l.starts_with(prefix));
+        self.buffers.retain(|(l, _)| !l.starts_with(prefix));
+    }
+
+    /// The buffer labelled `label`, if this tracker made one with COPY_SRC.
+    pub fn find_buffer(&self, label: &str) -> Option<&wgpu::Buffer> {
+        self.buffers.iter().find(|(l, _)| l == label).map(|(_, b)| b)
     }
 
     pub fn total_bytes(&self) -> u64 {
@@ -76,12 +90,16 @@ impl GpuMemory {
     ) -> wgpu::Buffer {
         let size = size.max(16);
         self.allocations.push((label.to_string(), size));
-        device.create_buffer(&wgpu::BufferDescriptor {
+        let b = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size,
             usage,
             mapped_at_creation: false,
-        })
+        });
+        if usage.contains(wgpu::BufferUsages::COPY_SRC) {
+            self.buffers.push((label.to_string(), b.clone()));
+        }
+        b
     }
 }
 

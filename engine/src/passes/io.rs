@@ -19,6 +19,8 @@ pub struct FrameIo<'a> {
     /// ([`crate::denoise::Denoiser::needs_previous_gbuffer`]).
     pub previous: Option<&'a PreviousGBuffer>,
     pub trace: &'a TraceTargets,
+    /// With supersampling (k > 1), the guides' light after eq. (7): offered as the trace's.
+    pub mixed: Option<&'a super::supersample::MixedLight>,
     /// The composite's linear HDR image, one vec4 per pixel.
     pub hdr: &'a wgpu::Buffer,
     /// Every per-pixel allocation of the frame, textures findable by label.
@@ -46,6 +48,12 @@ impl<'a> FrameIo<'a> {
             .texture("tr_direct", &t.direct.1);
         if let Some(gl) = &t.glossy {
             b = b.texture("tr_glossy", &gl.light.1).texture("tr_reflection", &gl.reflection.1).texture("tr_mirror", &gl.mirror.1).texture("tr_mirror_hit", &gl.mirror_hit.1);
+        }
+        if let Some(m) = self.mixed {
+            b = b.texture("tr_matte", &m.matte.1).texture("tr_direct", &m.direct.1);
+            if let Some(g) = &m.glossy {
+                b = b.texture("tr_glossy", &g.1);
+            }
         }
         if let Some(p) = self.previous {
             b = b.texture("prev_depth", &p.depth.1).texture("prev_normal", &p.normal.1);

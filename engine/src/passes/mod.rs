@@ -13,4 +13,5 @@ pub mod composite;
 pub mod gbuffer;
 pub mod glossy;
 pub mod matte;
+pub mod supersample;
 pub mod trace;

@@ -55,7 +55,8 @@ pub struct TracePass {
     groups: BindCache,
 }
 
-fn bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::Buffer, g: &'a GBufferTargets, t: &'a TraceTargets) -> Bindings<'a> {
+/// What the trace (and the supersampling's samples pass, which shades as it does) binds.
+pub fn bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::Buffer, g: &'a GBufferTargets, t: &'a TraceTargets) -> Bindings<'a> {
     let mut b = scene.bindings().buffer("params", params).buffer("frame", frame).texture("gb_ids", g.view("ids")).texture("out_matte", &t.matte.1).texture("out_direct", &t.direct.1);
     if let Some(gl) = &t.glossy {
         b = b.texture("out_glossy", &gl.light.1).texture("out_reflection", &gl.reflection.1).texture("out_mirror", &gl.mirror.1).texture("out_mirror_hit", &gl.mirror_hit.1);

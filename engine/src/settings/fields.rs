@@ -58,6 +58,7 @@ const FRAME_FIELDS: &[Field] = &[
     f("denoiser", "frame", "", Choice(denoisers), "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. svgf: SVGF with Voorhuis's extensions, then TAA. Others: denoisers the application registered."),
     f("max_depth", "trace", "bounces", Int(-1, 64), "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded)."),
     f("paths_per_pixel", "trace", "paths", Int(1, 64), "Indirect paths per pixel per frame (1 is the paper's real-time setting)."),
+    f("samples_per_pixel", "trace", "samples", Int(1, super::MAX_SAMPLES_PER_PIXEL as i64), "Samples per pixel: the raster's guide and k - 1 traced, mixed into their most similar guides (Voorhuis §5)."),
 ];
 
 /// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then

@@ -43,7 +43,17 @@ pub struct FrameSettings {
     /// Indirect paths per pixel per frame (each of the matte and glossy estimators, and the
     /// area-light sample, is averaged over them). 1 is the paper's real-time setting.
     pub paths_per_pixel: u32,
+    /// Samples per pixel k of the real-time frame (Voorhuis §5, guide rays): the raster's sample
+    /// (the guide) and k - 1 traced at random positions in the pixel, each mixed into its most
+    /// similar guide among the four nearest pixels before denoising (eq. 7), the pixel then the
+    /// mean of its samples' guides after the composite. Anti-aliases without TAA and feeds the
+    /// denoiser k times the samples; costs a traced primary ray and a full sample per extra
+    /// sample. The accumulate mode ignores it (it box-filters by itself).
+    pub samples_per_pixel: u32,
 }
+
+/// The most samples per pixel the real-time frame takes.
+pub const MAX_SAMPLES_PER_PIXEL: u32 = 16;
 
 impl FrameSettings {
     /// The multiplier 2^EV applied before tone mapping (EV clamped to +-30).
@@ -54,7 +64,7 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), paths_per_pixel: 1 }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1 }
     }
 }
 

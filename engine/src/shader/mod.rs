@@ -103,6 +103,13 @@ embed!(
     "svgf/variance.wgsl",
     "svgf/atrous.wgsl",
     "svgf/final.wgsl",
+    "supersample/common.wgsl",
+    "supersample/samples.wgsl",
+    "supersample/assign.wgsl",
+    "supersample/mix.wgsl",
+    "supersample/mix_glossy.wgsl",
+    "supersample/mix_glossy_none.wgsl",
+    "supersample/resolve.wgsl",
     "accel/raycast.wgsl",
 );
 
@@ -275,6 +282,11 @@ mod tests {
                 }
             }
         }
+        for glossy in [false, true] {
+            for stage in ["supersample/assign.wgsl", "supersample/mix.wgsl", "supersample/resolve.wgsl"] {
+                v.push(compose(stage, "", &crate::passes::supersample::modules(stage, glossy)).unwrap());
+            }
+        }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             v.push(compose("raycast", "", &["common/math.wgsl", "common/geometry.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
             for (i, set) in FEATURE_SETS.iter().enumerate() {
@@ -287,6 +299,8 @@ mod tests {
                 let glossy = if i % 2 == 0 { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" };
                 m.extend(["realtime/frame.wgsl", glossy, "realtime/trace.wgsl"]);
                 v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
+                m.extend(["supersample/common.wgsl", "supersample/samples.wgsl"]);
+                v.push(compose(&format!("supersample samples {bvh} {i}"), &prelude, &m).unwrap());
             }
         }
         v

@@ -1,0 +1,159 @@
+//! Supersampling with guide rays (Voorhuis §5; shaders/supersample/*.wgsl), for k =
+//! `FrameSettings::samples_per_pixel` > 1: `supersample/samples` traces k - 1 extra samples per
+//! pixel beside the raster's guide, `supersample/assign` gives each the most similar of its
+//! four nearest guides, `supersample/mix` averages them into their guides' light (eq. 7), which
+//! the denoiser and the composite then read in place of the trace's (`FrameIo::mixed`); after
+//! the composite, `supersample/resolve` makes each pixel the mean of its samples' guides.
+//!
+//! Per pixel: 56 bytes per extra sample, 16 for the guides' features, 16 or 24 for the mixed
+//! light and 16 for the resolved image (k = 4 in a glossy scene: 224 bytes).
+
+use super::chain::ChainStage;
+use super::io::FrameIo;
+use crate::gpu::scene::compute_pipeline;
+use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups};
+use crate::shader::{Reload, Reloadable};
+use anyhow::Result;
+
+pub const SAMPLES: &str = "supersample/samples";
+const RECORD_BYTES: u64 = 56;
+
+type Tex = (wgpu::Texture, wgpu::TextureView);
+
+/// The guide light after eq. (7): what the denoiser and the composite read as `tr_matte`,
+/// `tr_direct` and `tr_glossy`.
+pub struct MixedLight {
+    pub matte: Tex,
+    pub direct: Tex,
+    pub glossy: Option<Tex>,
+}
+
+pub struct SupersampleTargets {
+    /// Samples per pixel these were made for, and the frame targets' epoch.
+    pub k: u32,
+    pub epoch: u64,
+    samples: wgpu::Buffer,
+    guides: wgpu::Buffer,
+    pub mixed: MixedLight,
+    resolved: wgpu::Buffer,
+}
+
+impl SupersampleTargets {
+    /// Labels of everything it allocates start with this.
+    pub const PREFIX: &str = "supersample/";
+
+    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), k: u32, glossy: bool, epoch: u64) -> SupersampleTargets {
+        let pixels = size.0 as u64 * size.1 as u64;
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let f = super::trace::MATTE_FORMAT;
+        let mut t = |label: &str| mem.texture(d, label, size, f, rw);
+        let mixed = MixedLight { matte: t("supersample/matte"), direct: t("supersample/direct"), glossy: glossy.then(|| t("supersample/glossy")) };
+        SupersampleTargets {
+            k,
+            epoch,
+            samples: mem.buffer(d, "supersample/samples", pixels * (k.max(2) - 1) as u64 * RECORD_BYTES, storage),
+            guides: mem.buffer(d, "supersample/guides", pixels * 16, storage),
+            mixed,
+            resolved: mem.buffer(d, "supersample/resolved", pixels * 16, storage),
+        }
+    }
+}
+
+/// The modules of the mix, assign and resolve programs.
+pub fn modules(stage: &'static str, glossy: bool) -> Vec<&'static str> {
+    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl"];
+    m.push(if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" });
+    m.push("supersample/common.wgsl");
+    if stage == "supersample/mix.wgsl" {
+        m.push(if glossy { "supersample/mix_glossy.wgsl" } else { "supersample/mix_glossy_none.wgsl" });
+    }
+    m.push(stage);
+    m
+}
+
+/// The samples program: the trace's (it shades as the trace does) and the supersampling's.
+pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
+    let mut m = scene.shading_modules();
+    m.push("realtime/frame.wgsl");
+    m.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
+    m.extend(["realtime/trace.wgsl", "supersample/common.wgsl", "supersample/samples.wgsl"]);
+    m
+}
+
+pub struct Supersample {
+    samples: Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>,
+    stages: Option<[ChainStage; 3]>,
+}
+
+impl Supersample {
+    pub fn new() -> Supersample {
+        Supersample { samples: None, stages: None }
+    }
+
+    /// Its pipelines, for hot reload.
+    pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
+        let mut v: Vec<&mut dyn Reload> = vec![];
+        if let Some((p, _)) = self.samples.as_mut() {
+            v.push(p);
+        }
+        if let Some(s) = self.stages.as_mut() {
+            v.extend(s.iter_mut().map(|s| &mut s.pipeline as &mut dyn Reload));
+        }
+        v
+    }
+
+    fn own<'a>(t: &'a SupersampleTargets, b: Bindings<'a>) -> Bindings<'a> {
+        let b = b.buffer("ss_samples", &t.samples).buffer("ss_guides", &t.guides).texture("out_matte", &t.mixed.matte.1).texture("out_direct", &t.mixed.direct.1).buffer("resolved", &t.resolved);
+        match &t.mixed.glossy {
+            Some(g) => b.texture("out_glossy", &g.1),
+            None => b,
+        }
+    }
+
+    /// Trace the extra samples, assign and mix them (before the denoiser). `io`: the frame's
+    /// I/O with the trace's own light.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_mix(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, scene: &GpuScene, trace_bindings: Bindings, io: &FrameIo, t: &SupersampleTargets, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        let size = io.size;
+        let sample_bindings = Self::own(t, trace_bindings);
+        if self.samples.is_none() {
+            let p = Reloadable::new(gpu, SAMPLES, &scene.prelude(), &sample_modules(scene), wgpu::ShaderStages::COMPUTE, &sample_bindings, |d, m, l| compute_pipeline(d, SAMPLES, m, l, "samples"))?;
+            self.samples = Some((p, BindCache::default()));
+        }
+        let (p, cache) = self.samples.as_mut().unwrap();
+        let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &sample_bindings))?;
+        {
+            let _scope = crate::profile::scope(SAMPLES);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(SAMPLES), timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(SAMPLES)) });
+            pass.set_pipeline(p.get());
+            set_compute_groups(&mut pass, groups);
+            pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        }
+        let offered = Self::own(t, io.bindings().buffer("hdr", io.hdr));
+        if self.stages.is_none() {
+            let glossy = t.mixed.glossy.is_some();
+            let stage = |label, file| ChainStage::new(gpu, label, &modules(file, glossy), "main", &offered);
+            self.stages = Some([stage("supersample/assign", "supersample/assign.wgsl")?, stage("supersample/mix", "supersample/mix.wgsl")?, stage("supersample/resolve", "supersample/resolve.wgsl")?]);
+        }
+        let [assign, mix, _] = self.stages.as_mut().unwrap();
+        assign.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| offered.clone())?;
+        mix.record_variant(gpu, enc, key, (1, 0), size, timer, |_| offered.clone())
+    }
+
+    /// After the composite: each pixel the mean of its samples' guides, copied back into the
+    /// composite's image for TAA and the display.
+    pub fn record_resolve(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, io: &FrameIo, t: &SupersampleTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
+        let offered = Self::own(t, io.bindings().buffer("hdr", io.hdr));
+        let Some([_, _, resolve]) = self.stages.as_mut() else { anyhow::bail!("the supersampling resolves before it mixed") };
+        resolve.record_variant(gpu, enc, key, (1, 0), io.size, timer, |_| offered.clone())?;
+        enc.copy_buffer_to_buffer(&t.resolved, 0, io.hdr, 0, io.size.0 as u64 * io.size.1 as u64 * 16);
+        Ok(())
+    }
+}
+
+impl Default for Supersample {
+    fn default() -> Self {
+        Supersample::new()
+    }
+}
