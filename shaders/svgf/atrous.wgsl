@@ -3,6 +3,7 @@
 // (common.wgsl: edge_weight) with the luminance bandwidth sigma_l sqrt(g3x3(var)) of the
 // pixel's variance blurred by a 3x3 Gaussian; Voorhuis eq. (8) widens it for young histories.
 // The signal may bound the reach with a Gaussian of its own (signal_sigma: the glossy light's).
+// Light accumulated from many samples runs only the first levels (SvgfSettings::settled_samples).
 // The variance is filtered with the squared weights (eq. (6)) unless Voorhuis §6 turns that off,
 // when every level uses the first level's. The first level's output is also next frame's
 // history (Schied et al. §4.3: filtered, so the temporal stage accumulates smoother light).
@@ -40,7 +41,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let c = textureLoad(src, p, 0);
     var out = c;
-    if has_surface(p) {
+    // Settled light (SvgfSettings::settled_samples): the wide levels pass it through.
+    let samples = 1.0 / max(textureLoad(moments, p, 0).w, 1e-6);
+    let settled = sv.settled_samples > 0.0 && samples >= sv.settled_samples && level.index >= sv.settled_levels;
+    if has_surface(p) && !settled {
         let fc = signal_features(p);
         let lc = luminance(c.rgb);
         var sigma_l = sv.sigma_l;

@@ -17,17 +17,18 @@ struct SvgfParams {
     clip_roughness: f32,
     // In a still view the moving averages' weights fall to 1 / this (0: never).
     still_frames: f32,
+    // Light of at least this many samples' worth runs only the first settled_levels levels.
+    settled_samples: f32,
+    settled_levels: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 // Per dispatch: which a-trous level (step 2^level pixels), whether it writes the history.
 struct Level {
     step: i32,
     write_history: u32,
+    index: u32,
     _pad0: u32,
-    _pad1: u32,
 }
 
 var<uniform> sv: SvgfParams;
@@ -43,6 +44,7 @@ const SV_CLIPPING: u32 = 128u;
 const SV_MIRROR_FEATURES: u32 = 256u;
 const SV_VARIANCE_OF_MEAN: u32 = 512u;
 const SV_FILTERED_HISTORY: u32 = 1024u;
+const SV_GLOSSY_TEMPORAL: u32 = 2048u;
 
 fn sv_on(bit: u32) -> bool {
     return (sv.bits & bit) != 0u;

@@ -9,8 +9,6 @@
 // sharp reflection seen from afar is not blurred across the surface.
 var features: texture_2d<f32>;
 
-const SIGNAL_MATTE: bool = false;
-
 fn signal_features(p: vec2i) -> Features {
     let f = textureLoad(features, p, 0).xy;
     var r = Features(f.x, f.y, oct_decode(textureLoad(gb_normal, p, 0).xy));
@@ -28,4 +26,11 @@ fn signal_remodulation(p: vec2i) -> vec3f {
 fn signal_sigma(p: vec2i) -> f32 {
     let x = position_at(p);
     return max(glossy_sigma(roughness_at(p), ray_differential(p, x)), 0.5);
+}
+
+// Behind a mirror the glossy light is what a diffuse surface reflects (§4.1: the first non-
+// specular hit), so Voorhuis §6's firefly median runs there too, among mirror pixels; on glossy
+// surfaces it would cut their highlights.
+fn signal_diffuse(p: vec2i) -> bool {
+    return has_surface(p) && sv_on(SV_MIRROR_FEATURES) && is_mirror(roughness_at(p));
 }

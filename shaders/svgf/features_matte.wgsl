@@ -2,8 +2,6 @@
 // composite alone.
 var features: texture_2d<f32>;
 
-const SIGNAL_MATTE: bool = true;
-
 fn signal_features(p: vec2i) -> Features {
     let f = textureLoad(features, p, 0).xy;
     return Features(f.x, f.y, oct_decode(textureLoad(gb_normal, p, 0).xy));
@@ -16,4 +14,9 @@ fn signal_remodulation(p: vec2i) -> vec3f {
 // The matte light's filter has no spatial bound beyond the kernel's.
 fn signal_sigma(p: vec2i) -> f32 {
     return 1e9;
+}
+
+// Voorhuis §6's firefly median runs on the matte light of every surface.
+fn signal_diffuse(p: vec2i) -> bool {
+    return has_surface(p);
 }

@@ -1,7 +1,8 @@
 // SVGF's output for the composite: the last a-trous level remodulated where the signal was
-// demodulated (behind mirrors), and for the matte light Voorhuis §6's firefly suppression: the
-// 3x3 neighbour of median luminance, among neighbours with a surface, outside the history loop
-// (the next frame's history is the first level's, untouched).
+// demodulated (behind mirrors), and where the signal is diffuse light (signal_diffuse: the matte
+// light, the glossy light behind mirrors) Voorhuis §6's firefly suppression: the 3x3 neighbour of
+// median luminance among the neighbours where it is too, outside the history loop (the next
+// frame's history is untouched).
 
 var src: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
@@ -13,13 +14,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     var c = textureLoad(src, p, 0).rgb;
-    if SIGNAL_MATTE && sv_on(SV_FIREFLY) && has_surface(p) {
+    if sv_on(SV_FIREFLY) && signal_diffuse(p) {
         var values: array<vec3f, 9>;
         var lum: array<f32, 9>;
         var n = 0;
         for (var k = 0; k < 9; k++) {
             let q = p + neighbour_3x3(k);
-            if in_bounds(q) && has_surface(q) {
+            if in_bounds(q) && signal_diffuse(q) {
                 values[n] = textureLoad(src, q, 0).rgb;
                 lum[n] = luminance(values[n]);
                 n++;

@@ -58,7 +58,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var reprojected = false;
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);
-    if sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
+    if sv_on(SV_TEMPORAL) && sv_on(SV_GLOSSY_TEMPORAL) && dn.history_valid != 0u {
         // In a static view the reflection stood still too: the surface test is exact there.
         let reflected = sv_on(SV_REFLECTION_REPROJECTION) && roughness < sv.roughness_threshold && gp.static_view == 0u;
         let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;

@@ -1,5 +1,5 @@
-//! `hush-cli reflections`: how well the glossy chain reprojects reflections, measured as
-//! Voorhuis §7.3-7.4 does.
+//! `hush-cli reflections`: how well a denoiser (`--denoiser mara`: the glossy chain; `svgf`: its
+//! glossy signal) reprojects reflections, measured as Voorhuis §7.3-7.4 does.
 //! 1. Temporal error (Schied et al.: mean |luminance change| between consecutive frames, still
 //!    camera and scene) on surfaces with a specular lobe, of the glossy chain's output (TAA and
 //!    its jitter off) and of the final image (TAA on), for each reflection motion vector
@@ -52,6 +52,9 @@ pub struct ReflectionsArgs {
     /// Brute-force search radius in pixels.
     #[arg(long, default_value_t = 32)]
     pub search_radius: u32,
+    /// The denoiser measured: `mara` (its glossy chain) or `svgf` (its glossy signal).
+    #[arg(long, default_value = "mara")]
+    pub denoiser: String,
     /// Stages to switch off in every configuration (see `render --disable`), for ablations.
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
@@ -103,9 +106,21 @@ fn masked_mean(values: impl Iterator<Item = f64>, mask: &[bool]) -> f64 {
     if n == 0 { 0.0 } else { s / n as f64 }
 }
 
-/// The four ways of reprojecting reflections that are compared.
+/// The ways of reprojecting reflections that are compared: Mara's chain with each reflection
+/// motion vector and with none, or SVGF with and without Voorhuis's reflection reprojection and
+/// with no glossy accumulation ("NoSpecReproj").
 fn configs(base: &FrameSettings) -> Vec<(&'static str, FrameSettings)> {
     let mut v = vec![];
+    if base.denoiser.name() == "svgf" {
+        v.push(("diamond", base.clone()));
+        let mut primary = base.clone();
+        primary.svgf.reflection_reprojection = false;
+        v.push(("primary", primary));
+        let mut off = base.clone();
+        off.svgf.glossy_temporal = false;
+        v.push(("no reprojection", off));
+        return v;
+    }
     for mv in [ReflectionMv::Diamond, ReflectionMv::Virtual, ReflectionMv::Primary] {
         let mut s = base.clone();
         s.glossy.reflection_mv = mv;
@@ -130,8 +145,14 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     let size = image_size(&scene, Some(a.width), a.height);
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
-    let base = crate::realtime::denoiser_settings("mara", &a.disable, "diamond")?;
-    let threshold = base.glossy.roughness_threshold;
+    let base = crate::realtime::denoiser_settings(&a.denoiser, &a.disable, "diamond")?;
+    let svgf = base.denoiser.name() == "svgf";
+    if !svgf && base.denoiser != hush_engine::settings::Denoiser::MARA {
+        anyhow::bail!("--denoiser {}: reflections measures mara or svgf", a.denoiser);
+    }
+    let threshold = if svgf { base.svgf.roughness_threshold } else { base.glossy.roughness_threshold };
+    // What the glossy denoiser writes for the composite.
+    let glossy_output = if svgf { "svgf/glossy out" } else { "glossy/denoised" };
     let camera = scene.camera_or_default();
     let mut csv = std::fs::File::create(a.out_dir.join("reflections.csv"))?;
     writeln!(csv, "part,config,metric,value")?;
@@ -157,7 +178,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
                 let y: Vec<f32> = if taa {
                     r.read_hdr(&gpu)?.data.iter().map(|v| luminance(*v)).collect()
                 } else {
-                    read_vec4(&r, &gpu, "glossy/denoised")?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect()
+                    read_vec4(&r, &gpu, glossy_output)?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect()
                 };
                 let raw: Vec<f32> = read_vec4(&r, &gpu, "trace/glossy")?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect();
                 if let Some((p, pr)) = &prev {
@@ -247,8 +268,10 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
                 continue;
             }
             let m = mask(&r, &gpu, threshold)?;
-            let motion = read_vec4(&r, &gpu, "glossy/motion")?;
-            let search = read_vec4(&r, &gpu, "glossy/search")?;
+            // SVGF runs the glossy chain's search on textures of its own.
+            let prefix = if svgf { "svgf/glossy " } else { "glossy/" };
+            let motion = read_vec4(&r, &gpu, &format!("{prefix}motion"))?;
+            let search = read_vec4(&r, &gpu, &format!("{prefix}search"))?;
             for i in 0..motion.len() {
                 // Reflective pixels where the brute force found a match (finite distance).
                 if !m.reflective[i] || !search[i][3].is_finite() || search[i][3] > 6.0e4 {

@@ -92,7 +92,7 @@ pub struct RenderArgs {
     pub preset: Option<PathBuf>,
     /// Real-time mode: denoiser stages to switch off, comma-separated (matte.temporal,
     /// matte.history_bilateral, matte.disocclusion, matte.firefly, matte.bilateral, taa,
-    /// glossy.temporal, glossy.clipping, glossy.bilateral; svgf.temporal,
+    /// glossy.temporal, glossy.clipping, glossy.bilateral; svgf.temporal, svgf.glossy_temporal,
     /// svgf.spatial_variance, svgf.atrous, svgf.accumulated_moments, svgf.bandwidth_boost,
     /// svgf.firefly, svgf.reflection_reprojection, svgf.clipping, svgf.mirror_features).
     #[arg(long, value_delimiter = ',')]

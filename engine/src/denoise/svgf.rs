@@ -39,7 +39,9 @@ pub struct SvgfParams {
     pub roughness_threshold: f32,
     pub clip_roughness: f32,
     pub still_frames: f32,
-    pub _pad: [u32; 3],
+    pub settled_samples: f32,
+    pub settled_levels: u32,
+    pub _pad: u32,
 }
 
 impl SvgfParams {
@@ -54,7 +56,9 @@ impl SvgfParams {
             roughness_threshold: s.roughness_threshold,
             clip_roughness: s.clip_roughness,
             still_frames: s.still_frames.clamp(0.0, 1024.0),
-            _pad: [0; 3],
+            settled_samples: s.settled_samples.max(0.0),
+            settled_levels: s.settled_levels,
+            _pad: 0,
         }
     }
 }
@@ -65,7 +69,8 @@ impl SvgfParams {
 struct Level {
     step: i32,
     write_history: u32,
-    _pad: [u32; 2],
+    index: u32,
+    _pad: u32,
 }
 
 /// The previous frame's surfaces must point the same way within this angle for its light to be
@@ -81,7 +86,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let gp = memory.buffer(d, "svgf/glossy params", size_of::<GlossyParams>() as u64, u);
     let levels = std::array::from_fn(|i| {
         let b = memory.buffer(d, &format!("svgf/level {i}"), size_of::<Level>() as u64, u);
-        gpu.queue.write_buffer(&b, 0, bytemuck::bytes_of(&Level { step: 1 << i, write_history: (i == 0) as u32, _pad: [0; 2] }));
+        gpu.queue.write_buffer(&b, 0, bytemuck::bytes_of(&Level { step: 1 << i, write_history: (i == 0) as u32, index: i as u32, _pad: 0 }));
         b
     });
     Ok(Box::new(Svgf { scene: *scene, sv, dn, gp, levels, targets: None, matte: None, glossy: None, motion: None }))

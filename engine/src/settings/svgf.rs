@@ -33,6 +33,14 @@ pub struct SvgfSettings {
     /// Levels of the edge-avoiding a-trous wavelet filter (5x5 kernel, step 2^i; SVGF: 5).
     /// The first level's output is the next frame's history. 0: no spatial filter.
     pub levels: u32,
+    /// Where the light accumulated at least this many samples' worth (1 / the sum of the squared
+    /// integration weights: a still view's long mean, not a moving pixel's 0.2 average of about
+    /// 9), only the first `settled_levels` levels filter it: the wide levels' blur then costs
+    /// more (light pulled across corners and shadow edges) than their noise reduction gains.
+    /// 0: every level everywhere (Schied et al.).
+    pub settled_samples: f32,
+    /// Levels that still filter settled light (see `settled_samples`).
+    pub settled_levels: u32,
     /// Luminance edge-stop sigma_l, in standard deviations of the variance (SVGF: 4).
     pub sigma_l: f32,
     /// Normal edge-stop exponent sigma_n (SVGF: 128).
@@ -48,8 +56,13 @@ pub struct SvgfSettings {
     /// Voorhuis §6 turns it off for indirect light (all Hush filters), trading some overblur
     /// for smoother, steadier light.
     pub variance_filtering: bool,
-    /// Voorhuis §6: a 3x3 median of the matte light after the a-trous, outside the history loop.
+    /// Voorhuis §6: a 3x3 median of diffuse light (the matte light, and the glossy light behind
+    /// mirrors, which is what a diffuse surface reflects) after the a-trous, outside the history
+    /// loop.
     pub firefly: bool,
+    /// Temporal accumulation of the glossy light; off (with `temporal` on), only the matte light
+    /// accumulates: Voorhuis's "NoSpecReproj" (§7.1), the glossy light filtered spatially alone.
+    pub glossy_temporal: bool,
     /// Voorhuis §4: glossy light below `roughness_threshold` is reprojected with the reflection
     /// motion vectors of the diamond search (the Mara glossy chain's `glossy/motion` stage);
     /// off, with the surface's.
@@ -78,6 +91,8 @@ impl Default for SvgfSettings {
             filtered_history: false,
             spatial_variance: true,
             levels: 5,
+            settled_samples: 16.0,
+            settled_levels: 2,
             sigma_l: 4.0,
             sigma_n: 128.0,
             sigma_z: 1.0,
@@ -85,6 +100,7 @@ impl Default for SvgfSettings {
             bandwidth_boost: true,
             variance_filtering: true,
             firefly: true,
+            glossy_temporal: true,
             reflection_reprojection: true,
             clipping: false,
             mirror_features: true,
@@ -96,8 +112,9 @@ impl Default for SvgfSettings {
 
 impl SvgfSettings {
     /// Its `--disable` names.
-    pub const STAGES: [&str; 9] = [
+    pub const STAGES: [&str; 10] = [
         "svgf.temporal",
+        "svgf.glossy_temporal",
         "svgf.spatial_variance",
         "svgf.atrous",
         "svgf.accumulated_moments",
@@ -112,6 +129,7 @@ impl SvgfSettings {
     pub fn disable(&mut self, name: &str) -> bool {
         let f = match name {
             "svgf.temporal" => &mut self.temporal,
+            "svgf.glossy_temporal" => &mut self.glossy_temporal,
             "svgf.spatial_variance" => &mut self.spatial_variance,
             "svgf.atrous" => {
                 self.levels = 0;
@@ -142,6 +160,7 @@ impl SvgfSettings {
             clipping: false,
             mirror_features: false,
             still_frames: 0.0,
+            settled_samples: 0.0,
             variance_of_mean: false,
             filtered_history: true,
             ..Default::default()
@@ -162,6 +181,7 @@ impl SvgfSettings {
             self.mirror_features,
             self.variance_of_mean,
             self.filtered_history,
+            self.glossy_temporal,
         ]
         .iter()
         .enumerate()
@@ -187,17 +207,20 @@ pub const FIELDS: &[Field] = &[
     f("svgf.filtered_history", "svgf/temporal", "", Bool, "History is the first a-trous level's output (Schied et al.); off, the unfiltered integrated light."),
     f("svgf.variance_of_mean", "svgf/atrous", "", Bool, "Edge-stop against the variance of the accumulated light, not of one sample."),
     f("svgf.accumulated_moments", "svgf/temporal", "", Bool, "Voorhuis §6: true moment averages up to 4 frames; the spatial estimate reads accumulated moments."),
+    f("svgf.glossy_temporal", "svgf/temporal", "", Bool, "Accumulate the glossy light over time (off: Voorhuis's NoSpecReproj)."),
     f("svgf.reflection_reprojection", "svgf/temporal", "", Bool, "Voorhuis §4: glossy light follows the reflection motion vectors (diamond search)."),
     f("svgf.clipping", "svgf/temporal", "", Bool, "Voorhuis §4.2.3: glossy history clipped to the blurred current 5x5 neighbourhood."),
     f("svgf.roughness_threshold", "svgf/temporal", "", Float(0.0, 1.0, 0.01), "Below this roughness reflections use reflection motion vectors."),
     f("svgf.clip_roughness", "svgf/temporal", "", Float(0.0, 1.0, 0.01), "Below this roughness glossy history is clipped."),
     f("svgf.spatial_variance", "svgf/variance", "", Bool, "7x7 spatial variance estimate while fewer than 4 frames accumulated."),
     f("svgf.levels", "svgf/atrous", "levels", Int(0, MAX_LEVELS as i64), "Levels of the a-trous wavelet filter (0: no spatial filter)."),
+    f("svgf.settled_samples", "svgf/atrous", "samples", Float(0.0, 1024.0, 1.0), "Light accumulated from at least this many samples runs only settled_levels levels (0: all levels everywhere)."),
+    f("svgf.settled_levels", "svgf/atrous", "levels", Int(0, MAX_LEVELS as i64), "Levels that filter settled light."),
     f("svgf.sigma_l", "svgf/atrous", "sigma", Float(0.0, 64.0, 0.1), "Luminance edge-stop, in standard deviations."),
     f("svgf.sigma_n", "svgf/atrous", "", Float(0.0, 512.0, 1.0), "Normal edge-stop exponent."),
     f("svgf.sigma_z", "svgf/atrous", "gradients", Float(0.0, 64.0, 0.1), "Depth edge-stop, in depth gradients."),
     f("svgf.bandwidth_boost", "svgf/atrous", "", Bool, "Voorhuis eq. (8): sigma_l x (8 - min(7, h))."),
     f("svgf.variance_filtering", "svgf/atrous", "", Bool, "Filter the variance at every level (off: Voorhuis §6 for indirect light)."),
     f("svgf.mirror_features", "svgf/atrous", "", Bool, "Voorhuis §4.1: behind mirrors, demodulate by and edge-stop on the reflected surface."),
-    f("svgf.firefly", "svgf/final", "", Bool, "Voorhuis §6: 3x3 median of the matte light after the filter."),
+    f("svgf.firefly", "svgf/final", "", Bool, "Voorhuis §6: 3x3 median of diffuse light (matte, and glossy behind mirrors) after the filter."),
 ];
