@@ -1,5 +1,5 @@
 //! `hush-cli sweep`: the speed/accuracy trade. Presets over resolution scale, indirect paths per
-//! pixel, path length and denoiser on/off; each point's GPU milliseconds per frame (median of the
+//! pixel or samples per pixel, path length and denoiser (none, mara, svgf); each point's GPU milliseconds per frame (median of the
 //! second half of its frames) and FLIP against the converged image after those frames (a still
 //! camera). Writes sweep.csv and pareto.png and prints the table with the Pareto front marked.
 
@@ -35,6 +35,8 @@ pub struct SweepArgs {
 struct Point {
     scale: f32,
     paths: u32,
+    /// Samples per pixel (guide rays, Voorhuis §5).
+    samples: u32,
     max_depth: i32,
     denoiser: Denoiser,
     ms: f64,
@@ -78,10 +80,11 @@ pub fn run(a: SweepArgs) -> Result<()> {
         let mut r = Renderer::new(&gpu, scene.clone(), PreparedScene::new(&scene, bvh_kind(&None)?)?, size)?;
         // A lower resolution is scored against the reference box-filtered to its size.
         let target = if size == full { reference.clone() } else { reference.box_downsample(full.0 / size.0)? };
-        for denoiser in [Denoiser::NONE, Denoiser::MARA] {
-            for paths in [1u32, 2, 4] {
+        for denoiser in [Denoiser::NONE, Denoiser::MARA, Denoiser::named("svgf")] {
+            // More paths at one primary hit, or (one path) more samples per pixel.
+            for (paths, samples) in [(1u32, 1u32), (2, 1), (4, 1), (1, 4)] {
                 for max_depth in [3, depth] {
-                    let s = FrameSettings { denoiser: denoiser.clone(), paths_per_pixel: paths, max_depth, ..Default::default() };
+                    let s = FrameSettings { denoiser: denoiser.clone(), paths_per_pixel: paths, samples_per_pixel: samples, max_depth, ..Default::default() };
                     // One raw frame between points: the denoiser's history starts over.
                     r.render(&gpu, &input, &FrameSettings::default(), None)?;
                     let mut ms = vec![];
@@ -93,7 +96,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
                         }
                     }
                     let flip = compare(&r.read_hdr(&gpu)?, &target)?.flip as f64;
-                    points.push(Point { scale, paths, max_depth, denoiser: denoiser.clone(), ms: median(ms), flip, pareto: false });
+                    points.push(Point { scale, paths, samples, max_depth, denoiser: denoiser.clone(), ms: median(ms), flip, pareto: false });
                 }
             }
         }
@@ -103,14 +106,14 @@ pub fn run(a: SweepArgs) -> Result<()> {
         points[i].pareto = !points.iter().any(|q| q.ms <= points[i].ms && q.flip < points[i].flip || q.ms < points[i].ms && q.flip <= points[i].flip);
     }
     let mut f = std::fs::File::create(a.out_dir.join("sweep.csv"))?;
-    writeln!(f, "resolution_scale,paths_per_pixel,max_depth,denoiser,gpu_ms,flip,pareto")?;
+    writeln!(f, "resolution_scale,paths_per_pixel,samples_per_pixel,max_depth,denoiser,gpu_ms,flip,pareto")?;
     println!("{} at {}x{} full resolution, {} frames per point, on {}", a.scene, full.0, full.1, a.frames, gpu.info.name);
-    println!("  scale  paths  depth  denoiser   GPU ms   FLIP    Pareto");
+    println!("  scale  paths  spp  depth  denoiser   GPU ms   FLIP    Pareto");
     points.sort_by(|p, q| p.ms.total_cmp(&q.ms));
     for p in &points {
-        let d = if p.denoiser == Denoiser::MARA { "mara" } else { "none" };
-        writeln!(f, "{},{},{},{d},{:.3},{:.5},{}", p.scale, p.paths, p.max_depth, p.ms, p.flip, p.pareto)?;
-        println!("  {:5.2}  {:5}  {:5}  {d:8} {:8.2}  {:.4}  {}", p.scale, p.paths, p.max_depth, p.ms, p.flip, if p.pareto { "*" } else { "" });
+        let d = p.denoiser.name();
+        writeln!(f, "{},{},{},{},{d},{:.3},{:.5},{}", p.scale, p.paths, p.samples, p.max_depth, p.ms, p.flip, p.pareto)?;
+        println!("  {:5.2}  {:5}  {:3}  {:5}  {d:8} {:8.2}  {:.4}  {}", p.scale, p.paths, p.samples, p.max_depth, p.ms, p.flip, if p.pareto { "*" } else { "" });
     }
     plot(&a.out_dir.join("pareto.png"), &points, &a.scene)
 }
@@ -131,8 +134,8 @@ fn plot(path: &std::path::Path, points: &[Point], title: &str) -> Result<()> {
         .build_cartesian_2d(0.0..xmax, 0.0..ymax)
         .map_err(|x| e(&x))?;
     chart.configure_mesh().x_desc("GPU ms per frame").y_desc("FLIP against the converged image").draw().map_err(|x| e(&x))?;
-    for (den, color) in [(Denoiser::NONE, RED), (Denoiser::MARA, BLUE)] {
-        let name = if den == Denoiser::MARA { "denoiser: mara" } else { "denoiser: none" };
+    for (den, color) in [(Denoiser::NONE, RED), (Denoiser::MARA, BLUE), (Denoiser::named("svgf"), GREEN)] {
+        let name = format!("denoiser: {}", den.name());
         chart
             .draw_series(points.iter().filter(|p| p.denoiser == den).map(|p| Circle::new((p.ms, p.flip), 4 + 2 * (p.scale >= 1.0) as i32, color.filled())))
             .map_err(|x| e(&x))?

@@ -206,12 +206,12 @@ fn sweep_marks_a_pareto_front() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
-    // 2 scales x 2 denoisers x 3 path counts x 2 path lengths.
-    assert_eq!(rows.len(), 24, "{csv}");
-    assert!(rows.iter().any(|r| r[6] == "true"), "no Pareto point: {csv}");
+    // 2 scales x 3 denoisers x 4 (paths, samples) x 2 path lengths.
+    assert_eq!(rows.len(), 48, "{csv}");
+    assert!(rows.iter().any(|r| r[7] == "true"), "no Pareto point: {csv}");
     for r in &rows {
-        let ms: f64 = r[4].parse().unwrap();
-        let flip: f64 = r[5].parse().unwrap();
+        let ms: f64 = r[5].parse().unwrap();
+        let flip: f64 = r[6].parse().unwrap();
         assert!(ms > 0.0 && flip > 0.0 && flip < 1.0, "{r:?}");
     }
     assert_eq!(image_size(&dir.join("pareto.png")), (960, 640));

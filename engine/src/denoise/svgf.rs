@@ -94,7 +94,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
 
 type Tex = (wgpu::Texture, wgpu::TextureView);
 
-/// One signal's textures: 104 bytes per pixel.
+/// One signal's textures: 88 bytes per pixel.
 pub struct SignalTargets {
     /// The first a-trous level's output, by parity: what the next frame reprojects.
     pub history: [Tex; 2],
@@ -127,7 +127,7 @@ impl SignalTargets {
     }
 }
 
-/// What the reflection motion search and the clip's neighbourhood need (glossy scenes): 64
+/// What the reflection motion search and the clip's neighbourhood need (glossy scenes): 72
 /// bytes per pixel.
 pub struct MotionTargets {
     pub hit: [Tex; 2],
