@@ -51,6 +51,9 @@ fn bad_arguments_are_clear_errors() {
         (vec!["render", "level", "--mode", "realtime", "--frames", "0", "--out", "x.exr"], "--frames"),
         (vec!["render", "level", "--mode", "realtime", "--denoiser", "mara", "--reflection-mv", "sideways", "--out", "x.exr"], "--reflection-mv"),
         (vec!["render", "level", "--mode", "realtime", "--denoiser", "mara", "--disable", "glossy.nothing", "--out", "x.exr"], "glossy.bilateral"),
+        (vec!["render", "level", "--mode", "realtime", "--denoiser", "svgf", "--disable", "svgf.nothing", "--out", "x.exr"], "svgf.bandwidth_boost"),
+        (vec!["render", "level", "--mode", "realtime", "--spp", "17", "--out", "x.exr"], "at most 16"),
+        (vec!["render", "level", "--mode", "realtime", "--denoiser", "oidn", "--out", "x.exr"], "svgf"),
     ] {
         let o = bin("hush-cli").args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
