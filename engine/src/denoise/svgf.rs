@@ -277,7 +277,7 @@ impl Svgf {
                 let dst = if level % 2 == 0 { &s.pong } else { &s.ping };
                 b.texture("src", &src.1).texture("dst", &dst.1).texture("moments", &s.moments[1 - parity].1).texture("out_history", &s.history[1 - parity].1).buffer("level", &self.levels[level])
             }
-            Pass::Final(last) => b.texture("src", &[&s.variance, &s.ping, &s.pong][last].1).texture("dst", &s.out.1),
+            Pass::Final(last) => b.texture("src", &[&s.variance, &s.ping, &s.pong][last].1).texture("moments", &s.moments[1 - parity].1).texture("dst", &s.out.1),
         }
     }
 
@@ -345,7 +345,7 @@ impl Svgf {
         }
         // The last level wrote pong when its index was even.
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
-        st.last.record_variant(gpu, enc, key, (3, last), size, timer, |v| self.bindings(io, glossy, Pass::Final(v), parity))
+        st.last.record_variant(gpu, enc, key, (6, 2 * last + parity), size, timer, |v| self.bindings(io, glossy, Pass::Final(v / 2), v % 2))
     }
 
     fn record_motion(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {

@@ -56,9 +56,11 @@ pub struct SvgfSettings {
     /// Voorhuis §6 turns it off for indirect light (all Hush filters), trading some overblur
     /// for smoother, steadier light.
     pub variance_filtering: bool,
-    /// Voorhuis §6: a 3x3 median of diffuse light (the matte light, and the glossy light behind
-    /// mirrors, which is what a diffuse surface reflects) after the a-trous, outside the history
-    /// loop.
+    /// Voorhuis §6's firefly suppression after the a-trous, outside the history loop, on diffuse
+    /// light (the matte light, and the glossy light behind mirrors, which is what a diffuse
+    /// surface reflects) that has not settled (`settled_samples`): a pixel brighter than all its
+    /// neighbours is brought down to the brightest of them. Voorhuis's 3x3 median erased thin
+    /// lit edges (staircase, 160x284, 60 still frames: FLIP 0.0739; this 0.0656, as without it).
     pub firefly: bool,
     /// Temporal accumulation of the glossy light; off (with `temporal` on), only the matte light
     /// accumulates: Voorhuis's "NoSpecReproj" (§7.1), the glossy light filtered spatially alone.
@@ -222,5 +224,5 @@ pub const FIELDS: &[Field] = &[
     f("svgf.bandwidth_boost", "svgf/atrous", "", Bool, "Voorhuis eq. (8): sigma_l x (8 - min(7, h))."),
     f("svgf.variance_filtering", "svgf/atrous", "", Bool, "Filter the variance at every level (off: Voorhuis §6 for indirect light)."),
     f("svgf.mirror_features", "svgf/atrous", "", Bool, "Voorhuis §4.1: behind mirrors, demodulate by and edge-stop on the reflected surface."),
-    f("svgf.firefly", "svgf/final", "", Bool, "Voorhuis §6: 3x3 median of diffuse light (matte, and glossy behind mirrors) after the filter."),
+    f("svgf.firefly", "svgf/final", "", Bool, "Voorhuis §6: unsettled diffuse light (matte, glossy behind mirrors) brighter than all 8 neighbours is brought down to the brightest."),
 ];
