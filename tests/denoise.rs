@@ -4,7 +4,7 @@ use glam::DVec3;
 use hush_engine::accel::BvhKind;
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::passes::matte::history_rejected;
-use hush_engine::quality::{Image, compare, flip_over, luminance};
+use hush_engine::quality::{Image, compare, flip_over};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MatteSettings, TaaSettings};
 use hush_tests::reproject::{DepthFrame, Surface, neighbours_3x3};
@@ -163,7 +163,7 @@ fn still_view_flickers_at_a_tenth_of_raw() {
         let mut sum = 0.0;
         for _ in 0..PAIRS {
             let b = frames(&mut r, &gpu, s, view(), 1);
-            sum += a.data.iter().zip(&b.data).map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64).sum::<f64>() / a.data.len() as f64;
+            sum += hush_tests::luminance_change(&a, &b);
             a = b;
         }
         sum / PAIRS as f64

@@ -231,3 +231,30 @@ fn decode_hit_class(w: f32) -> u32 {
     }
     return select(HIT_GLOSSY, HIT_ROUGH, w >= 1e30);
 }
+
+// Clip h towards the box centre along the line between them (Karis 2014), in YCoCg.
+fn clip_to_box(h: vec3f, lo: vec3f, hi: vec3f) -> vec3f {
+    let centre = 0.5 * (lo + hi);
+    let extent = max(0.5 * (hi - lo), vec3f(1e-6));
+    let d = h - centre;
+    let t = max3(abs(d) / extent);
+    if t <= 1.0 {
+        return h;
+    }
+    return centre + d / t;
+}
+
+// Voorhuis §4.2.3: h clipped to the 5x5 box, in YCoCg, of the pre-blurred current glossy light
+// around p (glossy/prefilter.wgsl), the glossy chain's and SVGF's clip alike.
+fn clip_to_neighbourhood(neighbourhood: texture_2d<f32>, p: vec2i, h: vec3f) -> vec3f {
+    var lo = vec3f(3.0e38);
+    var hi = vec3f(-3.0e38);
+    for (var dy = -2; dy <= 2; dy++) {
+        for (var dx = -2; dx <= 2; dx++) {
+            let s = to_ycocg(textureLoad(neighbourhood, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb);
+            lo = min(lo, s);
+            hi = max(hi, s);
+        }
+    }
+    return from_ycocg(clip_to_box(to_ycocg(h), lo, hi));
+}

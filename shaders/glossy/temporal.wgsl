@@ -26,18 +26,6 @@ var dst: texture_storage_2d<rgba32float, write>;
 var motion: texture_2d<f32>;
 var out_info: texture_storage_2d<rgba16float, write>;
 
-// Clip h towards the box centre along the line between them (Karis 2014), in YCoCg.
-fn clip_to_box(h: vec3f, lo: vec3f, hi: vec3f) -> vec3f {
-    let centre = 0.5 * (lo + hi);
-    let extent = max(0.5 * (hi - lo), vec3f(1e-6));
-    let d = h - centre;
-    let t = max3(abs(d) / extent);
-    if t <= 1.0 {
-        return h;
-    }
-    return centre + d / t;
-}
-
 // Eq. (11) on the reflected hit, as `reproject` does it on the surface (matte/common.wgsl): the
 // previous frame saw each pixel's reflection at another jitter, so where the pixel under the
 // reflection motion vector shows another point, its 3x3 neighbours are tried and the closest
@@ -122,16 +110,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         own = select(0.0, 1.0, all(r.texel == p) && (!r.bilinear || all(prev == vec2f(p) + 0.5)));
         var clipped = hist;
         if gstage_on(GSTAGE_CLIPPING) && roughness < gp.clip_roughness {
-            var lo = vec3f(3.0e38);
-            var hi = vec3f(-3.0e38);
-            for (var dy = -2; dy <= 2; dy++) {
-                for (var dx = -2; dx <= 2; dx++) {
-                    let s = to_ycocg(textureLoad(neighbourhood, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb);
-                    lo = min(lo, s);
-                    hi = max(hi, s);
-                }
-            }
-            clipped = from_ycocg(clip_to_box(to_ycocg(hist), lo, hi));
+            clipped = clip_to_neighbourhood(neighbourhood, p, hist);
             clip = clamp(length(clipped - hist) / max(length(hist), 1e-4), 0.0, 1.0);
         }
         result = mix(clipped, current, max(1.0 - c, 1.0 / n));

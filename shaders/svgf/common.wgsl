@@ -12,15 +12,14 @@ struct SvgfParams {
     sigma_l: f32,
     sigma_n: f32,
     sigma_z: f32,
-    // Voorhuis §4.2.1 and §4.2.3.
-    roughness_threshold: f32,
-    clip_roughness: f32,
     // In a still view the moving averages' weights fall to 1 / this (0: never).
     still_frames: f32,
     // Light of at least this many samples' worth runs only the first settled_levels levels.
     settled_samples: f32,
     settled_levels: u32,
     _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Per dispatch: which a-trous level (step 2^level pixels), whether it writes the history.

@@ -1,11 +1,8 @@
 // SVGF's output for the composite: the last a-trous level remodulated where the signal was
-// demodulated (behind mirrors), and where the signal is diffuse light (signal_diffuse: the matte
-// light, the glossy light behind mirrors) and not yet settled, Voorhuis §6's firefly
-// suppression outside the history loop. Not his 3x3 median: a median erases every line thinner
-// than two pixels (the staircase's lit table edge came out as a row of dots: FLIP 0.0739
-// against 0.0656 without the stage); a pixel brighter than all eight neighbours is brought down
-// to the brightest of them instead (0.0663). Light of settled_samples or more has averaged its
-// fireflies away and is left alone (0.0656).
+// demodulated (behind mirrors), and Voorhuis §6's firefly suppression outside the history loop,
+// on diffuse light (signal_diffuse: the matte light, the glossy light behind mirrors) that has
+// not settled: a pixel brighter than all eight neighbours is brought down to the brightest of
+// them, which keeps thin lit lines that the paper's 3x3 median erases (docs/decisions.md).
 
 var src: texture_2d<f32>;
 var moments: texture_2d<f32>;

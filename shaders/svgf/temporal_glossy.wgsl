@@ -16,31 +16,6 @@ var neighbourhood: texture_2d<f32>;
 var out_integrated: texture_storage_2d<rgba16float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
 
-// Clip h towards the box centre along the line between them (Karis 2014), in YCoCg.
-fn clip_to_box(h: vec3f, lo: vec3f, hi: vec3f) -> vec3f {
-    let centre = 0.5 * (lo + hi);
-    let extent = max(0.5 * (hi - lo), vec3f(1e-6));
-    let d = h - centre;
-    let t = max3(abs(d) / extent);
-    if t <= 1.0 {
-        return h;
-    }
-    return centre + d / t;
-}
-
-fn clip(p: vec2i, h: vec3f) -> vec3f {
-    var lo = vec3f(3.0e38);
-    var hi = vec3f(-3.0e38);
-    for (var dy = -2; dy <= 2; dy++) {
-        for (var dx = -2; dx <= 2; dx++) {
-            let s = to_ycocg(textureLoad(neighbourhood, clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1), 0).rgb);
-            lo = min(lo, s);
-            hi = max(hi, s);
-        }
-    }
-    return from_ycocg(clip_to_box(to_ycocg(h), lo, hi));
-}
-
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     let p = vec2i(gid.xy);
@@ -60,7 +35,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var mom = vec4f(0.0);
     if sv_on(SV_TEMPORAL) && sv_on(SV_GLOSSY_TEMPORAL) && dn.history_valid != 0u {
         // In a static view the reflection stood still too: the surface test is exact there.
-        let reflected = sv_on(SV_REFLECTION_REPROJECTION) && roughness < sv.roughness_threshold && gp.static_view == 0u;
+        let reflected = sv_on(SV_REFLECTION_REPROJECTION) && roughness < gp.roughness_threshold && gp.static_view == 0u;
         let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
         var r = Reprojection(vec2i(floor(prev)), true, -1.0);
         if reflected {
@@ -81,8 +56,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 mom = vec4f(load_bilinear(moments, prev).xy, mom.zw);
             }
             reprojected = mom.z >= 1.0;
-            if reprojected && sv_on(SV_CLIPPING) && roughness < sv.clip_roughness {
-                hist = clip(p, hist);
+            if reprojected && sv_on(SV_CLIPPING) && roughness < gp.clip_roughness {
+                hist = clip_to_neighbourhood(neighbourhood, p, hist);
             }
         }
     }

@@ -105,3 +105,10 @@ pub fn oct_normal(texel: &[u8]) -> glam::Vec3 {
     }
     n.normalize()
 }
+
+/// Schied et al.'s temporal error between two consecutive frames: the mean absolute change of
+/// luminance per pixel.
+pub fn luminance_change(a: &hush_engine::quality::Image, b: &hush_engine::quality::Image) -> f64 {
+    use hush_engine::quality::luminance;
+    a.data.iter().zip(&b.data).map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64).sum::<f64>() / a.data.len() as f64
+}

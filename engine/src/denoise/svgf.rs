@@ -36,12 +36,10 @@ pub struct SvgfParams {
     pub sigma_l: f32,
     pub sigma_n: f32,
     pub sigma_z: f32,
-    pub roughness_threshold: f32,
-    pub clip_roughness: f32,
     pub still_frames: f32,
     pub settled_samples: f32,
     pub settled_levels: u32,
-    pub _pad: u32,
+    pub _pad: [u32; 3],
 }
 
 impl SvgfParams {
@@ -53,12 +51,10 @@ impl SvgfParams {
             sigma_l: s.sigma_l.max(0.0),
             sigma_n: s.sigma_n.max(0.0),
             sigma_z: s.sigma_z.max(1e-3),
-            roughness_threshold: s.roughness_threshold,
-            clip_roughness: s.clip_roughness,
             still_frames: s.still_frames.clamp(0.0, 1024.0),
             settled_samples: s.settled_samples.max(0.0),
             settled_levels: s.settled_levels,
-            _pad: 0,
+            _pad: [0; 3],
         }
     }
 }
@@ -196,14 +192,13 @@ struct SignalStages {
 
 impl SignalStages {
     fn new(gpu: &Gpu, glossy: bool, animated: bool, offered: &Bindings) -> Result<SignalStages> {
-        let (prefix, temporal) = if glossy { ("svgf/glossy", "svgf/temporal_glossy.wgsl") } else { ("svgf/matte", "svgf/temporal.wgsl") };
+        let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
         // Labels are 'static: the profiler and the pass timings key on them.
         let labels: [&'static str; 4] = if glossy {
             ["svgf/glossy temporal", "svgf/glossy variance", "svgf/glossy atrous", "svgf/glossy final"]
         } else {
             ["svgf/matte temporal", "svgf/matte variance", "svgf/matte atrous", "svgf/matte final"]
         };
-        debug_assert!(labels[0].starts_with(prefix));
         let stage = |label, file, b: &Bindings| ChainStage::new(gpu, label, &modules(file, glossy, animated), "main", b);
         Ok(SignalStages {
             temporal: stage(labels[0], temporal, offered)?,

@@ -57,10 +57,10 @@ pub struct SvgfSettings {
     /// for smoother, steadier light.
     pub variance_filtering: bool,
     /// Voorhuis §6's firefly suppression after the a-trous, outside the history loop, on diffuse
-    /// light (the matte light, and the glossy light behind mirrors, which is what a diffuse
-    /// surface reflects) that has not settled (`settled_samples`): a pixel brighter than all its
-    /// neighbours is brought down to the brightest of them. Voorhuis's 3x3 median erased thin
-    /// lit edges (staircase, 160x284, 60 still frames: FLIP 0.0739; this 0.0656, as without it).
+    /// light (the matte light, and the glossy light behind mirrors) that has not settled
+    /// (`settled_samples`): a pixel brighter than all its neighbours is brought down to the
+    /// brightest of them. Catches the fireflies of young histories; costs a 3x3 read per pixel
+    /// and signal.
     pub firefly: bool,
     /// Temporal accumulation of the glossy light; off (with `temporal` on), only the matte light
     /// accumulates: Voorhuis's "NoSpecReproj" (§7.1), the glossy light filtered spatially alone.

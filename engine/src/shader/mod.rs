@@ -405,7 +405,7 @@ mod tests {
         use crate::denoise::svgf::SvgfParams;
         let (size, offs) = wgsl_layout(atrous, "SvgfParams");
         assert_eq!(size as usize, size_of::<SvgfParams>());
-        assert_eq!(offs[7] as usize, offset_of!(SvgfParams, clip_roughness));
+        assert_eq!(offs[8] as usize, offset_of!(SvgfParams, settled_levels));
         assert_eq!(wgsl_layout(atrous, "Level").0, 16);
         // obvhs's CWBVH node is read as five vec4u.
         assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
