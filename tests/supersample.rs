@@ -1,6 +1,6 @@
 //! Supersampling with guide rays (Voorhuis §5; hush_engine::passes::supersample): each extra
 //! sample's guide and eq. (7)'s mixing against a CPU implementation, and the anti-aliasing the
-//! extra samples buy without TAA.
+//! extra samples buy without TAA; and the heaviest frame with them has every pass timed.
 
 use glam::{DVec3, Vec3};
 use hush_engine::accel::BvhKind;
@@ -163,4 +163,27 @@ fn extra_samples_antialias_without_taa() {
     assert!(four.data.iter().all(|p| p.is_finite()));
     assert!(m4.flip < 0.8 * m1.flip, "k = 4 FLIP {} against k = 1's {}", m4.flip, m1.flip);
     assert!(m4.relmse < 0.5 * m1.relmse, "k = 4 relMSE {} against k = 1's {}", m4.relmse, m1.relmse);
+}
+
+/// The heaviest frame Hush records (SVGF on both signals, k = 4, TAA) times every pass: none
+/// finds the timestamp query set full, and a-trous levels add up under their stage's label.
+#[test]
+fn heaviest_frame_times_every_pass() {
+    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let s = FrameSettings { denoiser: hush_engine::settings::Denoiser::named("svgf"), samples_per_pixel: 4, ..Default::default() };
+    frames(&mut r, &gpu, &s, 2);
+    assert_eq!(r.untimed_passes(), 0);
+    let spans = r.pass_spans(&gpu).unwrap();
+    if spans.is_empty() {
+        return; // no timestamp queries on this device
+    }
+    let times = r.pass_times(&gpu).unwrap();
+    let levels = spans.iter().filter(|s| s.label == "svgf/matte atrous").count();
+    assert_eq!(levels, 5, "{spans:?}");
+    let summed: f64 = spans.iter().filter(|s| s.label == "svgf/matte atrous").map(|s| s.ms).sum();
+    let merged = times.iter().find(|t| t.0 == "svgf/matte atrous").unwrap().1;
+    assert!((merged - summed).abs() < 1e-9, "{merged} vs {summed}");
+    for p in ["trace", "supersample/samples", "svgf/glossy atrous", "composite", "supersample/resolve", "taa"] {
+        assert!(times.iter().any(|t| t.0 == p), "{p} has no time: {times:?}");
+    }
 }

@@ -331,7 +331,7 @@ impl Running {
         }
         // The times of a frame the GPU finished (one or two frames back); never waits.
         if let Some(spans) = self.renderer.poll_pass_spans(&self.gpu) {
-            self.panel.pass_ms = spans.into_iter().map(|s| (s.label, s.ms)).collect();
+            self.panel.pass_ms = hush_engine::profile::per_label(&spans);
         }
         hush_engine::profile::end_frame();
         self.profiler.after_frame();

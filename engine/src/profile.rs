@@ -29,6 +29,19 @@ pub struct PassSpan {
     pub ms: f64,
 }
 
+/// GPU milliseconds per label, summed over the frame's passes of that label (an a-trous stage
+/// runs one pass per level under one label), in the order the labels first ran.
+pub fn per_label(spans: &[PassSpan]) -> Vec<(&'static str, f64)> {
+    let mut out: Vec<(&'static str, f64)> = vec![];
+    for s in spans {
+        match out.iter_mut().find(|p| p.0 == s.label) {
+            Some(p) => p.1 += s.ms,
+            None => out.push((s.label, s.ms)),
+        }
+    }
+    out
+}
+
 /// A CPU scope named `label` (puffin's macros take one name per call site; passes share a call
 /// site, so their ids are registered here by name).
 pub fn scope(label: &'static str) -> Option<puffin::ProfilerScope> {

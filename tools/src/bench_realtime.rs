@@ -92,10 +92,14 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         }
         let recorded = start.elapsed();
         let spans = r.pass_spans(&gpu)?;
+        if r.untimed_passes() > 0 {
+            bail!("{} passes of the frame found no timestamp slot; their time would be missing from the totals", r.untimed_passes());
+        }
         let closing = Instant::now();
         hush_engine::profile::end_frame();
         let recorded = (recorded + closing.elapsed()).as_secs_f64() * 1e3;
-        let times: Vec<(&'static str, f64)> = spans.into_iter().map(|s| (s.label, s.ms)).collect();
+        // One time per label and frame: an a-trous stage's levels share its label.
+        let times = hush_engine::profile::per_label(&spans);
         let wall = start.elapsed().as_secs_f64() * 1e3;
         if k < 2 {
             continue;

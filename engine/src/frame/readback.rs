@@ -28,10 +28,16 @@ impl Renderer {
         image::RgbaImage::from_raw(w, h, bytes).context("display image has the wrong size")
     }
 
-    /// GPU milliseconds per pass of the last frame (blocks until it finished); empty without
-    /// timestamp queries.
+    /// GPU milliseconds per pass label of the last frame, passes of one label summed (blocks
+    /// until it finished); empty without timestamp queries.
     pub fn pass_times(&self, gpu: &Gpu) -> Result<Vec<(&'static str, f64)>> {
-        Ok(self.pass_spans(gpu)?.into_iter().map(|s| (s.label, s.ms)).collect())
+        Ok(crate::profile::per_label(&self.pass_spans(gpu)?))
+    }
+
+    /// Passes of the last recorded frame that found no timestamp slot left (their time is
+    /// missing from [`Renderer::pass_spans`]); 0 unless a frame runs more passes than the timer holds.
+    pub fn untimed_passes(&self) -> u32 {
+        self.timer.as_ref().map_or(0, |t| t.dropped())
     }
 
     /// Each pass of the last frame with its start and duration (blocks until it finished); when

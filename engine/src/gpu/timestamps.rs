@@ -14,6 +14,8 @@ pub struct GpuTimer {
     resolve: wgpu::Buffer,
     capacity: u32,
     labels: Vec<&'static str>,
+    /// Passes of this frame that found the query set full.
+    dropped: u32,
     period_ns: f64,
     /// puffin's clock when the frame was submitted (where its GPU timeline starts).
     pub submitted_ns: i64,
@@ -47,16 +49,22 @@ impl GpuTimer {
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        Some(GpuTimer { set, resolve, capacity, labels: vec![], period_ns: gpu.queue.get_timestamp_period() as f64, submitted_ns: 0, ring: vec![], copying: None })
+        Some(GpuTimer { set, resolve, capacity, labels: vec![], dropped: 0, period_ns: gpu.queue.get_timestamp_period() as f64, submitted_ns: 0, ring: vec![], copying: None })
     }
 
     pub fn begin_frame(&mut self) {
         self.labels.clear();
+        self.dropped = 0;
+    }
+
+    pub fn dropped(&self) -> u32 {
+        self.dropped
     }
 
     fn next(&mut self, label: &'static str) -> Option<u32> {
         let i = self.labels.len() as u32 * 2;
         if i + 2 > self.capacity {
+            self.dropped += 1;
             return None;
         }
         self.labels.push(label);
