@@ -166,6 +166,9 @@ fn a_denoisers_own_wgsl_joins_the_library() {
     assert!(gpu.shaders.add(MODULE, "fn f() {}").is_err(), "a module path holds one text");
     assert!(gpu.shaders.add("matte/temporal.wgsl", WGSL).is_err(), "a module of shaders/ cannot be replaced");
     let p = gpu.shaders.compose("t", "", &["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "realtime/motion_static.wgsl", MODULE]).unwrap();
-    let names: Vec<String> = hush_engine::shader::reflect("t", &p.validate().unwrap()).unwrap().names().map(str::to_string).collect();
+    let names: Vec<String> = {
+        let (m, info) = p.validate_with_info().unwrap();
+        hush_engine::shader::reflect("t", &m, &info).unwrap()
+    }.names().map(str::to_string).collect();
     assert!(names.contains(&"history".to_string()) && names.contains(&"frame".to_string()), "{names:?}");
 }

@@ -205,11 +205,16 @@ impl Program {
 
     /// Parse and validate with naga; errors name the source file and line.
     pub fn validate(&self) -> Result<naga::Module> {
+        Ok(self.validate_with_info()?.0)
+    }
+
+    /// Validate; also naga's analysis of the module (what each entry point uses).
+    pub fn validate_with_info(&self) -> Result<(naga::Module, naga::valid::ModuleInfo)> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
             let at = self.at(e.location(&self.text).filter(|l| l.length > 0).map(|l| l.line_number as usize));
             anyhow!("{}: WGSL parse error at {at}: {}", self.label, e.message())
         })?;
-        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
             .validate(&module)
             .map_err(|e| {
                 let at = self.at(e.spans().next().map(|(s, _)| s.location(&self.text).line_number as usize));
@@ -223,7 +228,7 @@ impl Program {
                 }
                 anyhow!("{}: WGSL validation error at {at}: {why}", self.label)
             })?;
-        Ok(module)
+        Ok((module, info))
     }
 
     /// Validate, then create the wgpu module.

@@ -21,11 +21,18 @@ pub struct ProgramBindings {
     pub slots: Vec<Slot>,
 }
 
-/// Read the resources of `module` (the program `label`).
-pub fn reflect(label: &str, module: &naga::Module) -> Result<ProgramBindings> {
+/// Read the resources of `module` (the program `label`) that one of its entry points uses
+/// (naga's `info` says which). A resource a module declares but the entry point never reaches
+/// (a helper module's texture that this stage does not read) is left out of the layout, so a
+/// stage binds only what it reads and need not be offered the rest.
+pub fn reflect(label: &str, module: &naga::Module, info: &naga::valid::ModuleInfo) -> Result<ProgramBindings> {
+    let used = |h: naga::Handle<naga::GlobalVariable>| (0..module.entry_points.len()).any(|i| !info.get_entry_point(i)[h].is_empty());
     let mut slots = vec![];
-    for (_, var) in module.global_variables.iter() {
+    for (h, var) in module.global_variables.iter() {
         let Some(rb) = &var.binding else { continue };
+        if !used(h) {
+            continue;
+        }
         let name = var.name.clone().unwrap_or_default();
         let ty = match binding_type(var.space, &module.types[var.ty].inner) {
             Ok(ty) => ty,
@@ -136,7 +143,8 @@ impl FixedCompute {
     /// more fails here rather than at the first dispatch).
     pub fn new(gpu: &crate::gpu::Gpu, label: &str, prelude: &str, modules: &[&'static str], offered: &[&str]) -> Result<FixedCompute> {
         let program = gpu.shaders.compose(label, prelude, modules)?;
-        let bindings = reflect(label, &program.validate()?)?;
+        let (module, info) = program.validate_with_info()?;
+        let bindings = reflect(label, &module, &info)?;
         bindings.check_offered(label, offered)?;
         let layouts = bindings.layouts(&gpu.device, label, wgpu::ShaderStages::COMPUTE);
         let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
@@ -161,7 +169,8 @@ mod tests {
             Ok(std::sync::Arc::from(if m == "common/a.wgsl" { "var<uniform> u: vec4f;\nvar<private> p: f32;\n" } else { text }))
         })
         .unwrap();
-        reflect("t", &p.validate().unwrap()).unwrap()
+        let (m, info) = p.validate_with_info().unwrap();
+        reflect("t", &m, &info).unwrap()
     }
 
     #[test]
@@ -177,7 +186,13 @@ mod tests {
 
     #[test]
     fn an_indented_var_is_not_a_resource() {
-        let b = program("fn f() -> f32 {\n    var x = 1.0;\n    return x;\n}\n");
+        let b = program("fn f() -> f32 {\n    var x = 1.0;\n    return x;\n}\n@compute @workgroup_size(1) fn main() { let y = f() + u.x; }\n");
         assert_eq!(b.names().collect::<Vec<_>>(), ["u"]);
+    }
+
+    #[test]
+    fn a_resource_no_entry_point_reaches_is_left_out() {
+        let b = program("var t: texture_2d<f32>;\nvar unused: texture_2d<u32>;\nfn g() -> f32 { return textureLoad(t, vec2i(0), 0).x; }\nfn h() -> u32 { return textureLoad(unused, vec2i(0), 0).x; }\n@compute @workgroup_size(1) fn main() { let y = g(); }\n");
+        assert_eq!(b.names().collect::<Vec<_>>(), ["t"], "u and `unused` are declared but never reached");
     }
 }

@@ -93,8 +93,8 @@ impl<P> Reloadable<P> {
 
 fn make<P>(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], visibility: wgpu::ShaderStages, offered: &[String], build: &Build<P>) -> Result<Built<P>> {
     let program = gpu.shaders.compose(label, prelude, modules)?;
-    let module = program.validate()?;
-    let bindings = super::reflect(label, &module)?;
+    let (module, info) = program.validate_with_info()?;
+    let bindings = super::reflect(label, &module, &info)?;
     bindings.check_offered(label, &offered.iter().map(String::as_str).collect::<Vec<_>>())?;
     // naga accepts some programs the pipeline still rejects (an entry point that is gone); the
     // error scope turns those into errors too.
