@@ -10,11 +10,18 @@
 
 var src: texture_2d<f32>;
 var moments: texture_2d<f32>;
+// The signal's features as the variance stage packed them (z, dz, oct normal; dz < 0: no
+// surface), one record per pixel.
+var<storage, read> taps: array<vec4u>;
 var dst: texture_storage_2d<rgba16float, write>;
 var out_history: texture_storage_2d<rgba16float, write>;
 var<uniform> level: Level;
 
 const KERNEL = array<f32, 3>(0.375, 0.25, 0.0625);
+
+fn tap_features(t: vec4u) -> Features {
+    return Features(bitcast<f32>(t.x), bitcast<f32>(t.y), oct_decode(unpack2x16snorm(t.z)));
+}
 
 // The 3x3 Gaussian of the variance around p (SVGF's prefilter of eq. (5)).
 fn blurred_variance(p: vec2i) -> f32 {
@@ -45,6 +52,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let samples = 1.0 / max(textureLoad(moments, p, 0).w, 1e-6);
     let settled = sv.settled_samples > 0.0 && samples >= sv.settled_samples && level.index >= sv.settled_levels;
     if has_surface(p) && !settled {
+        // The pixel's own features come unpacked (exact normal); its 24 taps' from the record.
         let fc = signal_features(p);
         let lc = luminance(c.rgb);
         var sigma_l = sv.sigma_l;
@@ -61,13 +69,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         for (var dy = -2; dy <= 2; dy++) {
             for (var dx = -2; dx <= 2; dx++) {
                 let q = p + vec2i(dx, dy) * level.step;
-                if (dx == 0 && dy == 0) || !in_bounds(q) || !has_surface(q) {
+                if (dx == 0 && dy == 0) || !in_bounds(q) {
+                    continue;
+                }
+                let fq = tap_features(taps[tap_index(q)]);
+                if fq.dz < 0.0 {
                     continue;
                 }
                 let t = textureLoad(src, q, 0);
                 let offset = f32(level.step) * length(vec2f(f32(dx), f32(dy)));
                 let spatial = exp(-0.5 * offset * offset / (sigma * sigma));
-                let w = KERNEL[abs(dx)] * KERNEL[abs(dy)] * spatial * edge_weight(fc, signal_features(q), offset, lc, luminance(t.rgb), phi_l);
+                let w = KERNEL[abs(dx)] * KERNEL[abs(dy)] * spatial * edge_weight(fc, fq, offset, lc, luminance(t.rgb), phi_l);
                 sum += w * t.rgb;
                 sum_var += w * w * t.a;
                 wsum += w;

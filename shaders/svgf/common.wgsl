@@ -113,6 +113,11 @@ fn steering_variance(sample_variance: f32, moments: vec4f) -> f32 {
     return min(v, 65000.0);
 }
 
+// A pixel's record in a per-pixel storage buffer (row-major).
+fn tap_index(p: vec2i) -> u32 {
+    return u32(p.y) * frame.size.x + u32(p.x);
+}
+
 // Feature buffer written by the matte temporal: linear depth and its gradient.
 fn linear_depth(x: vec3f) -> f32 {
     return dot(x - frame.cam_pos.xyz, frame.cam_fwd.xyz) / length(frame.cam_fwd.xyz);
