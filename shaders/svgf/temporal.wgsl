@@ -1,7 +1,7 @@
 // SVGF §4.1 for the matte light: reverse-reproject last frame's filtered light and moments with
 // the G-buffer's motion vectors, test the previous depth and normal (matte/common.wgsl's
 // `reproject`: the texel under the vector sampled bilinearly where it passes, else the closest
-// of its 3x3 neighbours), and integrate (common.wgsl). Also writes the features every later
+// of its 3x3 neighbours) and object (common.wgsl: same_object), and integrate (common.wgsl). Also writes the features every later
 // stage edge-stops on: linear depth and its gradient.
 // Outputs: integrated (rgb, this frame's raw luminance), moments (m1, m2, h), features (z, dz).
 
@@ -58,7 +58,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
         let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
         let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
-        if r.distance >= 0.0 && r.distance <= dn.d1_px {
+        if r.distance >= 0.0 && r.distance <= dn.d1_px && same_object(p, r.texel) {
             mom = textureLoad(moments, r.texel, 0);
             hist = half_safe(textureLoad(history, r.texel, 0).rgb);
             if r.bilinear {

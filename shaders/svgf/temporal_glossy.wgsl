@@ -43,7 +43,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         } else {
             let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
             r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
-            if r.distance > dn.d1_px {
+            if r.distance > dn.d1_px || (r.distance >= 0.0 && !same_object(p, r.texel)) {
                 r.distance = -1.0;
             }
         }

@@ -48,8 +48,18 @@ impl GBufferTargets {
     }
 
     pub fn view(&self, name: &str) -> &wgpu::TextureView {
+        &self.channel(name).1
+    }
+
+    /// A colour channel by name (`normal`, `ids`, ...).
+    pub fn channel(&self, name: &str) -> &(wgpu::Texture, wgpu::TextureView) {
         let i = COLOR_FORMATS.iter().position(|(l, _)| l.strip_prefix("gbuffer/") == Some(name)).expect("G-buffer channel");
-        &self.color[i].1
+        &self.color[i]
+    }
+
+    /// A colour channel's format by name.
+    pub fn format(name: &str) -> wgpu::TextureFormat {
+        COLOR_FORMATS.iter().find(|(l, _)| l.strip_prefix("gbuffer/") == Some(name)).expect("G-buffer channel").1
     }
 }
 

@@ -15,7 +15,7 @@ pub struct FrameIo<'a> {
     /// Per object, previous-from-current transforms (animated scenes only).
     pub objects: Option<&'a wgpu::Buffer>,
     pub gbuffer: &'a GBufferTargets,
-    /// The previous frame's G-buffer depth and normal, where a stage asked for them
+    /// The previous frame's G-buffer depth, normal and object ids, where a stage asked for them
     /// ([`crate::denoise::Denoiser::needs_previous_gbuffer`]).
     pub previous: Option<&'a PreviousGBuffer>,
     pub trace: &'a TraceTargets,
@@ -30,7 +30,7 @@ pub struct FrameIo<'a> {
 impl<'a> FrameIo<'a> {
     /// The frame's resources by WGSL name: `frame`, the G-buffer (`gb_*`, realtime/gbuffer_in.wgsl),
     /// the trace's light (`tr_*`, raw; a stage that filters offers its own `tr_matte` on top),
-    /// object motion, and the previous depth and normal where they exist.
+    /// object motion, and the previous depth, normal and object ids where they exist.
     pub fn bindings(&self) -> Bindings<'a> {
         let g = self.gbuffer;
         let t = self.trace;
@@ -56,18 +56,20 @@ impl<'a> FrameIo<'a> {
             }
         }
         if let Some(p) = self.previous {
-            b = b.texture("prev_depth", &p.depth.1).texture("prev_normal", &p.normal.1);
+            b = b.texture("prev_depth", &p.depth.1).texture("prev_normal", &p.normal.1).texture("prev_object", &p.ids.1);
         }
         b
     }
 }
 
-/// The previous frame's depth and normal: copied from the G-buffer after each frame that a
-/// stage needing them ran in (8 bytes per pixel), made on first use.
+/// The previous frame's depth, normal and object ids: copied from the G-buffer after each frame
+/// that a stage needing them ran in (16 bytes per pixel), made on first use.
 pub struct PreviousGBuffer {
     pub depth: (wgpu::Texture, wgpu::TextureView),
     /// Octahedral normals, for the reprojections' normal test.
     pub normal: (wgpu::Texture, wgpu::TextureView),
+    /// Object index and triangle slot, for SVGF's object test.
+    pub ids: (wgpu::Texture, wgpu::TextureView),
 }
 
 impl PreviousGBuffer {
@@ -75,14 +77,17 @@ impl PreviousGBuffer {
         let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
         PreviousGBuffer {
             depth: mem.texture(device, "gbuffer/previous depth", size, super::gbuffer::DEPTH_FORMAT, usage),
-            normal: mem.texture(device, "gbuffer/previous normal", size, super::gbuffer::COLOR_FORMATS[0].1, usage),
+            normal: mem.texture(device, "gbuffer/previous normal", size, GBufferTargets::format("normal"), usage),
+            ids: mem.texture(device, "gbuffer/previous ids", size, GBufferTargets::format("ids"), usage),
         }
     }
 
-    /// Record the copy of this frame's depth and normal, after every stage read the previous.
+    /// Record the copy of this frame's depth, normal and ids, after every stage read the previous.
     pub fn record_copy(&self, enc: &mut wgpu::CommandEncoder, g: &GBufferTargets, size: (u32, u32)) {
         let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
         enc.copy_texture_to_texture(g.depth.0.as_image_copy(), self.depth.0.as_image_copy(), extent);
-        enc.copy_texture_to_texture(g.color[0].0.as_image_copy(), self.normal.0.as_image_copy(), extent);
+        for (from, to) in [("normal", &self.normal), ("ids", &self.ids)] {
+            enc.copy_texture_to_texture(g.channel(from).0.as_image_copy(), to.0.as_image_copy(), extent);
+        }
     }
 }
