@@ -54,8 +54,8 @@ pub struct Denoised<'a> {
 }
 
 pub trait Denoiser {
-    /// Whether it reads the previous frame's depth and normal (`prev_depth`, `prev_normal`);
-    /// the frame then keeps them (8 bytes per pixel).
+    /// Whether it reads the previous frame's depth, normal and object ids (`prev_depth`,
+    /// `prev_normal`, `prev_object`); the frame then keeps them (16 bytes per pixel).
     fn needs_previous_gbuffer(&self) -> bool;
 
     /// Make its per-pixel textures in `memory` (labelled `name/...`), for frame targets of
