@@ -25,11 +25,62 @@ struct Frame {
     representative_roughness: f32,
     // Samples per pixel k (Voorhuis §5): the raster's guide and k - 1 traced samples.
     samples: u32,
-    _pad2: u32,
-    _pad3: u32,
+    // Frames between two samples of a pixel (1 / f; 1: every pixel every frame), and whether
+    // tiles start the order at their own phase.
+    period: u32,
+    staggered: u32,
 }
 
 var<uniform> frame: Frame;
+
+// Sub-1-spp tracing (Dundr et al. §5; engine/src/frame/schedule.rs, which documents and tests
+// it): with period N = 2^k the image is cut into 2^ceil(k/2) x 2^floor(k/2) tiles and each
+// frame traces one pixel per tile, in the Bayer order from a phase hashed per tile.
+fn schedule_tile() -> vec2u {
+    let k = countTrailingZeros(max(frame.period, 1u));
+    return vec2u(1u << ((k + 1u) / 2u), 1u << (k / 2u));
+}
+
+fn schedule_hash(v: u32) -> u32 {
+    var x = v;
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
+}
+
+// The pixel of tile t traced this frame.
+fn scheduled_pixel(t: vec2u) -> vec2u {
+    let n = max(frame.period, 1u);
+    let k = countTrailingZeros(n);
+    var phase = 0u;
+    if frame.staggered != 0u {
+        phase = schedule_hash((t.x * 0x8da6b343u) ^ (t.y * 0xd8163841u)) & (n - 1u);
+    }
+    let rank = (frame.index + phase) & (n - 1u);
+    var v = 0u;
+    if k > 0u {
+        v = reverseBits(rank) >> (32u - k);
+    }
+    var c = vec2u(0u);
+    for (var i = 0u; i < k; i++) {
+        let bit = (v >> i) & 1u;
+        if i % 2u == 0u {
+            c.x |= bit << (i / 2u);
+        } else {
+            c.y |= bit << (i / 2u);
+        }
+    }
+    c.x ^= c.y;
+    return t * schedule_tile() + c;
+}
+
+// Whether pixel p is traced this frame.
+fn traced_this_frame(p: vec2u) -> bool {
+    return frame.period <= 1u || all(scheduled_pixel(p / schedule_tile()) == p);
+}
 
 // The camera ray through this frame's sample position in pixel px.
 fn camera_ray(px: vec2u) -> vec3f {

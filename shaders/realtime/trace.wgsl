@@ -194,7 +194,11 @@ fn raster_hit(ro: vec3f, rd: vec3f, slot: u32) -> Hit {
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
-    let px = gid.xy;
+    // Below one sample per pixel the dispatch covers the tiles, one thread each (frame.wgsl).
+    var px = gid.xy;
+    if frame.period > 1u {
+        px = scheduled_pixel(gid.xy);
+    }
     if px.x >= frame.size.x || px.y >= frame.size.y {
         return;
     }

@@ -4,7 +4,7 @@ use crate::render::{RenderArgs, bvh_kind, check_output, check_output_dir, check_
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::scene::CameraPath;
-use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv, disable_stage, stage_names};
+use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv, SampleFraction, disable_stage, stage_names};
 
 pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
     match hush_engine::denoise::find(s) {
@@ -60,7 +60,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         bail!("--frames must be at least 1");
     }
     let max_spp = hush_engine::settings::MAX_SAMPLES_PER_PIXEL;
-    if let Some(spp) = a.spp.filter(|s| *s > max_spp) {
+    if let Some(crate::render::Spp::Samples(spp)) = a.spp.filter(|s| matches!(s, crate::render::Spp::Samples(n) if *n > max_spp)) {
         bail!("--spp {spp}: real-time mode takes at most {max_spp} samples per pixel per frame; use --frames (or --accumulate) for more");
     }
     let fps = a.fps.unwrap_or(60.0);
@@ -104,8 +104,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
     }
     let max_depth = path_length(a.max_depth, a.preset.as_deref(), scene.max_depth)?;
-    let samples_per_pixel = a.spp.unwrap_or(chains.samples_per_pixel);
-    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, samples_per_pixel, ..chains };
+    let (samples_per_pixel, sample_fraction) = match a.spp {
+        None => (chains.samples_per_pixel, chains.sample_fraction),
+        Some(crate::render::Spp::Samples(n)) => (n, SampleFraction::ONE),
+        Some(crate::render::Spp::Fraction(f)) => (1, f),
+    };
+    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, samples_per_pixel, sample_fraction, ..chains };
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;

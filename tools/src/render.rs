@@ -118,9 +118,10 @@ pub struct RenderArgs {
     pub out_dir: Option<PathBuf>,
     /// Samples per pixel. Reference mode: the progressive tracer's (default 64). Real-time mode:
     /// per frame, the raster's guide and k - 1 traced samples mixed into their most similar
-    /// guides (Voorhuis §5; default 1, at most 16).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    pub spp: Option<u32>,
+    /// guides (Voorhuis §5; default 1, at most 16), or a fraction 1/N (N = 2, 4, ... 128): each
+    /// frame traces one pixel in N (Dundr §5).
+    #[arg(long, value_parser = parse_spp)]
+    pub spp: Option<Spp>,
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub width: Option<u32>,
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -231,7 +232,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let out = a.out.clone().context("--out is required in reference mode")?;
     check_output(&out, &["exr", "png"], "--out")?;
     check_sides(a.width, a.height, hush_engine::passes::reference::MAX_SIDE, "reference mode")?;
-    let spp = a.spp.unwrap_or(64);
+    let spp = match a.spp {
+        None => 64,
+        Some(Spp::Samples(n)) => n,
+        Some(Spp::Fraction(f)) => bail!("--spp {f}: reference mode traces whole samples per pixel; fractions are for --mode realtime"),
+    };
     let kind = bvh_kind(&a.bvh)?;
     let camera = a.camera.as_deref().map(parse_camera).transpose()?;
     let scene = load_scene(&a.scene, &a.load)?;
@@ -274,4 +279,21 @@ pub fn run(a: RenderArgs) -> Result<()> {
         scene.name, w, h, spp, secs, (w as f64 * h as f64 * spp as f64) / secs / 1e6, gpu.info.name, out.display()
     );
     Ok(())
+}
+
+/// `--spp`: whole samples per pixel, or (real-time mode) a fraction of the pixels per frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Spp {
+    Samples(u32),
+    Fraction(hush_engine::settings::SampleFraction),
+}
+
+pub fn parse_spp(s: &str) -> Result<Spp> {
+    if s.contains('/') {
+        return Ok(Spp::Fraction(s.parse()?));
+    }
+    match s.trim().parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(Spp::Samples(n)),
+        _ => bail!("{s:?}: samples per pixel are a whole number from 1, or a fraction 1/N"),
+    }
 }

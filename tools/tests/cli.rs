@@ -53,6 +53,9 @@ fn bad_arguments_are_clear_errors() {
         (vec!["render", "level", "--mode", "realtime", "--denoiser", "mara", "--disable", "glossy.nothing", "--out", "x.exr"], "glossy.bilateral"),
         (vec!["render", "level", "--mode", "realtime", "--denoiser", "svgf", "--disable", "svgf.nothing", "--out", "x.exr"], "svgf.bandwidth_boost"),
         (vec!["render", "level", "--mode", "realtime", "--spp", "17", "--out", "x.exr"], "at most 16"),
+        (vec!["render", "level", "--mode", "realtime", "--spp", "1/3", "--out", "x.exr"], "power of two"),
+        (vec!["render", "default", "--spp", "1/4", "--out", "x.exr"], "--mode realtime"),
+        (vec!["render", "level", "--mode", "realtime", "--spp", "1/4", "--denoiser", "mara", "--width", "8", "--height", "8", "--out", "x.exr"], "fills untraced pixels"),
         (vec!["render", "level", "--mode", "realtime", "--denoiser", "oidn", "--out", "x.exr"], "svgf"),
     ] {
         let o = bin("hush-cli").args(&args).output().unwrap();

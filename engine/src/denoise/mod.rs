@@ -68,6 +68,13 @@ pub trait Denoiser {
     /// The light it produced this frame (after [`Denoiser::record`]).
     fn output(&self, parity: usize) -> Denoised<'_>;
 
+    /// Whether it takes frames where only some pixels were traced (a sample fraction below 1,
+    /// [`crate::settings::SampleFraction`]; `traced_this_frame` in shaders/realtime/frame.wgsl
+    /// says which). The default, false: the frame refuses fractions below 1 with it.
+    fn fills_untraced_pixels(&self) -> bool {
+        false
+    }
+
     /// What TAA may follow (the default, nothing: TAA averages the composite alone).
     fn taa_follow(&self, _parity: usize) -> TaaFollow<'_> {
         TaaFollow::default()

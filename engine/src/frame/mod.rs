@@ -5,6 +5,7 @@
 //! BVH rebuilds) and the denoiser chosen (its textures are made on its first frame).
 
 mod params;
+pub mod schedule;
 mod readback;
 mod reload;
 
@@ -392,6 +393,17 @@ impl Renderer {
         }
         // Samples per pixel (Voorhuis §5); the accumulate mode box-filters by itself.
         let samples = if settings.accumulate { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) };
+        // Below one sample per pixel (Dundr §5): only denoisers that fill the untraced pixels.
+        let period = if settings.accumulate { 1 } else { settings.sample_fraction.period() };
+        if period > 1 {
+            if samples > 1 {
+                bail!("sample fraction {} traces some pixels each frame and {samples} samples per pixel traces every pixel {samples} times: choose one", settings.sample_fraction);
+            }
+            if let Some(i) = denoiser.filter(|&i| !self.denoisers[i].denoiser.fills_untraced_pixels()) {
+                let fills: Vec<&str> = std::iter::once("none").chain(self.denoisers.iter().filter(|d| d.denoiser.fills_untraced_pixels()).map(|d| d.name.as_str())).collect();
+                bail!("the {} denoiser needs every pixel traced each frame; sample fraction {} needs one that fills untraced pixels ({})", self.denoisers[i].name, settings.sample_fraction, fills.join(", "));
+            }
+        }
         if samples > 1 && self.targets.supersample.as_ref().is_none_or(|s| s.k != samples || s.epoch != self.targets.epoch) {
             let t = &mut self.targets;
             t.memory.forget(SupersampleTargets::PREFIX);
@@ -422,7 +434,7 @@ impl Renderer {
         drop(pass);
         let t = &self.targets;
         let pass = crate::profile::scope(crate::passes::trace::LABEL);
-        self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, self.timer.as_mut())?;
+        self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, period, self.timer.as_mut())?;
         drop(pass);
         let mut io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
         let ss = t.supersample.as_ref().filter(|s| s.k == samples);

@@ -26,7 +26,10 @@ pub struct FrameParams {
     pub representative_roughness: f32,
     /// Samples per pixel k (Voorhuis §5): the raster's guide and k - 1 traced ones.
     pub samples: u32,
-    pub _pad: [u32; 2],
+    /// Frames between two samples of a pixel, 1 / f (1: every pixel every frame; frame/schedule.rs).
+    pub period: u32,
+    /// Whether each tile starts the Bayer order at its own phase (schedule::phase).
+    pub staggered: u32,
 }
 
 impl FrameParams {
@@ -50,7 +53,8 @@ impl FrameParams {
             paths: settings.paths_per_pixel.clamp(1, 64),
             representative_roughness,
             samples: if accumulated > 0 { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) },
-            _pad: [0; 2],
+            period: if accumulated > 0 { 1 } else { settings.sample_fraction.period() },
+            staggered: 1,
         }
     }
 }

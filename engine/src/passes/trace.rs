@@ -76,15 +76,18 @@ impl TracePass {
     }
 
     /// `key`: (scene generation, frame target generation); bind groups are rebuilt when it changes.
+    /// `period`: 1 / f, the frames between two samples of a pixel.
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), period: u32, timer: Option<&mut GpuTimer>) -> Result<()> {
         use crate::shader::Reload;
         let p = &self.pipeline;
         let groups = self.groups.get(key.0 * 1_000_003 + key.1, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t)))?;
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
-        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        // Below one sample per pixel one thread per tile (frame/schedule.rs), so the cost falls as f.
+        let (tw, th) = crate::frame::schedule::tile(period);
+        pass.dispatch_workgroups(size.0.div_ceil(tw).div_ceil(8), size.1.div_ceil(th).div_ceil(8), 1);
         Ok(())
     }
 }

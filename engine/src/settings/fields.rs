@@ -38,6 +38,9 @@ pub(super) fn names<T: serde::Serialize>(all: &[T]) -> Vec<String> {
 fn views() -> Vec<String> {
     std::iter::once(View::FINAL.name().to_string()).chain(super::all_views().into_iter().map(|v| v.name.to_string())).collect()
 }
+fn fractions() -> Vec<String> {
+    super::SampleFraction::all().map(|f| f.to_string()).collect()
+}
 fn denoisers() -> Vec<String> {
     super::denoiser_names().into_iter().map(str::to_string).collect()
 }
@@ -59,6 +62,7 @@ const FRAME_FIELDS: &[Field] = &[
     f("max_depth", "trace", "bounces", Int(-1, 64), "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded)."),
     f("paths_per_pixel", "trace", "paths", Int(1, 64), "Indirect paths per pixel per frame (1 is the paper's real-time setting)."),
     f("samples_per_pixel", "trace", "samples", Int(1, super::MAX_SAMPLES_PER_PIXEL as i64), "Samples per pixel: the raster's guide and k - 1 traced, mixed into their most similar guides (Voorhuis §5)."),
+    f("sample_fraction", "trace", "", Choice(fractions), "Fraction of the pixels traced per frame (Dundr §5): 1/N traces one pixel of every N-pixel tile, each pixel once in N frames."),
 ];
 
 /// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then

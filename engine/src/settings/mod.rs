@@ -2,6 +2,7 @@
 //! one for panels and presets; `preset.rs` saves and loads them as TOML.
 
 mod fields;
+mod fraction;
 mod glossy;
 mod matte;
 mod preset;
@@ -10,6 +11,7 @@ mod taa;
 mod view;
 
 pub use fields::{Field, Kind, fields, get as get_field, get_mut as get_field_mut, leaves};
+pub use fraction::{MAX_SAMPLE_PERIOD, SampleFraction};
 pub use glossy::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 pub use matte::MatteSettings;
 pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, SvgfSettings};
@@ -50,6 +52,12 @@ pub struct FrameSettings {
     /// denoiser k times the samples; costs a traced primary ray and a full sample per extra
     /// sample. The accumulate mode ignores it (it box-filters by itself).
     pub samples_per_pixel: u32,
+    /// Fraction f of the pixels traced per frame, 1 or 1/N (N = 2 ... 128; Dundr et al. §5):
+    /// each frame traces one pixel of every N-pixel tile, each pixel once in N frames, and the
+    /// trace's cost falls with f; a pixel not traced keeps its last sample. Only denoisers that
+    /// fill the gaps accept f < 1 (none: shows each pixel's last sample). Needs k = 1 samples per
+    /// pixel; the accumulate mode ignores it.
+    pub sample_fraction: SampleFraction,
 }
 
 /// The most samples per pixel the real-time frame takes.
@@ -64,7 +72,7 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1 }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1, sample_fraction: SampleFraction::ONE }
     }
 }
 
