@@ -8,6 +8,7 @@ pub mod accel;
 pub mod denoise;
 pub mod frame;
 pub mod fuzz;
+pub mod governor;
 pub mod gpu;
 pub mod limits;
 pub mod passes;

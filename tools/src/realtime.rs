@@ -116,6 +116,25 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let Some(dir) = &a.out_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
+    if let Some(target) = a.target_ms {
+        let inputs = (0..frames).map(|k| match &path {
+            Some(p) => {
+                let key = p.frame(k as usize);
+                FrameInput { camera: key.camera(), time: key.time }
+            }
+            None => FrameInput { camera, time: k as f64 / fps },
+        });
+        let pinned = a.spp.is_some().then_some(settings.sample_fraction);
+        let rows = governed(&gpu, &mut r, &settings, inputs, target, a.min_scale.unwrap_or(0.25), pinned, size, a.out_dir.as_deref())?;
+        let mut wall: Vec<f64> = rows.iter().map(|r| r.wall_ms).collect();
+        wall.sort_by(f64::total_cmp);
+        let pct = |q: f64| wall[((wall.len() - 1) as f64 * q).round() as usize];
+        eprintln!("{name}: {frames} frames governed to {target} ms: wall median {:.1} ms, 95th percentile {:.1} ms on {}", pct(0.5), pct(0.95), gpu.info.name);
+        if let Some(out) = &a.out {
+            r.read_hdr(&gpu)?.save(out)?;
+        }
+        return Ok(());
+    }
     for k in 0..frames {
         let input = match &path {
             Some(p) => {
@@ -147,4 +166,58 @@ pub fn run(a: RenderArgs) -> Result<()> {
         gpu.info.name
     );
     Ok(())
+}
+
+/// One governed frame as frames.csv records it.
+struct GovernedFrame {
+    wall_ms: f64,
+    gpu_ms: f64,
+    spp: f64,
+    size: (u32, u32),
+}
+
+/// Render `inputs` with the governor holding `target_ms` (hush_engine::governor): before each
+/// frame the renderer takes the governor's scale of `full` and its sample fraction; after it,
+/// the frame's wall time (render and its timings read back) and trace time go back to it.
+#[allow(clippy::too_many_arguments)]
+fn governed(gpu: &hush_engine::gpu::Gpu, r: &mut Renderer, settings: &FrameSettings, inputs: impl Iterator<Item = FrameInput>, target_ms: f64, min_scale: f32, pinned: Option<SampleFraction>, full: (u32, u32), out_dir: Option<&std::path::Path>) -> Result<Vec<GovernedFrame>> {
+    if !(target_ms > 0.0 && target_ms.is_finite()) {
+        bail!("--target-ms must be a positive number of milliseconds");
+    }
+    if !(min_scale > 0.0 && min_scale <= 1.0) {
+        bail!("--min-scale must be in (0, 1]");
+    }
+    let mut g = hush_engine::governor::Governor::new(target_ms);
+    g.min_scale = min_scale;
+    g.pinned_fraction = pinned;
+    g.fractions_allowed = r.fills_untraced_pixels(gpu, settings)?;
+    let mut rows = vec![];
+    let mut last_camera = None;
+    for (k, input) in inputs.enumerate() {
+        let c = g.choice();
+        let size = ((full.0 as f32 * c.scale).round().max(1.0) as u32, (full.1 as f32 * c.scale).round().max(1.0) as u32);
+        let s = FrameSettings { sample_fraction: c.fraction, ..settings.clone() };
+        let start = std::time::Instant::now();
+        r.resize(gpu, size)?;
+        r.render(gpu, &input, &s, None)?;
+        let passes = r.pass_times(gpu)?;
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        let trace_ms = passes.iter().filter(|p| p.0 == hush_engine::passes::trace::LABEL).map(|p| p.1).sum();
+        let moving = last_camera.is_some_and(|l| l != input.camera);
+        last_camera = Some(input.camera);
+        g.record(hush_engine::governor::FrameCost { wall_ms, trace_ms, choice: c, moving });
+        rows.push(GovernedFrame { wall_ms, gpu_ms: passes.iter().map(|p| p.1).sum(), spp: 1.0 / c.fraction.period() as f64, size });
+        if let Some(dir) = out_dir {
+            r.read_hdr(gpu)?.save(&dir.join(format!("frame_{k:05}.exr")))?;
+        }
+    }
+    if let Some(dir) = out_dir {
+        let mut csv = String::from("frame,wall_ms,gpu_ms,spp,width,height\n");
+        for (k, f) in rows.iter().enumerate() {
+            csv += &format!("{k},{:.3},{:.3},{},{},{}\n", f.wall_ms, f.gpu_ms, f.spp, f.size.0, f.size.1);
+        }
+        let path = dir.join("frames.csv");
+        std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(rows)
 }

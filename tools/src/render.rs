@@ -105,6 +105,15 @@ pub struct RenderArgs {
     /// Real-time mode: sum all frames with a still camera and write their mean.
     #[arg(long)]
     pub accumulate: bool,
+    /// Real-time mode: hold this frame time (ms) with the governor, which picks the resolution
+    /// scale and (for denoisers that fill untraced pixels) the sample fraction each frame; with
+    /// --out-dir, writes frames.csv (frame, wall_ms, gpu_ms, spp, width, height). --spp pins the
+    /// fraction.
+    #[arg(long)]
+    pub target_ms: Option<f64>,
+    /// Real-time mode with --target-ms: the smallest resolution scale per side (default 0.25).
+    #[arg(long)]
+    pub min_scale: Option<f32>,
     /// Real-time mode: frames per second of the animation clock when no camera path gives times
     /// (default 60).
     #[arg(long)]
@@ -220,6 +229,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ("--disable", !a.disable.is_empty()),
         ("--reflection-mv", a.reflection_mv.is_some()),
         ("--accumulate", a.accumulate),
+        ("--target-ms", a.target_ms.is_some()),
+        ("--min-scale", a.min_scale.is_some()),
         ("--fps", a.fps.is_some()),
         ("--view", a.view.is_some()),
         ("--out-dir", a.out_dir.is_some()),

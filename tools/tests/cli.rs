@@ -261,3 +261,31 @@ fn a_preset_sets_the_frame() {
     let direct = mean(&["--preset", preset.to_str().unwrap()], "direct.png");
     assert!(direct < plain * 0.95, "max_depth 2 from the preset: mean {direct:.1} vs {plain:.1}");
 }
+
+/// `--target-ms` writes one row per frame with the governor's choices; a target far below what
+/// the software driver can do drives it to its smallest choices within a few frames.
+#[test]
+fn governed_render_writes_frames_csv() {
+    let dir = temp_dir("governed");
+    let o = bin("hush-cli")
+        .args(["render", "level", "--mode", "realtime", "--target-ms", "1", "--frames", "8", "--width", "64", "--height", "36", "--min-scale", "0.5", "--out-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows[0], ["frame", "wall_ms", "gpu_ms", "spp", "width", "height"]);
+    assert_eq!(rows.len(), 9, "{csv}");
+    for (k, r) in rows[1..].iter().enumerate() {
+        assert_eq!(r[0], k.to_string());
+        assert!(r[1].parse::<f64>().unwrap() > 0.0);
+        let spp: f64 = r[3].parse().unwrap();
+        assert!(spp > 0.0 && spp <= 1.0);
+        let (w, h): (u32, u32) = (r[4].parse().unwrap(), r[5].parse().unwrap());
+        assert!((32..=64).contains(&w) && (18..=36).contains(&h), "{r:?}");
+    }
+    // 1 ms cannot be met: from the second frame on, the smallest scale and fraction.
+    let last = &rows[8];
+    assert_eq!((last[3], last[4], last[5]), ("0.0078125", "32", "18"), "{csv}");
+}

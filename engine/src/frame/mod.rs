@@ -319,6 +319,16 @@ impl Renderer {
         Ok(Some(i))
     }
 
+    /// Whether the denoiser `settings` asks for takes sample fractions below 1 (the raw frame
+    /// does: it shows each pixel's last sample).
+    pub fn fills_untraced_pixels(&mut self, gpu: &Gpu, settings: &FrameSettings) -> Result<bool> {
+        let plain = FrameSettings { accumulate: false, ..settings.clone() };
+        Ok(match self.denoiser_for(gpu, &plain)? {
+            None => true,
+            Some(i) => self.denoisers[i].denoiser.fills_untraced_pixels(),
+        })
+    }
+
     /// Accumulation restarts whenever anything that changes the image changes.
     fn update_accumulation(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings) {
         if !settings.accumulate {

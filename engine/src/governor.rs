@@ -1,0 +1,270 @@
+//! A frame-time governor: picks the resolution scale and the sample fraction (Dundr et al. §5)
+//! that hold a target frame time on whatever device runs, from the frames it has seen.
+//!
+//! Model: a frame at scale s (of each side) and fraction f costs s^2 (rest + trace f) ms, where
+//! `trace` is the trace pass's time per full-resolution frame at f = 1 and `rest` everything
+//! else (raster, denoiser, display, the CPU's share of the wall time). Both are re-estimated
+//! after every frame from its wall time and its trace time, and smoothed by the median of the
+//! last [`WINDOW`] frames: one slow frame (a hitch, a shader compile) moves nothing, a load
+//! that lasts (a heavier view, another program) is followed within three frames.
+//!
+//! Choice: among the scales [`SCALES`] down to `min_scale` and the fractions the denoiser
+//! accepts, the largest scale whose best fraction fits, then the largest fraction that fits
+//! (a still camera can afford a small fraction, since its samples accumulate; a moving one
+//! wants fresh samples, so while the camera moves a fraction below 1/4 costs a step of scale
+//! first). Changing the scale reallocates the frame and restarts every history, so the scale
+//! rises only after [`RISE_FRAMES`] frames in a row predicted under 80% of the target at the
+//! larger scale; it falls at once when the prediction is over the target.
+
+use crate::settings::SampleFraction;
+
+/// Resolution scales the governor chooses among (per side), largest first.
+pub const SCALES: [f32; 7] = [1.0, 0.875, 0.75, 0.625, 0.5, 0.375, 0.25];
+/// Frames whose costs the estimate takes the median of.
+pub const WINDOW: usize = 5;
+/// Consecutive frames with room to spare before the scale goes up.
+pub const RISE_FRAMES: u32 = 8;
+
+/// What the governor runs the next frame at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Choice {
+    pub scale: f32,
+    pub fraction: SampleFraction,
+}
+
+/// One finished frame as the governor sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameCost {
+    /// Wall time from the start of the frame to the start of the next (ms).
+    pub wall_ms: f64,
+    /// The trace pass's GPU time (ms); 0 when the device has no timestamps (then all of the
+    /// frame is taken to scale with the pixels alone).
+    pub trace_ms: f64,
+    /// The choice the frame ran at.
+    pub choice: Choice,
+    /// The camera moved since the last frame.
+    pub moving: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Governor {
+    /// The frame time to hold (ms).
+    pub target_ms: f64,
+    /// The smallest scale it may pick.
+    pub min_scale: f32,
+    /// Knobs the user pinned: the governor keeps them and turns the other.
+    pub pinned_scale: Option<f32>,
+    pub pinned_fraction: Option<SampleFraction>,
+    /// Whether fractions below 1 are allowed (the denoiser fills untraced pixels).
+    pub fractions_allowed: bool,
+    /// Recent (rest, trace) costs per full-resolution frame at f = 1 (ms).
+    costs: Vec<(f64, f64)>,
+    current: Choice,
+    room_frames: u32,
+}
+
+impl Governor {
+    pub fn new(target_ms: f64) -> Governor {
+        Governor {
+            target_ms,
+            min_scale: 0.25,
+            pinned_scale: None,
+            pinned_fraction: None,
+            fractions_allowed: false,
+            costs: vec![],
+            current: Choice { scale: 1.0, fraction: SampleFraction::ONE },
+            room_frames: 0,
+        }
+    }
+
+    /// The choice for the next frame (before any frame: full scale, every pixel, or the pins).
+    pub fn choice(&self) -> Choice {
+        Choice { scale: self.pinned_scale.unwrap_or(self.current.scale), fraction: self.pinned_fraction.unwrap_or(self.current.fraction) }
+    }
+
+    /// Predicted frame time (ms) of `c` from the current estimate; None before any frame.
+    pub fn predict(&self, c: Choice) -> Option<f64> {
+        let (rest, trace) = self.estimate()?;
+        let area = (c.scale * c.scale) as f64;
+        Some(area * (rest + trace / c.fraction.period() as f64))
+    }
+
+    /// Take a finished frame into account and choose the next.
+    pub fn record(&mut self, f: FrameCost) -> Choice {
+        let area = (f.choice.scale * f.choice.scale).max(1e-6) as f64;
+        let period = f.choice.fraction.period() as f64;
+        let (wall, trace) = (finite_or(f.wall_ms, 0.0).max(0.0), finite_or(f.trace_ms, 0.0).clamp(0.0, f64::MAX));
+        let trace = trace.min(wall);
+        self.costs.push(((wall - trace) / area, trace * period / area));
+        if self.costs.len() > WINDOW {
+            self.costs.remove(0);
+        }
+        self.current = self.pick(f.moving);
+        self.choice()
+    }
+
+    /// Median of the window, per component.
+    fn estimate(&self) -> Option<(f64, f64)> {
+        if self.costs.is_empty() {
+            return None;
+        }
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        Some((median(self.costs.iter().map(|c| c.0).collect()), median(self.costs.iter().map(|c| c.1).collect())))
+    }
+
+    fn fractions(&self) -> Vec<SampleFraction> {
+        match self.pinned_fraction {
+            Some(f) => vec![f],
+            None if self.fractions_allowed => SampleFraction::all().collect(),
+            None => vec![SampleFraction::ONE],
+        }
+    }
+
+    fn scales(&self) -> Vec<f32> {
+        match self.pinned_scale {
+            Some(s) => vec![s],
+            None => SCALES.iter().copied().filter(|&s| s >= self.min_scale - 1e-6).collect(),
+        }
+    }
+
+    /// The largest fraction at scale `s` predicted within `budget` ms (while moving, none
+    /// below 1/4 unless nothing else fits at any scale).
+    fn best_fraction(&self, s: f32, budget: f64, moving: bool) -> Option<SampleFraction> {
+        let floor = if moving { 4 } else { u32::MAX };
+        self.fractions().into_iter().filter(|f| f.period() <= floor).find(|&fraction| self.predict(Choice { scale: s, fraction }).is_some_and(|t| t <= budget))
+    }
+
+    fn pick(&mut self, moving: bool) -> Choice {
+        let scales = self.scales();
+        let fits = |g: &Governor, budget: f64| -> Option<Choice> {
+            for pass in [moving, false] {
+                for &s in &scales {
+                    if let Some(fraction) = g.best_fraction(s, budget, pass) {
+                        return Some(Choice { scale: s, fraction });
+                    }
+                }
+            }
+            None
+        };
+        let smallest = Choice { scale: *scales.last().unwrap_or(&1.0), fraction: *self.fractions().last().unwrap_or(&SampleFraction::ONE) };
+        let want = fits(self, self.target_ms).unwrap_or(smallest);
+        let cur = self.current;
+        if want.scale > cur.scale {
+            // Rise only after RISE_FRAMES frames that would fit the larger scale with room.
+            let roomy = fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
+            self.room_frames = if roomy { self.room_frames + 1 } else { 0 };
+            if self.room_frames < RISE_FRAMES {
+                let fraction = self.best_fraction(cur.scale, self.target_ms, moving).or_else(|| self.best_fraction(cur.scale, self.target_ms, false)).unwrap_or(smallest.fraction);
+                return Choice { scale: cur.scale, fraction };
+            }
+        }
+        self.room_frames = 0;
+        want
+    }
+}
+
+fn finite_or(v: f64, or: f64) -> f64 {
+    if v.is_finite() { v } else { or }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A device whose frame costs `area * (rest + trace f)` ms.
+    fn run(g: &mut Governor, rest: f64, trace: f64, frames: usize, moving: bool) -> Vec<(Choice, f64)> {
+        let mut out = vec![];
+        for _ in 0..frames {
+            let c = g.choice();
+            let area = (c.scale * c.scale) as f64;
+            let t = area * trace / c.fraction.period() as f64;
+            let wall = area * rest + t;
+            out.push((c, wall));
+            g.record(FrameCost { wall_ms: wall, trace_ms: t, choice: c, moving });
+        }
+        out
+    }
+
+    #[test]
+    fn holds_the_target_and_prefers_scale_when_still() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        // Full frame: 60 ms of raster/denoise/display, 1200 ms of trace.
+        let frames = run(&mut g, 60.0, 1200.0, 20, false);
+        let (c, t) = frames.last().copied().unwrap();
+        assert!(t <= 100.0, "{c:?} takes {t} ms");
+        assert_eq!(c.scale, 1.0, "a still camera keeps full resolution and lowers the fraction: {c:?}");
+        assert_eq!(c.fraction.period(), 32, "the largest fraction that fits: 60 + 1200/32 = 97.5 ms");
+        // The first frame is over (nothing known yet); from the second on every frame fits.
+        assert!(frames[1..].iter().all(|(_, t)| *t <= 100.0), "{frames:?}");
+    }
+
+    #[test]
+    fn a_moving_camera_keeps_fresh_samples() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        let (c, t) = run(&mut g, 60.0, 1200.0, 20, true).last().copied().unwrap();
+        assert!(t <= 100.0 && c.fraction.period() <= 4 && c.scale < 1.0, "{c:?} {t}");
+    }
+
+    #[test]
+    fn without_fractions_only_the_scale_moves() {
+        let mut g = Governor::new(100.0);
+        let (c, t) = run(&mut g, 60.0, 300.0, 10, false).last().copied().unwrap();
+        assert_eq!(c.fraction, SampleFraction::ONE);
+        // 360 ms at full scale: 0.5^2 * 360 = 90 fits, 0.625^2 * 360 = 141 does not.
+        assert_eq!(c.scale, 0.5, "{c:?} {t}");
+    }
+
+    #[test]
+    fn one_slow_frame_changes_nothing_a_lasting_load_is_followed() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        run(&mut g, 60.0, 1200.0, 20, false);
+        let settled = g.choice();
+        // One frame ten times slower (a hitch).
+        let c = g.choice();
+        g.record(FrameCost { wall_ms: 1000.0, trace_ms: 400.0, choice: c, moving: false });
+        assert_eq!(g.choice(), settled, "one hitch moved the choice");
+        let after = run(&mut g, 60.0, 1200.0, 5, false);
+        assert!(after.iter().all(|(c, _)| *c == settled));
+        // The device becomes twice as slow for good: within three frames the frames fit again.
+        let slow = run(&mut g, 120.0, 2400.0, 8, false);
+        let first_fit = slow.iter().position(|(_, t)| *t <= 100.0).expect("never fits again");
+        assert!(first_fit <= 3, "{slow:?}");
+        assert!(slow[first_fit..].iter().all(|(_, t)| *t <= 100.0), "{slow:?}");
+    }
+
+    #[test]
+    fn the_scale_rises_only_after_lasting_room() {
+        let mut g = Governor::new(100.0);
+        run(&mut g, 60.0, 300.0, 10, false);
+        assert_eq!(g.choice().scale, 0.5);
+        // The load halves: the scale rises, but not before RISE_FRAMES frames.
+        let frames = run(&mut g, 30.0, 150.0, 20, false);
+        let rose = frames.iter().position(|(c, _)| c.scale > 0.5).expect("never rose");
+        assert!(rose >= RISE_FRAMES as usize, "rose after {rose} frames");
+        assert!(frames.iter().all(|(_, t)| *t <= 100.0));
+    }
+
+    #[test]
+    fn pins_are_kept_and_bad_timings_do_not_break_it() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        g.pinned_scale = Some(0.75);
+        run(&mut g, 60.0, 1200.0, 10, false);
+        assert_eq!(g.choice().scale, 0.75);
+        g.pinned_scale = None;
+        g.pinned_fraction = Some(SampleFraction::ONE);
+        run(&mut g, 60.0, 1200.0, 10, false);
+        assert_eq!(g.choice().fraction, SampleFraction::ONE);
+        for wall in [f64::NAN, f64::INFINITY, -5.0, 0.0] {
+            let c = g.choice();
+            let next = g.record(FrameCost { wall_ms: wall, trace_ms: f64::NAN, choice: c, moving: false });
+            assert!(next.scale > 0.0 && next.scale <= 1.0);
+        }
+    }
+}
