@@ -93,6 +93,10 @@ struct Running {
     shader_read_errors: Vec<String>,
     render_error: Option<String>,
     profiler: profiler::Profiler,
+    governor: hush_engine::governor::Governor,
+    /// The governor's choice the last frame ran at, and its camera (motion tells it to keep
+    /// fresh samples).
+    governed: Option<(hush_engine::governor::Choice, hush_engine::scene::Camera)>,
     /// Budgets for scenes dropped on the window (`--limit`).
     load: hush_engine::scene::LoadOptions,
 }
@@ -103,7 +107,7 @@ struct Viewer {
     error: Option<anyhow::Error>,
 }
 
-fn panel_for(r: &Renderer, message: String) -> ui::Panel {
+fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
     ui::Panel {
         settings: hush_engine::settings::FrameSettings { max_depth: r.scene.max_depth.max(2), denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() },
         resolution_scale: 1.0,
@@ -118,7 +122,14 @@ fn panel_for(r: &Renderer, message: String) -> ui::Panel {
         recording: false,
         playing: false,
         preset_path: "presets/my.toml".into(),
+        governor: ui::GovernorPanel { on: true, target_ms: default_target_ms(gpu), pin_scale: false, pin_fraction: false, choice: String::new() },
     }
+}
+
+/// The governor's starting target: 10 frames a second on a software rasterizer (a CPU device,
+/// e.g. lavapipe), 30 on a GPU.
+fn default_target_ms(gpu: &Gpu) -> f64 {
+    if gpu.info.device_type == wgpu::DeviceType::Cpu { 100.0 } else { 33.3 }
 }
 
 impl Viewer {
@@ -164,7 +175,7 @@ impl Viewer {
         let mut renderer = Renderer::new(&gpu, scene, prepared, (w, h))?;
         renderer.set_async_timings(true);
         let fly = fly::FlyCamera::from_camera(&renderer.scene.camera_or_default(), extent);
-        let mut panel = panel_for(&renderer, format!("loaded in {load_ms:.0} ms"));
+        let mut panel = panel_for(&gpu, &renderer, format!("loaded in {load_ms:.0} ms"));
         if let Some(p) = &self.args.preset {
             panel.settings = hush_engine::settings::FrameSettings::load_preset(p)?;
             panel.preset_path = p.display().to_string();
@@ -198,6 +209,8 @@ impl Viewer {
             shader_read_errors: vec![],
             render_error: None,
             profiler,
+            governor: hush_engine::governor::Governor::new(100.0),
+            governed: None,
             load: self.args.load,
         });
         Ok(())
@@ -231,7 +244,7 @@ impl Running {
         match r {
             Ok((r, extent)) => {
                 self.fly = fly::FlyCamera::from_camera(&r.scene.camera_or_default(), extent);
-                self.panel = panel_for(&r, format!("loaded {}", path.display()));
+                self.panel = panel_for(&self.gpu, &r, format!("loaded {}", path.display()));
                 self.window.set_title(&format!("Hush: {}", r.scene.name));
                 self.renderer = r;
             }
@@ -339,6 +352,33 @@ impl Running {
         Ok(())
     }
 
+    /// With the governor on: report the last frame (its whole loop's time and its trace's GPU
+    /// time, which arrives a frame or two late) and take its choice for this one.
+    fn govern(&mut self, dt: f64, input: &FrameInput) {
+        let g = &mut self.governor;
+        let p = &mut self.panel;
+        if !p.governor.on || p.settings.accumulate {
+            self.governed = None;
+            return;
+        }
+        g.target_ms = p.governor.target_ms;
+        g.pinned_scale = p.governor.pin_scale.then_some(p.resolution_scale);
+        g.pinned_fraction = p.governor.pin_fraction.then_some(p.settings.sample_fraction);
+        g.fractions_allowed = self.renderer.fills_untraced_pixels(&self.gpu, &p.settings).unwrap_or(false);
+        let choice = match self.governed {
+            Some((last, camera)) => {
+                let trace_ms = p.pass_ms.iter().filter(|(l, _)| *l == hush_engine::passes::trace::LABEL).map(|(_, ms)| ms).sum();
+                g.record(hush_engine::governor::FrameCost { wall_ms: dt * 1e3, trace_ms, choice: last, moving: camera != input.camera })
+            }
+            None => g.choice(),
+        };
+        p.resolution_scale = choice.scale;
+        p.settings.sample_fraction = choice.fraction;
+        let predicted = g.predict(choice).map_or(String::new(), |t| format!(", about {t:.0} ms"));
+        p.governor.choice = format!("scale {:.3}, {} spp{predicted}", choice.scale, choice.fraction);
+        self.governed = Some((choice, input.camera));
+    }
+
     fn frame_inner(&mut self) -> Result<()> {
         self.reload_shaders();
         let now = Instant::now();
@@ -360,6 +400,7 @@ impl Running {
         if let Some(rec) = &mut self.recording {
             rec.keys.push(CameraKey::from_camera(&input.camera, input.time));
         }
+        self.govern(dt, &input);
         let size = self.frame_size();
         self.renderer.resize(&self.gpu, size)?;
 

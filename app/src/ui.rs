@@ -22,6 +22,17 @@ pub struct Panel {
     pub playing: bool,
     /// Where presets are saved and loaded (TOML).
     pub preset_path: String,
+    /// The frame-time governor (hush_engine::governor): on, its target, the knobs the user
+    /// pinned, and what it chose for the last frame.
+    pub governor: GovernorPanel,
+}
+
+pub struct GovernorPanel {
+    pub on: bool,
+    pub target_ms: f64,
+    pub pin_scale: bool,
+    pub pin_fraction: bool,
+    pub choice: String,
 }
 
 #[derive(Default)]
@@ -40,7 +51,20 @@ impl Panel {
         let mut a = Actions::default();
         ui.heading("Hush");
         ui.label(format!("frame {:.1} ms (CPU, whole loop)", self.frame_ms));
-        ui.add(egui::Slider::new(&mut self.resolution_scale, 0.25..=1.0).text("resolution scale"));
+        let g = &mut self.governor;
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut g.on, "frame-time governor");
+            ui.add(egui::DragValue::new(&mut g.target_ms).range(5.0..=2000.0).speed(1.0).suffix(" ms"));
+        });
+        if g.on {
+            ui.label(&g.choice).on_hover_text("The resolution scale and sample fraction the governor chose to hold the target; pin either to keep it and let the governor turn the other.");
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut g.pin_scale, "pin scale");
+                ui.checkbox(&mut g.pin_fraction, "pin sample fraction");
+            });
+        }
+        let governed = g.on && !g.pin_scale;
+        ui.add_enabled(!governed, egui::Slider::new(&mut self.resolution_scale, 0.25..=1.0).text("resolution scale"));
         if let Some((az, el)) = &mut self.sun {
             let c1 = ui.add(egui::Slider::new(az, -180.0..=180.0).text("sun azimuth (deg)")).changed();
             let c2 = ui.add(egui::Slider::new(el, 1.0..=89.0).text("sun elevation (deg)")).changed();
