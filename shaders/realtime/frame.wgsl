@@ -77,11 +77,6 @@ fn scheduled_pixel(t: vec2u) -> vec2u {
     return t * schedule_tile() + c;
 }
 
-// Whether pixel p is traced this frame.
-fn traced_this_frame(p: vec2u) -> bool {
-    return frame.period <= 1u || all(scheduled_pixel(p / schedule_tile()) == p);
-}
-
 // The camera ray through this frame's sample position in pixel px.
 fn camera_ray(px: vec2u) -> vec3f {
     return camera_ray_at(vec2f(px) + frame.jitter);

@@ -69,7 +69,7 @@ pub trait Denoiser {
     fn output(&self, parity: usize) -> Denoised<'_>;
 
     /// Whether it takes frames where only some pixels were traced (a sample fraction below 1,
-    /// [`crate::settings::SampleFraction`]; `traced_this_frame` in shaders/realtime/frame.wgsl
+    /// [`crate::settings::SampleFraction`]; `scheduled_pixel` in shaders/realtime/frame.wgsl
     /// says which). The default, false: the frame refuses fractions below 1 with it.
     fn fills_untraced_pixels(&self) -> bool {
         false
