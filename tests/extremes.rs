@@ -116,6 +116,17 @@ fn unusable_input_is_a_clear_error() {
     assert!(e.contains("leaves the scene's folder"), "{e}");
     let e = load_err("res", json!({"asset": {"version": "2.0"}, "scenes": [{"extras": {"resolution": [0, 10]}}]}));
     assert!(e.contains("resolution"), "{e}");
+    // A thin lens needs both numbers, each finite and positive.
+    for (name, extras, needle) in [
+        ("lens_neg", json!({"aperture_radius": -0.1, "focus_distance": 3.0}), "aperture radius"),
+        ("lens_half", json!({"aperture_radius": 0.1}), "both"),
+        ("lens_str", json!({"aperture_radius": 0.1, "focus_distance": "far"}), "focus_distance"),
+    ] {
+        let doc = json!({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"camera": 0}],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.01}, "extras": extras}]});
+        let e = load_err(name, doc);
+        assert!(e.contains("cameras[0].extras") && e.contains(needle), "{e}");
+    }
     let e = format!("{:#}", load_gltf(std::path::Path::new("/nonexistent/x.gltf")).unwrap_err());
     assert!(e.contains("/nonexistent/x.gltf"), "{e}");
     std::fs::write(hush_tests::gltf_writer::temp_dir("garbage").join("g.gltf"), b"{not json").unwrap();

@@ -22,6 +22,8 @@ struct Params {
     env_size: vec4u,
     // x: 1 / sum(area x luminance) over emissive triangles.
     emit: vec4f,
+    // Thin lens: x aperture radius (0: a pinhole), y focus distance.
+    lens: vec4f,
 }
 
 var<uniform> params: Params;

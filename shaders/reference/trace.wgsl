@@ -17,8 +17,19 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         (f32(gid.x) + j.x) / f32(params.width) * 2.0 - 1.0,
         1.0 - (f32(gid.y) + j.y) / f32(params.height) * 2.0,
     );
-    let rd = normalize(params.cam_fwd.xyz + ndc.x * params.cam_right.xyz + ndc.y * params.cam_up.xyz);
-    var l = trace_path(camera_path(params.cam_pos.xyz, rd), &rng).radiance;
+    let d = params.cam_fwd.xyz + ndc.x * params.cam_right.xyz + ndc.y * params.cam_up.xyz;
+    var ro = params.cam_pos.xyz;
+    var rd = normalize(d);
+    if params.lens.x > 0.0 {
+        // Thin lens (Mitsuba's thinlens): a uniform point on the aperture disk, aimed at where
+        // the pinhole ray meets the focus plane (d has unit length along fwd).
+        let u = rand2(&rng);
+        let r = params.lens.x * sqrt(u.x);
+        let a = 6.283185307 * u.y;
+        ro += r * (cos(a) * normalize(params.cam_right.xyz) + sin(a) * normalize(params.cam_up.xyz));
+        rd = normalize(params.cam_pos.xyz + d * params.lens.y - ro);
+    }
+    var l = trace_path(camera_path(ro, rd), &rng).radiance;
     var bad = 0.0;
     // NaN and Inf never reach the image: the sample is dropped and counted.
     if !is_finite3(l) {

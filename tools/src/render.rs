@@ -140,7 +140,8 @@ pub struct RenderArgs {
     pub max_depth: Option<i32>,
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
-    /// "eye=x,y,z;target=x,y,z;fov=deg" (fov is vertical, in degrees).
+    /// "eye=x,y,z;target=x,y,z;fov=deg" (fov is vertical, in degrees); add ";aperture=r;focus=d"
+    /// (meters) for a thin lens (reference mode).
     #[arg(long)]
     pub camera: Option<String>,
     /// BVH layout: bvh2 or cwbvh.
@@ -158,6 +159,7 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
     let mut eye = None;
     let mut target = None;
     let mut fov = 45.0f32;
+    let (mut aperture, mut focus) = (None, None);
     for part in s.split(';').map(str::trim).filter(|p| !p.is_empty()) {
         let (k, v) = part.split_once('=').with_context(|| format!("camera part {part:?} is not key=value"))?;
         let nums = || -> Result<glam::DVec3> {
@@ -177,14 +179,21 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
                     bail!("camera fov must be in (0, 180) degrees, got {fov}");
                 }
             }
-            other => bail!("unknown camera key {other:?} (use eye, target, fov)"),
+            "aperture" => aperture = Some(v.trim().parse::<f64>().with_context(|| format!("camera aperture={v:?}: the aperture radius in meters"))?),
+            "focus" => focus = Some(v.trim().parse::<f64>().with_context(|| format!("camera focus={v:?}: the focus distance in meters"))?),
+            other => bail!("unknown camera key {other:?} (use eye, target, fov, aperture, focus)"),
         }
     }
+    let lens = match (aperture, focus) {
+        (None, None) => None,
+        (Some(a), Some(f)) => Some(hush_engine::scene::ThinLens::new(a, f).context("--camera")?),
+        _ => bail!("a thin-lens camera needs both aperture=R and focus=D (meters)"),
+    };
     let (eye, target) = (eye.context("camera needs eye=x,y,z")?, target.context("camera needs target=x,y,z")?);
     if (eye - target).length() == 0.0 {
         bail!("camera eye and target coincide");
     }
-    Ok(Camera::look_at(eye, target, fov))
+    Ok(Camera { lens, ..Camera::look_at(eye, target, fov) })
 }
 
 pub fn load_scene(path: &str, load: &LoadArgs) -> Result<Scene> {

@@ -43,6 +43,8 @@ fn bad_arguments_are_clear_errors() {
         (vec!["render", "level", "--mode", "realtime", "--preset", &bad_preset, "--out", "x.exr"], "matte.hysteresis"),
         (vec!["bench", "level", "--mode", "realtime", "--preset", "/nonexistent.toml"], "/nonexistent.toml"),
         (vec!["render", "default", "--camera", "eye=0,0,0;target=0,0,0", "--out", "x.exr"], "coincide"),
+        (vec!["render", "default", "--camera", "eye=0,1,4;target=0,1,0;aperture=0.1", "--out", "x.exr"], "focus"),
+        (vec!["render", "default", "--camera", "eye=0,1,4;target=0,1,0;aperture=0;focus=3", "--out", "x.exr"], "aperture radius"),
         (vec!["render", "default", "--spp", "0", "--out", "x.exr"], "--spp"),
         (vec!["render", "default", "--spp", "1", "--out", "x.bmp"], ".exr or .png"),
         (vec!["render", "/nonexistent.gltf", "--out", "x.exr"], "/nonexistent.gltf"),

@@ -29,6 +29,8 @@ pub struct TraceParams {
     pub env_rot: [f32; 4],
     pub env_size: [u32; 4],
     pub emit: [f32; 4],
+    /// Thin lens: aperture radius and focus distance in scene units (0: a pinhole), unused, unused.
+    pub lens: [f32; 4],
 }
 
 /// What to render: the camera, image size and path settings.
@@ -185,5 +187,6 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
         env_rot: [rot.cos(), rot.sin(), p.env_pdf_norm, 0.0],
         env_size: p.env_size,
         emit: [if f.emitters { p.emit_inv_total } else { 0.0 }, 0.0, 0.0, 0.0],
+        lens: cam.lens.map_or([0.0; 4], |l| [l.aperture_radius, l.focus_distance, 0.0, 0.0]),
     }
 }

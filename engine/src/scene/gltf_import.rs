@@ -221,7 +221,7 @@ impl Importer<'_> {
                     match camera_pose(world, rotation) {
                         None => self.warn(format!("nodes[{}] places cameras[{}] with a degenerate transform; using a default view", node.index(), cam.index())),
                         Some(pose) => match cam.projection() {
-                            gltf::camera::Projection::Perspective(p) => scene.camera = Some(Camera { world: pose, yfov: p.yfov() }),
+                            gltf::camera::Projection::Perspective(p) => scene.camera = Some(Camera { world: pose, yfov: p.yfov(), lens: camera_lens(&cam)? }),
                             gltf::camera::Projection::Orthographic(o) => {
                                 ortho = Some(Orthographic { index: cam.index(), pose, ymag: o.ymag().abs() as f64 })
                             }
@@ -282,7 +282,7 @@ impl Importer<'_> {
             2.0 * o.ymag,
             d
         ));
-        Camera { world: o.pose, yfov }
+        Camera { world: o.pose, yfov, lens: None }
     }
 
     fn load_buffers(&mut self, doc: &gltf::Document, mut blob: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>> {
@@ -567,4 +567,18 @@ impl Importer<'_> {
 fn shown(v: &serde_json::Value) -> String {
     let s = v.to_string();
     if s.len() > 80 { short(&s) } else { s }
+}
+
+/// A camera's thin lens from its `extras` (`aperture_radius` and `focus_distance`, meters):
+/// both or neither.
+fn camera_lens(cam: &gltf::Camera) -> Result<Option<crate::scene::ThinLens>> {
+    let Some(raw) = cam.extras() else { return Ok(None) };
+    let here = format!("cameras[{}].extras", cam.index());
+    let v: serde_json::Value = serde_json::from_str(raw.get()).with_context(|| format!("parsing {here}"))?;
+    let num = |k: &str| v.get(k).map(|x| x.as_f64().ok_or_else(|| anyhow!("{here}.{k} must be a number of meters, got {}", shown(x)))).transpose();
+    match (num("aperture_radius")?, num("focus_distance")?) {
+        (None, None) => Ok(None),
+        (Some(a), Some(f)) => crate::scene::ThinLens::new(a, f).map(Some).with_context(|| here.clone()),
+        _ => Err(anyhow!("{here} needs both aperture_radius and focus_distance for a thin lens")),
+    }
 }

@@ -138,6 +138,32 @@ pub struct Camera {
     pub world: DMat4,
     /// Full vertical field of view, radians.
     pub yfov: f32,
+    /// A thin lens (depth of field); None: a pinhole.
+    pub lens: Option<ThinLens>,
+}
+
+/// A thin lens (the oracle's convention, Mitsuba's `thinlens`): rays start uniformly over the
+/// disk of `aperture_radius` in the camera's local XY plane and meet on the plane at
+/// `focus_distance` along its -Z. Both in meters, > 0. The reference tracer follows it; the
+/// real-time frame's raster G-buffer stays a pinhole (its primary rays would have to be traced).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    pub aperture_radius: f32,
+    pub focus_distance: f32,
+}
+
+impl ThinLens {
+    /// A lens from its two numbers, or an error naming the one out of range.
+    pub fn new(aperture_radius: f64, focus_distance: f64) -> anyhow::Result<ThinLens> {
+        let ok = |v: f64| v.is_finite() && v > 0.0 && v < 1e9;
+        if !ok(aperture_radius) {
+            anyhow::bail!("the aperture radius must be a finite number of meters > 0, got {aperture_radius}");
+        }
+        if !ok(focus_distance) {
+            anyhow::bail!("the focus distance must be a finite number of meters > 0, got {focus_distance}");
+        }
+        Ok(ThinLens { aperture_radius: aperture_radius as f32, focus_distance: focus_distance as f32 })
+    }
 }
 
 impl Camera {
@@ -147,7 +173,7 @@ impl Camera {
         let x = DVec3::Y.cross(z).normalize_or(DVec3::X);
         let y = z.cross(x);
         let world = DMat4::from_cols(x.extend(0.0), y.extend(0.0), z.extend(0.0), eye.extend(1.0));
-        Camera { world, yfov: yfov_degrees.to_radians() }
+        Camera { world, yfov: yfov_degrees.to_radians(), lens: None }
     }
     pub fn eye(&self) -> DVec3 {
         self.world.w_axis.truncate()
