@@ -111,3 +111,15 @@ fn mirrored_transforms_keep_front_faces_counter_clockwise() {
     let acc = render(&scene, 4, 4, 4, 0).unwrap();
     assert!((acc.mean.mean() - Vec3::ONE).abs().max_element() < 1e-4, "{}", acc.mean.mean());
 }
+
+/// A thin-lens camera survives Hush's own glTF export.
+#[test]
+fn a_thin_lens_round_trips_through_export() {
+    let scene = hush_engine::scene::load_gltf(&hush_tests::oracle("cornell_dof").join("cornell_dof.gltf")).unwrap();
+    let path = hush_tests::gltf_writer::temp_dir("lens_export").join("dof.gltf");
+    hush_engine::scene::save_gltf(&scene, &path).unwrap();
+    let back = hush_engine::scene::load_gltf(&path).unwrap();
+    let lens = |s: &hush_engine::scene::Scene| s.camera.as_ref().and_then(|c| c.lens);
+    assert!(lens(&scene).is_some());
+    assert_eq!(lens(&back), lens(&scene));
+}

@@ -228,7 +228,11 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
 
     let mut cameras = vec![];
     if let Some(c) = &scene.camera {
-        cameras.push(json!({"type": "perspective", "perspective": {"yfov": c.yfov, "znear": 0.01}}));
+        let mut cam = json!({"type": "perspective", "perspective": {"yfov": c.yfov, "znear": 0.01}});
+        if let Some(l) = c.lens {
+            cam["extras"] = json!({"aperture_radius": l.aperture_radius, "focus_distance": l.focus_distance});
+        }
+        cameras.push(cam);
         roots.push(nodes.len());
         nodes.push(json!({"name": "camera", "camera": 0, "matrix": mat(c.world)}));
     }
