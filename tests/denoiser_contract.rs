@@ -86,7 +86,7 @@ impl Denoiser for Accumulate {
 
     fn output(&self, parity: usize) -> Denoised<'_> {
         // Written this frame: history[1 - parity].
-        Denoised { matte: self.history.as_ref().map(|h| &h[1 - parity].1), glossy: None }
+        Denoised { matte: self.history.as_ref().map(|h| &h[1 - parity].1), glossy: None, direct: None }
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn hush_engine::shader::Reload> {
@@ -99,7 +99,7 @@ const VIEWS: &[ViewSpec] = &[ViewSpec { name: "accumulate/length", texture: "acc
 
 fn register() {
     static ONCE: Once = Once::new();
-    ONCE.call_once(|| hush_engine::denoise::register(Entry { name: NAME, summary: "a running mean of the matte light (test only)", make: Some(make), views: VIEWS }).unwrap());
+    ONCE.call_once(|| hush_engine::denoise::register(Entry { name: NAME, summary: "a running mean of the matte light (test only)", make: Some(make), views: VIEWS, fractions: false }).unwrap());
 }
 
 const SIZE: (u32, u32) = (96, 54);

@@ -109,7 +109,7 @@ struct Viewer {
 
 fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
     ui::Panel {
-        settings: hush_engine::settings::FrameSettings { max_depth: r.scene.max_depth.max(2), denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() },
+        settings: hush_engine::settings::FrameSettings { max_depth: r.scene.max_depth.max(2), denoiser: default_denoiser(gpu), ..Default::default() },
         resolution_scale: 1.0,
         sun: r.scene.sun_direction().map(ui::sun_angles),
         paused: false,
@@ -124,6 +124,13 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
         preset_path: "presets/my.toml".into(),
         governor: ui::GovernorPanel { on: true, target_ms: default_target_ms(gpu), pin_scale: false, pin_fraction: false, choice: String::new() },
     }
+}
+
+/// The denoiser the viewer starts with: on a software rasterizer the progressive filter, whose
+/// sample fractions below 1 let the governor hold its target at full resolution; on a GPU Mara's
+/// chains.
+fn default_denoiser(gpu: &Gpu) -> hush_engine::settings::Denoiser {
+    if gpu.info.device_type == wgpu::DeviceType::Cpu { hush_engine::settings::Denoiser::named("progressive") } else { hush_engine::settings::Denoiser::MARA }
 }
 
 /// The governor's starting target: 10 frames a second on a software rasterizer (a CPU device,

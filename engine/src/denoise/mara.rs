@@ -64,7 +64,7 @@ impl Denoiser for Mara {
 
     fn output(&self, _parity: usize) -> Denoised<'_> {
         let Some((m, g)) = &self.targets else { return Denoised::default() };
-        Denoised { matte: Some(&m.denoised.1), glossy: g.as_ref().map(|g| &g.denoised.1) }
+        Denoised { matte: Some(&m.denoised.1), glossy: g.as_ref().map(|g| &g.denoised.1), direct: None }
     }
 
     fn taa_follow(&self, parity: usize) -> TaaFollow<'_> {

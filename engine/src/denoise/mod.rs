@@ -12,6 +12,7 @@
 //! [`register`]). Its name then works in `--denoiser`, presets and the viewer.
 
 pub mod mara;
+pub mod progressive;
 pub mod svgf;
 
 use crate::gpu::{Gpu, GpuMemory, GpuTimer};
@@ -51,6 +52,8 @@ pub struct FrameContext<'a> {
 pub struct Denoised<'a> {
     pub matte: Option<&'a wgpu::TextureView>,
     pub glossy: Option<&'a wgpu::TextureView>,
+    /// The direct light (None: the trace's, which needs no denoising at one sample per pixel).
+    pub direct: Option<&'a wgpu::TextureView>,
 }
 
 pub trait Denoiser {
@@ -98,13 +101,17 @@ pub struct Entry {
     pub make: Option<MakeDenoiser>,
     /// Its debug views: textures it allocates, by label, and how to show them.
     pub views: &'static [ViewSpec],
+    /// It takes sample fractions below 1 (as [`Denoiser::fills_untraced_pixels`] says once made;
+    /// here so that an error can name the denoisers that do without making them).
+    pub fractions: bool,
 }
 
 /// The denoisers built into Hush.
 pub const BUILT_IN: &[Entry] = &[
-    Entry { name: "none", summary: "the raw 1-sample frame (composite only)", make: None, views: &[] },
-    Entry { name: "mara", summary: "Mara et al. 2017: the matte and glossy chains, then TAA", make: Some(mara::make), views: crate::settings::MARA_VIEWS },
-    Entry { name: "svgf", summary: "SVGF (Schied et al. 2017) with Voorhuis's reflections and robustness, then TAA", make: Some(svgf::make), views: crate::settings::SVGF_VIEWS },
+    Entry { name: "none", summary: "the raw 1-sample frame (composite only)", make: None, views: &[], fractions: true },
+    Entry { name: "mara", summary: "Mara et al. 2017: the matte and glossy chains, then TAA", make: Some(mara::make), views: crate::settings::MARA_VIEWS, fractions: false },
+    Entry { name: "svgf", summary: "SVGF (Schied et al. 2017) with Voorhuis's reflections and robustness, then TAA", make: Some(svgf::make), views: crate::settings::SVGF_VIEWS, fractions: false },
+    Entry { name: "progressive", summary: "Dundr et al.'s progressive SVGF, for sample fractions below 1 (--spp 1/N), then TAA", make: Some(progressive::make), views: crate::settings::PROGRESSIVE_VIEWS, fractions: true },
 ];
 
 static REGISTERED: RwLock<Vec<Entry>> = RwLock::new(Vec::new());

@@ -396,7 +396,7 @@ impl Denoiser for Svgf {
 
     fn output(&self, _parity: usize) -> Denoised<'_> {
         let Some(t) = &self.targets else { return Denoised::default() };
-        Denoised { matte: Some(&t.matte.out.1), glossy: t.glossy.as_ref().map(|(s, _)| &s.out.1) }
+        Denoised { matte: Some(&t.matte.out.1), glossy: t.glossy.as_ref().map(|(s, _)| &s.out.1), direct: None }
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {

@@ -180,7 +180,7 @@ impl Renderer {
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
         let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
         let io = targets.io(&frame_buf, gpu_scene.objects.as_ref());
-        let fb = FrameBuffers { io, shown: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: None, glossy: None };
+        let fb = FrameBuffers { io, shown: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: None, glossy: None, direct: None };
         let composite = CompositePass::new(gpu, &fb).context("creating the composite pass")?;
         let taa = TaaStage::new(gpu, &mut memory, prepared.features.animated);
         let timer = GpuTimer::new(gpu, TIMED_PASSES);
@@ -410,7 +410,7 @@ impl Renderer {
                 bail!("sample fraction {} traces some pixels each frame and {samples} samples per pixel traces every pixel {samples} times: choose one", settings.sample_fraction);
             }
             if let Some(i) = denoiser.filter(|&i| !self.denoisers[i].denoiser.fills_untraced_pixels()) {
-                let fills: Vec<&str> = std::iter::once("none").chain(self.denoisers.iter().filter(|d| d.denoiser.fills_untraced_pixels()).map(|d| d.name.as_str())).collect();
+                let fills: Vec<&str> = crate::denoise::entries().into_iter().filter(|e| e.fractions).map(|e| e.name).collect();
                 bail!("the {} denoiser needs every pixel traced each frame; sample fraction {} needs one that fills untraced pixels ({})", self.denoisers[i].name, settings.sample_fraction, fills.join(", "));
             }
         }
@@ -462,7 +462,7 @@ impl Renderer {
         let accumulation = t.accumulation.as_ref().unwrap_or(&self.no_accumulation);
         let fb = |p: usize| {
             let out = denoiser.map(|d| d.output(p)).unwrap_or_default();
-            FrameBuffers { io, shown: &t.hdr, accumulation, display: &self.display_buf, matte: out.matte, glossy: out.glossy }
+            FrameBuffers { io, shown: &t.hdr, accumulation, display: &self.display_buf, matte: out.matte, glossy: out.glossy, direct: out.direct }
         };
         let pass = crate::profile::scope(crate::passes::composite::COMPOSITE);
         self.composite.record(gpu, &mut enc, output_key, fb, parity, self.timer.as_mut())?;
@@ -563,6 +563,7 @@ fn shown_buffers<'a>(t: &'a Targets, io: &FrameIo<'a>, display: &'a wgpu::Buffer
         display,
         matte: None,
         glossy: None,
+        direct: None,
     }
 }
 

@@ -21,6 +21,7 @@ pub struct FrameBuffers<'a> {
     /// The light the composite remodulates: the denoiser's output (None: the trace's).
     pub matte: Option<&'a wgpu::TextureView>,
     pub glossy: Option<&'a wgpu::TextureView>,
+    pub direct: Option<&'a wgpu::TextureView>,
 }
 
 /// What the composite binds (`shown` as `hdr` for the display, `io.hdr` for the composite).
@@ -28,6 +29,9 @@ fn inputs<'a>(b: &FrameBuffers<'a>, hdr: &'a wgpu::Buffer) -> Bindings<'a> {
     let mut s = b.io.bindings();
     if let Some(m) = b.matte {
         s = s.texture("tr_matte", m);
+    }
+    if let Some(d) = b.direct {
+        s = s.texture("tr_direct", d);
     }
     if let (Some(g), true) = (b.glossy, b.io.trace.glossy.is_some()) {
         s = s.texture("tr_glossy", g);

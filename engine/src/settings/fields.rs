@@ -58,7 +58,7 @@ const FRAME_FIELDS: &[Field] = &[
     f("exposure_ev", "display", "EV", Float(-30.0, 30.0, 0.05), "The image is multiplied by 2^EV before tone mapping."),
     f("accumulate", "frame", "", Bool, "Sum frames while nothing changes and show their mean (the converged image)."),
     f("seed", "frame", "", Int(0, u32::MAX as i64), "Seed of every random sequence."),
-    f("denoiser", "frame", "", Choice(denoisers), "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. svgf: SVGF with Voorhuis's extensions, then TAA. Others: denoisers the application registered."),
+    f("denoiser", "frame", "", Choice(denoisers), "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. svgf: SVGF with Voorhuis's extensions, then TAA. progressive: Dundr's filter, for sample fractions below 1. Others: denoisers the application registered."),
     f("max_depth", "trace", "bounces", Int(-1, 64), "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded)."),
     f("paths_per_pixel", "trace", "paths", Int(1, 64), "Indirect paths per pixel per frame (1 is the paper's real-time setting)."),
     f("samples_per_pixel", "trace", "samples", Int(1, super::MAX_SAMPLES_PER_PIXEL as i64), "Samples per pixel: the raster's guide and k - 1 traced, mixed into their most similar guides (Voorhuis §5)."),
@@ -68,7 +68,7 @@ const FRAME_FIELDS: &[Field] = &[
 /// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then
 /// each technique's own slice (matte chain, TAA, glossy chain, SVGF).
 pub fn fields() -> impl Iterator<Item = &'static Field> {
-    FRAME_FIELDS.iter().chain(super::matte::FIELDS).chain(super::taa::FIELDS).chain(super::glossy::FIELDS).chain(super::svgf::FIELDS)
+    FRAME_FIELDS.iter().chain(super::matte::FIELDS).chain(super::taa::FIELDS).chain(super::glossy::FIELDS).chain(super::svgf::FIELDS).chain(super::progressive::FIELDS)
 }
 
 /// The value at a dotted path of a serde form.

@@ -6,6 +6,7 @@ mod fraction;
 mod glossy;
 mod matte;
 mod preset;
+mod progressive;
 mod svgf;
 mod taa;
 mod view;
@@ -14,9 +15,10 @@ pub use fields::{Field, Kind, fields, get as get_field, get_mut as get_field_mut
 pub use fraction::{MAX_SAMPLE_PERIOD, SampleFraction};
 pub use glossy::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 pub use matte::MatteSettings;
+pub use progressive::{MAX_LEVELS as PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
 pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, SvgfSettings};
 pub use taa::TaaSettings;
-pub use view::{FRAME_VIEWS, MARA_VIEWS, SVGF_VIEWS, View, ViewMap, ViewSpec, all_views, register_views};
+pub use view::{FRAME_VIEWS, MARA_VIEWS, PROGRESSIVE_VIEWS, SVGF_VIEWS, View, ViewMap, ViewSpec, all_views, register_views};
 
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -42,6 +44,7 @@ pub struct FrameSettings {
     pub taa: TaaSettings,
     pub glossy: GlossySettings,
     pub svgf: SvgfSettings,
+    pub progressive: ProgressiveSettings,
     /// Indirect paths per pixel per frame (each of the matte and glossy estimators, and the
     /// area-light sample, is averaged over them). 1 is the paper's real-time setting.
     pub paths_per_pixel: u32,
@@ -72,7 +75,7 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1, sample_fraction: SampleFraction::ONE }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), progressive: ProgressiveSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1, sample_fraction: SampleFraction::ONE }
     }
 }
 
@@ -120,7 +123,7 @@ impl<'de> Deserialize<'de> for Denoiser {
 static DENOISER_NAMES: RwLock<Vec<&'static str>> = RwLock::new(Vec::new());
 
 pub fn denoiser_names() -> Vec<&'static str> {
-    let mut v = vec![Denoiser::NONE.0.as_ref(), "mara", "svgf"];
+    let mut v = vec![Denoiser::NONE.0.as_ref(), "mara", "svgf", "progressive"];
     v.extend(DENOISER_NAMES.read().unwrap().iter());
     v
 }
@@ -136,10 +139,10 @@ pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
         s.taa.enabled = false;
         return true;
     }
-    s.matte.disable(name) || s.glossy.disable(name) || s.svgf.disable(name)
+    s.matte.disable(name) || s.glossy.disable(name) || s.svgf.disable(name) || s.progressive.disable(name)
 }
 
 /// Every stage name `--disable` accepts.
 pub fn stage_names() -> Vec<&'static str> {
-    MatteSettings::STAGES.iter().chain(&[TaaSettings::STAGE]).chain(GlossySettings::STAGES.iter()).chain(SvgfSettings::STAGES.iter()).copied().collect()
+    MatteSettings::STAGES.iter().chain(&[TaaSettings::STAGE]).chain(GlossySettings::STAGES.iter()).chain(SvgfSettings::STAGES.iter()).chain(ProgressiveSettings::STAGES.iter()).copied().collect()
 }

@@ -111,7 +111,7 @@ pub struct ViewSpec {
 impl ViewSpec {
     /// Views of buffers that exist only in scenes with a specular lobe.
     pub fn needs_glossy(&self) -> bool {
-        self.texture.starts_with("glossy/") || self.texture.starts_with("svgf/glossy") || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
+        self.texture.starts_with("glossy/") || self.texture.starts_with("svgf/glossy") || self.texture.starts_with("progressive/glossy") || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
     }
 }
 
@@ -179,6 +179,17 @@ pub const SVGF_VIEWS: &[ViewSpec] = &[
     v("svgf/glossy", "svgf/glossy out", ViewMap::Light),
 ];
 
+/// The progressive filter's views (`crate::denoise::progressive`).
+pub const PROGRESSIVE_VIEWS: &[ViewSpec] = &[
+    v("progressive/matte accumulated", "progressive/matte history 0", ViewMap::Light),
+    // The 3x3-blurred luminance variance; 1 is white (no estimate yet: white).
+    v("progressive/matte variance", "progressive/matte variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    // Samples accumulated per pixel; 32 is white, black where none arrived yet.
+    v("progressive/matte samples", "progressive/matte moments 0", ViewMap::Grey { channel: 2, divisor: 32.0 }),
+    v("progressive/direct accumulated", "progressive/direct history 0", ViewMap::Light),
+    v("progressive/glossy accumulated", "progressive/glossy history 0", ViewMap::Light),
+];
+
 /// Views that denoisers registered beside the built-in ones.
 static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
 
@@ -186,7 +197,7 @@ static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
 pub fn register_views(views: &[ViewSpec]) {
     let mut r = REGISTERED.write().unwrap();
     for v in views {
-        if !FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(r.iter()).any(|k| k.name == v.name) {
+        if !FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(PROGRESSIVE_VIEWS).chain(r.iter()).any(|k| k.name == v.name) {
             r.push(*v);
         }
     }
@@ -194,5 +205,5 @@ pub fn register_views(views: &[ViewSpec]) {
 
 /// Every view: the frame's, then the denoisers'.
 pub fn all_views() -> Vec<ViewSpec> {
-    FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(REGISTERED.read().unwrap().iter()).copied().collect()
+    FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(PROGRESSIVE_VIEWS).chain(REGISTERED.read().unwrap().iter()).copied().collect()
 }

@@ -97,6 +97,14 @@ embed!(
     "glossy/bilateral.wgsl",
     "svgf/common.wgsl",
     "svgf/features_matte.wgsl",
+    "progressive/common.wgsl",
+    "progressive/signal_matte.wgsl",
+    "progressive/signal_glossy.wgsl",
+    "progressive/signal_direct.wgsl",
+    "progressive/features.wgsl",
+    "progressive/temporal.wgsl",
+    "progressive/variance.wgsl",
+    "progressive/atrous.wgsl",
     "svgf/features_glossy.wgsl",
     "svgf/temporal.wgsl",
     "svgf/temporal_glossy.wgsl",
@@ -284,6 +292,17 @@ mod tests {
                 let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
                 for stage in [temporal, "svgf/variance.wgsl", "svgf/atrous.wgsl", "svgf/final.wgsl"] {
                     v.push(compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated)).unwrap());
+                }
+            }
+        }
+        for animated in [false, true] {
+            for glossy in [false, true] {
+                use crate::denoise::progressive::{Signal, modules};
+                let signals: &[Signal] = if glossy { &[Signal::Matte, Signal::Glossy, Signal::Direct] } else { &[Signal::Matte, Signal::Direct] };
+                for &signal in signals {
+                    for stage in ["progressive/features.wgsl", "progressive/temporal.wgsl", "progressive/variance.wgsl", "progressive/atrous.wgsl"] {
+                        v.push(compose(stage, "", &modules(stage, signal, glossy, animated)).unwrap());
+                    }
                 }
             }
         }

@@ -1,0 +1,320 @@
+//! The progressive filter of Dundr et al. ("Progressive spatiotemporal variance-guided
+//! filtering", §4-5) as a denoiser behind the frame's contract: the one that takes sample
+//! fractions below 1 (`--spp 1/N`), and runs at one sample per pixel too.
+//!
+//! Three signals, each through its own passes (shaders/progressive/*.wgsl): the matte light,
+//! the glossy light (scenes with a specular lobe) and the direct light (punctual lights and the
+//! environment the camera sees), since below one sample per pixel a pixel not traced would
+//! otherwise show its last direct light wherever the camera moved. `progressive/features`
+//! (depth and its gradient) -> per signal `temporal` (r = max(a, 1/age); an untraced pixel keeps
+//! light, age and moments) -> `variance` (3x3-blurred m2 - m1^2) -> `atrous` (3x3 kernel, large
+//! scale first, missing samples skipped and filled; the direct light only fills). The history is
+//! the accumulated light before the spatial filter (see docs/decisions.md). The composite and
+//! TAA (Dundr's §4.5 blend with a clamped history) follow as for every denoiser.
+
+use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::passes::chain::ChainStage;
+use crate::passes::io::FrameIo;
+use crate::passes::matte::DenoiseParams;
+use crate::settings::{FrameSettings, PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
+use anyhow::{Context, Result};
+use bytemuck::{Pod, Zeroable};
+
+const RGBA16F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+const LEVELS: usize = PROGRESSIVE_MAX_LEVELS as usize;
+
+/// Mirror of `ProgressiveParams` in shaders/progressive/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ProgressiveParams {
+    pub alpha: f32,
+    pub still_samples: f32,
+    pub sigma_n: f32,
+    pub sigma_d: f32,
+    pub sigma_l: f32,
+    pub epsilon_l: f32,
+    pub temporal: u32,
+    pub _pad: u32,
+}
+
+impl ProgressiveParams {
+    pub fn new(s: &ProgressiveSettings) -> ProgressiveParams {
+        ProgressiveParams {
+            alpha: s.alpha.clamp(1e-3, 1.0),
+            still_samples: s.still_samples.clamp(0.0, 1024.0),
+            sigma_n: s.sigma_n.max(0.0),
+            sigma_d: s.sigma_d.max(1e-3),
+            sigma_l: s.sigma_l.max(0.0),
+            epsilon_l: s.epsilon_l.max(1e-6),
+            temporal: s.temporal as u32,
+            _pad: 0,
+        }
+    }
+}
+
+/// Mirror of `Level` in shaders/progressive/common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Level {
+    step: i32,
+    fill_only: u32,
+    _pad: [u32; 2],
+}
+
+/// The reprojection's normal test, as SVGF's.
+const NORMAL_TEST_DEGREES: f32 = 25.0;
+
+/// The light a set of the filter's passes works on.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Signal {
+    Matte,
+    Glossy,
+    Direct,
+}
+
+impl Signal {
+    fn name(self) -> &'static str {
+        match self {
+            Signal::Matte => "matte",
+            Signal::Glossy => "glossy",
+            Signal::Direct => "direct",
+        }
+    }
+
+    fn module(self) -> &'static str {
+        match self {
+            Signal::Matte => "progressive/signal_matte.wgsl",
+            Signal::Glossy => "progressive/signal_glossy.wgsl",
+            Signal::Direct => "progressive/signal_direct.wgsl",
+        }
+    }
+
+    /// Labels are 'static: the profiler and the pass timings key on them.
+    fn labels(self) -> [&'static str; 3] {
+        match self {
+            Signal::Matte => ["progressive/matte temporal", "progressive/matte variance", "progressive/matte atrous"],
+            Signal::Glossy => ["progressive/glossy temporal", "progressive/glossy variance", "progressive/glossy atrous"],
+            Signal::Direct => ["progressive/direct temporal", "progressive/direct variance", "progressive/direct atrous"],
+        }
+    }
+}
+
+pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
+    let mut memory = GpuMemory::default();
+    let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+    let d = &gpu.device;
+    let pp = memory.buffer(d, "progressive/params", size_of::<ProgressiveParams>() as u64, u);
+    let dn = memory.buffer(d, "progressive/denoise params", size_of::<DenoiseParams>() as u64, u);
+    let levels = [false, true].map(|fill_only| {
+        std::array::from_fn(|i| {
+            let b = memory.buffer(d, &format!("progressive/level {i}"), size_of::<Level>() as u64, u);
+            gpu.queue.write_buffer(&b, 0, bytemuck::bytes_of(&Level { step: 1 << i, fill_only: fill_only as u32, _pad: [0; 2] }));
+            b
+        })
+    });
+    let mut signals = vec![Signal::Matte, Signal::Direct];
+    if scene.glossy {
+        signals.insert(1, Signal::Glossy);
+    }
+    Ok(Box::new(Progressive { scene: *scene, pp, dn, levels, targets: None, features: None, stages: vec![], signals }))
+}
+
+type Tex = (wgpu::Texture, wgpu::TextureView);
+
+/// One signal's textures: 64 bytes per pixel.
+pub struct SignalTargets {
+    /// The accumulated light (rgb) by parity: this frame's is next frame's history.
+    pub history: [Tex; 2],
+    /// Luminance moments and the samples accumulated (m1, m2, age), by parity.
+    pub moments: [Tex; 2],
+    /// The variance stage's output (rgb, variance; -1: no sample), then the levels' ping-pong.
+    pub variance: Tex,
+    pub ping: Tex,
+    pub pong: Tex,
+}
+
+impl SignalTargets {
+    fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), name: &str) -> SignalTargets {
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let mut t = |label: &str, f| mem.texture(d, &format!("progressive/{name} {label}"), size, f, rw);
+        SignalTargets {
+            history: [t("history 0", RGBA16F), t("history 1", RGBA16F)],
+            moments: [t("moments 0", RGBA32F), t("moments 1", RGBA32F)],
+            variance: t("variance", RGBA16F),
+            ping: t("ping", RGBA16F),
+            pong: t("pong", RGBA16F),
+        }
+    }
+
+    /// What the last of `levels` levels wrote (the variance stage's output when none ran).
+    fn output(&self, levels: usize) -> &Tex {
+        match levels {
+            0 => &self.variance,
+            l if l % 2 == 1 => &self.pong,
+            _ => &self.ping,
+        }
+    }
+}
+
+struct Targets {
+    /// Linear depth and its gradient (8 bytes per pixel).
+    features: Tex,
+    signals: Vec<(Signal, SignalTargets)>,
+    levels: usize,
+}
+
+struct SignalStages {
+    signal: Signal,
+    temporal: ChainStage,
+    variance: ChainStage,
+    atrous: ChainStage,
+}
+
+#[derive(Clone, Copy)]
+enum Pass {
+    Features,
+    Temporal,
+    Variance,
+    /// Level i reads the variance stage's output (i = 0), then pong and ping in turn.
+    Atrous(usize),
+}
+
+struct Progressive {
+    scene: DenoiserScene,
+    pp: wgpu::Buffer,
+    dn: wgpu::Buffer,
+    /// Per level, for filtering signals and for the direct light (fill only).
+    levels: [[wgpu::Buffer; LEVELS]; 2],
+    targets: Option<Targets>,
+    features: Option<ChainStage>,
+    stages: Vec<SignalStages>,
+    signals: Vec<Signal>,
+}
+
+/// The modules of a program of `signal`'s `stage`.
+pub fn modules(stage: &'static str, signal: Signal, glossy: bool, animated: bool) -> Vec<&'static str> {
+    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl"];
+    if glossy {
+        m.push("realtime/glossy_in.wgsl");
+    }
+    m.push("matte/common.wgsl");
+    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.extend(["progressive/common.wgsl", signal.module(), stage]);
+    m
+}
+
+impl Progressive {
+    fn bindings<'a>(&'a self, io: &FrameIo<'a>, signal: Signal, pass: Pass, parity: usize, levels: usize) -> Bindings<'a> {
+        let t = self.targets.as_ref().unwrap();
+        let s = &t.signals.iter().find(|(g, _)| *g == signal).unwrap().1;
+        let b = io.bindings().buffer("pp", &self.pp).buffer("dn", &self.dn).texture("features", &t.features.1);
+        match pass {
+            Pass::Features => b.texture("out_features", &t.features.1),
+            Pass::Temporal => b
+                .texture("history", &s.history[parity].1)
+                .texture("moments", &s.moments[parity].1)
+                .texture("out_integrated", &s.history[1 - parity].1)
+                .texture("out_moments", &s.moments[1 - parity].1),
+            Pass::Variance => b.texture("integrated", &s.history[1 - parity].1).texture("moments", &s.moments[1 - parity].1).texture("dst", &s.variance.1),
+            Pass::Atrous(i) => {
+                let src = if i == 0 { &s.variance } else { s.output(i) };
+                let dst = s.output(i + 1);
+                // Large scale first: level i of n steps 2^(n - 1 - i) pixels.
+                let step = levels.saturating_sub(1 + i).min(LEVELS - 1);
+                b.texture("src", &src.1).texture("dst", &dst.1).buffer("level", &self.levels[(signal == Signal::Direct) as usize][step])
+            }
+        }
+    }
+
+    fn write_params(&self, gpu: &Gpu, io: &FrameIo, cx: &FrameContext) {
+        let s: &FrameSettings = cx.settings;
+        gpu.queue.write_buffer(&self.pp, 0, bytemuck::bytes_of(&ProgressiveParams::new(&s.progressive)));
+        let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
+        dp.reprojection_min_cos = crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES);
+        gpu.queue.write_buffer(&self.dn, 0, bytemuck::bytes_of(&dp));
+    }
+
+    fn offered<'a>(&'a self, io: &FrameIo<'a>, signal: Signal) -> Bindings<'a> {
+        [Pass::Temporal, Pass::Variance, Pass::Atrous(0)].into_iter().fold(self.bindings(io, signal, Pass::Features, 0, 1), |b, pass| b.with(&self.bindings(io, signal, pass, 0, 1)))
+    }
+
+    fn make_stages(&self, gpu: &Gpu, io: &FrameIo, signal: Signal) -> Result<SignalStages> {
+        let (g, a) = (self.scene.glossy, self.scene.animated);
+        let offered = self.offered(io, signal);
+        let [lt, lv, la] = signal.labels();
+        let stage = |label, file| ChainStage::new(gpu, label, &modules(file, signal, g, a), "main", &offered);
+        Ok(SignalStages { signal, temporal: stage(lt, "progressive/temporal.wgsl")?, variance: stage(lv, "progressive/variance.wgsl")?, atrous: stage(la, "progressive/atrous.wgsl")? })
+    }
+}
+
+impl Denoiser for Progressive {
+    fn needs_previous_gbuffer(&self) -> bool {
+        true
+    }
+
+    fn fills_untraced_pixels(&self) -> bool {
+        true
+    }
+
+    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
+        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let features = memory.texture(&gpu.device, "progressive/features", size, wgpu::TextureFormat::Rg32Float, rw);
+        let signals = self.signals.iter().map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name()))).collect();
+        self.targets = Some(Targets { features, signals, levels: 0 });
+    }
+
+    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+        self.targets.as_mut().context("the progressive filter records before its textures exist")?.levels = cx.settings.progressive.levels.min(PROGRESSIVE_MAX_LEVELS) as usize;
+        self.write_params(gpu, io, cx);
+        let (key, parity, size) = (cx.key, cx.parity, io.size);
+        let levels = self.targets.as_ref().unwrap().levels;
+        if self.features.is_none() {
+            let m = modules("progressive/features.wgsl", Signal::Matte, self.scene.glossy, self.scene.animated);
+            self.features = Some(ChainStage::new(gpu, "progressive/features", &m, "main", &self.bindings(io, Signal::Matte, Pass::Features, 0, levels)).context("creating the progressive filter's stages")?);
+        }
+        if self.stages.is_empty() {
+            self.stages = self.signals.iter().map(|&s| self.make_stages(gpu, io, s)).collect::<Result<_>>().context("creating the progressive filter's stages")?;
+        }
+        let mut features = self.features.take().unwrap();
+        let r = features.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, Signal::Matte, Pass::Features, p, levels));
+        self.features = Some(features);
+        r?;
+        let mut stages = std::mem::take(&mut self.stages);
+        let mut result = Ok(());
+        for st in stages.iter_mut() {
+            let s = st.signal;
+            result = st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, s, Pass::Temporal, p, levels));
+            result = result.and_then(|_| st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, s, Pass::Variance, p, levels)));
+            for i in 0..levels {
+                // Bind groups are keyed by (parity, level); the level count is in the key, since
+                // it picks each level's step.
+                let k = key.wrapping_mul(8).wrapping_add(levels as u64);
+                result = result.and_then(|_| st.atrous.record_variant(gpu, enc, k, (2 * LEVELS, parity * LEVELS + i), size, timer.as_deref_mut(), |v| self.bindings(io, s, Pass::Atrous(v % LEVELS), v / LEVELS, levels)));
+            }
+            if result.is_err() {
+                break;
+            }
+        }
+        self.stages = stages;
+        result
+    }
+
+    fn output(&self, _parity: usize) -> Denoised<'_> {
+        let Some(t) = &self.targets else { return Denoised::default() };
+        let out = |s: Signal| t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(t.levels).1);
+        Denoised { matte: out(Signal::Matte), glossy: out(Signal::Glossy), direct: out(Signal::Direct) }
+    }
+
+    fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
+        let mut v: Vec<&mut dyn crate::shader::Reload> = vec![];
+        if let Some(f) = self.features.as_mut() {
+            v.push(&mut f.pipeline);
+        }
+        for s in self.stages.iter_mut() {
+            v.extend([&mut s.temporal, &mut s.variance, &mut s.atrous].into_iter().map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload));
+        }
+        v
+    }
+}

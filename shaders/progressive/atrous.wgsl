@@ -1,0 +1,60 @@
+// Dundr §4.4 and §5: one level of the edge-avoiding a-trous filter with the 3x3 kernel
+// (1/4, 1/2, 1/4 per axis), taps `step` pixels apart, large scale first. Taps without a sample
+// (variance < 0) are skipped; a pixel without one takes its neighbours' weighted mean (without
+// a luminance weight) and so has a sample for the next level. The variance follows the weights
+// (Dundr's var_{L+1} = w^2 var_L, normalised as the variance of the weighted mean:
+// sum w^2 var / (sum w)^2). The direct light's levels only fill missing pixels.
+
+var src: texture_2d<f32>;
+var dst: texture_storage_2d<rgba16float, write>;
+var<uniform> level: Level;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let c = textureLoad(src, p, 0);
+    let missing = c.a < 0.0;
+    let fc = textureLoad(features, p, 0).xy;
+    if fc.x < 0.0 || (level.fill_only != 0u && !missing) {
+        textureStore(dst, p, c);
+        return;
+    }
+    let nc = oct_decode(textureLoad(gb_normal, p, 0).xy);
+    let lc = select(luma(c.rgb), -1.0, missing);
+    var sum = vec3f(0.0);
+    var sum_var = 0.0;
+    var wsum = 0.0;
+    if !missing {
+        sum = c.rgb * 0.25;
+        sum_var = c.a * 0.0625;
+        wsum = 0.25;
+    }
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = p + vec2i(dx, dy) * level.step;
+            if (dx == 0 && dy == 0) || !in_bounds(q) {
+                continue;
+            }
+            let t = textureLoad(src, q, 0);
+            let fq = textureLoad(features, q, 0).xy;
+            if t.a < 0.0 || fq.x < 0.0 {
+                continue;
+            }
+            let nq = oct_decode(textureLoad(gb_normal, q, 0).xy);
+            let h = 0.25 * select(0.5, 1.0, dx == 0) * select(0.5, 1.0, dy == 0);
+            let offset = f32(level.step) * length(vec2f(f32(dx), f32(dy)));
+            let w = h * dundr_weight(fc, nc, lc, max(c.a, 0.0), fq, nq, luma(t.rgb), offset);
+            sum += w * t.rgb;
+            sum_var += w * w * t.a;
+            wsum += w;
+        }
+    }
+    if wsum <= 0.0 {
+        textureStore(dst, p, c);
+        return;
+    }
+    textureStore(dst, p, vec4f(half_safe(sum / wsum), clamp(sum_var / (wsum * wsum), 0.0, 60000.0)));
+}

@@ -1,0 +1,63 @@
+// Shared by the progressive filter's stages (Dundr et al., progressive SVGF, §4-5):
+// parameters, the schedule test, the weights of §4.4. engine/src/denoise/progressive.rs
+// mirrors ProgressiveParams and Level.
+
+struct ProgressiveParams {
+    // a of r = max(a, 1 / age) (§4.2); in a still view at most 1 / still_samples.
+    alpha: f32,
+    still_samples: f32,
+    // §4.4.1-4.4.3: sigma_N, sigma_D, sigma_L, epsilon of the luminance weight.
+    sigma_n: f32,
+    sigma_d: f32,
+    sigma_l: f32,
+    epsilon_l: f32,
+    // 1: accumulate over samples (§4.2); 0: each frame alone.
+    temporal: u32,
+    _pad: u32,
+}
+
+// Per dispatch: the a-trous step (large scale first) and whether the signal only fills pixels
+// without samples (the direct light: it carries the material, which a filter would blur).
+struct Level {
+    step: i32,
+    fill_only: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+var<uniform> pp: ProgressiveParams;
+// The previous frame's object ids (the reprojection's object test).
+var prev_object: texture_2d<u32>;
+// Linear depth and its screen-space gradient, written by the matte accumulation.
+var features: texture_2d<f32>;
+
+// Whether pixel p was traced this frame (realtime/frame.wgsl: scheduled_pixel).
+fn traced(p: vec2i) -> bool {
+    let q = vec2u(p);
+    return frame.period <= 1u || all(scheduled_pixel(q / schedule_tile()) == q);
+}
+
+// Dundr's luminance (§4.2: 0.299 R + 0.587 G + 0.114 B).
+fn luma(c: vec3f) -> f32 {
+    return dot(c, vec3f(0.299, 0.587, 0.114));
+}
+
+// §4.4: w = w_N w_D w_L between pixel p (features fc, normal nc, luminance lc, variance;
+// lc < 0: no light there yet, no luminance weight) and tap q `offset` pixels away.
+fn dundr_weight(fc: vec2f, nc: vec3f, lc: f32, variance: f32, fq: vec2f, nq: vec3f, lq: f32, offset: f32) -> f32 {
+    // §4.4.1
+    let w_n = pow(max(dot(nc, nq), 0.0), pp.sigma_n);
+    // §4.4.2: deviation from the local slope; epsilon 0.5% of the depth (Dundr's 0.005 of a
+    // normalised depth buffer). Very steep surfaces (a tenth of the depth per pixel) keep the
+    // normal weight alone.
+    var w_d = 1.0;
+    if fc.y < 0.1 * fc.x {
+        w_d = exp(-abs(fc.x - fq.x) / (abs(pp.sigma_d * fc.y * offset) + 0.005 * fc.x));
+    }
+    // §4.4.3
+    var w_l = 1.0;
+    if lc >= 0.0 {
+        w_l = exp(-abs(lc - lq) / (pp.sigma_l * variance + pp.epsilon_l));
+    }
+    return w_n * w_d * w_l;
+}

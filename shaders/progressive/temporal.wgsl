@@ -1,0 +1,60 @@
+// Dundr §4.2 and §5: accumulation with r = max(a, 1 / age), where age counts the samples this
+// surface accumulated; a pixel not traced this frame keeps its light, age and moments as they
+// were (reprojected), and a pixel with neither a sample nor a history is missing (age 0).
+// The matte signal's pass also writes the features (linear depth and its gradient).
+// Outputs: integrated (rgb), moments (m1, m2, age).
+
+var prev_depth: texture_depth_2d;
+var prev_normal: texture_2d<f32>;
+var history: texture_2d<f32>;
+var moments: texture_2d<f32>;
+var out_integrated: texture_storage_2d<rgba16float, write>;
+var out_moments: texture_storage_2d<rgba32float, write>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let sampled = traced(p);
+    let current = half_safe(signal_input(p));
+    var hist = vec3f(0.0);
+    var mom = vec4f(0.0);
+    var found = false;
+    if pp.temporal != 0u && dn.history_valid != 0u {
+        if has_surface(p) {
+            let x = position_at(p);
+            let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
+            let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
+            let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
+            if r.distance >= 0.0 && r.distance <= dn.d1_px && textureLoad(prev_object, r.texel, 0).x == textureLoad(gb_object, p, 0).x {
+                hist = half_safe(textureLoad(history, r.texel, 0).rgb);
+                mom = textureLoad(moments, r.texel, 0);
+                found = mom.z >= 1.0;
+            }
+        } else if textureLoad(prev_object, p, 0).y == NO_SURFACE {
+            // The sky stays where it was on screen.
+            hist = half_safe(textureLoad(history, p, 0).rgb);
+            mom = textureLoad(moments, p, 0);
+            found = mom.z >= 1.0;
+        }
+    }
+    var light = hist;
+    if sampled {
+        let l = luma(current);
+        let age = select(1.0, min(mom.z + 1.0, 65536.0), found);
+        var a = pp.alpha;
+        if dn.static_view != 0u && pp.still_samples > 0.0 {
+            a = min(a, 1.0 / pp.still_samples);
+        }
+        let r = max(a, 1.0 / age);
+        light = select(current, mix(hist, current, r), found);
+        let m = select(vec2f(l, l * l), mix(mom.xy, vec2f(l, l * l), r), found);
+        mom = vec4f(m, age, 0.0);
+    } else if !found {
+        mom = vec4f(0.0);
+    }
+    textureStore(out_integrated, p, vec4f(half_safe(light), 1.0));
+    textureStore(out_moments, p, vec4f(select(vec3f(0.0), mom.xyz, all(abs(mom.xyz) < vec3f(3.0e38))), 0.0));
+}
