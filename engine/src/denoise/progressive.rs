@@ -123,7 +123,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
 
 type Tex = (wgpu::Texture, wgpu::TextureView);
 
-/// One signal's textures: 64 bytes per pixel.
+/// One signal's textures: 72 bytes per pixel.
 pub struct SignalTargets {
     /// The accumulated light (rgb) by parity: this frame's is next frame's history.
     pub history: [Tex; 2],
