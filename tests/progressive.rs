@@ -198,7 +198,7 @@ fn an_atrous_level_matches_a_cpu_implementation() {
     let (w, h) = (SIZE.0 as i32, SIZE.1 as i32);
     let at = |x: i32, y: i32| (y * w + x) as usize;
     let texel = |i: usize| [0, 1, 2, 3].map(|k| half(&src[i * 8 + k * 2..]) as f64);
-    let feat = |i: usize| (f32_at(&features, i * 2) as f64, f32_at(&features, i * 2 + 1) as f64);
+    let feat = |i: usize| (f32_at(&features, i * 4) as f64, f32_at(&features, i * 4 + 1) as f64);
     let normal = |i: usize| oct_normal(&normals[i * 4..]).as_dvec3();
     let (mut surface, mut agree) = (0u32, 0u32);
     for y in 0..h {

@@ -17,12 +17,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let c = textureLoad(src, p, 0);
     let missing = c.a < 0.0;
-    let fc = textureLoad(features, p, 0).xy;
+    let f = textureLoad(features, p, 0);
+    let fc = f.xy;
     if fc.x < 0.0 || (level.fill_only != 0u && !missing) {
         textureStore(dst, p, c);
         return;
     }
-    let nc = oct_decode(textureLoad(gb_normal, p, 0).xy);
+    let nc = oct_decode(f.zw);
     let lc = select(luma(c.rgb), -1.0, missing);
     var sum = vec3f(0.0);
     var sum_var = 0.0;
@@ -39,11 +40,12 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 continue;
             }
             let t = textureLoad(src, q, 0);
-            let fq = textureLoad(features, q, 0).xy;
+            let g = textureLoad(features, q, 0);
+            let fq = g.xy;
             if t.a < 0.0 || fq.x < 0.0 {
                 continue;
             }
-            let nq = oct_decode(textureLoad(gb_normal, q, 0).xy);
+            let nq = oct_decode(g.zw);
             let h = 0.25 * select(0.5, 1.0, dx == 0) * select(0.5, 1.0, dy == 0);
             let offset = f32(level.step) * length(vec2f(f32(dx), f32(dy)));
             let w = h * dundr_weight(fc, nc, lc, max(c.a, 0.0), fq, nq, luma(t.rgb), offset);

@@ -28,7 +28,7 @@ struct Level {
 var<uniform> pp: ProgressiveParams;
 // The previous frame's object ids (the reprojection's object test).
 var prev_object: texture_2d<u32>;
-// Linear depth and its screen-space gradient, written by the matte accumulation.
+// Linear depth, its screen-space gradient and the octahedral normal (progressive/features).
 var features: texture_2d<f32>;
 
 // Whether pixel p was traced this frame (realtime/frame.wgsl: scheduled_pixel).

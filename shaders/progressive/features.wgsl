@@ -1,7 +1,8 @@
-// The edge-stopping features every later stage reads: linear depth and its screen-space
-// gradient (|dz/dx| + |dz/dy|, one-sided where a silhouette is on one side); -1 off surfaces.
+// The edge-stopping features every later stage reads, in one texel: linear depth, its
+// screen-space gradient (|dz/dx| + |dz/dy|, one-sided where a silhouette is on one side; depth
+// -1 off surfaces) and the G-buffer's octahedral normal.
 
-var out_features: texture_storage_2d<rg32float, write>;
+var out_features: texture_storage_2d<rgba32float, write>;
 
 fn depth_at(q: vec2i) -> f32 {
     if !in_bounds(q) || !has_surface(q) {
@@ -34,5 +35,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let dz = gradient(z, depth_at(p - vec2i(1, 0)), depth_at(p + vec2i(1, 0))) + gradient(z, depth_at(p - vec2i(0, 1)), depth_at(p + vec2i(0, 1)));
-    textureStore(out_features, p, vec4f(z, dz, 0.0, 0.0));
+    textureStore(out_features, p, vec4f(z, dz, textureLoad(gb_normal, p, 0).xy));
 }

@@ -159,7 +159,8 @@ impl SignalTargets {
 }
 
 struct Targets {
-    /// Linear depth and its gradient (8 bytes per pixel).
+    /// Linear depth, its gradient and the octahedral normal (16 bytes per pixel): one load per
+    /// a-trous tap where three were.
     features: Tex,
     signals: Vec<(Signal, SignalTargets)>,
     levels: usize,
@@ -260,7 +261,7 @@ impl Denoiser for Progressive {
 
     fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
         let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
-        let features = memory.texture(&gpu.device, "progressive/features", size, wgpu::TextureFormat::Rg32Float, rw);
+        let features = memory.texture(&gpu.device, "progressive/features", size, RGBA32F, rw);
         let signals = self.signals.iter().map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name()))).collect();
         self.targets = Some(Targets { features, signals, levels: 0 });
     }
