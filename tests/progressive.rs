@@ -50,7 +50,7 @@ fn the_trace_writes_exactly_the_scheduled_pixels() {
             let mut scheduled = vec![false; after.len()];
             for ty in 0..SIZE.1.div_ceil(th) {
                 for tx in 0..SIZE.0.div_ceil(tw) {
-                    let (x, y) = scheduled_pixel(tx, ty, index, period, true);
+                    let (x, y) = scheduled_pixel(tx, ty, index, period);
                     if x < SIZE.0 && y < SIZE.1 {
                         scheduled[(y * SIZE.0 + x) as usize] = true;
                     }
@@ -137,7 +137,7 @@ fn missing_samples_leave_history_and_moments_unchanged() {
                 if u32::from_le_bytes(ids[i * 8 + 4..i * 8 + 8].try_into().unwrap()) == u32::MAX {
                     continue; // sky
                 }
-                let traced = scheduled_pixel(x / tw, y / th, frame, 4, true) == (x, y);
+                let traced = scheduled_pixel(x / tw, y / th, frame, 4) == (x, y);
                 let c = &mut cpu[i];
                 if traced {
                     let v = [0, 1, 2].map(|k| half(&sample[i * 8 + k * 2..]) as f64);

@@ -93,7 +93,7 @@ impl Governor {
     pub fn record(&mut self, f: FrameCost) -> Choice {
         let area = (f.choice.scale * f.choice.scale).max(1e-6) as f64;
         let period = f.choice.fraction.period() as f64;
-        let (wall, trace) = (finite_or(f.wall_ms, 0.0).max(0.0), finite_or(f.trace_ms, 0.0).clamp(0.0, f64::MAX));
+        let (wall, trace) = (finite_or(f.wall_ms, 0.0).max(0.0), finite_or(f.trace_ms, 0.0).max(0.0));
         let trace = trace.min(wall);
         self.costs.push(((wall - trace) / area, trace * period / area));
         if self.costs.len() > WINDOW {

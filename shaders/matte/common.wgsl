@@ -109,6 +109,47 @@ fn position_at(p: vec2i) -> vec3f {
     return world_from_depth(dn.inv_view_proj, p, textureLoad(gb_depth, p, 0));
 }
 
+// The previous frame's object index and triangle slot (SVGF's and the progressive filter's
+// object test; bound only where a stage reads it).
+var prev_object: texture_2d<u32>;
+
+// Schied et al. §4.1's object test: previous texel t showed the object pixel p shows. Depth
+// and normal alone pass history between two objects that touch in one plane (a box on the
+// floor, a door in its frame), and a moving object's history onto what it uncovers.
+fn same_object(p: vec2i, t: vec2i) -> bool {
+    return textureLoad(prev_object, t, 0).x == textureLoad(gb_object, p, 0).x;
+}
+
+// Linear view depth of a rebased world position.
+fn linear_depth(x: vec3f) -> f32 {
+    return dot(x - frame.cam_pos.xyz, frame.cam_fwd.xyz) / length(frame.cam_fwd.xyz);
+}
+
+// Linear depth of pixel q (or -1 off the surface).
+fn depth_at(q: vec2i) -> f32 {
+    if !in_bounds(q) || !has_surface(q) {
+        return -1.0;
+    }
+    return linear_depth(position_at(q));
+}
+
+// The smaller one-sided difference along an axis (a silhouette on one side does not count).
+fn one_sided_gradient(z: f32, a: f32, b: f32) -> f32 {
+    var g = 1e30;
+    if a >= 0.0 {
+        g = abs(a - z);
+    }
+    if b >= 0.0 {
+        g = min(g, abs(b - z));
+    }
+    return select(g, 0.0, g >= 1e30);
+}
+
+// SVGF's fwidth of the depth z at pixel p: |dz/dx| + |dz/dy|, each one-sided.
+fn depth_gradient(p: vec2i, z: f32) -> f32 {
+    return one_sided_gradient(z, depth_at(p - vec2i(1, 0)), depth_at(p + vec2i(1, 0))) + one_sided_gradient(z, depth_at(p - vec2i(0, 1)), depth_at(p + vec2i(0, 1)));
+}
+
 // Size of one pixel, in scene units, at the distance of x.
 fn footprint(x: vec3f) -> f32 {
     let z = max(dot(x - frame.cam_pos.xyz, frame.cam_fwd.xyz), 1e-6);

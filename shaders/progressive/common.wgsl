@@ -26,8 +26,6 @@ struct Level {
 }
 
 var<uniform> pp: ProgressiveParams;
-// The previous frame's object ids (the reprojection's object test).
-var prev_object: texture_2d<u32>;
 // Linear depth, its screen-space gradient and the octahedral normal (progressive/features).
 var features: texture_2d<f32>;
 

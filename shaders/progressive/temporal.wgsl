@@ -28,7 +28,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
             let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
             let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
-            if r.distance >= 0.0 && r.distance <= dn.d1_px && textureLoad(prev_object, r.texel, 0).x == textureLoad(gb_object, p, 0).x {
+            if r.distance >= 0.0 && r.distance <= dn.d1_px && same_object(p, r.texel) {
                 hist = half_safe(textureLoad(history, r.texel, 0).rgb);
                 mom = textureLoad(moments, r.texel, 0);
                 found = mom.z >= 1.0;

@@ -25,10 +25,9 @@ struct Frame {
     representative_roughness: f32,
     // Samples per pixel k (Voorhuis §5): the raster's guide and k - 1 traced samples.
     samples: u32,
-    // Frames between two samples of a pixel (1 / f; 1: every pixel every frame), and whether
-    // tiles start the order at their own phase.
+    // Frames between two samples of a pixel (1 / f; 1: every pixel every frame).
     period: u32,
-    staggered: u32,
+    _pad2: u32,
 }
 
 var<uniform> frame: Frame;
@@ -55,10 +54,7 @@ fn schedule_hash(v: u32) -> u32 {
 fn scheduled_pixel(t: vec2u) -> vec2u {
     let n = max(frame.period, 1u);
     let k = countTrailingZeros(n);
-    var phase = 0u;
-    if frame.staggered != 0u {
-        phase = schedule_hash((t.x * 0x8da6b343u) ^ (t.y * 0xd8163841u)) & (n - 1u);
-    }
+    let phase = schedule_hash((t.x * 0x8da6b343u) ^ (t.y * 0xd8163841u)) & (n - 1u);
     let rank = (frame.index + phase) & (n - 1u);
     var v = 0u;
     if k > 0u {

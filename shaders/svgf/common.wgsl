@@ -31,8 +31,6 @@ struct Level {
 }
 
 var<uniform> sv: SvgfParams;
-// The previous frame's object index and triangle slot (the temporal stages' object test).
-var prev_object: texture_2d<u32>;
 
 const SV_TEMPORAL: u32 = 1u;
 const SV_SPATIAL_VARIANCE: u32 = 2u;
@@ -115,19 +113,8 @@ fn steering_variance(sample_variance: f32, moments: vec4f) -> f32 {
     return min(v, 65000.0);
 }
 
-// Schied et al. §4.1's object test: previous texel t showed the object pixel p shows. Depth
-// and normal alone pass history between two objects that touch in one plane (a box on the
-// floor, a door in its frame), and a moving object's history onto what it uncovers.
-fn same_object(p: vec2i, t: vec2i) -> bool {
-    return textureLoad(prev_object, t, 0).x == textureLoad(gb_object, p, 0).x;
-}
-
 // A pixel's record in a per-pixel storage buffer (row-major).
 fn tap_index(p: vec2i) -> u32 {
     return u32(p.y) * frame.size.x + u32(p.x);
 }
 
-// Feature buffer written by the matte temporal: linear depth and its gradient.
-fn linear_depth(x: vec3f) -> f32 {
-    return dot(x - frame.cam_pos.xyz, frame.cam_fwd.xyz) / length(frame.cam_fwd.xyz);
-}

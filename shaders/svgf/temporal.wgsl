@@ -1,7 +1,7 @@
 // SVGF §4.1 for the matte light: reverse-reproject last frame's filtered light and moments with
 // the G-buffer's motion vectors, test the previous depth and normal (matte/common.wgsl's
 // `reproject`: the texel under the vector sampled bilinearly where it passes, else the closest
-// of its 3x3 neighbours) and object (common.wgsl: same_object), and integrate (common.wgsl). Also writes the features every later
+// of its 3x3 neighbours) and object (matte/common.wgsl: same_object), and integrate (common.wgsl). Also writes the features every later
 // stage edge-stops on: linear depth and its gradient.
 // Outputs: integrated (rgb, this frame's raw luminance), moments (m1, m2, h), features (z, dz).
 
@@ -12,26 +12,6 @@ var moments: texture_2d<f32>;
 var out_integrated: texture_storage_2d<rgba16float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
 var out_features: texture_storage_2d<rg32float, write>;
-
-// Linear depth of pixel q (or -1 off the surface).
-fn depth_at(q: vec2i) -> f32 {
-    if !in_bounds(q) || !has_surface(q) {
-        return -1.0;
-    }
-    return linear_depth(position_at(q));
-}
-
-// The smaller one-sided difference along an axis (a silhouette on one side does not count).
-fn gradient(z: f32, a: f32, b: f32) -> f32 {
-    var g = 1e30;
-    if a >= 0.0 {
-        g = abs(a - z);
-    }
-    if b >= 0.0 {
-        g = min(g, abs(b - z));
-    }
-    return select(g, 0.0, g >= 1e30);
-}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
@@ -48,7 +28,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let x = position_at(p);
     let z = linear_depth(x);
-    let dz = gradient(z, depth_at(p - vec2i(1, 0)), depth_at(p + vec2i(1, 0))) + gradient(z, depth_at(p - vec2i(0, 1)), depth_at(p + vec2i(0, 1)));
+    let dz = depth_gradient(p, z);
     textureStore(out_features, p, vec4f(z, dz, 0.0, 0.0));
 
     var reprojected = false;

@@ -60,7 +60,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         bail!("--frames must be at least 1");
     }
     let max_spp = hush_engine::settings::MAX_SAMPLES_PER_PIXEL;
-    if let Some(crate::render::Spp::Samples(spp)) = a.spp.filter(|s| matches!(s, crate::render::Spp::Samples(n) if *n > max_spp)) {
+    if let Some(crate::render::Spp::Samples(spp)) = a.spp
+        && spp > max_spp
+    {
         bail!("--spp {spp}: real-time mode takes at most {max_spp} samples per pixel per frame; use --frames (or --accumulate) for more");
     }
     let fps = a.fps.unwrap_or(60.0);

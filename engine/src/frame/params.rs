@@ -28,8 +28,7 @@ pub struct FrameParams {
     pub samples: u32,
     /// Frames between two samples of a pixel, 1 / f (1: every pixel every frame; frame/schedule.rs).
     pub period: u32,
-    /// Whether each tile starts the Bayer order at its own phase (schedule::phase).
-    pub staggered: u32,
+    pub _pad: u32,
 }
 
 impl FrameParams {
@@ -54,7 +53,7 @@ impl FrameParams {
             representative_roughness,
             samples: if accumulated > 0 { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) },
             period: if accumulated > 0 { 1 } else { settings.sample_fraction.period() },
-            staggered: 1,
+            _pad: 0,
         }
     }
 }

@@ -32,18 +32,15 @@ pub fn cell(rank: u32, period: u32) -> (u32, u32) {
     (x ^ y, y)
 }
 
-/// The tile's phase in the Bayer order (0 for all tiles when `staggered` is off).
-pub fn phase(tile_x: u32, tile_y: u32, period: u32, staggered: bool) -> u32 {
-    if !staggered {
-        return 0;
-    }
+/// The tile's phase in the Bayer order.
+pub fn phase(tile_x: u32, tile_y: u32, period: u32) -> u32 {
     hash(tile_x.wrapping_mul(0x8da6_b343) ^ tile_y.wrapping_mul(0xd816_3841)) & (period - 1)
 }
 
 /// The pixel of tile (tile_x, tile_y) traced in frame `index`.
-pub fn scheduled_pixel(tile_x: u32, tile_y: u32, index: u32, period: u32, staggered: bool) -> (u32, u32) {
+pub fn scheduled_pixel(tile_x: u32, tile_y: u32, index: u32, period: u32) -> (u32, u32) {
     let (w, h) = tile(period);
-    let rank = index.wrapping_add(phase(tile_x, tile_y, period, staggered)) & (period - 1);
+    let rank = index.wrapping_add(phase(tile_x, tile_y, period)) & (period - 1);
     let (cx, cy) = cell(rank, period);
     (tile_x * w + cx, tile_y * h + cy)
 }
@@ -66,25 +63,23 @@ mod tests {
     fn every_pixel_is_traced_once_per_period() {
         let (w, h): (u32, u32) = (37, 23);
         for period in [1, 2, 4, 8, 16, 32, 64, 128] {
-            for staggered in [false, true] {
-                let (tw, th) = tile(period);
-                assert_eq!(tw * th, period);
-                // Start anywhere: frame indices wrap.
-                let start = u32::MAX - 5;
-                let mut count = vec![0u32; (w * h) as usize];
-                for f in 0..period {
-                    for ty in 0..h.div_ceil(th) {
-                        for tx in 0..w.div_ceil(tw) {
-                            let (x, y) = scheduled_pixel(tx, ty, start.wrapping_add(f), period, staggered);
-                            assert!(x / tw == tx && y / th == ty, "the pixel stays in its tile");
-                            if x < w && y < h {
-                                count[(y * w + x) as usize] += 1;
-                            }
+            let (tw, th) = tile(period);
+            assert_eq!(tw * th, period);
+            // Start anywhere: frame indices wrap.
+            let start = u32::MAX - 5;
+            let mut count = vec![0u32; (w * h) as usize];
+            for f in 0..period {
+                for ty in 0..h.div_ceil(th) {
+                    for tx in 0..w.div_ceil(tw) {
+                        let (x, y) = scheduled_pixel(tx, ty, start.wrapping_add(f), period);
+                        assert!(x / tw == tx && y / th == ty, "the pixel stays in its tile");
+                        if x < w && y < h {
+                            count[(y * w + x) as usize] += 1;
                         }
                     }
                 }
-                assert!(count.iter().all(|&c| c == 1), "period {period} staggered {staggered}: {count:?}");
             }
+            assert!(count.iter().all(|&c| c == 1), "period {period}: {count:?}");
         }
     }
 
