@@ -8,6 +8,7 @@ mod realtime;
 mod reflections;
 mod render;
 mod sweep;
+mod time_to_quality;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -27,6 +28,9 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Score a denoised stream against per-frame references: CSV, plot, ablations.
     Quality(quality::QualityArgs),
+    /// Time to quality: FLIP on screen against wall-clock seconds since the camera stopped
+    /// (after a strafe, and after a cut), per denoiser, sample rate and governor: CSV, plot.
+    TimeToQuality(time_to_quality::TimeToQualityArgs),
     /// Reflection reprojection: temporal error, FLIP and ghosting under a strafe, motion vector
     /// accuracy against a brute-force search (Voorhuis §7.3-7.4).
     Reflections(reflections::ReflectionsArgs),
@@ -64,6 +68,7 @@ fn main() {
         Command::Bench(a) => bench::run(a),
         Command::Level(a) => level(a),
         Command::Quality(a) => quality::run(a),
+        Command::TimeToQuality(a) => time_to_quality::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Reflections(a) => reflections::run(a),
     };

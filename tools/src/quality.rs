@@ -231,26 +231,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
             references.push(references[k - 1].clone());
             continue;
         }
-        let cached = a.reference_cache.as_ref().map(|dir| dir.join(format!("reference_{:016x}.exr", reference_key(&a, &s, input, &acc))));
-        if let Some(path) = cached.as_ref().filter(|p| p.exists()) {
-            let img = Image::load(path).with_context(|| format!("reading the cached reference {}", path.display()))?;
-            if (img.width, img.height) != s.size {
-                bail!("cached reference {} is {}x{}, not {}x{}", path.display(), img.width, img.height, s.size.0, s.size.1);
-            }
-            references.push(img);
-            continue;
-        }
-        if let Some(path) = &cached {
-            eprintln!("rendering the reference of frame {k} into {}", path.display());
-        }
-        for _ in 0..a.reference_frames {
-            refr.render(&s.gpu, input, &acc, None)?;
-        }
-        let img = refr.read_hdr(&s.gpu)?;
-        if let Some(path) = &cached {
-            std::fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).with_context(|| format!("creating the folder of {}", path.display()))?;
-            img.save(path)?;
-        }
+        let img = reference(&s.gpu, &mut refr, &a.scene, input, a.reference_frames, &acc, a.reference_cache.as_deref())?;
         references.push(img);
     }
     // The yardstick: the last frame's view accumulated over 64 frames, raw, as the mean
@@ -340,16 +321,43 @@ pub fn run(a: QualityArgs) -> Result<()> {
 
 /// What a reference depends on, hashed with FNV-1a: the standard library's hasher may change
 /// between Rust releases, and a cache key has to outlive the build that wrote it.
-fn reference_key(a: &QualityArgs, s: &Setup, input: &FrameInput, acc: &FrameSettings) -> u64 {
+pub fn reference_cache_key(scene: &str, size: (u32, u32), input: &FrameInput, frames: u32, acc: &FrameSettings) -> u64 {
     // A scene file's size and modification time stand for its content. `default` and `level`
     // are built in: their key changes with Hush's version only, so clear the cache after
     // editing them.
-    let stamp = match std::fs::metadata(&a.scene) {
+    let stamp = match std::fs::metadata(scene) {
         Ok(m) => format!("{} {:?}", m.len(), m.modified().ok()),
         Err(_) => format!("built-in {}", env!("CARGO_PKG_VERSION")),
     };
-    let key = format!("{} {stamp} {:?} {:?} {} {} {:?}", a.scene, s.size, input, a.reference_frames, acc.seed, acc.max_depth);
+    let key = format!("{scene} {stamp} {size:?} {input:?} {frames} {} {:?}", acc.seed, acc.max_depth);
     key.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
+}
+
+/// The real-time frame of `input` accumulated over `frames` frames with `acc` (the converged
+/// image every stream is scored against), from `cache` when it holds it, else rendered and
+/// kept there.
+pub fn reference(gpu: &Gpu, r: &mut Renderer, scene: &str, input: &FrameInput, frames: u32, acc: &FrameSettings, cache: Option<&Path>) -> Result<Image> {
+    let size = r.size();
+    let cached = cache.map(|dir| dir.join(format!("reference_{:016x}.exr", reference_cache_key(scene, size, input, frames, acc))));
+    if let Some(path) = cached.as_ref().filter(|p| p.exists()) {
+        let img = Image::load(path).with_context(|| format!("reading the cached reference {}", path.display()))?;
+        if (img.width, img.height) != size {
+            bail!("cached reference {} is {}x{}, not {}x{}", path.display(), img.width, img.height, size.0, size.1);
+        }
+        return Ok(img);
+    }
+    if let Some(path) = &cached {
+        eprintln!("rendering the reference into {}", path.display());
+    }
+    for _ in 0..frames {
+        r.render(gpu, input, acc, None)?;
+    }
+    let img = r.read_hdr(gpu)?;
+    if let Some(path) = &cached {
+        std::fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).with_context(|| format!("creating the folder of {}", path.display()))?;
+        img.save(path)?;
+    }
+    Ok(img)
 }
 
 fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> Result<()> {

@@ -174,11 +174,31 @@ pub fn run(a: RenderArgs) -> Result<()> {
 }
 
 /// One governed frame as frames.csv records it.
-struct GovernedFrame {
-    wall_ms: f64,
-    gpu_ms: f64,
-    spp: f64,
-    size: (u32, u32),
+pub struct GovernedFrame {
+    pub wall_ms: f64,
+    pub gpu_ms: f64,
+    pub spp: f64,
+    pub size: (u32, u32),
+}
+
+/// Render one frame at the governor's choice (its scale of `full`, its sample fraction) and
+/// tell the governor what it cost: the frame's wall time (resize, render and its timings read
+/// back, which waits for the device) and its trace time. `last_camera` tells it whether the
+/// camera moved.
+pub fn governed_frame(gpu: &hush_engine::gpu::Gpu, r: &mut Renderer, g: &mut hush_engine::governor::Governor, settings: &FrameSettings, input: &FrameInput, full: (u32, u32), last_camera: &mut Option<hush_engine::scene::Camera>) -> Result<GovernedFrame> {
+    let c = g.choice();
+    let size = ((full.0 as f32 * c.scale).round().max(1.0) as u32, (full.1 as f32 * c.scale).round().max(1.0) as u32);
+    let s = FrameSettings { sample_fraction: c.fraction, ..settings.clone() };
+    let start = std::time::Instant::now();
+    r.resize(gpu, size)?;
+    r.render(gpu, input, &s, None)?;
+    let passes = r.pass_times(gpu)?;
+    let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    let trace_ms = passes.iter().filter(|p| p.0 == hush_engine::passes::trace::LABEL).map(|p| p.1).sum();
+    let moving = last_camera.is_some_and(|l| l != input.camera);
+    *last_camera = Some(input.camera);
+    g.record(hush_engine::governor::FrameCost { wall_ms, trace_ms, choice: c, moving });
+    Ok(GovernedFrame { wall_ms, gpu_ms: passes.iter().map(|p| p.1).sum(), spp: 1.0 / c.fraction.period() as f64, size })
 }
 
 /// Render `inputs` with the governor holding `target_ms` (hush_engine::governor): before each
@@ -199,19 +219,7 @@ fn governed(gpu: &hush_engine::gpu::Gpu, r: &mut Renderer, settings: &FrameSetti
     let mut rows = vec![];
     let mut last_camera = None;
     for (k, input) in inputs.enumerate() {
-        let c = g.choice();
-        let size = ((full.0 as f32 * c.scale).round().max(1.0) as u32, (full.1 as f32 * c.scale).round().max(1.0) as u32);
-        let s = FrameSettings { sample_fraction: c.fraction, ..settings.clone() };
-        let start = std::time::Instant::now();
-        r.resize(gpu, size)?;
-        r.render(gpu, &input, &s, None)?;
-        let passes = r.pass_times(gpu)?;
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        let trace_ms = passes.iter().filter(|p| p.0 == hush_engine::passes::trace::LABEL).map(|p| p.1).sum();
-        let moving = last_camera.is_some_and(|l| l != input.camera);
-        last_camera = Some(input.camera);
-        g.record(hush_engine::governor::FrameCost { wall_ms, trace_ms, choice: c, moving });
-        rows.push(GovernedFrame { wall_ms, gpu_ms: passes.iter().map(|p| p.1).sum(), spp: 1.0 / c.fraction.period() as f64, size });
+        rows.push(governed_frame(gpu, r, &mut g, settings, &input, full, &mut last_camera)?);
         if let Some(dir) = out_dir {
             r.read_hdr(gpu)?.save(&dir.join(format!("frame_{k:05}.exr")))?;
         }

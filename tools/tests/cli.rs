@@ -291,3 +291,33 @@ fn governed_render_writes_frames_csv() {
     let last = &rows[8];
     assert_eq!((last[3], last[4], last[5]), ("0.0078125", "32", "18"), "{csv}");
 }
+
+#[test]
+fn time_to_quality_follows_each_run_past_the_last_time() {
+    let dir = temp_dir("time-to-quality");
+    let o = bin("hush-cli")
+        .args(["time-to-quality", "level", "--width", "32", "--reference-frames", "4", "--seconds", "0.4", "--lead-in", "0.1", "--at", "0,0.2,0.4"])
+        .args(["--run", "none", "--run", "progressive@30"])
+        .arg("--out-dir")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Two runs in two scenarios, at three times each.
+    let at = std::fs::read_to_string(dir.join("at_times.csv")).unwrap();
+    assert_eq!(at.lines().count(), 1 + 2 * 2 * 3, "{at}");
+    let frames = std::fs::read_to_string(dir.join("time_to_quality.csv")).unwrap();
+    for run in ["none", "progressive@30"] {
+        for sc in ["stop", "cut"] {
+            let rows: Vec<Vec<&str>> = frames.lines().map(|l| l.split(',').collect::<Vec<_>>()).filter(|r| r[0] == run && r[1] == sc).collect();
+            // The image before the stop, then frames until the clock passes --seconds.
+            assert!(rows.len() >= 2, "{run} {sc}: {frames}");
+            let ends: Vec<f64> = rows[1..].iter().map(|r| r[3].parse().unwrap()).collect();
+            assert!(ends.windows(2).all(|w| w[1] >= w[0]) && *ends.last().unwrap() >= 0.4, "{run} {sc}: {ends:?}");
+            assert!(rows.iter().all(|r| r[9].parse::<f64>().unwrap().is_finite()), "{frames}");
+        }
+    }
+    assert!(stdout.contains("progressive@30 at or below none") || stdout.contains("progressive@30 above none"), "{stdout}");
+    assert_eq!(image_size(&dir.join("time_to_quality.png")), (960, 840));
+}

@@ -72,6 +72,39 @@ impl Image {
         Ok(out)
     }
 
+    /// The image resampled to `width` x `height` bilinearly between pixel centres, edges
+    /// clamped: a frame rendered at a resolution scale as the display's linear sampler
+    /// stretches it over the full-size window. Written here because the `image` crate's resize
+    /// clamps 32-bit float pixels to [0, 1], which would cut off HDR light.
+    pub fn resized(&self, width: u32, height: u32) -> Result<Image> {
+        if (width, height) == (self.width, self.height) {
+            return Ok(self.clone());
+        }
+        if width == 0 || height == 0 || self.width == 0 || self.height == 0 {
+            bail!("cannot resize {}x{} to {width}x{height}", self.width, self.height);
+        }
+        // Source coordinate of a destination pixel centre, and its two neighbours and weight.
+        let taps = |dst: u32, src: u32| -> Vec<(u32, u32, f32)> {
+            (0..dst)
+                .map(|i| {
+                    let x = ((i as f32 + 0.5) * src as f32 / dst as f32 - 0.5).clamp(0.0, (src - 1) as f32);
+                    let x0 = x.floor() as u32;
+                    (x0, (x0 + 1).min(src - 1), x - x0 as f32)
+                })
+                .collect()
+        };
+        let (xs, ys) = (taps(width, self.width), taps(height, self.height));
+        let mut out = Image::new(width, height);
+        for (y, &(y0, y1, fy)) in ys.iter().enumerate() {
+            for (x, &(x0, x1, fx)) in xs.iter().enumerate() {
+                let top = self.at(x0, y0).lerp(self.at(x1, y0), fx);
+                let bottom = self.at(x0, y1).lerp(self.at(x1, y1), fx);
+                out.data[y * width as usize + x] = top.lerp(bottom, fy);
+            }
+        }
+        Ok(out)
+    }
+
     pub fn nonfinite_pixels(&self) -> usize {
         self.data.iter().filter(|p| !p.is_finite()).count()
     }
@@ -151,4 +184,26 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 
 fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resizing_keeps_a_flat_image_and_interpolates_a_ramp() {
+        let mut img = Image::new(4, 2);
+        for (i, p) in img.data.iter_mut().enumerate() {
+            *p = Vec3::splat((i % 4) as f32);
+        }
+        let up = img.resized(8, 4).unwrap();
+        assert_eq!((up.width, up.height), (8, 4));
+        // Rows stay identical, columns rise monotonically from the first value to the last.
+        let row: Vec<f32> = (0..8).map(|x| up.at(x, 1).x).collect();
+        assert!(row.windows(2).all(|w| w[1] >= w[0]), "{row:?}");
+        assert!(row[0] >= 0.0 && row[7] <= 3.0 && row[7] > row[0], "{row:?}");
+        let flat = Image { width: 3, height: 3, data: vec![Vec3::new(0.5, 1.0, 2.0); 9] };
+        assert!(flat.resized(7, 5).unwrap().data.iter().all(|p| (*p - Vec3::new(0.5, 1.0, 2.0)).abs().max_element() < 1e-6));
+        assert!(img.resized(0, 4).is_err());
+    }
 }
