@@ -6,15 +6,17 @@
 //! else (raster, denoiser, display, the CPU's share of the wall time). Both are re-estimated
 //! after every frame from its wall time and its trace time, and smoothed by the median of the
 //! last [`WINDOW`] frames: one slow frame (a hitch, a shader compile) moves nothing, a load
-//! that lasts (a heavier view, another program) is followed within three frames.
+//! that lasts (another program) is followed within three frames, and two frames in a row over
+//! [`OVER`] x the target (a cut to a heavier view) within two.
 //!
 //! Choice: among the scales [`SCALES`] down to `min_scale` and the fractions the denoiser
 //! accepts, the largest scale whose best fraction fits, then the largest fraction that fits
-//! (a still camera can afford a small fraction, since its samples accumulate; a moving one
-//! wants fresh samples, so while the camera moves a fraction below 1/4 costs a step of scale
-//! first). Changing the scale reallocates the frame and restarts every history, so the scale
-//! rises only after [`RISE_FRAMES`] frames in a row predicted under 80% of the target at the
-//! larger scale; it falls at once when the prediction is over the target.
+//! (a still camera can afford a smaller fraction, since its samples accumulate; a moving one
+//! wants fresh samples, so a fraction below 1/4 while the camera moves, or below 1/8 while it
+//! stands, costs a step of scale first). Changing the scale reallocates the frame and restarts every history, so the scale
+//! rises only while the camera moves, after [`RISE_FRAMES`] frames in a row predicted under
+//! 80% of the target at the larger scale; it falls at once when the prediction is over the
+//! target.
 
 use crate::settings::SampleFraction;
 
@@ -24,6 +26,8 @@ pub const SCALES: [f32; 7] = [1.0, 0.875, 0.75, 0.625, 0.5, 0.375, 0.25];
 pub const WINDOW: usize = 5;
 /// Consecutive frames with room to spare before the scale goes up.
 pub const RISE_FRAMES: u32 = 8;
+/// A frame over this multiple of the target counts towards a lasting overload.
+pub const OVER: f64 = 1.5;
 
 /// What the governor runs the next frame at.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,6 +65,8 @@ pub struct Governor {
     costs: Vec<(f64, f64)>,
     current: Choice,
     room_frames: u32,
+    /// Consecutive frames over OVER x the target.
+    over_frames: u32,
 }
 
 impl Governor {
@@ -74,6 +80,7 @@ impl Governor {
             costs: vec![],
             current: Choice { scale: 1.0, fraction: SampleFraction::ONE },
             room_frames: 0,
+            over_frames: 0,
         }
     }
 
@@ -98,6 +105,14 @@ impl Governor {
         self.costs.push(((wall - trace) / area, trace * period / area));
         if self.costs.len() > WINDOW {
             self.costs.remove(0);
+        }
+        // Two frames in a row far over the target (a cut to a heavier view): the older costs
+        // no longer apply, so the estimate follows these two at once rather than after the
+        // window's median turns (three frames). One such frame alone stays a hitch.
+        self.over_frames = if wall > OVER * self.target_ms { self.over_frames + 1 } else { 0 };
+        if self.over_frames >= 2 {
+            let n = self.costs.len();
+            self.costs.drain(..n.saturating_sub(2));
         }
         self.current = self.pick(f.moving);
         self.choice()
@@ -130,19 +145,17 @@ impl Governor {
         }
     }
 
-    /// The largest fraction at scale `s` predicted within `budget` ms (while moving, none
-    /// below 1/4 unless nothing else fits at any scale).
-    fn best_fraction(&self, s: f32, budget: f64, moving: bool) -> Option<SampleFraction> {
-        let floor = if moving { 4 } else { u32::MAX };
+    /// The largest fraction at scale `s` predicted within `budget` ms, none below 1 / `floor`.
+    fn best_fraction(&self, s: f32, budget: f64, floor: u32) -> Option<SampleFraction> {
         self.fractions().into_iter().filter(|f| f.period() <= floor).find(|&fraction| self.predict(Choice { scale: s, fraction }).is_some_and(|t| t <= budget))
     }
 
     fn pick(&mut self, moving: bool) -> Choice {
         let scales = self.scales();
         let fits = |g: &Governor, budget: f64| -> Option<Choice> {
-            for pass in [moving, false] {
+            for floor in [floor(moving), u32::MAX] {
                 for &s in &scales {
-                    if let Some(fraction) = g.best_fraction(s, budget, pass) {
+                    if let Some(fraction) = g.best_fraction(s, budget, floor) {
                         return Some(Choice { scale: s, fraction });
                     }
                 }
@@ -153,17 +166,29 @@ impl Governor {
         let want = fits(self, self.target_ms).unwrap_or(smallest);
         let cur = self.current;
         if want.scale > cur.scale {
-            // Rise only after RISE_FRAMES frames that would fit the larger scale with room.
-            let roomy = fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
+            // Rise only while the camera moves, after RISE_FRAMES frames that would fit the
+            // larger scale with room: a rise restarts every history, which on a still view
+            // trades converged light for a noisy image (time-to-quality, level 320x180: FLIP
+            // 0.156 -> 0.499 at a rise 0.84 s after a stop, back to 0.156 only after 3.6 s).
+            let roomy = moving && fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
             self.room_frames = if roomy { self.room_frames + 1 } else { 0 };
             if self.room_frames < RISE_FRAMES {
-                let fraction = self.best_fraction(cur.scale, self.target_ms, moving).or_else(|| self.best_fraction(cur.scale, self.target_ms, false)).unwrap_or(smallest.fraction);
+                let fraction = self.best_fraction(cur.scale, self.target_ms, floor(moving)).or_else(|| self.best_fraction(cur.scale, self.target_ms, u32::MAX)).unwrap_or(smallest.fraction);
                 return Choice { scale: cur.scale, fraction };
             }
         }
         self.room_frames = 0;
         want
     }
+}
+
+/// The smallest fraction (as a period) taken before a step of scale: while the camera moves it
+/// wants fresh samples (1/4); a still view accumulates, but below 1/8 a pixel waits so long
+/// for its next sample that a smaller scale converges sooner (time-to-quality on the level at
+/// 320x180 and 100 ms, FLIP 5 s after a cut: 0.133 pinned at 1/4, 0.147 at 1/8, 0.176 at 1/16,
+/// 0.183 when free to go to 1/64).
+fn floor(moving: bool) -> u32 {
+    if moving { 4 } else { 8 }
 }
 
 fn finite_or(v: f64, or: f64) -> f64 {
@@ -189,17 +214,23 @@ mod tests {
     }
 
     #[test]
-    fn holds_the_target_and_prefers_scale_when_still() {
+    fn holds_the_target_and_keeps_an_eighth_when_still() {
         let mut g = Governor::new(100.0);
         g.fractions_allowed = true;
         // Full frame: 60 ms of raster/denoise/display, 1200 ms of trace.
         let frames = run(&mut g, 60.0, 1200.0, 20, false);
         let (c, t) = frames.last().copied().unwrap();
         assert!(t <= 100.0, "{c:?} takes {t} ms");
-        assert_eq!(c.scale, 1.0, "a still camera keeps full resolution and lowers the fraction: {c:?}");
-        assert_eq!(c.fraction.period(), 32, "the largest fraction that fits: 60 + 1200/32 = 97.5 ms");
+        // 1/8 fits at 0.625 (0.39 x (60 + 150) = 82 ms), not at 0.75 (118 ms); 1/4 fits nowhere
+        // above that (0.625: 141 ms). Full scale would fit only at 1/32.
+        assert_eq!((c.scale, c.fraction.period()), (0.625, 8), "{c:?}");
         // The first frame is over (nothing known yet); from the second on every frame fits.
         assert!(frames[1..].iter().all(|(_, t)| *t <= 100.0), "{frames:?}");
+        // Where nothing fits at 1/8 even at the smallest scale, smaller fractions are taken.
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        let (c, t) = run(&mut g, 60.0, 40000.0, 20, false).last().copied().unwrap();
+        assert!(t <= 100.0 && c.fraction.period() > 8, "{c:?} {t}");
     }
 
     #[test]
@@ -239,12 +270,26 @@ mod tests {
     }
 
     #[test]
+    fn a_cut_to_a_heavier_view_is_followed_after_two_frames() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        run(&mut g, 30.0, 300.0, 20, false);
+        // The new view costs four times as much; the median of five would take three frames.
+        let after = run(&mut g, 120.0, 1200.0, 6, true);
+        assert!(after[0].1 > 150.0 && after[1].1 > 150.0, "{after:?}");
+        assert!(after[2..].iter().all(|(_, t)| *t <= 100.0), "{after:?}");
+    }
+
+    #[test]
     fn the_scale_rises_only_after_lasting_room() {
         let mut g = Governor::new(100.0);
         run(&mut g, 60.0, 300.0, 10, false);
         assert_eq!(g.choice().scale, 0.5);
-        // The load halves: the scale rises, but not before RISE_FRAMES frames.
-        let frames = run(&mut g, 30.0, 150.0, 20, false);
+        // The load halves: a still camera keeps its scale (a rise would restart the history).
+        let still = run(&mut g, 30.0, 150.0, 20, false);
+        assert!(still.iter().all(|(c, _)| c.scale == 0.5), "{still:?}");
+        // Once it moves, the scale rises, but not before RISE_FRAMES frames.
+        let frames = run(&mut g, 30.0, 150.0, 20, true);
         let rose = frames.iter().position(|(c, _)| c.scale > 0.5).expect("never rose");
         assert!(rose >= RISE_FRAMES as usize, "rose after {rose} frames");
         assert!(frames.iter().all(|(_, t)| *t <= 100.0));
