@@ -26,6 +26,8 @@ pub const SCALES: [f32; 7] = [1.0, 0.875, 0.75, 0.625, 0.5, 0.375, 0.25];
 pub const WINDOW: usize = 5;
 /// Consecutive frames with room to spare before the scale goes up.
 pub const RISE_FRAMES: u32 = 8;
+/// Frames at one scale during which a still view may still rise from it (its history is young).
+pub const YOUNG_FRAMES: u32 = 16;
 /// A frame over this multiple of the target counts towards a lasting overload.
 pub const OVER: f64 = 1.5;
 
@@ -67,6 +69,8 @@ pub struct Governor {
     room_frames: u32,
     /// Consecutive frames over OVER x the target.
     over_frames: u32,
+    /// Frames rendered at the current scale.
+    scale_frames: u32,
 }
 
 impl Governor {
@@ -81,6 +85,7 @@ impl Governor {
             current: Choice { scale: 1.0, fraction: SampleFraction::ONE },
             room_frames: 0,
             over_frames: 0,
+            scale_frames: 0,
         }
     }
 
@@ -114,6 +119,7 @@ impl Governor {
             let n = self.costs.len();
             self.costs.drain(..n.saturating_sub(2));
         }
+        self.scale_frames = if f.choice.scale == self.current.scale { self.scale_frames.saturating_add(1) } else { 1 };
         self.current = self.pick(f.moving);
         self.choice()
     }
@@ -166,11 +172,13 @@ impl Governor {
         let want = fits(self, self.target_ms).unwrap_or(smallest);
         let cur = self.current;
         if want.scale > cur.scale {
-            // Rise only while the camera moves, after RISE_FRAMES frames that would fit the
-            // larger scale with room: a rise restarts every history, which on a still view
-            // trades converged light for a noisy image (time-to-quality, level 320x180: FLIP
-            // 0.156 -> 0.499 at a rise 0.84 s after a stop, back to 0.156 only after 3.6 s).
-            let roomy = moving && fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
+            // Rise after RISE_FRAMES frames that would fit the larger scale with room, and on a
+            // still view only while the history at this scale is young: a rise restarts every
+            // history, which on a settled view trades converged light for a noisy image
+            // (time-to-quality, level 320x180: FLIP 0.156 -> 0.499 at a rise 0.84 s after a
+            // stop, back to 0.156 only after 3.6 s), while a scale chosen from the first
+            // frames (a shader compile) must not stay until the camera moves.
+            let roomy = (moving || self.scale_frames < YOUNG_FRAMES) && fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
             self.room_frames = if roomy { self.room_frames + 1 } else { 0 };
             if self.room_frames < RISE_FRAMES {
                 let fraction = self.best_fraction(cur.scale, self.target_ms, floor(moving)).or_else(|| self.best_fraction(cur.scale, self.target_ms, u32::MAX)).unwrap_or(smallest.fraction);
@@ -281,11 +289,24 @@ mod tests {
     }
 
     #[test]
+    fn a_slow_first_frame_does_not_hold_a_still_view_at_a_small_scale() {
+        let mut g = Governor::new(100.0);
+        // The first frame compiles its shaders: 20 times its later cost.
+        let c = g.choice();
+        g.record(FrameCost { wall_ms: 1200.0, trace_ms: 0.0, choice: c, moving: false });
+        assert!(g.choice().scale < 0.5);
+        let frames = run(&mut g, 60.0, 0.0, 20, false);
+        assert_eq!(frames.last().unwrap().0.scale, 1.0, "{frames:?}");
+    }
+
+    #[test]
     fn the_scale_rises_only_after_lasting_room() {
         let mut g = Governor::new(100.0);
         run(&mut g, 60.0, 300.0, 10, false);
         assert_eq!(g.choice().scale, 0.5);
-        // The load halves: a still camera keeps its scale (a rise would restart the history).
+        // The load halves: a settled still view keeps its scale (a rise would restart the
+        // history).
+        run(&mut g, 60.0, 300.0, YOUNG_FRAMES as usize, false);
         let still = run(&mut g, 30.0, 150.0, 20, false);
         assert!(still.iter().all(|(c, _)| c.scale == 0.5), "{still:?}");
         // Once it moves, the scale rises, but not before RISE_FRAMES frames.

@@ -183,6 +183,10 @@ pub fn run(a: TimeToQualityArgs) -> Result<()> {
     crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
     let runs: Vec<RunSpec> = a.runs.iter().map(|r| parse_run(r)).collect::<Result<_>>()?;
     let scenarios: Vec<Scenario> = a.scenarios.iter().map(|s| Scenario::parse(s)).collect::<Result<_>>()?;
+    // Before any reference is rendered: a misspelt denoiser is a clear error at once.
+    for r in &runs {
+        preset_settings(None, Some(&r.denoiser), &[], None).with_context(|| format!("--run {:?}", r.label))?;
+    }
     if !(a.seconds > 0.0 && a.seconds <= 600.0) || !(a.lead_in >= 0.0 && a.lead_in <= 600.0) {
         bail!("--seconds must be in (0, 600] and --lead-in in [0, 600]");
     }

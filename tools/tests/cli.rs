@@ -39,6 +39,7 @@ fn bad_arguments_are_clear_errors() {
     let bad_preset = temp_dir("bad-preset").join("bad.toml");
     std::fs::write(&bad_preset, "[matte]\nhysteresis = 2.0\n").unwrap();
     let bad_preset = bad_preset.to_str().unwrap().to_string();
+    let ttq = temp_dir("bad-ttq").to_str().unwrap().to_string();
     for (args, needle) in [
         (vec!["render", "level", "--mode", "realtime", "--preset", &bad_preset, "--out", "x.exr"], "matte.hysteresis"),
         (vec!["bench", "level", "--mode", "realtime", "--preset", "/nonexistent.toml"], "/nonexistent.toml"),
@@ -59,6 +60,10 @@ fn bad_arguments_are_clear_errors() {
         (vec!["render", "default", "--spp", "1/4", "--out", "x.exr"], "--mode realtime"),
         (vec!["render", "level", "--mode", "realtime", "--spp", "1/4", "--denoiser", "mara", "--width", "8", "--height", "8", "--out", "x.exr"], "fills untraced pixels"),
         (vec!["render", "level", "--mode", "realtime", "--denoiser", "oidn", "--out", "x.exr"], "svgf"),
+        (vec!["time-to-quality", "level", "--run", "oidn", "--out-dir", &ttq], "--run \"oidn\""),
+        (vec!["time-to-quality", "level", "--run", "mara@0", "--out-dir", &ttq], "positive"),
+        (vec!["time-to-quality", "level", "--run", "mara:1/4", "--width", "8", "--height", "8", "--reference-frames", "1", "--out-dir", &ttq], "sample fractions below 1"),
+        (vec!["time-to-quality", "level", "--run", "mara", "--scenarios", "pan", "--out-dir", &ttq], "stop or cut"),
     ] {
         let o = bin("hush-cli").args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
