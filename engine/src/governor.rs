@@ -13,10 +13,10 @@
 //! accepts, the largest scale whose best fraction fits, then the largest fraction that fits
 //! (a still camera can afford a smaller fraction, since its samples accumulate; a moving one
 //! wants fresh samples, so a fraction below 1/4 while the camera moves, or below 1/8 while it
-//! stands, costs a step of scale first). Changing the scale reallocates the frame and restarts every history, so the scale
-//! rises only while the camera moves, after [`RISE_FRAMES`] frames in a row predicted under
-//! 80% of the target at the larger scale; it falls at once when the prediction is over the
-//! target.
+//! stands, costs a step of scale first). Changing the scale reallocates the frame and restarts
+//! every history, so the scale rises only after [`RISE_FRAMES`] frames in a row predicted under
+//! 80% of the target at the larger scale, and on a still view only within [`YOUNG_FRAMES`]
+//! frames of its last change; it falls at once when the prediction is over the target.
 
 use crate::settings::SampleFraction;
 

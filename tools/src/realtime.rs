@@ -198,7 +198,7 @@ pub fn governed_frame(gpu: &hush_engine::gpu::Gpu, r: &mut Renderer, g: &mut hus
     let moving = last_camera.is_some_and(|l| l != input.camera);
     *last_camera = Some(input.camera);
     g.record(hush_engine::governor::FrameCost { wall_ms, trace_ms, choice: c, moving });
-    Ok(GovernedFrame { wall_ms, gpu_ms: passes.iter().map(|p| p.1).sum(), spp: 1.0 / c.fraction.period() as f64, size })
+    Ok(GovernedFrame { wall_ms, gpu_ms: passes.iter().map(|p| p.1).sum(), spp: s.samples_per_pixel as f64 / c.fraction.period() as f64, size })
 }
 
 /// Render `inputs` with the governor holding `target_ms` (hush_engine::governor): before each

@@ -150,27 +150,18 @@ struct Curve {
     frames: Vec<GovernedFrame>,
 }
 
-/// How a run renders a frame: at full size with fixed settings, or at the governor's choice.
+/// A run's renderer and its governor (a fixed run's pins both knobs: full size, its fraction).
 struct Runner {
     renderer: Renderer,
     settings: FrameSettings,
-    governor: Option<Governor>,
+    governor: Governor,
     last_camera: Option<Camera>,
     full: (u32, u32),
 }
 
 impl Runner {
     fn frame(&mut self, gpu: &Gpu, input: &FrameInput) -> Result<GovernedFrame> {
-        if let Some(g) = &mut self.governor {
-            return governed_frame(gpu, &mut self.renderer, g, &self.settings, input, self.full, &mut self.last_camera);
-        }
-        let start = std::time::Instant::now();
-        self.renderer.render(gpu, input, &self.settings, None)?;
-        let passes = self.renderer.pass_times(gpu)?;
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        self.last_camera = Some(input.camera);
-        let f = self.settings.sample_fraction.period() as f64;
-        Ok(GovernedFrame { wall_ms, gpu_ms: passes.iter().map(|p| p.1).sum(), spp: self.settings.samples_per_pixel as f64 / f, size: self.full })
+        governed_frame(gpu, &mut self.renderer, &mut self.governor, &self.settings, input, self.full, &mut self.last_camera)
     }
 
     /// The frame on screen, at full size.
@@ -256,9 +247,13 @@ fn follow(a: &TimeToQualityArgs, gpu: &Gpu, scene: &Scene, full: (u32, u32), run
             let mut g = Governor::new(t);
             g.fractions_allowed = renderer.fills_untraced_pixels(gpu, &settings)?;
             g.pinned_fraction = run.spp.map(|_| sample_fraction);
-            Some(g)
+            g
         }
-        None => None,
+        None => {
+            let mut g = Governor::new(f64::INFINITY);
+            (g.pinned_scale, g.pinned_fraction) = (Some(1.0), Some(sample_fraction));
+            g
+        }
     };
     // One frame before the clock starts: it compiles the pipelines, which a viewer does once.
     let first = FrameInput { camera: scenario.lead_camera(view, 0.0, a.lead_in, a.speed), time: 0.0 };
@@ -274,9 +269,10 @@ fn follow(a: &TimeToQualityArgs, gpu: &Gpu, scene: &Scene, full: (u32, u32), run
     }
     let mut timeline = Timeline::new(compare(&runner.shown(gpu)?, reference)?.flip);
     let mut frames = vec![];
+    let stopped = FrameInput { camera: *view, time: 0.0 };
     let mut t = 0.0;
     while t < a.seconds {
-        let f = runner.frame(gpu, &input_at(view))?;
+        let f = runner.frame(gpu, &stopped)?;
         t += f.wall_ms / 1e3;
         let shown = runner.shown(gpu)?;
         if shown.nonfinite_pixels() > 0 {
@@ -286,10 +282,6 @@ fn follow(a: &TimeToQualityArgs, gpu: &Gpu, scene: &Scene, full: (u32, u32), run
         frames.push(f);
     }
     Ok(Curve { run: run.clone(), scenario, timeline, frames })
-}
-
-fn input_at(view: &Camera) -> FrameInput {
-    FrameInput { camera: *view, time: 0.0 }
 }
 
 fn write_outputs(a: &TimeToQualityArgs, curves: &[Curve], full: (u32, u32)) -> Result<()> {

@@ -32,15 +32,6 @@ impl Timeline {
         if finished == 0 { self.before } else { self.frames[finished - 1].1 }
     }
 
-    /// Seconds from the stop until the screen first shows a score at or under `goal` (0 when
-    /// the image from before already does); None if no frame reaches it.
-    pub fn time_to(&self, goal: f64) -> Option<f64> {
-        if self.before <= goal {
-            return Some(0.0);
-        }
-        self.frames.iter().find(|f| f.1 <= goal).map(|f| f.0)
-    }
-
     /// Seconds the timeline covers (when its last frame finished).
     pub fn span(&self) -> f64 {
         self.frames.last().map_or(0.0, |f| f.0)
@@ -63,9 +54,6 @@ mod tests {
         assert_eq!(t.shown_at(1.0), 0.5);
         assert_eq!(t.shown_at(1.25), 0.3);
         assert_eq!(t.shown_at(5.0), 0.2);
-        assert_eq!(t.time_to(0.3), Some(1.2));
-        assert_eq!(t.time_to(0.95), Some(0.0));
-        assert_eq!(t.time_to(0.1), None);
         assert_eq!(t.span(), 1.3);
     }
 
