@@ -11,16 +11,24 @@ struct Bvh2Node {
     r_count: u32,
 }
 
-var<storage, read> bvh_nodes: array<Bvh2Node>;
+// Four texels per node (read as texels: see tri_texels in geometry.wgsl).
+var bvh_texels: texture_2d<u32>;
 
-const BVH_STACK: u32 = 64u;
+fn bvh2_node(i: u32) -> Bvh2Node {
+    let a = textureLoad(bvh_texels, texel_at(i * 4u), 0);
+    let b = textureLoad(bvh_texels, texel_at(i * 4u + 1u), 0);
+    let c = textureLoad(bvh_texels, texel_at(i * 4u + 2u), 0);
+    let d = textureLoad(bvh_texels, texel_at(i * 4u + 3u), 0);
+    return Bvh2Node(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, bitcast<vec3f>(c.xyz), c.w, bitcast<vec3f>(d.xyz), d.w);
+}
 
 // Closest accepted hit along o + t d, t in (0, tmax). With `any_hit`, the first accepted hit.
 fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
     var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
-    var stack: array<u32, 64>;
+    // TRAVERSAL_STACK comes from the scene (engine/src/accel, traversal_stack).
+    var stack: array<u32, TRAVERSAL_STACK>;
     var sp = 0u;
     // Items are (index, count) pairs packed: leaves have their count in the high 8 bits.
     var item = 0u;
@@ -41,7 +49,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
             }
             is_leaf = false;
         } else {
-            let n = bvh_nodes[item];
+            let n = bvh2_node(item);
             let tl = intersect_box(o, inv_d, n.lmin, n.lmax, tmax);
             let tr = intersect_box(o, inv_d, n.rmin, n.rmax, tmax);
             let hl = tl < INF;
@@ -58,7 +66,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
                     second_i = n.l_index;
                     second_c = n.l_count;
                 }
-                if hl && hr && sp < BVH_STACK {
+                if hl && hr && sp < TRAVERSAL_STACK {
                     stack[sp] = second_i | (min(second_c, 255u) << 24u);
                     sp += 1u;
                 }

@@ -4,22 +4,23 @@
 //   [0] p.xyz (f32 bits), e0 | e1 << 8 | e2 << 16 | imask << 24
 //   [1] child_base_idx, primitive_base_idx, child_meta[0..4], child_meta[4..8]
 //   [2] child_min_x (8 bytes), child_max_x (8 bytes); [3] the same for y; [4] for z.
+// Nodes are read as texels (see tri_texels in geometry.wgsl).
 
-var<storage, read> cw_nodes: array<vec4u>;
+var bvh_texels: texture_2d<u32>;
 
-fn cw_byte(lo: u32, hi: u32, i: u32) -> u32 {
-    let w = select(hi, lo, i < 4u);
-    return (w >> ((i & 3u) * 8u)) & 0xffu;
+fn cw_node(i: u32) -> vec4u {
+    return textureLoad(bvh_texels, texel_at(i), 0);
 }
 
 // Bit mask of hit children: inner children in the high byte (bit = 24 + traversal priority),
-// leaf triangles in the low 24 bits.
-fn cw_intersect(node: u32, o: vec3f, inv_d: vec3f, oct_inv4: u32, tmax: f32) -> u32 {
-    let n0 = cw_nodes[node * 5u];
-    let n1 = cw_nodes[node * 5u + 1u];
-    let nx = cw_nodes[node * 5u + 2u];
-    let ny = cw_nodes[node * 5u + 3u];
-    let nz = cw_nodes[node * 5u + 4u];
+// leaf triangles in the low 24 bits; then the node's child and primitive base indices and its
+// inner-child mask.
+fn cw_intersect(node: u32, o: vec3f, inv_d: vec3f, oct_inv4: u32, tmax: f32) -> vec4u {
+    let n0 = cw_node(node * 5u);
+    let n1 = cw_node(node * 5u + 1u);
+    let nx = cw_node(node * 5u + 2u);
+    let ny = cw_node(node * 5u + 3u);
+    let nz = cw_node(node * 5u + 4u);
     let p = bitcast<vec3f>(n0.xyz);
     let e = vec3u(n0.w & 0xffu, (n0.w >> 8u) & 0xffu, (n0.w >> 16u) & 0xffu);
     let extent = bitcast<vec3f>(e << vec3u(23u));
@@ -27,28 +28,39 @@ fn cw_intersect(node: u32, o: vec3f, inv_d: vec3f, oct_inv4: u32, tmax: f32) -> 
     let adj_o = (p - o) * inv_d;
     let neg = inv_d < vec3f(0.0);
     var mask = 0u;
-    for (var c = 0u; c < 8u; c++) {
-        let cmeta = cw_byte(n1.z, n1.w, c);
-        if cmeta == 0u {
-            continue;
-        }
-        let qlo = vec3f(f32(cw_byte(nx.x, nx.y, c)), f32(cw_byte(ny.x, ny.y, c)), f32(cw_byte(nz.x, nz.y, c)));
-        let qhi = vec3f(f32(cw_byte(nx.z, nx.w, c)), f32(cw_byte(ny.z, ny.w, c)), f32(cw_byte(nz.z, nz.w, c)));
-        let t0 = select(qlo, qhi, neg) * adj_inv + adj_o;
-        let t1 = select(qhi, qlo, neg) * adj_inv + adj_o;
-        let tn = max(max3(t0), 0.0);
-        let tf = min(min(min(t1.x, t1.y), t1.z), tmax);
-        if tn <= tf {
-            let is_inner = (cmeta & (cmeta << 1u) & 0x10u) != 0u;
-            let bits = (cmeta >> 5u) & 7u;
-            let index = select(cmeta & 0x1fu, (cmeta ^ (oct_inv4 & 0xffu)) & 0x1fu, is_inner);
-            mask |= bits << index;
-        }
+    // Children 0-3, then 4-7: each word holds one byte per child, unpacked four at a time.
+    for (var h = 0u; h < 2u; h++) {
+        let first = h == 0u;
+        let metas = unpack4xU8(select(n1.w, n1.z, first));
+        let qlo_x = vec4f(unpack4xU8(select(nx.y, nx.x, first)));
+        let qlo_y = vec4f(unpack4xU8(select(ny.y, ny.x, first)));
+        let qlo_z = vec4f(unpack4xU8(select(nz.y, nz.x, first)));
+        let qhi_x = vec4f(unpack4xU8(select(nx.w, nx.z, first)));
+        let qhi_y = vec4f(unpack4xU8(select(ny.w, ny.z, first)));
+        let qhi_z = vec4f(unpack4xU8(select(nz.w, nz.z, first)));
+        let tx0 = select(qlo_x, qhi_x, neg.x) * adj_inv.x + adj_o.x;
+        let tx1 = select(qhi_x, qlo_x, neg.x) * adj_inv.x + adj_o.x;
+        let ty0 = select(qlo_y, qhi_y, neg.y) * adj_inv.y + adj_o.y;
+        let ty1 = select(qhi_y, qlo_y, neg.y) * adj_inv.y + adj_o.y;
+        let tz0 = select(qlo_z, qhi_z, neg.z) * adj_inv.z + adj_o.z;
+        let tz1 = select(qhi_z, qlo_z, neg.z) * adj_inv.z + adj_o.z;
+        let tn = max(max(max(tx0, ty0), tz0), vec4f(0.0));
+        let tf = min(min(min(tx1, ty1), tz1), vec4f(tmax));
+        // An empty child has meta 0.
+        let hit = (tn <= tf) & (metas != vec4u(0u));
+        let is_inner = (metas & (metas << vec4u(1u)) & vec4u(0x10u)) != vec4u(0u);
+        let bits = (metas >> vec4u(5u)) & vec4u(7u);
+        let index = select(metas & vec4u(0x1fu), (metas ^ vec4u(oct_inv4 & 0xffu)) & vec4u(0x1fu), is_inner);
+        let m = select(vec4u(0u), bits << index, hit);
+        mask |= m.x | m.y | m.z | m.w;
     }
-    return mask;
+    return vec4u(mask, n1.x, n1.y, n0.w >> 24u);
 }
 
-const CW_STACK: u32 = 32u;
+// `cur` is a group of a node's children still to visit: (child base, hit bits << 24 | the node's
+// inner-child mask, which places each child after the base); the stack holds such groups. Its
+// length, TRAVERSAL_STACK, comes from the scene (engine/src/accel, traversal_stack): lavapipe
+// pays for every entry at every traversal.
 
 fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
@@ -56,8 +68,9 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     let inv_d = safe_inverse(d);
     let oct_inv4 = select(0x04040404u, 0u, d.x < 0.0) | select(0x02020202u, 0u, d.y < 0.0)
         | select(0x01010101u, 0u, d.z < 0.0);
-    var stack: array<vec2u, 32>;
+    var stack: array<vec2u, TRAVERSAL_STACK>;
     var sp = 0u;
+    // The root as the one hit child of a virtual parent.
     var cur = vec2u(0u, 0x80000000u);
     var prim = vec2u(0u);
     loop {
@@ -78,7 +91,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
             let hits = cur.y;
             let off = firstLeadingBit(hits);
             cur.y &= ~(1u << off);
-            if (cur.y & 0xff000000u) != 0u && sp < CW_STACK {
+            if (cur.y & 0xff000000u) != 0u && sp < TRAVERSAL_STACK {
                 stack[sp] = cur;
                 sp += 1u;
             }
@@ -86,10 +99,8 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
             let rel = countOneBits(hits & ~(0xffffffffu << slot_index));
             let child = cur.x + rel;
             let m = cw_intersect(child, o, inv_d, oct_inv4, tmax);
-            let c1 = cw_nodes[child * 5u + 1u];
-            let imask = cw_nodes[child * 5u].w >> 24u;
-            cur = vec2u(c1.x, (m & 0xff000000u) | imask);
-            prim = vec2u(c1.y, m & 0x00ffffffu);
+            cur = vec2u(m.y, (m.x & 0xff000000u) | m.w);
+            prim = vec2u(m.z, m.x & 0x00ffffffu);
         } else {
             cur = vec2u(0u);
         }

@@ -1,6 +1,20 @@
 // Triangles in BVH leaf order: three vec4 per triangle, xyz = vertex; v0.w = material index,
 // v1.w = index of the triangle in the scene's input order (both as bits).
 var<storage, read> tris: array<vec4f>;
+// The same records as texel rows (engine/src/gpu/scene.rs, Texels), for the intersection tests:
+// lavapipe loads a texel per lane in one read, a storage buffer one word at a time.
+var tri_texels: texture_2d<f32>;
+
+// Texel i of a texel-row texture (rows of 1 << TEXEL_ROW_SHIFT texels).
+const TEXEL_ROW_SHIFT: u32 = 12u;
+
+fn texel_at(i: u32) -> vec2u {
+    return vec2u(i & ((1u << TEXEL_ROW_SHIFT) - 1u), i >> TEXEL_ROW_SHIFT);
+}
+
+fn tri_texel(i: u32) -> vec4f {
+    return textureLoad(tri_texels, texel_at(i), 0);
+}
 
 struct Hit {
     t: f32,
@@ -23,9 +37,9 @@ fn tri_material(slot: u32) -> u32 {
 // Möller-Trumbore, both faces (sidedness is decided by the shader that shades the hit).
 // Returns (t, b1, b2) with t = INF on a miss.
 fn intersect_triangle(o: vec3f, d: vec3f, slot: u32, tmax: f32) -> vec3f {
-    let v0 = tris[slot * 3u].xyz;
-    let e1 = tris[slot * 3u + 1u].xyz - v0;
-    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    let v0 = tri_texel(slot * 3u).xyz;
+    let e1 = tri_texel(slot * 3u + 1u).xyz - v0;
+    let e2 = tri_texel(slot * 3u + 2u).xyz - v0;
     let pv = cross(d, e2);
     let det = dot(e1, pv);
     if abs(det) < 1e-30 {

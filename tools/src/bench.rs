@@ -53,6 +53,8 @@ struct LayoutResult {
     bvh: &'static str,
     bvh_build_seconds: f64,
     bvh_nodes: usize,
+    /// Node levels from the root to the deepest leaf.
+    bvh_depth: usize,
     /// Incoherent closest-hit rays per second (random origins in the bounds, random directions).
     rays_per_second: f64,
     /// Reference-tracer paths (camera samples) per second.
@@ -144,6 +146,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
             bvh: kind.name(),
             bvh_build_seconds: prepared.accel.build_time.as_secs_f64(),
             bvh_nodes: prepared.accel.node_count,
+            bvh_depth: prepared.accel.depth,
             rays_per_second,
             samples_per_second: (a.width * a.height * a.spp) as f64 / secs,
             gpu_bytes: gscene.memory.total_bytes() + tracer.memory.total_bytes(),
@@ -165,8 +168,8 @@ pub fn run(a: BenchArgs) -> Result<()> {
         println!("{} ({} triangles) on {}", res.scene, res.triangles, res.adapter);
         for l in &res.layouts {
             println!(
-                "  {:6} build {:.3} s, {} nodes, {:.2} M rays/s, {:.3} M samples/s, {:.1} MiB",
-                l.bvh, l.bvh_build_seconds, l.bvh_nodes, l.rays_per_second / 1e6, l.samples_per_second / 1e6, l.gpu_bytes as f64 / 1048576.0
+                "  {:6} build {:.3} s, {} nodes (depth {}), {:.2} M rays/s, {:.3} M samples/s, {:.1} MiB",
+                l.bvh, l.bvh_build_seconds, l.bvh_nodes, l.bvh_depth, l.rays_per_second / 1e6, l.samples_per_second / 1e6, l.gpu_bytes as f64 / 1048576.0
             );
         }
         if let Some(m) = res.mitsuba_samples_per_second {

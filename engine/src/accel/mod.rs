@@ -65,12 +65,15 @@ pub struct Accel {
     /// The SAH tree came out deeper than the GPU traversal holds and this one was built by
     /// median splits instead ([`CWBVH_MAX_DEPTH`], [`BVH2_MAX_DEPTH`]).
     pub median_fallback: bool,
+    /// Levels of nodes from the root to the deepest leaf (the root alone is 1): the traversal
+    /// stack holds at most this many entries.
+    pub depth: usize,
 }
 
 impl Accel {
     /// Placeholder before the first build (no nodes).
     pub fn empty(kind: BvhKind) -> Accel {
-        Accel { kind, nodes: vec![], node_count: 0, order: vec![], build_time: Duration::ZERO, median_fallback: false }
+        Accel { kind, nodes: vec![], node_count: 0, order: vec![], build_time: Duration::ZERO, median_fallback: false, depth: 0 }
     }
 }
 
@@ -83,13 +86,50 @@ fn params() -> BvhBuildParams {
 const EMPTY_MIN: [f32; 3] = [f32::MAX; 3];
 const EMPTY_MAX: [f32; 3] = [-f32::MAX; 3];
 
-/// The deepest tree the GPU traversals hold: the CWBVH stack (`CW_STACK` in
-/// shaders/common/cwbvh.wgsl) and the BVH2 stack (`BVH_STACK` in shaders/common/bvh2.wgsl).
-/// A deeper tree would lose the subtrees that overflow the stack: missing geometry, silently.
+/// The deepest tree the GPU traversals hold. Each program's traversal stack is sized for its
+/// scene ([`traversal_stack`], `TRAVERSAL_STACK` in shaders/common/cwbvh.wgsl and bvh2.wgsl)
+/// and never past these; a tree deeper than its stack would lose the subtrees that overflow it:
+/// missing geometry, silently.
 pub const CWBVH_MAX_DEPTH: usize = 32;
 pub const BVH2_MAX_DEPTH: usize = 64;
 
+impl BvhKind {
+    pub fn max_depth(self) -> usize {
+        match self {
+            BvhKind::Bvh2 => BVH2_MAX_DEPTH,
+            BvhKind::Cwbvh => CWBVH_MAX_DEPTH,
+        }
+    }
+}
+
+/// Entries of the traversal stack the programs of a scene are built with. The stack is a
+/// private array that lavapipe zero-fills at every traversal and indexes by a ladder over all
+/// its entries, so its cost grows with its length: on cornell_diffuse (tree depth 2) the
+/// reference tracer made 0.69 M samples/s with 32 entries of two words, 0.98 with 16 of one
+/// word, 1.13 with 8 and 1.20 with 4. A static scene's stack holds its tree's depth (rounded up
+/// to 4). An animated scene rebuilds its tree every frame with the same stack
+/// ([`build_within`]), so its stack also holds what the median fallback can reach over `n`
+/// triangles (ceil(log2 n) + 1 binary levels, each at most one level of any layout) and four
+/// levels of headroom for the SAH tree.
+pub fn traversal_stack(kind: BvhKind, depth: usize, triangles: usize, animated: bool) -> u32 {
+    let need = if animated { (depth + 4).max(median_depth_bound(triangles)) } else { depth };
+    need.max(4).next_multiple_of(4).min(kind.max_depth()) as u32
+}
+
+/// The depth a median build ([`median_bvh2`], one triangle per leaf) reaches over `n` triangles
+/// in either layout: ceil(log2 n) + 1.
+fn median_depth_bound(n: usize) -> usize {
+    n.max(1).next_power_of_two().trailing_zeros() as usize + 1
+}
+
 pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
+    build_within(tris, kind, kind.max_depth())
+}
+
+/// [`build`], with the SAH tree kept only where it is at most `max_depth` deep (a traversal
+/// stack of that many entries holds it); the median tree otherwise.
+pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel {
+    let max_depth = max_depth.min(kind.max_depth());
     let start = Instant::now();
     if tris.is_empty() {
         let node = Bvh2GpuNode {
@@ -105,7 +145,7 @@ pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
         // An empty scene binds one node no ray can enter, in either layout's size.
         let mut nodes = bytemuck::bytes_of(&node).to_vec();
         nodes.resize(80, 0);
-        return Accel { kind: BvhKind::Bvh2, nodes, node_count: 1, order: vec![], build_time: start.elapsed(), median_fallback: false };
+        return Accel { kind: BvhKind::Bvh2, nodes, node_count: 1, order: vec![], build_time: start.elapsed(), median_fallback: false, depth: 1 };
     }
     // obvhs's PLOC merges mutual nearest neighbours. Triangles that share one centroid (stacked
     // or nested copies) are all equally near each other: they merge one pair per pass (quadratic
@@ -118,12 +158,12 @@ pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
         (true, _) => None,
         (false, true) => {
             log::info!("{} neighbour pairs of {} triangles share one merge cost: PLOC's boxes are jittered", survey.tied, tris.len());
-            sah_build(&tris.iter().enumerate().map(|(i, t)| TieBroken::new(t.aabb(), i)).collect::<Vec<_>>(), kind)
+            sah_build(&tris.iter().enumerate().map(|(i, t)| TieBroken::new(t.aabb(), i)).collect::<Vec<_>>(), kind, max_depth)
         }
-        (false, false) => sah_build(tris, kind),
+        (false, false) => sah_build(tris, kind, max_depth),
     };
     let median_fallback = sah.is_none();
-    let (nodes, node_count, order) = sah.unwrap_or_else(|| {
+    let (nodes, node_count, order, depth) = sah.unwrap_or_else(|| {
         log::warn!(
             "the {} BVH over {} triangles is built by median splits, which trace slower: many triangles share one bounding box, and the SAH build would be too deep for the GPU's traversal stack",
             kind.name(),
@@ -131,43 +171,42 @@ pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
         );
         median_build(tris, kind)
     });
-    Accel { kind, nodes, node_count, order, build_time: start.elapsed(), median_fallback }
+    Accel { kind, nodes, node_count, order, build_time: start.elapsed(), median_fallback, depth }
 }
 
-/// Node bytes in the layout's GPU form, node count and triangle order.
-type Built = (Vec<u8>, usize, Vec<u32>);
+/// Node bytes in the layout's GPU form, node count, triangle order and depth.
+type Built = (Vec<u8>, usize, Vec<u32>, usize);
 
 /// obvhs's PLOC build with its reinsertion optimisation (and, for the binary layout, leaf
 /// collapsing), as its `build_*_from_tris` helpers do it but without their debug-build
 /// validation, which panics on a tree deeper than obvhs's own stack. None where the tree is
 /// deeper than the GPU traversal holds: checked before the reinsertion pass, which is slow on
 /// deep trees, and after it.
-fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind) -> Option<Built> {
+fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind, max_depth: usize) -> Option<Built> {
     let p = params();
     let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(prims.len()).build(p.ploc_search_distance, prims, (0..prims.len() as u32).collect(), p.sort_precision, p.search_depth_threshold);
     let reinsert = |bvh: &mut obvhs::bvh2::Bvh2, ratio: f32| obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(bvh, ratio, None);
     match kind {
         BvhKind::Bvh2 => {
-            if bvh2_depth(&bvh.nodes) > 2 * BVH2_MAX_DEPTH {
+            if bvh2_depth(&bvh.nodes) > 2 * max_depth {
                 return None;
             }
             reinsert(&mut bvh, p.reinsertion_batch_ratio);
             obvhs::bvh2::leaf_collapser::collapse(&mut bvh, p.max_prims_per_leaf, p.collapse_traversal_cost);
             reinsert(&mut bvh, p.reinsertion_batch_ratio * p.post_collapse_reinsertion_batch_ratio_multiplier);
-            if bvh2_depth(&bvh.nodes) > BVH2_MAX_DEPTH {
-                return None;
-            }
             let nodes = pack_bvh2(&bvh.nodes);
-            Some((bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices))
+            let depth = packed_bvh2_depth(&nodes);
+            (depth <= max_depth).then(|| (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices, depth))
         }
         BvhKind::Cwbvh => {
             // A CWBVH node spans up to three binary levels.
-            if bvh2_depth(&bvh.nodes) > 3 * CWBVH_MAX_DEPTH {
+            if bvh2_depth(&bvh.nodes) > 3 * max_depth {
                 return None;
             }
             reinsert(&mut bvh, p.reinsertion_batch_ratio);
             let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&bvh, p.max_prims_per_leaf.clamp(1, 3), true, false);
-            (cwbvh_depth(&cw.nodes) <= CWBVH_MAX_DEPTH).then(|| (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices))
+            let depth = cwbvh_depth(&cw.nodes);
+            (depth <= max_depth).then(|| (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices, depth))
         }
     }
 }
@@ -178,12 +217,12 @@ fn median_build(tris: &[Triangle], kind: BvhKind) -> Built {
         BvhKind::Bvh2 => {
             let bvh = median_bvh2(tris, p.max_prims_per_leaf as usize);
             let nodes = pack_bvh2(&bvh.nodes);
-            (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices)
+            (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices, packed_bvh2_depth(&nodes))
         }
         BvhKind::Cwbvh => {
             // obvhs's CWBVH leaves hold at most 3 triangles.
             let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&median_bvh2(tris, 1), p.max_prims_per_leaf.clamp(1, 3), true, false);
-            (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices)
+            (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices, cwbvh_depth(&cw.nodes))
         }
     }
 }
@@ -266,6 +305,22 @@ fn bvh2_depth(nodes: &[obvhs::bvh2::node::Bvh2Node]) -> usize {
         if n.prim_count == 0 {
             stack.push((n.first_index as usize, d + 1));
             stack.push((n.first_index as usize + 1, d + 1));
+        }
+    }
+    deepest
+}
+
+/// Depth of a packed binary BVH ([`Bvh2GpuNode`]) in nodes (the root alone is 1).
+fn packed_bvh2_depth(nodes: &[Bvh2GpuNode]) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1usize)];
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        let n = &nodes[i];
+        for (index, count) in [(n.l_index, n.l_count), (n.r_index, n.r_count)] {
+            if count == 0 {
+                stack.push((index as usize, d + 1));
+            }
         }
     }
     deepest
@@ -400,5 +455,32 @@ mod tests {
         }
         let median = median_bvh2(&stacked, 1);
         assert_eq!(bvh2_depth(&median.nodes), 14, "ceil(log2(5000)) + 1");
+    }
+
+    /// The stack a scene's programs get holds its tree, and an animated scene's stack holds any
+    /// tree a rebuild within it can return (the median tree where the SAH tree is too deep).
+    #[test]
+    fn traversal_stacks_hold_the_trees_built_within_them() {
+        let t = Triangle { v0: glam::Vec3A::new(-1.0, 0.0, -1.0), v1: glam::Vec3A::new(1.0, 0.0, 1.0), v2: glam::Vec3A::new(1.0, 0.0, -1.0) };
+        // A row of triangles shrinking geometrically: PLOC chains them into a deep tree.
+        let chain: Vec<Triangle> = (0..3000).map(|i| {
+            let k = 0.99f32.powi(i);
+            let o = glam::Vec3A::new(k * 100.0, 0.0, 0.0);
+            Triangle { v0: t.v0 * k + o, v1: t.v1 * k + o, v2: t.v2 * k + o }
+        }).collect();
+        for kind in [BvhKind::Bvh2, BvhKind::Cwbvh] {
+            let a = build(&chain, kind);
+            let stack = traversal_stack(kind, a.depth, chain.len(), false) as usize;
+            assert!(stack >= a.depth && stack % 4 == 0 && stack < a.depth + 4, "{kind:?}: depth {} stack {stack}", a.depth);
+            let animated = traversal_stack(kind, a.depth, chain.len(), true) as usize;
+            assert!(animated >= median_depth_bound(chain.len()) && animated >= a.depth + 4, "{kind:?}");
+            // A limit below the SAH tree's depth gets the median tree, which fits the animated
+            // scene's stack.
+            let limited = build_within(&chain, kind, a.depth - 1);
+            assert!(limited.median_fallback && limited.depth <= animated, "{kind:?}: depth {} limit {}", limited.depth, a.depth - 1);
+            assert!(limited.depth <= median_depth_bound(chain.len()), "{kind:?}: median depth {}", limited.depth);
+        }
+        assert_eq!(median_depth_bound(5000), 14);
+        assert_eq!(median_depth_bound(1), 1);
     }
 }

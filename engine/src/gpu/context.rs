@@ -25,6 +25,8 @@ pub struct GpuRequirements {
     pub max_sampled_textures_per_shader_stage: u32,
     /// Render-target bytes per sample of the widest render pass (WebGPU's accounting).
     pub max_color_attachment_bytes_per_sample: u32,
+    /// Rows of the tallest texel texture (the BVH nodes or the triangles, [`super::scene::Texels`]).
+    pub max_texture_dimension_2d: u32,
     /// Ask for everything the adapter offers (the viewer, which may load larger scenes later).
     pub adapter_limits: bool,
 }
@@ -41,6 +43,7 @@ impl Default for GpuRequirements {
             max_storage_textures_per_shader_stage: d.max_storage_textures_per_shader_stage,
             max_color_attachment_bytes_per_sample: d.max_color_attachment_bytes_per_sample,
             max_sampled_textures_per_shader_stage: d.max_sampled_textures_per_shader_stage,
+            max_texture_dimension_2d: d.max_texture_dimension_2d,
             adapter_limits: false,
         }
     }
@@ -95,6 +98,16 @@ impl Gpu {
         limits.max_storage_textures_per_shader_stage = limits.max_storage_textures_per_shader_stage.max(req.max_storage_textures_per_shader_stage);
         limits.max_color_attachment_bytes_per_sample = limits.max_color_attachment_bytes_per_sample.max(req.max_color_attachment_bytes_per_sample);
         limits.max_sampled_textures_per_shader_stage = limits.max_sampled_textures_per_shader_stage.max(req.max_sampled_textures_per_shader_stage);
+        limits.max_texture_dimension_2d = limits.max_texture_dimension_2d.max(req.max_texture_dimension_2d);
+        if limits.max_texture_dimension_2d > have.max_texture_dimension_2d {
+            return Err(anyhow!(
+                "adapter {:?} allows textures of {} rows; the scene's BVH and triangles need {} rows of {} texels",
+                info.name,
+                have.max_texture_dimension_2d,
+                req.max_texture_dimension_2d,
+                super::scene::TEXEL_ROW
+            ));
+        }
         if limits.max_sampled_textures_per_shader_stage > have.max_sampled_textures_per_shader_stage {
             return Err(anyhow!(
                 "adapter {:?} allows {} sampled textures per stage; the real-time frame's debug views need {}",

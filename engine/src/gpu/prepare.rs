@@ -88,6 +88,10 @@ pub const MAT_ALPHA_MASK: u32 = 2;
 pub struct PreparedScene {
     pub features: SceneFeatures,
     pub accel: Accel,
+    /// Entries of the traversal stack this scene's programs are built with
+    /// ([`accel::traversal_stack`]); fixed at load, and every rebuild of an animated scene's
+    /// tree stays within it.
+    pub traversal_stack: u32,
     /// World position the GPU scene is relative to.
     pub origin: DVec3,
     /// Length of the bounds' diagonal (scene units).
@@ -244,6 +248,7 @@ impl PreparedScene {
                 animated: scene.is_animated(),
             },
             accel: Accel::empty(kind),
+            traversal_stack: kind.max_depth() as u32,
             origin,
             extent,
             tris: vec![],
@@ -266,6 +271,7 @@ impl PreparedScene {
             time: 0.0,
         };
         p.assemble();
+        p.traversal_stack = accel::traversal_stack(kind, p.accel.depth, count, p.features.animated);
         p.features.emitters = !p.emitters.is_empty();
         Ok(p)
     }
@@ -309,7 +315,12 @@ impl PreparedScene {
             tans.extend(f.tans.iter());
             mats.extend_from_slice(&f.mats);
         }
-        let accel = accel::build(&tris_in, kind);
+        let accel = accel::build_within(&tris_in, kind, self.traversal_stack as usize);
+        if accel.depth > self.traversal_stack as usize {
+            // Not reachable: the stack of an animated scene holds any median tree over its
+            // triangles ([`accel::traversal_stack`]).
+            log::error!("the rebuilt BVH is {} levels deep; the traversal holds {}: geometry will be missing", accel.depth, self.traversal_stack);
+        }
         self.tris.clear();
         self.shading.clear();
         self.tangents.clear();

@@ -34,7 +34,7 @@ impl Raycaster {
         // The per-cast buffers are made by each cast: offer the scene's and their names.
         let mut offered: Vec<&str> = scene.bindings().names().collect();
         offered.extend(CAST_BUFFERS);
-        Ok(Raycaster { compute: FixedCompute::new(gpu, LABEL, "", &modules, &offered)? })
+        Ok(Raycaster { compute: FixedCompute::new(gpu, LABEL, &scene.traversal_prelude(), &modules, &offered)? })
     }
 
     /// Trace `rays` (origin, direction, tmax) in scene-relative coordinates. Returns the hits

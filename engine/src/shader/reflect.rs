@@ -149,7 +149,7 @@ impl FixedCompute {
         let layouts = bindings.layouts(&gpu.device, label, wgpu::ShaderStages::COMPUTE);
         let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
         let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &refs, immediate_size: 0 });
-        let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(program.text.as_str().into()) });
+        let module = crate::shader::create_module(&gpu.device, label, &program.text);
         let pipeline = crate::gpu::scene::compute_pipeline(&gpu.device, label, &module, &pl, "main");
         Ok(FixedCompute { pipeline, label: label.to_string(), bindings, layouts })
     }

@@ -102,7 +102,7 @@ fn make<P>(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], visi
         let layouts = bindings.layouts(&gpu.device, label, visibility);
         let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
         let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &refs, immediate_size: 0 });
-        let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(program.text.as_str().into()) });
+        let module = crate::shader::create_module(&gpu.device, label, &program.text);
         let pipeline = build(&gpu.device, &module, &pl);
         Ok(Built { pipeline, bindings, layouts })
     })
