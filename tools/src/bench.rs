@@ -9,7 +9,8 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// A .gltf/.glb file, `default` or `level`.
+    /// A .gltf/.glb file or a built-in scene: `default`, `level`, `reflections`, `spheres`, or
+    /// `terrain:N` (a generated height field of about N triangles).
     pub scene: String,
     /// `reference` (BVH build, rays/s, tracer samples/s) or `realtime` (GPU time per pass of the
     /// real-time frame).
@@ -40,6 +41,11 @@ pub struct BenchArgs {
     pub rays: u32,
     #[arg(long)]
     pub json: bool,
+    /// Reference mode: also render the scene with Mitsuba 3 (scalar_rgb, path) at the same size
+    /// and spp in this run and report its samples/s (needs python3 with `mitsuba` and `numpy`;
+    /// the scene must follow the oracle scenes' conventions).
+    #[arg(long)]
+    pub mitsuba: bool,
     /// Real-time mode: write a puffin capture of the measured frames (CPU scopes and the GPU
     /// passes) to this `.puffin` file (open it with puffin_viewer).
     #[arg(long)]
@@ -74,6 +80,47 @@ struct BenchResult {
     layouts: Vec<LayoutResult>,
     /// From the oracle's render_info.json beside the scene, when there is one.
     mitsuba_samples_per_second: Option<f64>,
+    /// Mitsuba 3 timed in this run (`--mitsuba`), same size and spp.
+    mitsuba_measured: Option<MitsubaRun>,
+}
+
+#[derive(Serialize, serde::Deserialize)]
+struct MitsubaRun {
+    /// Render time (scene loading excluded, as Hush's excludes its BVH build).
+    seconds: f64,
+    samples_per_second: f64,
+    mean_rgb: Vec<f64>,
+}
+
+/// The script `--mitsuba` runs (tools/scripts/mitsuba_time.py), carried in the binary.
+const MITSUBA_SCRIPT: &str = include_str!("../scripts/mitsuba_time.py");
+
+/// Render `scene` with Mitsuba in a child python3 and read its timing.
+fn time_mitsuba(scene: &str, width: u32, height: u32, spp: u32) -> Result<MitsubaRun> {
+    let dir = std::env::temp_dir().join(format!("hush-mitsuba-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let script = dir.join("mitsuba_time.py");
+    std::fs::write(&script, MITSUBA_SCRIPT).with_context(|| format!("writing {}", script.display()))?;
+    let out = std::process::Command::new("python3")
+        .arg(&script)
+        .arg(scene)
+        .args(["--width", &width.to_string(), "--height", &height.to_string(), "--spp", &spp.to_string()])
+        .output()
+        .context("running python3 for --mitsuba");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = out?;
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().last().unwrap_or("");
+    if let Ok(v) = serde_json::from_str::<serde_json::Value>(line) {
+        if let Some(e) = v.get("error") {
+            anyhow::bail!("--mitsuba: {scene}: {}", e.as_str().unwrap_or_default());
+        }
+        if out.status.success() {
+            return serde_json::from_value(v).context("--mitsuba: reading the script's result");
+        }
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    anyhow::bail!("--mitsuba: python3 failed ({}): {}", out.status, err.lines().last().unwrap_or("no output"))
 }
 
 /// Mitsuba's samples per second from `render_info.json` next to an oracle scene.
@@ -161,6 +208,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         spp: a.spp,
         layouts,
         mitsuba_samples_per_second: mitsuba_rate(&a.scene),
+        mitsuba_measured: if a.mitsuba { Some(time_mitsuba(&a.scene, a.width, a.height, a.spp)?) } else { None },
     };
     if a.json {
         println!("{}", serde_json::to_string_pretty(&res)?);
@@ -173,7 +221,11 @@ pub fn run(a: BenchArgs) -> Result<()> {
             );
         }
         if let Some(m) = res.mitsuba_samples_per_second {
-            println!("  Mitsuba 3 (scalar_rgb, CPU): {:.3} M samples/s", m / 1e6);
+            println!("  Mitsuba 3 (scalar_rgb, CPU): {:.3} M samples/s (render_info.json)", m / 1e6);
+        }
+        if let Some(m) = &res.mitsuba_measured {
+            let ours = res.layouts.iter().map(|l| l.samples_per_second).fold(0.0, f64::max);
+            println!("  Mitsuba 3 (scalar_rgb, CPU) in this run: {:.3} M samples/s ({:.2} s); Hush / Mitsuba {:.2}", m.samples_per_second / 1e6, m.seconds, ours / m.samples_per_second);
         }
     }
     Ok(())

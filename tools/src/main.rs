@@ -47,13 +47,17 @@ struct LevelArgs {
     /// Output .gltf (side files are written beside it).
     #[arg(long, default_value = "assets/level/level.gltf")]
     out: std::path::PathBuf,
+    /// The built-in scene to write instead of the level (`default`, `reflections`, `spheres`,
+    /// `terrain:N`), e.g. to load the same geometry into another renderer or an older build.
+    #[arg(long, default_value = "level")]
+    scene: String,
 }
 
 fn level(a: LevelArgs) -> Result<()> {
     if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
     }
-    let scene = hush_engine::scene::default_level();
+    let scene = hush_engine::scene::builtin_scene(&a.scene).ok_or_else(|| anyhow::anyhow!("--scene {:?}: no such built-in scene (one of {:?}, or terrain:N with N from 2 to {})", a.scene, hush_engine::scene::BUILTIN_SCENES, hush_engine::scene::MAX_TERRAIN_TRIANGLES))?;
     hush_engine::scene::save_gltf(&scene, &a.out)?;
     eprintln!("wrote {} ({} triangles, {} objects)", a.out.display(), scene.triangle_count(), scene.objects.len());
     Ok(())

@@ -15,11 +15,13 @@ mod gltf_mesh;
 mod level;
 mod reflections;
 mod sky;
+mod terrain;
 mod texture;
 
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::{cuboid, default_scene, quad};
+pub use terrain::{MAX_TERRAIN_TRIANGLES, terrain};
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
 pub use environment::{EnvMap, Environment};
@@ -206,7 +208,7 @@ pub struct Scene {
 pub const DEFAULT_MAX_DEPTH: i32 = 6;
 
 impl Scene {
-    /// Load a `.gltf`/`.glb` file or a built-in scene by name ([`BUILTIN_SCENES`]).
+    /// Load a `.gltf`/`.glb` file or a built-in scene by name ([`BUILTIN_SCENES`], or `terrain:N`).
     pub fn load(path_or_default: &str) -> Result<Scene> {
         Scene::load_with(path_or_default, &LoadOptions::default())
     }

@@ -17,7 +17,7 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "level" => Some(super::default_level()),
         "reflections" => Some(reflection_scene(true)),
         "spheres" => Some(reflection_scene(false)),
-        _ => None,
+        _ => super::terrain::parse_terrain(name),
     }
 }
 
