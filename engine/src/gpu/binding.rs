@@ -41,6 +41,14 @@ impl<'a> Bindings<'a> {
         }
     }
 
+    /// `texture` where `view` exists (a feature of the scene).
+    pub fn texture_opt(self, name: &'a str, view: Option<&'a wgpu::TextureView>) -> Self {
+        match view {
+            Some(v) => self.texture(name, v),
+            None => self,
+        }
+    }
+
     /// Everything `other` offers, over what this offers.
     pub fn with(mut self, other: &Bindings<'a>) -> Self {
         for (n, r) in &other.entries {

@@ -20,7 +20,8 @@ pub struct GpuScene {
     pub lights: Option<wgpu::Buffer>,
     pub emitters: Option<wgpu::Buffer>,
     pub env: Option<wgpu::Buffer>,
-    pub textures: Option<wgpu::Buffer>,
+    /// The scene's textures as words in texel rows (`tex_words` in shaders/common/textures.wgsl).
+    pub textures: Option<Texels>,
     pub tangents: Option<wgpu::Buffer>,
     /// Per object: rebased previous-from-current transform (animated scenes only).
     pub objects: Option<wgpu::Buffer>,
@@ -42,14 +43,12 @@ impl PreparedScene {
             (self.shading.len() * 16) as u64,
             (self.tangents.len() * 16) as u64,
             (self.env_data.len() * 4) as u64,
-            (self.tex_data.len() * 4) as u64,
             output_bytes,
         ];
         let count = 4
             + f.punctual_lights as u32
             + f.emitters as u32
             + (f.env == EnvKind::Map) as u32
-            + f.textures as u32
             + f.normal_maps as u32;
         let d = GpuRequirements::default();
         GpuRequirements {
@@ -57,7 +56,7 @@ impl PreparedScene {
             max_storage_buffers_per_shader_stage: count.max(d.max_storage_buffers_per_shader_stage),
             output_bytes,
             output_pixels,
-            max_texture_dimension_2d: texel_row_count(self.accel.nodes.len()).max(texel_row_count(self.tris.len() * 16)).max(d.max_texture_dimension_2d),
+            max_texture_dimension_2d: [self.accel.nodes.len(), self.tris.len() * 16, self.tex_data.len() * 4].into_iter().map(texel_row_count).max().unwrap_or(1).max(d.max_texture_dimension_2d),
             ..d
         }
     }
@@ -81,7 +80,7 @@ impl PreparedScene {
         let lights = f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), copy));
         let emitters = f.emitters.then(|| mem.buffer_init(d, "scene/emitters", b(&self.emitters), s));
         let env = (f.env == EnvKind::Map).then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), copy));
-        let textures = f.textures.then(|| mem.buffer_init(d, "scene/textures", b(&self.tex_data), s));
+        let textures = f.textures.then(|| Texels::new(gpu, &mut mem, "scene/textures", b(&self.tex_data), wgpu::TextureFormat::Rgba32Uint));
         let tangents = f.normal_maps.then(|| mem.buffer_init(d, "scene/tangents", b(&self.tangents), s));
         let objects = f.animated.then(|| mem.buffer_init(d, "scene/object motion", b(&self.prev_from_current), copy));
         log::info!(
@@ -184,7 +183,7 @@ impl GpuScene {
             .buffer_opt("lights", self.lights.as_ref())
             .buffer_opt("emitters", self.emitters.as_ref())
             .buffer_opt("env_data", self.env.as_ref())
-            .buffer_opt("tex_data", self.textures.as_ref())
+            .texture_opt("tex_words", self.textures.as_ref().map(|t| &t.view))
             .buffer_opt("tangents", self.tangents.as_ref())
             .buffer_opt("prev_from_current", self.objects.as_ref())
     }
