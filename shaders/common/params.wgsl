@@ -24,6 +24,8 @@ struct Params {
     emit: vec4f,
     // Thin lens: x aperture radius (0: a pinhole), y focus distance.
     lens: vec4f,
+    // x: samples per pixel this dispatch traces (the reference tracer), from sample_index on.
+    batch: vec4u,
 }
 
 var<uniform> params: Params;

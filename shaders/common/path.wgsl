@@ -61,120 +61,154 @@ struct PathResult {
     first_normal: vec3f,
 }
 
-fn trace_path(start: PathStart, rng: ptr<function, u32>) -> PathResult {
-    let eps = params.cam_pos.w;
-    let select_p = 1.0 / f32(max(light_groups(), 1u));
-    var ro = start.ro;
-    var rd = start.rd;
-    var radiance = vec3f(0.0);
-    var beta = start.beta;
-    // Segments so far, counting the one about to be traced.
-    var segments = start.segments;
-    var prev_pdf = start.prev_pdf;
-    var prev_delta = start.prev_delta;
-    var first_t = -1.0;
-    var first_reflectance = vec3f(1.0);
-    var first_normal = -start.rd;
-    var prev_select = start.nee_select;
-    loop {
-        if !depth_ok(segments) {
-            break;
-        }
-        let hit = traverse(ro, rd, INF, false);
-        if first_t < 0.0 {
-            first_t = hit.t;
-        }
-        if hit.tri == NO_HIT {
-            if HAS_ENV {
-                let le = env_radiance(rd);
-                var w = 1.0;
-                if !prev_delta {
-                    w = power_heuristic(prev_pdf, prev_select * env_pdf(rd));
-                }
-                radiance += beta * le * w;
-            }
-            break;
-        }
-        let s = surface_at(hit, rd);
-        let m = materials[s.material];
-        // The back of a single-sided surface is a black absorber, as in Mitsuba.
-        if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
-            break;
-        }
-        let ms = material_at(m, s.uv);
-        let emission = ms.emission;
-        if segments == start.segments {
-            let b = material_bsdf(m, ms);
-            first_reflectance = min(b.albedo + b.f0, vec3f(1.0));
-            first_normal = s.ns;
-        }
-        if s.front && max3(emission) > 0.0 {
-            var w = 1.0;
-            if !prev_delta {
-                let cos_l = abs(dot(s.ng, rd));
-                let d2 = dot(s.p - ro, s.p - ro);
-                let light_pdf = prev_select * emitter_pdf_area(m.emission) * d2 / max(cos_l, 1e-12);
-                w = power_heuristic(prev_pdf, light_pdf);
-            }
-            radiance += beta * emission * w;
-        }
-        if !depth_ok(segments + 1) {
-            break;
-        }
-        let bsdf = material_bsdf(m, ms);
-        let frame = onb(s.ns);
-        let wo = to_local(frame, -rd);
-        let origin = offset_ray(s.p, s.ng, eps);
-
-        // Next-event estimation (skipped when the glossy lobe is a pure mirror and there is no
-        // matte lobe: no light sample can land in a delta lobe).
-        let matte_present = max3(bsdf.albedo) > 0.0;
-        if light_groups() > 0u && (matte_present || !bsdf.delta) {
-            let ls = sample_light(s.p, rng);
-            let wi_l = to_local(frame, ls.wi);
-            if max3(ls.li) > 0.0 && wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
-                let e = bsdf_eval(bsdf, wo, wi_l);
-                if max3(e.f_cos) > 0.0 {
-                    let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-                    let blocked = traverse(origin, ls.wi, tmax, true).tri != NO_HIT;
-                    if !blocked {
-                        var w = 1.0;
-                        if ls.pdf > 0.0 {
-                            w = power_heuristic(ls.pdf, e.pdf);
-                        }
-                        radiance += beta * e.f_cos * ls.li * w;
-                    }
-                }
-            }
-        }
-
-        // Continue the path by sampling the BSDF.
-        let u_lobe = rand(rng);
-        let bs = bsdf_sample(bsdf, wo, u_lobe, rand2(rng));
-        if max3(bs.weight) <= 0.0 {
-            break;
-        }
-        let wi = frame * bs.wi;
-        // A direction below the geometric surface would start inside the object.
-        if dot(wi, s.ng) <= 0.0 {
-            break;
-        }
-        beta *= bs.weight;
-        prev_pdf = bs.pdf;
-        prev_delta = bs.delta;
-        prev_select = select_p;
-        ro = origin;
-        rd = normalize(wi);
-        segments += 1;
-        // Russian roulette from the fifth segment on, as Mitsuba (unbiased).
-        if segments > params.rr_depth {
-            let q = min(max3(beta), 0.95);
-            if rand(rng) >= q {
-                break;
-            }
-            beta /= q;
-        }
-    }
-    return PathResult(radiance, select(first_t, INF, first_t < 0.0), first_reflectance, first_normal);
+// A path in flight: where it continues from and what it has gathered. `path_step` traces one
+// segment, so that a loop may advance a path and, when it ends, start another one in the same
+// iterations (the reference tracer's samples, the real-time trace's matte then glossy path):
+// on SIMD lanes a loop of whole paths waits for the longest path of every round.
+struct PathState {
+    ro: vec3f,
+    rd: vec3f,
+    beta: vec3f,
+    // Segments so far, counting the one about to be traced; the count the path started at.
+    segments: i32,
+    start_segments: i32,
+    prev_pdf: f32,
+    prev_delta: bool,
+    prev_select: f32,
+    radiance: vec3f,
+    first_t: f32,
+    first_reflectance: vec3f,
+    first_normal: vec3f,
+    done: bool,
 }
 
+fn path_begin(start: PathStart) -> PathState {
+    return PathState(start.ro, start.rd, start.beta, start.segments, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false);
+}
+
+fn path_result(st: PathState) -> PathResult {
+    return PathResult(st.radiance, select(st.first_t, INF, st.first_t < 0.0), st.first_reflectance, st.first_normal);
+}
+
+fn trace_path(start: PathStart, rng: ptr<function, u32>) -> PathResult {
+    var st = path_begin(start);
+    loop {
+        if st.done {
+            break;
+        }
+        path_step(&st, rng);
+    }
+    return path_result(st);
+}
+
+// One segment of the path: trace it, add what it finds, and choose the next (or end the path).
+fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
+    let eps = params.cam_pos.w;
+    let select_p = 1.0 / f32(max(light_groups(), 1u));
+    let segments = (*st).segments;
+    let ro = (*st).ro;
+    let rd = (*st).rd;
+    let beta = (*st).beta;
+    let prev_delta = (*st).prev_delta;
+    let prev_pdf = (*st).prev_pdf;
+    let prev_select = (*st).prev_select;
+    (*st).done = true;
+    if !depth_ok(segments) {
+        return;
+    }
+    let hit = traverse(ro, rd, INF, false);
+    if (*st).first_t < 0.0 {
+        (*st).first_t = hit.t;
+    }
+    if hit.tri == NO_HIT {
+        if HAS_ENV {
+            let le = env_radiance(rd);
+            var w = 1.0;
+            if !prev_delta {
+                w = power_heuristic(prev_pdf, prev_select * env_pdf(rd));
+            }
+            (*st).radiance += beta * le * w;
+        }
+        return;
+    }
+    let s = surface_at(hit, rd);
+    let m = materials[s.material];
+    // The back of a single-sided surface is a black absorber, as in Mitsuba.
+    if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
+        return;
+    }
+    let ms = material_at(m, s.uv);
+    let emission = ms.emission;
+    let bsdf = material_bsdf(m, ms);
+    if segments == (*st).start_segments {
+        (*st).first_reflectance = min(bsdf.albedo + bsdf.f0, vec3f(1.0));
+        (*st).first_normal = s.ns;
+    }
+    if s.front && max3(emission) > 0.0 {
+        var w = 1.0;
+        if !prev_delta {
+            let cos_l = abs(dot(s.ng, rd));
+            let d2 = dot(s.p - ro, s.p - ro);
+            let light_pdf = prev_select * emitter_pdf_area(m.emission) * d2 / max(cos_l, 1e-12);
+            w = power_heuristic(prev_pdf, light_pdf);
+        }
+        (*st).radiance += beta * emission * w;
+    }
+    if !depth_ok(segments + 1) {
+        return;
+    }
+    let frame = onb(s.ns);
+    let wo = to_local(frame, -rd);
+    let origin = offset_ray(s.p, s.ng, eps);
+
+    // Next-event estimation (skipped when the glossy lobe is a pure mirror and there is no
+    // matte lobe: no light sample can land in a delta lobe).
+    let matte_present = max3(bsdf.albedo) > 0.0;
+    if light_groups() > 0u && (matte_present || !bsdf.delta) {
+        let ls = sample_light(s.p, rng);
+        let wi_l = to_local(frame, ls.wi);
+        if max3(ls.li) > 0.0 && wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
+            let e = bsdf_eval(bsdf, wo, wi_l);
+            if max3(e.f_cos) > 0.0 {
+                let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+                let blocked = traverse(origin, ls.wi, tmax, true).tri != NO_HIT;
+                if !blocked {
+                    var w = 1.0;
+                    if ls.pdf > 0.0 {
+                        w = power_heuristic(ls.pdf, e.pdf);
+                    }
+                    (*st).radiance += beta * e.f_cos * ls.li * w;
+                }
+            }
+        }
+    }
+
+    // Continue the path by sampling the BSDF.
+    let u_lobe = rand(rng);
+    let bs = bsdf_sample(bsdf, wo, u_lobe, rand2(rng));
+    if max3(bs.weight) <= 0.0 {
+        return;
+    }
+    let wi = frame * bs.wi;
+    // A direction below the geometric surface would start inside the object.
+    if dot(wi, s.ng) <= 0.0 {
+        return;
+    }
+    var next_beta = beta * bs.weight;
+    // Russian roulette from the fifth segment on, as Mitsuba (unbiased).
+    if segments + 1 > params.rr_depth {
+        let q = min(max3(next_beta), 0.95);
+        if rand(rng) >= q {
+            return;
+        }
+        next_beta /= q;
+    }
+    (*st).beta = next_beta;
+    (*st).prev_pdf = bs.pdf;
+    (*st).prev_delta = bs.delta;
+    (*st).prev_select = select_p;
+    (*st).ro = origin;
+    (*st).rd = normalize(wi);
+    (*st).segments = segments + 1;
+    (*st).done = false;
+}

@@ -4,18 +4,13 @@
 // Per pixel two vec4: (sum of rgb, 0) and (sum of rgb^2, count of discarded non-finite samples).
 var<storage, read_write> accum: array<vec4f>;
 
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if gid.x >= params.width || gid.y >= params.height {
-        return;
-    }
-    let pixel = gid.y * params.width + gid.x;
-    var rng = rng_init(pixel, params.sample_index, params.seed);
-    // A uniform position in the pixel's square (Mitsuba's box filter).
-    let j = rand2(&rng);
+// Camera ray of one sample: a uniform position in the pixel's square (Mitsuba's box filter),
+// through the thin lens where there is one.
+fn camera_start(px: vec2u, rng: ptr<function, u32>) -> PathStart {
+    let j = rand2(rng);
     let ndc = vec2f(
-        (f32(gid.x) + j.x) / f32(params.width) * 2.0 - 1.0,
-        1.0 - (f32(gid.y) + j.y) / f32(params.height) * 2.0,
+        (f32(px.x) + j.x) / f32(params.width) * 2.0 - 1.0,
+        1.0 - (f32(px.y) + j.y) / f32(params.height) * 2.0,
     );
     let d = params.cam_fwd.xyz + ndc.x * params.cam_right.xyz + ndc.y * params.cam_up.xyz;
     var ro = params.cam_pos.xyz;
@@ -23,21 +18,50 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if params.lens.x > 0.0 {
         // Thin lens (Mitsuba's thinlens): a uniform point on the aperture disk, aimed at where
         // the pinhole ray meets the focus plane (d has unit length along fwd).
-        let u = rand2(&rng);
+        let u = rand2(rng);
         let r = params.lens.x * sqrt(u.x);
         let a = 6.283185307 * u.y;
         ro += r * (cos(a) * normalize(params.cam_right.xyz) + sin(a) * normalize(params.cam_up.xyz));
         rd = normalize(params.cam_pos.xyz + d * params.lens.y - ro);
     }
-    var l = trace_path(camera_path(ro, rd), &rng).radiance;
+    return camera_path(ro, rd);
+}
+
+// params.batch.x samples of the pixel, each with its own random sequence (sample_index + k), as
+// one loop of path segments: a path that ends makes way for the pixel's next sample.
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    if gid.x >= params.width || gid.y >= params.height {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    var k = 0u;
+    var rng = rng_init(pixel, params.sample_index, params.seed);
+    var st = path_begin(camera_start(gid.xy, &rng));
+    var sum = vec3f(0.0);
+    var sum2 = vec3f(0.0);
     var bad = 0.0;
-    // NaN and Inf never reach the image: the sample is dropped and counted.
-    if !is_finite3(l) {
-        l = vec3f(0.0);
-        bad = 1.0;
+    loop {
+        if st.done {
+            var l = path_result(st).radiance;
+            // NaN and Inf never reach the image: the sample is dropped and counted.
+            if !is_finite3(l) {
+                l = vec3f(0.0);
+                bad += 1.0;
+            }
+            sum += l;
+            sum2 += l * l;
+            k += 1u;
+            if k >= params.batch.x {
+                break;
+            }
+            rng = rng_init(pixel, params.sample_index + k, params.seed);
+            st = path_begin(camera_start(gid.xy, &rng));
+        }
+        path_step(&st, &rng);
     }
     let a = accum[pixel * 2u];
     let b = accum[pixel * 2u + 1u];
-    accum[pixel * 2u] = vec4f(a.rgb + l, 0.0);
-    accum[pixel * 2u + 1u] = vec4f(b.rgb + l * l, b.w + bad);
+    accum[pixel * 2u] = vec4f(a.rgb + sum, 0.0);
+    accum[pixel * 2u + 1u] = vec4f(b.rgb + sum2, b.w + bad);
 }

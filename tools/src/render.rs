@@ -277,7 +277,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let start = std::time::Instant::now();
     let mut done = 0;
     while done < spp {
-        let n = (spp - done).min(4);
+        let n = (spp - done).min(hush_engine::passes::reference::BATCH);
         tracer.dispatch(&gpu, n);
         gpu.wait()?;
         done += n;

@@ -31,6 +31,9 @@ pub struct TraceParams {
     pub emit: [f32; 4],
     /// Thin lens: aperture radius and focus distance in scene units (0: a pinhole), unused, unused.
     pub lens: [f32; 4],
+    /// x: samples per pixel this dispatch traces (the reference tracer), from sample_index on;
+    /// y, z, w unused.
+    pub batch: [u32; 4],
 }
 
 /// What to render: the camera, image size and path settings.
@@ -66,6 +69,16 @@ pub struct ReferenceTracer {
     pub samples: u32,
     pub memory: GpuMemory,
 }
+
+/// Samples per pixel one dispatch traces at most, and the paths one dispatch traces at most
+/// (whichever is fewer). Each invocation starts its pixel's next sample as soon as a path ends,
+/// so a SIMD group waits for its longest path once per dispatch instead of once per sample, and
+/// the per-dispatch cost is paid once. Reference tracer on the software driver, M samples/s at
+/// 1, 8 and 32 samples a dispatch: cornell_diffuse 1.13 / 1.23 / 1.35, point_glossy 0.97 /
+/// 1.03 / 1.09. The path cap keeps a dispatch short (about 2 s on the software driver, far less
+/// on a GPU, whose driver may reset a dispatch that runs for seconds).
+pub const BATCH: u32 = 32;
+pub const BATCH_PATHS: u64 = 1 << 21;
 
 /// Largest image side the tracer accepts (one dispatch covers it).
 pub const MAX_SIDE: u32 = 16384;
@@ -111,10 +124,16 @@ impl ReferenceTracer {
         gpu.queue.submit([enc.finish()]);
     }
 
-    /// Record `count` one-sample-per-pixel dispatches; returns after submitting them.
+    /// Record dispatches that add `count` samples per pixel; returns after submitting them. A
+    /// dispatch traces up to [`BATCH`] samples per pixel and [`BATCH_PATHS`] paths.
     pub fn dispatch(&mut self, gpu: &Gpu, count: u32) {
-        for _ in 0..count {
+        let pixels = self.params.width as u64 * self.params.height as u64;
+        let most = (BATCH_PATHS / pixels).clamp(1, BATCH as u64) as u32;
+        let mut left = count;
+        while left > 0 {
+            let batch = left.min(most);
             self.params.sample_index = self.samples;
+            self.params.batch[0] = batch;
             gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
             let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
             {
@@ -124,7 +143,8 @@ impl ReferenceTracer {
                 pass.dispatch_workgroups(self.params.width.div_ceil(8), self.params.height.div_ceil(8), 1);
             }
             gpu.queue.submit([enc.finish()]);
-            self.samples += 1;
+            self.samples += batch;
+            left -= batch;
         }
     }
 
@@ -188,5 +208,6 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
         env_size: p.env_size,
         emit: [if f.emitters { p.emit_inv_total } else { 0.0 }, 0.0, 0.0, 0.0],
         lens: cam.lens.map_or([0.0; 4], |l| [l.aperture_radius, l.focus_distance, 0.0, 0.0]),
+        batch: [1, 0, 0, 0],
     }
 }
