@@ -38,8 +38,27 @@ impl Raycaster {
     }
 
     /// Trace `rays` (origin, direction, tmax) in scene-relative coordinates. Returns the hits
-    /// (None for a miss) and the GPU wall time of the dispatch alone.
+    /// (None for a miss) and the GPU wall time of the dispatches alone. Rays go in batches whose
+    /// buffers (32 bytes a ray) fit the device's storage binding.
     pub fn cast(
+        &self,
+        gpu: &Gpu,
+        scene: &GpuScene,
+        rays: &[(Vec3, Vec3, f32)],
+        any_hit: bool,
+    ) -> Result<(Vec<Option<RayHit>>, std::time::Duration)> {
+        let most = (gpu.device.limits().max_storage_buffer_binding_size as usize / 32).max(1);
+        let mut hits = Vec::with_capacity(rays.len());
+        let mut time = std::time::Duration::ZERO;
+        for chunk in rays.chunks(most) {
+            let (h, t) = self.cast_batch(gpu, scene, chunk, any_hit)?;
+            hits.extend(h);
+            time += t;
+        }
+        Ok((hits, time))
+    }
+
+    fn cast_batch(
         &self,
         gpu: &Gpu,
         scene: &GpuScene,
