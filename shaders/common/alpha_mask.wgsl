@@ -1,6 +1,6 @@
 // Alpha-masked materials cut their triangles out where base colour alpha < cutoff.
 fn alpha_accept(slot: u32, b: vec2f) -> bool {
-    let m = materials[tri_material(slot)];
+    let m = material(tri_material(slot));
     if (m.flags & MAT_ALPHA_MASK) == 0u {
         return true;
     }

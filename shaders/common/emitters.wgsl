@@ -35,7 +35,7 @@ fn sample_emitter(p: vec3f, u: vec3f) -> LightSample {
     let wi = v / dist;
     // One-sided emitters: only the counter-clockwise face emits.
     let cos_l = -dot(n, wi);
-    let m = materials[tri_material(slot)];
+    let m = material(tri_material(slot));
     if cos_l <= 0.0 || d2 <= 0.0 {
         return no_light();
     }

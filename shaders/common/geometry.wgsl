@@ -31,7 +31,7 @@ fn miss() -> Hit {
 }
 
 fn tri_material(slot: u32) -> u32 {
-    return bitcast<u32>(tris[slot * 3u].w);
+    return bitcast<u32>(tri_texel(slot * 3u).w);
 }
 
 // Möller-Trumbore, both faces (sidedness is decided by the shader that shades the hit).

@@ -132,7 +132,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
         return;
     }
     let s = surface_at(hit, rd);
-    let m = materials[s.material];
+    let m = material(s.material);
     // The back of a single-sided surface is a black absorber, as in Mitsuba.
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         return;

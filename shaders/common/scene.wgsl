@@ -1,7 +1,12 @@
 // Shading data and materials (engine/src/gpu/scene.rs mirrors these layouts).
 
-// Four vec4 per triangle: (n0, uv0.x), (n1, uv1.x), (n2, uv2.x), (uv0.y, uv1.y, uv2.y, 0).
-var<storage, read> shading: array<vec4f>;
+// Four vec4 per triangle: (n0, uv0.x), (n1, uv1.x), (n2, uv2.x), (uv0.y, uv1.y, uv2.y, object),
+// read as texels (see tri_texels in geometry.wgsl).
+var shading_texels: texture_2d<f32>;
+
+fn shading_at(i: u32) -> vec4f {
+    return textureLoad(shading_texels, texel_at(i), 0);
+}
 
 struct Material {
     base_color: vec4f,
@@ -20,20 +25,31 @@ struct Material {
 const MAT_DOUBLE_SIDED: u32 = 1u;
 const MAT_ALPHA_MASK: u32 = 2u;
 
-var<storage, read> materials: array<Material>;
+// Five texels per material (engine/src/gpu/prepare.rs, GpuMaterial).
+var material_texels: texture_2d<u32>;
+
+fn material(i: u32) -> Material {
+    let a = textureLoad(material_texels, texel_at(i * 5u), 0);
+    let b = textureLoad(material_texels, texel_at(i * 5u + 1u), 0);
+    let c = textureLoad(material_texels, texel_at(i * 5u + 2u), 0);
+    let d = textureLoad(material_texels, texel_at(i * 5u + 3u), 0);
+    let e = textureLoad(material_texels, texel_at(i * 5u + 4u), 0);
+    return Material(bitcast<vec4f>(a), bitcast<vec3f>(b.xyz), bitcast<f32>(b.w), bitcast<vec3f>(c.xyz), bitcast<f32>(c.w),
+        bitcast<f32>(d.x), bitcast<f32>(d.y), bitcast<f32>(d.z), d.w, bitcast<vec4i>(e));
+}
 
 fn tri_uv(slot: u32, b: vec2f) -> vec2f {
-    let s0 = shading[slot * 4u];
-    let s1 = shading[slot * 4u + 1u];
-    let s2 = shading[slot * 4u + 2u];
-    let s3 = shading[slot * 4u + 3u];
+    let s0 = shading_at(slot * 4u);
+    let s1 = shading_at(slot * 4u + 1u);
+    let s2 = shading_at(slot * 4u + 2u);
+    let s3 = shading_at(slot * 4u + 3u);
     let w = vec3f(1.0 - b.x - b.y, b.x, b.y);
     return vec2f(dot(w, vec3f(s0.w, s1.w, s2.w)), dot(w, s3.xyz));
 }
 
 fn tri_normal(slot: u32, b: vec2f) -> vec3f {
     let w = vec3f(1.0 - b.x - b.y, b.x, b.y);
-    return w.x * shading[slot * 4u].xyz + w.y * shading[slot * 4u + 1u].xyz + w.z * shading[slot * 4u + 2u].xyz;
+    return w.x * shading_at(slot * 4u).xyz + w.y * shading_at(slot * 4u + 1u).xyz + w.z * shading_at(slot * 4u + 2u).xyz;
 }
 
 // What a path needs at a hit.
@@ -50,9 +66,9 @@ struct Surface {
 
 fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     let slot = hit.tri;
-    let v0 = tris[slot * 3u].xyz;
-    let e1 = tris[slot * 3u + 1u].xyz - v0;
-    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    let v0 = tri_texel(slot * 3u).xyz;
+    let e1 = tri_texel(slot * 3u + 1u).xyz - v0;
+    let e2 = tri_texel(slot * 3u + 2u).xyz - v0;
     var s: Surface;
     s.material = tri_material(slot);
     s.p = v0 + hit.b.x * e1 + hit.b.y * e2;
@@ -67,7 +83,7 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     }
     s.uv = tri_uv(slot, hit.b);
     s.ng = ng;
-    s.ns = apply_normal_map(slot, hit.b, ns, s.uv, materials[s.material]);
+    s.ns = apply_normal_map(slot, hit.b, ns, s.uv, material(s.material));
     return s;
 }
 

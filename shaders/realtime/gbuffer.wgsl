@@ -17,7 +17,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     let slot = vi / 3u;
     let corner = vi % 3u;
     let p = tris[slot * 3u + corner].xyz;
-    let object = bitcast<u32>(shading[slot * 4u + 3u].w);
+    let object = bitcast<u32>(shading_at(slot * 4u + 3u).w);
     var o: VsOut;
     o.clip = frame.view_proj * vec4f(p, 1.0);
     o.bary = select(vec2f(0.0), select(vec2f(0.0, 1.0), vec2f(1.0, 0.0), corner == 1u), corner > 0u);
@@ -54,7 +54,7 @@ fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     if !alpha_accept(slot, b) {
         discard;
     }
-    let m = materials[tri_material(slot)];
+    let m = material(tri_material(slot));
     let uv = tri_uv(slot, b);
     let v0 = tris[slot * 3u].xyz;
     var ng = normalize(cross(tris[slot * 3u + 1u].xyz - v0, tris[slot * 3u + 2u].xyz - v0));
@@ -70,7 +70,7 @@ fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     var o: GBufferOut;
     o.normal = oct_encode(ns);
     o.motion = to_pixels(v.prev) - to_pixels(v.cur);
-    o.ids = vec2u(bitcast<u32>(shading[slot * 4u + 3u].w), slot);
+    o.ids = vec2u(bitcast<u32>(shading_at(slot * 4u + 3u).w), slot);
     if !front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         // The tracer's black absorber: no material, no light.
         o.base_color = vec4f(0.0);

@@ -65,7 +65,7 @@ struct Shaded {
 fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
     let eps = params.cam_pos.w;
     let s = surface_at(hit, rd);
-    let m = materials[s.material];
+    let m = material(s.material);
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         return Shaded(vec3f(0.0), vec3f(0.0), vec3f(0.0), INF, vec3f(1.0), -rd, rd, INF, s.ns, true);
     }

@@ -15,8 +15,10 @@ pub struct GpuScene {
     /// same as texel rows for the intersection tests.
     pub tris: wgpu::Buffer,
     pub tri_texels: Texels,
-    pub shading: wgpu::Buffer,
-    pub materials: wgpu::Buffer,
+    /// Per-triangle normals and UVs (four texels a triangle) and the materials (five texels
+    /// each), as texel rows like the nodes.
+    pub shading: Texels,
+    pub materials: Texels,
     pub lights: Option<wgpu::Buffer>,
     pub emitters: Option<wgpu::Buffer>,
     pub env: Option<wgpu::Buffer>,
@@ -40,12 +42,11 @@ impl PreparedScene {
         let f = &self.features;
         let sizes = [
             (self.tris.len() * 16) as u64,
-            (self.shading.len() * 16) as u64,
             (self.tangents.len() * 16) as u64,
             (self.env_data.len() * 4) as u64,
             output_bytes,
         ];
-        let count = 4
+        let count = 2
             + f.punctual_lights as u32
             + f.emitters as u32
             + (f.env == EnvKind::Map) as u32
@@ -56,7 +57,7 @@ impl PreparedScene {
             max_storage_buffers_per_shader_stage: count.max(d.max_storage_buffers_per_shader_stage),
             output_bytes,
             output_pixels,
-            max_texture_dimension_2d: [self.accel.nodes.len(), self.tris.len() * 16, self.tex_data.len() * 4].into_iter().map(texel_row_count).max().unwrap_or(1).max(d.max_texture_dimension_2d),
+            max_texture_dimension_2d: [self.accel.nodes.len(), self.tris.len() * 16, self.tex_data.len() * 4, self.shading.len() * 16, self.materials.len() * 80].into_iter().map(texel_row_count).max().unwrap_or(1).max(d.max_texture_dimension_2d),
             ..d
         }
     }
@@ -73,8 +74,8 @@ impl PreparedScene {
         let nodes = Texels::new(gpu, &mut mem, "scene/bvh nodes", &self.accel.nodes, wgpu::TextureFormat::Rgba32Uint);
         let tris = mem.buffer_init(d, "scene/triangles", b(&self.tris), s);
         let tri_texels = Texels::new(gpu, &mut mem, "scene/triangle texels", b(&self.tris), wgpu::TextureFormat::Rgba32Float);
-        let shading = mem.buffer_init(d, "scene/shading", b(&self.shading), s);
-        let materials = mem.buffer_init(d, "scene/materials", b(&self.materials), s);
+        let shading = Texels::new(gpu, &mut mem, "scene/shading", b(&self.shading), wgpu::TextureFormat::Rgba32Float);
+        let materials = Texels::new(gpu, &mut mem, "scene/materials", b(&self.materials), wgpu::TextureFormat::Rgba32Uint);
         let copy = s | wgpu::BufferUsages::COPY_DST;
         // Lights and environment are rewritten when the user moves the sun.
         let lights = f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), copy));
@@ -136,6 +137,7 @@ impl GpuScene {
         if moved {
             replaced |= self.nodes.write(gpu, mem, &p.accel.nodes);
             replaced |= self.tri_texels.write(gpu, mem, b(&p.tris));
+            replaced |= self.shading.write(gpu, mem, b(&p.shading));
         }
         let mut put = |buf: &mut wgpu::Buffer, label: &str, data: &[u8]| {
             if data.is_empty() {
@@ -155,7 +157,6 @@ impl GpuScene {
         };
         if moved {
             put(&mut self.tris, "scene/triangles", b(&p.tris));
-            put(&mut self.shading, "scene/shading", b(&p.shading));
             if let Some(t) = self.tangents.as_mut() {
                 put(t, "scene/tangents", b(&p.tangents));
             }
@@ -178,8 +179,8 @@ impl GpuScene {
             .texture("bvh_texels", &self.nodes.view)
             .texture("tri_texels", &self.tri_texels.view)
             .buffer("tris", &self.tris)
-            .buffer("shading", &self.shading)
-            .buffer("materials", &self.materials)
+            .texture("shading_texels", &self.shading.view)
+            .texture("material_texels", &self.materials.view)
             .buffer_opt("lights", self.lights.as_ref())
             .buffer_opt("emitters", self.emitters.as_ref())
             .buffer_opt("env_data", self.env.as_ref())
