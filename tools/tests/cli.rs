@@ -64,6 +64,10 @@ fn bad_arguments_are_clear_errors() {
         (vec!["time-to-quality", "level", "--run", "mara@0", "--out-dir", &ttq], "positive"),
         (vec!["time-to-quality", "level", "--run", "mara:1/4", "--width", "8", "--height", "8", "--reference-frames", "1", "--out-dir", &ttq], "sample fractions below 1"),
         (vec!["time-to-quality", "level", "--run", "mara", "--scenarios", "pan", "--out-dir", &ttq], "stop or cut"),
+        (vec!["level", "--scene", "terrain:1", "--out", "x.gltf"], "terrain:N"),
+        (vec!["level", "--scene", "nope", "--out", "x.gltf"], "no such built-in scene"),
+        // A built-in scene has no file for Mitsuba to read (and CI has no Mitsuba either way).
+        (vec!["bench", "default", "--mitsuba", "--width", "8", "--height", "8", "--spp", "1", "--rays", "64", "--bvh", "cwbvh"], "--mitsuba"),
     ] {
         let o = bin("hush-cli").args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
@@ -81,7 +85,21 @@ fn bench_reports_json() {
         assert!(l["rays_per_second"].as_f64().unwrap() > 0.0);
         assert!(l["samples_per_second"].as_f64().unwrap() > 0.0);
         assert!(l["gpu_bytes"].as_u64().unwrap() > 0);
+        assert!(l["bvh_depth"].as_u64().unwrap() >= 2);
     }
+}
+
+#[test]
+fn terrain_is_generated_and_written() {
+    let dir = temp_dir("terrain");
+    let out = dir.join("t.gltf");
+    let o = bin("hush-cli").args(["level", "--scene", "terrain:5000", "--out", out.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = bin("hush-cli").args(["bench", out.to_str().unwrap(), "--json", "--width", "8", "--height", "8", "--spp", "1", "--rays", "1024", "--bvh", "cwbvh"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let t = v["triangles"].as_u64().unwrap();
+    assert!((4900..=5100).contains(&t), "{t} triangles");
 }
 
 
