@@ -159,7 +159,7 @@ def main():
     if a.out:
         mi.util.write_bitmap(a.out, img)
     print(json.dumps({"seconds": secs, "load_seconds": load_s, "samples_per_second": a.width * a.height * a.spp / secs,
-                      "mean_rgb": img.reshape(-1, 3).mean(axis=0).tolist(), "threads": mi.Thread.thread_count() if hasattr(mi.Thread, "thread_count") else None}))
+                      "mean_rgb": img.reshape(-1, 3).mean(axis=0).tolist()}))
 
 
 if __name__ == "__main__":
