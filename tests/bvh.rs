@@ -119,3 +119,26 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
         assert!(hit_miss_disagree * 500 <= rays.len(), "{kind:?}: {hit_miss_disagree} hit/miss disagreements");
     }
 }
+
+/// A cast larger than the device's storage binding (32 bytes a ray) goes in batches: every ray
+/// gets its hit, in order.
+#[test]
+fn casts_larger_than_a_binding_go_in_batches() {
+    let scene = hush_engine::scene::load_gltf(&hush_tests::oracle("cornell_diffuse").join("cornell_diffuse.gltf")).unwrap();
+    let prepared = PreparedScene::new(&scene, BvhKind::Cwbvh).unwrap();
+    let gpu = Gpu::headless(&prepared.requirements(0, 0)).unwrap();
+    let gscene = prepared.upload(&gpu);
+    let caster = Raycaster::new(&gpu, &gscene).unwrap();
+    let most = gpu.device.limits().max_storage_buffer_binding_size as usize / 32;
+    // From the box's centre: straight up hits the ceiling, the rest alternate down to the floor.
+    let centre = ((scene.bounds().unwrap().0 + scene.bounds().unwrap().1) * 0.5 - prepared.origin).as_vec3();
+    let rays: Vec<(Vec3, Vec3, f32)> = (0..most + 1000).map(|i| (centre, if i % 2 == 0 { Vec3::Y } else { Vec3::NEG_Y }, f32::MAX)).collect();
+    let (hits, _) = caster.cast(&gpu, &gscene, &rays, false).unwrap();
+    assert_eq!(hits.len(), rays.len());
+    let (up, down) = (hits[0].unwrap().t, hits[1].unwrap().t);
+    for (i, h) in hits.iter().enumerate().skip(most - 2) {
+        let t = h.unwrap_or_else(|| panic!("ray {i} missed")).t;
+        assert_eq!(t, if i % 2 == 0 { up } else { down }, "ray {i}");
+    }
+}
+

@@ -73,18 +73,22 @@ impl Raycaster {
         let pbuf = mem.buffer_init(d, "raycast/params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
         let rbuf = mem.buffer_init(d, "raycast/rays", bytemuck::cast_slice(&ray_data), wgpu::BufferUsages::STORAGE);
         let hbuf = mem.buffer(d, "raycast/hits", n as u64 * 16, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let groups = self.compute.bind_groups(d, &cast_bindings(scene, &pbuf, &rbuf, &hbuf))?;
+        // A refused binding or dispatch is an error here, not a silently empty result.
+        let groups = gpu.validated(&format!("binding {n} rays"), || self.compute.bind_groups(d, &cast_bindings(scene, &pbuf, &rbuf, &hbuf)))?;
         gpu.wait()?;
         let start = std::time::Instant::now();
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: None });
-            pass.set_pipeline(&self.compute.pipeline);
-            crate::gpu::set_compute_groups(&mut pass, &groups);
-            let groups = n.div_ceil(64);
-            pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
-        }
-        gpu.queue.submit([enc.finish()]);
+        gpu.validated(&format!("casting {n} rays"), || {
+            let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: None });
+                pass.set_pipeline(&self.compute.pipeline);
+                crate::gpu::set_compute_groups(&mut pass, &groups);
+                let groups = n.div_ceil(64);
+                pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+            }
+            gpu.queue.submit([enc.finish()]);
+            Ok(())
+        })?;
         gpu.wait()?;
         let elapsed = start.elapsed();
         let bytes = readback_buffer(d, &gpu.queue, &hbuf, n as u64 * 16)?;
