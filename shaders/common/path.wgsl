@@ -69,9 +69,8 @@ struct PathState {
     ro: vec3f,
     rd: vec3f,
     beta: vec3f,
-    // Segments so far, counting the one about to be traced; the count the path started at.
+    // Segments so far, counting the one about to be traced.
     segments: i32,
-    start_segments: i32,
     prev_pdf: f32,
     prev_delta: bool,
     prev_select: f32,
@@ -83,7 +82,7 @@ struct PathState {
 }
 
 fn path_begin(start: PathStart) -> PathState {
-    return PathState(start.ro, start.rd, start.beta, start.segments, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false);
+    return PathState(start.ro, start.rd, start.beta, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false);
 }
 
 fn path_result(st: PathState) -> PathResult {
@@ -117,7 +116,9 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
         return;
     }
     let hit = traverse(ro, rd, INF, false);
-    if (*st).first_t < 0.0 {
+    // The path's first segment (first_t is negative until then).
+    let first = (*st).first_t < 0.0;
+    if first {
         (*st).first_t = hit.t;
     }
     if hit.tri == NO_HIT {
@@ -140,7 +141,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     let ms = material_at(m, s.uv);
     let emission = ms.emission;
     let bsdf = material_bsdf(m, ms);
-    if segments == (*st).start_segments {
+    if first {
         (*st).first_reflectance = min(bsdf.albedo + bsdf.f0, vec3f(1.0));
         (*st).first_normal = s.ns;
     }

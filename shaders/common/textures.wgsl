@@ -57,13 +57,9 @@ fn tex_sample(index: u32, uv_in: vec2f) -> vec4f {
     let f = vec2f(wrap_unit(uv.x, ws), wrap_unit(uv.y, wt)) * vec2f(f32(w), f32(h)) - 0.5;
     let i = floor(f);
     let t = f - i;
-    let xs = wrap_pair(i32(i.x), i32(w), ws);
-    let ys = wrap_pair(i32(i.y), i32(h), wt);
-    let xa = xs.x;
-    let xb = xs.y;
-    let ya = ys.x;
-    let yb = ys.y;
-    let a = mix(texel(off, w, xa, ya, srgb), texel(off, w, xb, ya, srgb), t.x);
-    let b = mix(texel(off, w, xa, yb, srgb), texel(off, w, xb, yb, srgb), t.x);
+    let x = wrap_pair(i32(i.x), i32(w), ws);
+    let y = wrap_pair(i32(i.y), i32(h), wt);
+    let a = mix(texel(off, w, x.x, y.x, srgb), texel(off, w, x.y, y.x, srgb), t.x);
+    let b = mix(texel(off, w, x.x, y.y, srgb), texel(off, w, x.y, y.y, srgb), t.x);
     return mix(a, b, t.y);
 }

@@ -105,12 +105,11 @@ impl BvhKind {
 /// Entries of the traversal stack the programs of a scene are built with. The stack is a
 /// private array that lavapipe zero-fills at every traversal and indexes by a ladder over all
 /// its entries, so its cost grows with its length: on cornell_diffuse (tree depth 2) the
-/// reference tracer made 0.69 M samples/s with 32 entries of two words, 0.98 with 16 of one
-/// word, 1.13 with 8 and 1.20 with 4. A static scene's stack holds its tree's depth (rounded up
-/// to 4). An animated scene rebuilds its tree every frame with the same stack
-/// ([`build_within`]), so its stack also holds what the median fallback can reach over `n`
-/// triangles (ceil(log2 n) + 1 binary levels, each at most one level of any layout) and four
-/// levels of headroom for the SAH tree.
+/// reference tracer made 0.69 M samples/s with 32 entries, 0.78 with 24, 0.91 with 16 and 1.00
+/// with 8. A static scene's stack holds its tree's depth (rounded up to 4). An animated scene
+/// rebuilds its tree every frame with the same stack ([`build_within`]), so its stack also
+/// holds what the median fallback can reach over `n` triangles (ceil(log2 n) + 1 binary levels,
+/// each at most one level of any layout) and four levels of headroom for the SAH tree.
 pub fn traversal_stack(kind: BvhKind, depth: usize, triangles: usize, animated: bool) -> u32 {
     let need = if animated { (depth + 4).max(median_depth_bound(triangles)) } else { depth };
     need.max(4).next_multiple_of(4).min(kind.max_depth()) as u32

@@ -25,7 +25,7 @@ pub struct GpuRequirements {
     pub max_sampled_textures_per_shader_stage: u32,
     /// Render-target bytes per sample of the widest render pass (WebGPU's accounting).
     pub max_color_attachment_bytes_per_sample: u32,
-    /// Rows of the tallest texel texture (the BVH nodes or the triangles, [`super::scene::Texels`]).
+    /// Rows of the tallest texel-row texture of the scene ([`super::scene::Texels`]).
     pub max_texture_dimension_2d: u32,
     /// Ask for everything the adapter offers (the viewer, which may load larger scenes later).
     pub adapter_limits: bool,
@@ -101,7 +101,7 @@ impl Gpu {
         limits.max_texture_dimension_2d = limits.max_texture_dimension_2d.max(req.max_texture_dimension_2d);
         if limits.max_texture_dimension_2d > have.max_texture_dimension_2d {
             return Err(anyhow!(
-                "adapter {:?} allows textures of {} rows; the scene's BVH and triangles need {} rows of {} texels",
+                "adapter {:?} allows textures of {} rows; the scene's geometry and materials need {} rows of {} texels",
                 info.name,
                 have.max_texture_dimension_2d,
                 req.max_texture_dimension_2d,

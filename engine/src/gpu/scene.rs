@@ -9,7 +9,7 @@ pub struct GpuScene {
     pub bvh_kind: BvhKind,
     /// [`PreparedScene::traversal_stack`].
     pub traversal_stack: u32,
-    /// The BVH nodes as texel rows ([`texel_rows`]): traversal reads them with textureLoad.
+    /// The BVH nodes as texel rows ([`Texels`]): traversal reads them with textureLoad.
     pub nodes: Texels,
     /// Triangle vertices, three vec4 each: a buffer for the raster pass and shading, and the
     /// same as texel rows for the intersection tests.
@@ -239,10 +239,12 @@ pub fn texel_row_count(bytes: usize) -> u32 {
 }
 
 /// An array of 16-byte records as a 2D texture, [`TEXEL_ROW`] texels to a row, read with
-/// textureLoad. Lavapipe reads a storage buffer at per-lane addresses one lane and one word at
-/// a time with a bounds check each, and a texel with one 16-byte load per lane: with the BVH
-/// nodes and the vertices the intersection tests read in texels, the reference tracer made 1.13
-/// M samples/s on cornell_diffuse instead of 0.97 (living room rays/s +10%).
+/// textureLoad (the BVH nodes, vertices, shading records, materials and texture words).
+/// Lavapipe reads a storage buffer at per-lane addresses one lane and one word at a time with a
+/// bounds check each, and a texel with one 16-byte load per lane: with the BVH nodes and the
+/// vertices the intersection tests read in texels, the reference tracer made 0.66 M samples/s
+/// on cornell_diffuse instead of 0.56 (living room rays/s +10%). On an H100 texels cost the
+/// real-time trace 2% against buffers.
 pub struct Texels {
     pub texture: wgpu::Texture,
     pub view: wgpu::TextureView,
@@ -291,8 +293,10 @@ impl Texels {
         let replaced = rows > self.texture.height();
         if replaced {
             mem.forget(&self.label);
-            // Headroom, so that a BVH a few nodes larger next frame does not reallocate again.
-            (self.texture, self.view) = Self::make(gpu, mem, &self.label, rows + rows / 4 + 1, self.format);
+            // Headroom, so that a BVH a few nodes larger next frame does not reallocate again,
+            // within what the device allows.
+            let most = gpu.device.limits().max_texture_dimension_2d.max(rows);
+            (self.texture, self.view) = Self::make(gpu, mem, &self.label, (rows + rows / 4 + 1).min(most), self.format);
         }
         self.upload(gpu, bytes);
         replaced

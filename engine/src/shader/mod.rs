@@ -246,17 +246,9 @@ impl Program {
     }
 }
 
+/// The wgpu module of composed program text (every pipeline's module is made here).
 pub fn create_module(device: &wgpu::Device, label: &str, text: &str) -> wgpu::ShaderModule {
-    let desc = wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(text.into()) };
-    match std::env::var("HUSH_CHECKS").as_deref() {
-        Ok("none") => unsafe { device.create_shader_module_trusted(desc, wgpu::ShaderRuntimeChecks::unchecked()) },
-        Ok("noloop") => unsafe {
-            let mut c = wgpu::ShaderRuntimeChecks::checked();
-            c.force_loop_bounding = false;
-            device.create_shader_module_trusted(desc, c)
-        },
-        _ => device.create_shader_module(desc),
-    }
+    device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(text.into()) })
 }
 
 #[cfg(test)]
