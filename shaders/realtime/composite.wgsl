@@ -16,10 +16,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let p = vec2i(px);
     let g = gbuffer_at(p);
     var l = textureLoad(tr_direct, p, 0).rgb;
+    // Emission is added where there is no surface too: traced primaries (a thin lens) store the
+    // mean over their k samples, which may hit an emitter where sample 0 missed.
+    l += g.emission;
     if g.hit {
         let rd = camera_ray(px);
         let f_s = fresnel_mirror(g, dot(g.n, -rd));
-        l += g.emission + textureLoad(tr_matte, p, 0).rgb * matte_factor(g, f_s);
+        l += textureLoad(tr_matte, p, 0).rgb * matte_factor(g, f_s);
         l += glossy_light(p) * f_s;
     }
     l = select(vec3f(0.0), l, (l == l) & (abs(l) <= vec3f(3.0e38)));

@@ -27,7 +27,8 @@ struct Frame {
     samples: u32,
     // Frames between two samples of a pixel (1 / f; 1: every pixel every frame).
     period: u32,
-    _pad2: u32,
+    // Primary samples per pixel of the traced primaries (realtime/primaries.wgsl); 0: raster.
+    primary_samples: u32,
 }
 
 var<uniform> frame: Frame;

@@ -12,8 +12,9 @@
 // - One matte path (cosine-sampled, eq. (6)) and one glossy path (GGX visible normals) continue
 //   with the reference tracer's loop (common/path.wgsl).
 //
-// The primary hit is re-derived from the triangle the raster stored and this frame's camera ray,
-// so it is exact (the same point the reference tracer would find for that ray). `shade` is also
+// The primary hit is re-derived from the triangle the raster (or, with a thin lens, the traced
+// primaries) stored and this frame's camera ray (realtime/lens.wgsl), so it is exact (the same
+// point the reference tracer would find for that ray). `shade` is also
 // the supersampling's (realtime/samples.wgsl) for the samples it traces beside the raster's.
 
 var gb_ids: texture_2d<u32>;
@@ -203,8 +204,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     var rng = rng_init(px.y * frame.size.x + px.x, frame.index, params.seed);
-    let ro = frame.cam_pos.xyz;
-    let rd = camera_ray(px);
+    // Sample 0 of the pixel: the raster's ray, or the traced primaries' first lens ray.
+    let ray = primary_ray(px, 0u);
+    let ro = ray.ro;
+    let rd = ray.rd;
     let slot = textureLoad(gb_ids, px, 0).y;
     if slot == NO_HIT {
         // Background: what the camera sees of the environment goes straight to the screen.
@@ -215,5 +218,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let hit = raster_hit(ro, rd, slot);
     let sh = shade(rd, hit, &rng);
     write_all(px, sh.matte, sh.direct);
-    write_glossy(px, sh.glossy, sh.glossy_t, select(rd * hit.t, rd, sh.backface), sh.mirror, sh.hit_reflectance, sh.hit_normal, sh.representative_t);
+    write_glossy(px, sh.glossy, sh.glossy_t, select(ro - frame.cam_pos.xyz + rd * hit.t, rd, sh.backface), sh.mirror, sh.hit_reflectance, sh.hit_normal, sh.representative_t);
 }

@@ -100,9 +100,6 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
-    if camera.lens.is_some() {
-        eprintln!("warning: the real-time frame renders the camera's thin lens as a pinhole (its G-buffer is rasterised); --mode reference renders the depth of field");
-    }
     if let Some(v) = &view {
         if v.spec().is_some_and(|s| s.needs_glossy()) && !hush_engine::gpu::PreparedScene::glossy_materials(&scene) {
             bail!("--view {}: the scene has no glossy buffers", v.name());

@@ -21,6 +21,8 @@ use crate::passes::io::{FrameIo, PreviousGBuffer};
 use crate::passes::matte::{ChainView, DenoiseParams};
 use crate::passes::reference::{TraceParams, TraceView, make_params};
 use crate::passes::taa::TaaStage;
+use crate::passes::prefilter::{Prefilter, PrefilterTargets};
+use crate::passes::primaries::{Primaries, PrimaryTargets};
 use crate::passes::supersample::{Supersample, SupersampleTargets};
 use crate::passes::trace::{TracePass, TraceTargets};
 use crate::scene::{Camera, Scene};
@@ -62,6 +64,10 @@ struct Targets {
     previous: Option<PreviousGBuffer>,
     /// Made for k > 1 samples per pixel (remade when k changes).
     supersample: Option<SupersampleTargets>,
+    /// Made when a camera with a thin lens is first rendered (traced primaries), and when the
+    /// pre-filter first runs.
+    primaries: Option<PrimaryTargets>,
+    prefilter: Option<PrefilterTargets>,
     /// Every per-pixel allocation, the denoisers' and TAA's included: bytes per pixel, and
     /// textures by label for readback.
     memory: GpuMemory,
@@ -79,7 +85,7 @@ impl Targets {
         // COPY_DST: the supersampling's resolve writes it back.
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let hdr = memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
-        Targets { size, gbuffer, trace, hdr, accumulation: None, previous: None, supersample: None, memory, epoch, generation }
+        Targets { size, gbuffer, trace, hdr, accumulation: None, previous: None, supersample: None, primaries: None, prefilter: None, memory, epoch, generation }
     }
 
     fn io<'a>(&'a self, frame: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>) -> FrameIo<'a> {
@@ -112,6 +118,8 @@ pub struct Renderer {
     denoisers: Vec<MadeDenoiser>,
     taa: TaaStage,
     supersample: Supersample,
+    primaries: Primaries,
+    prefilter: Prefilter,
     /// The index in `denoisers` of the one that ran last frame (its image is then TAA's).
     denoised_last: Option<usize>,
     timer: Option<GpuTimer>,
@@ -200,6 +208,8 @@ impl Renderer {
             denoisers: vec![],
             taa,
             supersample: Supersample::new(),
+            primaries: Primaries::default(),
+            prefilter: Prefilter::default(),
             denoised_last: None,
             timer,
             async_timings: false,
@@ -350,7 +360,8 @@ impl Renderer {
     /// This frame's jitter, its camera against the last frame's, and the frame and trace
     /// uniforms written; returns what the denoiser and TAA know of the cameras, and the
     /// jittered view-projection and jitter (the next frame's "previous").
-    fn upload_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, cam: &CameraSetup, moved: bool, denoised: bool) -> (ChainView, Mat4, Vec2) {
+    #[allow(clippy::too_many_arguments)]
+    fn upload_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, cam: &CameraSetup, moved: bool, denoised: bool, primary_samples: u32) -> (ChainView, Mat4, Vec2) {
         let size = self.targets.size;
         let jitter = if settings.accumulate {
             random_jitter(self.frame_index, settings.seed)
@@ -373,7 +384,8 @@ impl Renderer {
         // The glossy chain's reflection motion wants the representative ray of glossy surfaces.
         let representative = if denoised && g.trace_representative_ray && g.reflection_mv != crate::settings::ReflectionMv::Primary { g.roughness_threshold } else { 0.0 };
         let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
-        let fp = FrameParams::new(cam, jittered, prev, jitter, size, self.frame_index, settings, self.accumulated, self.prepared.ray_epsilon(), representative);
+        let mut fp = FrameParams::new(cam, jittered, prev, jitter, size, self.frame_index, settings, self.accumulated, self.prepared.ray_epsilon(), representative);
+        fp.primary_samples = primary_samples;
         let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
         let tp = make_params(&self.prepared, &trace_view);
         gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
@@ -420,7 +432,32 @@ impl Renderer {
             t.supersample = Some(SupersampleTargets::new(&gpu.device, &mut t.memory, t.size, samples, self.prepared.features.glossy, t.epoch));
             t.generation += 1;
         }
-        let (mut view, jittered, jitter) = self.upload_frame(gpu, input, settings, &cam, moved, denoiser.is_some());
+        // A thin lens: the G-buffer is traced (k lens rays per pixel), not rasterised; the
+        // accumulate mode traces one, so that its mean over frames is exact.
+        let lens = input.camera.lens.is_some_and(|l| l.aperture_radius > 0.0);
+        let primary_samples = match (lens, settings.accumulate) {
+            (false, _) => 0,
+            (true, true) => 1,
+            (true, false) => settings.primary_samples.clamp(1, crate::settings::MAX_PRIMARY_SAMPLES),
+        };
+        let prefilter = lens && settings.prefilter && !settings.accumulate;
+        if lens {
+            if samples > 1 {
+                bail!("{samples} samples per pixel (guide rays) need the raster's G-buffer, which a thin-lens camera does not have: set samples per pixel to 1 (the lens traces {} primary samples per pixel)", settings.primary_samples);
+            }
+            let t = &mut self.targets;
+            if t.primaries.as_ref().is_none_or(|p| p.epoch != t.epoch) {
+                t.memory.forget(PrimaryTargets::PREFIX);
+                t.primaries = Some(PrimaryTargets::new(&gpu.device, &mut t.memory, t.size, t.epoch));
+                t.generation += 1;
+            }
+            if prefilter && t.prefilter.as_ref().is_none_or(|p| p.epoch != t.epoch) {
+                t.memory.forget(PrefilterTargets::PREFIX);
+                t.prefilter = Some(PrefilterTargets::new(&gpu.device, &mut t.memory, t.size, t.epoch));
+                t.generation += 1;
+            }
+        }
+        let (mut view, jittered, jitter) = self.upload_frame(gpu, input, settings, &cam, moved, denoiser.is_some(), primary_samples);
         view.history_valid = denoiser.is_some() && self.denoised_last == denoiser && self.prev_jittered.is_some();
         self.denoised_last = denoiser;
         if let Some(target) = target {
@@ -439,10 +476,25 @@ impl Renderer {
         let output_key = key * 64 + denoiser.map_or(0, |i| i as u64 + 1);
         let parity = (self.frame_index % 2) as usize;
         // gbuffer -> trace -> denoise -> composite -> TAA -> display (Mara et al. 2017, Figure 2).
-        let pass = crate::profile::scope(gbuffer::LABEL);
-        self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &self.targets.gbuffer, self.timer.as_mut())?;
-        drop(pass);
         let t = &self.targets;
+        match t.primaries.as_ref().filter(|_| lens) {
+            None => {
+                let _pass = crate::profile::scope(gbuffer::LABEL);
+                self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &t.gbuffer, self.timer.as_mut())?;
+            }
+            Some(p) => {
+                // The pre-filter stage (Moon et al. 2017) between the traced features and the
+                // G-buffer every later stage reads.
+                self.primaries.record_trace(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, p, size, self.timer.as_mut())?;
+                let mut features = &p.features;
+                if let Some(pf) = t.prefilter.as_ref().filter(|_| prefilter) {
+                    let offered = crate::passes::prefilter::bindings(&self.frame_buf, p, pf);
+                    self.prefilter.record(gpu, &mut enc, key, size, &offered, self.timer.as_mut())?;
+                    features = &pf.features;
+                }
+                self.primaries.record_resolve(gpu, &mut enc, key, &self.frame_buf, features, prefilter, &t.gbuffer, self.timer.as_mut())?;
+            }
+        }
         let pass = crate::profile::scope(crate::passes::trace::LABEL);
         self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, period, self.timer.as_mut())?;
         drop(pass);

@@ -28,7 +28,9 @@ pub struct FrameParams {
     pub samples: u32,
     /// Frames between two samples of a pixel, 1 / f (1: every pixel every frame; frame/schedule.rs).
     pub period: u32,
-    pub _pad: u32,
+    /// Primary samples per pixel k of the traced primaries (realtime/primaries.wgsl), where a
+    /// thin lens makes the primary hit random; 0: the raster's G-buffer.
+    pub primary_samples: u32,
 }
 
 impl FrameParams {
@@ -53,7 +55,7 @@ impl FrameParams {
             representative_roughness,
             samples: if accumulated > 0 { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) },
             period: if accumulated > 0 { 1 } else { settings.sample_fraction.period() },
-            _pad: 0,
+            primary_samples: 0,
         }
     }
 }

@@ -15,6 +15,8 @@ impl Renderer {
         }
         v.extend(self.taa.pipelines());
         v.extend(self.supersample.pipelines());
+        v.extend(self.primaries.pipelines());
+        v.extend(self.prefilter.pipelines());
         for d in &mut self.denoisers {
             v.extend(d.denoiser.pipelines());
         }

@@ -13,5 +13,7 @@ pub mod composite;
 pub mod gbuffer;
 pub mod glossy;
 pub mod matte;
+pub mod prefilter;
+pub mod primaries;
 pub mod supersample;
 pub mod trace;

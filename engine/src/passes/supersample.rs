@@ -76,6 +76,7 @@ pub fn modules(stage: &'static str, glossy: bool) -> Vec<&'static str> {
 pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
     let mut m = scene.shading_modules();
     m.push("realtime/frame.wgsl");
+    m.push("realtime/lens.wgsl");
     m.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
     m.extend(["realtime/trace.wgsl", "supersample/common.wgsl", "supersample/samples.wgsl"]);
     m

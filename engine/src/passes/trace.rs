@@ -68,6 +68,7 @@ impl TracePass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets) -> Result<TracePass> {
         let mut modules = scene.shading_modules();
         modules.push("realtime/frame.wgsl");
+        modules.push("realtime/lens.wgsl");
         modules.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
         modules.push("realtime/trace.wgsl");
         let offered = bindings(scene, params, frame, g, t);

@@ -62,6 +62,8 @@ const FRAME_FIELDS: &[Field] = &[
     f("max_depth", "trace", "bounces", Int(-1, 64), "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded)."),
     f("paths_per_pixel", "trace", "paths", Int(1, 64), "Indirect paths per pixel per frame (1 is the paper's real-time setting)."),
     f("samples_per_pixel", "trace", "samples", Int(1, super::MAX_SAMPLES_PER_PIXEL as i64), "Samples per pixel: the raster's guide and k - 1 traced, mixed into their most similar guides (Voorhuis §5)."),
+    f("primary_samples", "gbuffer/primaries", "samples", Int(1, super::MAX_PRIMARY_SAMPLES as i64), "With a thin lens: primary rays traced per pixel, whose mean features are the G-buffer (Moon et al. 2017 §4.2). More: cleaner features, k rays each."),
+    f("prefilter", "prefilter", "", Bool, "With a thin lens: Moon et al. 2017's pre-filter of the traced G-buffer (world-position weights, bandwidth by SURE)."),
     f("sample_fraction", "trace", "", Choice(fractions), "Fraction of the pixels traced per frame (Dundr §5): 1/N traces one pixel of every N-pixel tile, each pixel once in N frames."),
 ];
 

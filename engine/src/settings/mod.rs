@@ -61,7 +61,26 @@ pub struct FrameSettings {
     /// fill the gaps accept f < 1 (none: shows each pixel's last sample). Needs k = 1 samples per
     /// pixel; the accumulate mode ignores it.
     pub sample_fraction: SampleFraction,
+    /// Primary samples per pixel k where the camera has a thin lens (depth of field): the
+    /// raster cannot draw a random primary hit, so `gbuffer/primaries` traces k lens rays per
+    /// pixel and writes the mean of their features as the G-buffer (Moon et al. 2017 §4.2), and
+    /// the path continues from the first. More samples give less noisy features (and
+    /// covariances for the pre-filter) at the cost of k closest-hit rays per pixel. The
+    /// accumulate mode traces 1 (its mean over frames is then exact). No effect without a lens.
+    pub primary_samples: u32,
+    /// Moon et al. 2017's G-buffer pre-filter (`prefilter`), where primaries are traced: the
+    /// features are filtered over 7x7 pixels with world-position weights (eq. 3-4) and a
+    /// per-pixel bandwidth chosen by SURE (eq. 6), so that a defocused region's noisy normals,
+    /// colours and depths stop cutting the denoisers' filters while in-focus detail stays.
+    pub prefilter: bool,
 }
+
+/// Traced primary samples per pixel by default (Moon et al. use 4 in their interactive tests'
+/// spirit: the fewest that give a covariance).
+pub const DEFAULT_PRIMARY_SAMPLES: u32 = 4;
+/// The most traced primary samples per pixel (256: the converged G-buffer the pre-filter's
+/// error is measured against).
+pub const MAX_PRIMARY_SAMPLES: u32 = 256;
 
 /// The most samples per pixel the real-time frame takes.
 pub const MAX_SAMPLES_PER_PIXEL: u32 = 16;
@@ -75,7 +94,7 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), progressive: ProgressiveSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1, sample_fraction: SampleFraction::ONE }
+        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), progressive: ProgressiveSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1, sample_fraction: SampleFraction::ONE, primary_samples: DEFAULT_PRIMARY_SAMPLES, prefilter: true }
     }
 }
 

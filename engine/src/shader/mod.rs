@@ -77,6 +77,13 @@ embed!(
     "realtime/glossy_in_none.wgsl",
     "realtime/composite.wgsl",
     "realtime/display.wgsl",
+    "realtime/lens.wgsl",
+    "realtime/primaries.wgsl",
+    "realtime/primaries_resolve.wgsl",
+    "prefilter/common.wgsl",
+    "prefilter/covariance.wgsl",
+    "prefilter/sure.wgsl",
+    "prefilter/features.wgsl",
     "matte/common.wgsl",
     "matte/sparse_bilateral.wgsl",
     "matte/temporal.wgsl",
@@ -313,6 +320,10 @@ mod tests {
                 v.push(compose(stage, "", &crate::passes::supersample::modules(stage, glossy)).unwrap());
             }
         }
+        v.push(compose("gbuffer/resolve", "", &["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"]).unwrap());
+        for stage in ["prefilter/covariance.wgsl", "prefilter/sure.wgsl", "prefilter/features.wgsl"] {
+            v.push(compose(stage, "", &["common/math.wgsl", "realtime/frame.wgsl", "prefilter/common.wgsl", stage]).unwrap());
+        }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             // A scene sets the traversal's stack length (accel::traversal_stack).
             let stack = "const TRAVERSAL_STACK: u32 = 16u;\n";
@@ -325,7 +336,10 @@ mod tests {
                 reference.push("reference/trace.wgsl");
                 v.push(compose(&format!("trace {bvh} {i}"), &prelude, &reference).unwrap());
                 let glossy = if i % 2 == 0 { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" };
-                m.extend(["realtime/frame.wgsl", glossy, "realtime/trace.wgsl"]);
+                let mut primaries = m.clone();
+                primaries.extend(["realtime/frame.wgsl", if i % 2 == 0 { "realtime/motion_static.wgsl" } else { "realtime/motion_objects.wgsl" }, "realtime/lens.wgsl", "realtime/primaries.wgsl"]);
+                v.push(compose(&format!("primaries {bvh} {i}"), &prelude, &primaries).unwrap());
+                m.extend(["realtime/frame.wgsl", "realtime/lens.wgsl", glossy, "realtime/trace.wgsl"]);
                 v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
                 m.extend(["supersample/common.wgsl", "supersample/samples.wgsl"]);
                 v.push(compose(&format!("supersample samples {bvh} {i}"), &prelude, &m).unwrap());

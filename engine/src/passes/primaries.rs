@@ -1,0 +1,139 @@
+//! Traced primaries, for a camera with a thin lens (depth of field): `gbuffer/primaries` traces
+//! k lens rays per pixel (shaders/realtime/primaries.wgsl) and keeps the mean of their features
+//! and the statistics of their world positions (Moon et al. 2017 §4.2, appendix B);
+//! `gbuffer/resolve` writes those features (raw, or the pre-filter's, passes/prefilter.rs) into
+//! the G-buffer's targets and depth, so that the trace, the denoisers and TAA read the G-buffer
+//! they always read. Without a lens the raster draws the G-buffer and none of this exists.
+//!
+//! Per pixel: 80 bytes of features and 64 of position moments (144 bytes).
+
+use crate::gpu::scene::compute_pipeline;
+use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups, set_render_groups};
+use crate::passes::gbuffer::{COLOR_FORMATS, DEPTH_FORMAT, GBufferTargets};
+use crate::shader::{Reload, Reloadable};
+use anyhow::Result;
+
+pub const LABEL: &str = "gbuffer/primaries";
+pub const RESOLVE: &str = "gbuffer/resolve";
+/// Words (vec4<u32>) per pixel of the features and of the moments (primaries.wgsl's layout).
+pub const FEATURE_WORDS: u64 = 5;
+pub const MOMENT_WORDS: u64 = 4;
+
+/// The traced primaries' per-pixel buffers.
+pub struct PrimaryTargets {
+    /// The frame targets' epoch these were made for.
+    pub epoch: u64,
+    pub features: wgpu::Buffer,
+    pub moments: wgpu::Buffer,
+}
+
+impl PrimaryTargets {
+    pub const PREFIX: &str = "primaries/";
+
+    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), epoch: u64) -> PrimaryTargets {
+        let pixels = size.0 as u64 * size.1 as u64;
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        PrimaryTargets { epoch, features: mem.buffer(d, "primaries/features", pixels * FEATURE_WORDS * 16, usage), moments: mem.buffer(d, "primaries/moments", pixels * MOMENT_WORDS * 16, usage) }
+    }
+}
+
+/// The trace and resolve programs, made on first use.
+#[derive(Default)]
+pub struct Primaries {
+    trace: Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>,
+    resolve: Option<(Reloadable<wgpu::RenderPipeline>, [BindCache; 2])>,
+}
+
+fn trace_bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::Buffer, t: &'a PrimaryTargets) -> Bindings<'a> {
+    scene.bindings().buffer("params", params).buffer("frame", frame).buffer("pr_features", &t.features).buffer("pr_moments", &t.moments)
+}
+
+impl Primaries {
+    pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
+        let mut v: Vec<&mut dyn Reload> = vec![];
+        if let Some((p, _)) = self.trace.as_mut() {
+            v.push(p);
+        }
+        if let Some((p, _)) = self.resolve.as_mut() {
+            v.push(p);
+        }
+        v
+    }
+
+    /// Trace frame.primary_samples lens rays per pixel into `t`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_trace(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, t: &PrimaryTargets, size: (u32, u32), timer: Option<&mut GpuTimer>) -> Result<()> {
+        let offered = trace_bindings(scene, params, frame, t);
+        if self.trace.is_none() {
+            let mut modules = scene.shading_modules();
+            modules.push("realtime/frame.wgsl");
+            modules.push(if scene.features.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+            modules.extend(["realtime/lens.wgsl", "realtime/primaries.wgsl"]);
+            let p = Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, wgpu::ShaderStages::COMPUTE, &offered, |d, m, l| compute_pipeline(d, LABEL, m, l, "main"))?;
+            self.trace = Some((p, BindCache::default()));
+        }
+        let (p, cache) = self.trace.as_mut().unwrap();
+        let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
+        let _scope = crate::profile::scope(LABEL);
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
+        pass.set_pipeline(p.get());
+        set_compute_groups(&mut pass, groups);
+        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        Ok(())
+    }
+
+    /// Write `features` (primaries.wgsl's layout; `filtered` says which buffer it is, for the
+    /// bind-group cache) into the G-buffer targets.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_resolve(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, frame: &wgpu::Buffer, features: &wgpu::Buffer, filtered: bool, g: &GBufferTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
+        let offered = Bindings::new().buffer("frame", frame).buffer("features", features);
+        if self.resolve.is_none() {
+            let modules = ["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"];
+            let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
+            let p = Reloadable::new(gpu, RESOLVE, "", &modules, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT, &offered, move |d, module, pl| {
+                d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(RESOLVE),
+                    layout: Some(pl),
+                    vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+                    primitive: Default::default(),
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH_FORMAT,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Always),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            })?;
+            self.resolve = Some((p, Default::default()));
+        }
+        let (p, caches) = self.resolve.as_mut().unwrap();
+        let groups = caches[filtered as usize].get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
+        let _scope = crate::profile::scope(RESOLVE);
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = g
+            .color
+            .iter()
+            .map(|(_, v)| Some(wgpu::RenderPassColorAttachment { view: v, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store } }))
+            .collect();
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(RESOLVE),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &g.depth.1,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.and_then(|t| t.render(RESOLVE)),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(p.get());
+        set_render_groups(&mut pass, groups);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+}

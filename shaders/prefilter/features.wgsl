@@ -1,0 +1,114 @@
+// Pre-filter step 3: the bandwidths SURE chose, smoothed by a Gaussian of 1.5 pixels (§5: they
+// "can be very noisy"), filter every feature with the same world-position weights (eq. (1), (3),
+// (4)): normal, view depth, base colour and metallic, F0 and roughness, emission and f90. Motion
+// and ids pass unchanged. The variance of the filtered normal and depth comes from dual buffers
+// (§5, after Rousselle et al. 2013): the features filtered once with the weights of the even
+// samples' positions and once with the odd samples', their squared difference over 4.
+
+var<storage, read> pf_bandwidth: array<f32>;
+var<storage, read_write> pf_features: array<vec4u>;
+// Debug views: x the chosen bandwidth before smoothing, y after, z the world positions' spread
+// (RMS distance from their mean) in pixels, w the filtered normal's variance (dual buffers).
+var pf_view: texture_storage_2d<rgba16float, write>;
+// xy the raw octahedral normal, zw the filtered one.
+var pf_normals: texture_storage_2d<rgba16float, write>;
+
+fn feature(i: u32, w: u32) -> vec4f {
+    return bitcast<vec4f>(pr_features[i * 5u + w]);
+}
+
+fn odd_position(m: Moments) -> vec3f {
+    let n_b = m.n - m.n_a;
+    return select(m.p, (m.p * m.n - m.p_a * m.n_a) / max(n_b, 1.0), n_b >= 1.0);
+}
+
+fn oct_of(n: vec3f) -> vec2f {
+    let len = length(n);
+    return select(vec2f(0.0), oct_encode(n / len), len > 1e-12);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let c = vec2i(gid.xy);
+    if !inside(c) {
+        return;
+    }
+    let ci = pixel_index(c);
+    for (var w = 0u; w < 5u; w++) {
+        pf_features[ci * 5u + w] = pr_features[ci * 5u + w];
+    }
+    let mc = moments_at(ci);
+    let ic = inverse_at(ci);
+    let raw_n = feature(ci, 0u);
+    if mc.n < 1.0 || ic.n < 1.0 {
+        textureStore(pf_view, c, vec4f(0.0));
+        textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), oct_of(raw_n.xyz)));
+        return;
+    }
+    // The bandwidth, smoothed over the pixels with a surface.
+    var h = 0.0;
+    var g_sum = 0.0;
+    for (var dy = -WINDOW_RADIUS; dy <= WINDOW_RADIUS; dy++) {
+        for (var dx = -WINDOW_RADIUS; dx <= WINDOW_RADIUS; dx++) {
+            let q = c + vec2i(dx, dy);
+            if !inside(q) || moments_at(pixel_index(q)).n < 1.0 {
+                continue;
+            }
+            let g = exp(-f32(dx * dx + dy * dy) / (2.0 * SMOOTH_SIGMA * SMOOTH_SIGMA));
+            h += g * pf_bandwidth[pixel_index(q)];
+            g_sum += g;
+        }
+    }
+    h /= g_sum;
+    let spread = sqrt(max(mc.s_a.x + mc.s_a.w + mc.s_b.y, 0.0)) / max(pixel_footprint(mc.p), 1e-30);
+    var variance = 0.0;
+    if h >= 0.05 {
+        var sum_w = 0.0;
+        var normal_depth = vec4f(0.0);
+        var base = vec4f(0.0);
+        var spec = vec4f(0.0);
+        var emission = vec4f(0.0);
+        // Dual buffers: the even samples' positions (a) and the odd samples' (b).
+        var w_ab = vec2f(0.0);
+        var nd_a = vec4f(0.0);
+        var nd_b = vec4f(0.0);
+        let pb_c = odd_position(mc);
+        for (var dy = -WINDOW_RADIUS; dy <= WINDOW_RADIUS; dy++) {
+            for (var dx = -WINDOW_RADIUS; dx <= WINDOW_RADIUS; dx++) {
+                let q = c + vec2i(dx, dy);
+                if !inside(q) {
+                    continue;
+                }
+                let qi = pixel_index(q);
+                let m = moments_at(qi);
+                if m.n < 1.0 {
+                    continue;
+                }
+                let iq = inverse_at(qi);
+                let wi = weight(mahalanobis(ic, iq, m.p - mc.p).w, h);
+                let nd = feature(qi, 0u);
+                sum_w += wi;
+                normal_depth += wi * nd;
+                base += wi * feature(qi, 1u);
+                spec += wi * feature(qi, 2u);
+                emission += wi * feature(qi, 3u);
+                let wa = weight(mahalanobis(ic, iq, m.p_a - mc.p_a).w, h);
+                let wb = weight(mahalanobis(ic, iq, odd_position(m) - pb_c).w, h);
+                w_ab += vec2f(wa, wb);
+                nd_a += wa * nd;
+                nd_b += wb * nd;
+            }
+        }
+        let inv = 1.0 / sum_w;
+        let f = ci * 5u;
+        pf_features[f] = bitcast<vec4u>(normal_depth * inv);
+        pf_features[f + 1u] = bitcast<vec4u>(base * inv);
+        pf_features[f + 2u] = bitcast<vec4u>(spec * inv);
+        pf_features[f + 3u] = bitcast<vec4u>(emission * inv);
+        let diff = nd_a / w_ab.x - nd_b / w_ab.y;
+        variance = dot(diff.xyz, diff.xyz) / 4.0;
+    }
+    let filtered = bitcast<vec4f>(pf_features[ci * 5u]);
+    textureStore(pf_view, c, vec4f(pf_bandwidth[ci], h, min(spread, 65000.0), min(variance, 65000.0)));
+    textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), oct_of(filtered.xyz)));
+}
