@@ -65,6 +65,13 @@ fn accumulation_converges_to_the_reference_glossy_point_light() {
     converges("point_glossy", 48, 256, 256);
 }
 
+/// The thin lens: the real-time frame traces its primaries through the lens (one per pixel per
+/// frame in the accumulate mode) and continues from that hit.
+#[test]
+fn accumulation_converges_to_the_reference_thin_lens() {
+    converges("cornell_dof", 48, 256, 256);
+}
+
 #[test]
 fn accumulation_converges_to_the_reference_furnace() {
     converges("furnace", 32, 64, 64);

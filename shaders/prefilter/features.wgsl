@@ -17,6 +17,19 @@ fn feature(i: u32, w: u32) -> vec4f {
     return bitcast<vec4f>(pr_features[i * 5u + w]);
 }
 
+// A pixel the filter may take from: a surface, with finite statistics and features.
+fn usable(i: u32) -> bool {
+    var ok = moments_at(i).n >= 1.0;
+    for (var w = 0u; w < 4u; w++) {
+        ok = ok && finite4(feature(i, w));
+    }
+    return ok;
+}
+
+fn finite_or_zero(v: vec4f) -> vec4f {
+    return select(vec4f(0.0), v, finite4(v));
+}
+
 fn odd_position(m: Moments) -> vec3f {
     let n_b = m.n - m.n_a;
     return select(m.p, (m.p * m.n - m.p_a * m.n_a) / max(n_b, 1.0), n_b >= 1.0);
@@ -34,13 +47,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let ci = pixel_index(c);
-    for (var w = 0u; w < 5u; w++) {
-        pf_features[ci * 5u + w] = pr_features[ci * 5u + w];
+    // Unfiltered (and non-finite values zeroed) unless the filter below replaces them.
+    for (var w = 0u; w < 4u; w++) {
+        pf_features[ci * 5u + w] = bitcast<vec4u>(finite_or_zero(feature(ci, w)));
     }
+    pf_features[ci * 5u + 4u] = pr_features[ci * 5u + 4u];
     let mc = moments_at(ci);
     let ic = inverse_at(ci);
-    let raw_n = feature(ci, 0u);
-    if mc.n < 1.0 || ic.n < 1.0 {
+    let raw_n = finite_or_zero(feature(ci, 0u));
+    if !usable(ci) || ic.n < 1.0 {
         textureStore(pf_view, c, vec4f(0.0));
         textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), oct_of(raw_n.xyz)));
         return;
@@ -51,7 +66,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     for (var dy = -WINDOW_RADIUS; dy <= WINDOW_RADIUS; dy++) {
         for (var dx = -WINDOW_RADIUS; dx <= WINDOW_RADIUS; dx++) {
             let q = c + vec2i(dx, dy);
-            if !inside(q) || moments_at(pixel_index(q)).n < 1.0 {
+            if !inside(q) || !usable(pixel_index(q)) {
                 continue;
             }
             let g = exp(-f32(dx * dx + dy * dy) / (2.0 * SMOOTH_SIGMA * SMOOTH_SIGMA));
@@ -80,10 +95,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                     continue;
                 }
                 let qi = pixel_index(q);
-                let m = moments_at(qi);
-                if m.n < 1.0 {
+                if !usable(qi) {
                     continue;
                 }
+                let m = moments_at(qi);
                 let iq = inverse_at(qi);
                 let wi = weight(mahalanobis(ic, iq, m.p - mc.p).w, h);
                 let nd = feature(qi, 0u);

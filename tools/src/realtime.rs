@@ -111,7 +111,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
         Some(crate::render::Spp::Samples(n)) => (n, SampleFraction::ONE),
         Some(crate::render::Spp::Fraction(f)) => (1, f),
     };
-    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, samples_per_pixel, sample_fraction, ..chains };
+    let max_primary = hush_engine::settings::MAX_PRIMARY_SAMPLES;
+    let primary_samples = a.primary_samples.unwrap_or(chains.primary_samples);
+    if !(1..=max_primary).contains(&primary_samples) {
+        bail!("--primary-samples {primary_samples}: use 1 to {max_primary}");
+    }
+    let prefilter = chains.prefilter && !a.no_prefilter;
+    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, samples_per_pixel, sample_fraction, primary_samples, prefilter, ..chains };
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;

@@ -105,6 +105,14 @@ pub struct RenderArgs {
     /// Real-time mode: sum all frames with a still camera and write their mean.
     #[arg(long)]
     pub accumulate: bool,
+    /// Real-time mode with a thin-lens camera: primary rays traced per pixel for the G-buffer
+    /// (default 4, or the preset's; at most 256).
+    #[arg(long)]
+    pub primary_samples: Option<u32>,
+    /// Real-time mode with a thin-lens camera: leave the traced G-buffer unfiltered (no Moon et
+    /// al. 2017 pre-filter).
+    #[arg(long)]
+    pub no_prefilter: bool,
     /// Real-time mode: hold this frame time (ms) with the governor, which picks the resolution
     /// scale and (for denoisers that fill untraced pixels) the sample fraction each frame; with
     /// --out-dir, writes frames.csv (frame, wall_ms, gpu_ms, spp, width, height). --spp pins the
@@ -141,7 +149,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
     /// "eye=x,y,z;target=x,y,z;fov=deg" (fov is vertical, in degrees); add ";aperture=r;focus=d"
-    /// (meters) for a thin lens (reference mode).
+    /// (meters) for a thin lens (depth of field in both modes).
     #[arg(long)]
     pub camera: Option<String>,
     /// BVH layout: bvh2 or cwbvh.
