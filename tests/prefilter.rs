@@ -395,7 +395,9 @@ fn primaries_covariance_matches_the_thin_lens() {
 /// MSE of the normal 1.66x lower, base colour 1.73x, view depth 1.02x; at the scene's 256x256,
 /// 2.46x, 2.90x and 1.50x. Asserted (128x128): normal and base colour at least 1.4x lower, depth
 /// no more than 1.1x higher; on in-focus pixels (positions spread over less than a pixel) the
-/// normal's MSE no higher than 1.1x raw (no loss of in-focus detail; measured 0.84x).
+/// normal's MSE no higher than 1.1x raw (no loss of in-focus detail; measured 0.84x). Read from
+/// the primaries' and the pre-filter's feature buffers (the G-buffer takes the filtered normal
+/// and depth, and the raw material: gbuffer/resolve).
 #[test]
 fn prefiltered_gbuffer_is_closer_to_the_converged_one() {
     use hush_engine::frame::{FrameInput, Renderer};
@@ -403,37 +405,34 @@ fn prefiltered_gbuffer_is_closer_to_the_converged_one() {
     use hush_engine::settings::FrameSettings;
     let scene = load_gltf(&hush_tests::oracle("cornell_dof").join("cornell_dof.gltf")).unwrap();
     let size = (128u32, 128u32);
+    let pixels = (size.0 * size.1) as usize;
     let camera = scene.camera_or_default();
-    let gbuffer = |settings: &FrameSettings| {
+    // Per pixel the features (primaries.wgsl's layout, as f32) and, with the pre-filter, its
+    // features and the positions' spread in pixels.
+    let run = |settings: &FrameSettings| {
         let (gpu, mut r) = Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, size).unwrap();
         r.render(&gpu, &FrameInput { camera, time: 0.0 }, settings, None).unwrap();
-        let read = |name: &str| r.read_texture(&gpu, name).unwrap().0;
-        let spread = r.read_texture(&gpu, "prefilter/view").map(|t| t.0).unwrap_or_default();
-        (read("gbuffer/normal"), read("gbuffer/base_color"), read("gbuffer/depth"), read("gbuffer/ids"), spread)
+        let floats = |b: Vec<u8>| -> Vec<f32> { bytemuck::cast_slice(&b).to_vec() };
+        let raw = floats(r.read_buffer(&gpu, "primaries/features").unwrap());
+        let filtered = r.read_buffer(&gpu, "prefilter/features").map(floats).unwrap_or_default();
+        let spread: Vec<f32> = r.read_texture(&gpu, "prefilter/view").map(|t| (0..pixels).map(|i| hush_tests::half(&t.0[i * 8 + 4..])).collect()).unwrap_or_default();
+        (raw, filtered, spread)
     };
-    let reference = gbuffer(&FrameSettings { primary_samples: 256, prefilter: false, seed: 9, ..Default::default() });
-    let raw = gbuffer(&FrameSettings { primary_samples: 4, prefilter: false, ..Default::default() });
-    let filtered = gbuffer(&FrameSettings { primary_samples: 4, prefilter: true, ..Default::default() });
-    let srgb = |b: u8| {
-        let c = b as f64 / 255.0;
-        if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-    };
-    let pixels = (size.0 * size.1) as usize;
-    let surface = |i: usize, g: &(Vec<u8>, Vec<u8>, Vec<u8>, Vec<u8>, Vec<u8>)| u32::from_le_bytes(g.3[i * 8 + 4..i * 8 + 8].try_into().unwrap()) != u32::MAX;
-    let mse = |g: &(Vec<u8>, Vec<u8>, Vec<u8>, Vec<u8>, Vec<u8>), in_focus_only: bool| {
+    let (reference, _, _) = run(&FrameSettings { primary_samples: 256, prefilter: false, seed: 9, ..Default::default() });
+    let (raw, filtered, spread) = run(&FrameSettings { primary_samples: 4, prefilter: true, ..Default::default() });
+    let surface = |f: &[f32], i: usize| f[i * 20 + 19].to_bits() != u32::MAX;
+    let normal = |f: &[f32], i: usize| glam::Vec3::new(f[i * 20], f[i * 20 + 1], f[i * 20 + 2]).normalize_or_zero();
+    // Normal, base colour (linear) and view depth (relative) squared errors, over the pixels
+    // with a surface in both; `in_focus`: only where the positions spread over less than a pixel.
+    let mse = |f: &[f32], in_focus: bool| {
         let (mut n, mut b, mut d, mut count) = (0.0, 0.0, 0.0, 0usize);
         for i in 0..pixels {
-            if !surface(i, g) || !surface(i, &reference) {
+            if !surface(&raw, i) || !surface(&reference, i) || (in_focus && spread[i] >= 1.0) {
                 continue;
             }
-            if in_focus_only && hush_tests::half(&filtered.4[i * 8 + 4..]) >= 1.0 {
-                continue;
-            }
-            n += (hush_tests::oct_normal(&g.0[i * 4..]) - hush_tests::oct_normal(&reference.0[i * 4..])).length_squared() as f64;
-            b += (0..3).map(|k| (srgb(g.1[i * 4 + k]) - srgb(reference.1[i * 4 + k])).powi(2)).sum::<f64>() / 3.0;
-            let depth = |t: &Vec<u8>| f32::from_le_bytes(t[i * 4..i * 4 + 4].try_into().unwrap()) as f64;
-            // Reversed Z is near / view depth: the relative error of the view depth.
-            d += (depth(&reference.2) / depth(&g.2) - 1.0).powi(2);
+            n += (normal(f, i) - normal(&reference, i)).length_squared() as f64;
+            b += (4..7).map(|k| (f[i * 20 + k] - reference[i * 20 + k]).powi(2) as f64).sum::<f64>() / 3.0;
+            d += (f[i * 20 + 3] as f64 / reference[i * 20 + 3] as f64 - 1.0).powi(2);
             count += 1;
         }
         let c = count.max(1) as f64;

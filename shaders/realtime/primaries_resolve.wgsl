@@ -1,8 +1,15 @@
-// Writes the traced primaries' features (realtime/primaries.wgsl's pr_features layout: raw, or
-// the pre-filter's) into the G-buffer's targets and depth, so that every stage after it reads
-// the G-buffer it always reads. One full-screen triangle.
+// Writes the traced primaries' features (realtime/primaries.wgsl's pr_features layout) into
+// the G-buffer's targets and depth, so that every stage after it reads the G-buffer it always
+// reads. One full-screen triangle.
+//
+// The normal and depth come from `edges` (the pre-filter's, or the raw ones without it): they
+// are what the denoisers edge-stop and reproject on (Moon et al. 2017 §3, fig. 2). The material
+// (base colour, metallic, F0, roughness) and the emission come from `features`, the raw means:
+// the composite and TAA multiply the image by them, so a filtered copy would blur the image's
+// own texture and emitters beyond the lens's blur, and TAA would converge to that blur.
 
 var<storage, read> features: array<vec4u>;
+var<storage, read> edges: array<vec4u>;
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4f {
@@ -24,7 +31,7 @@ struct GBufferOut {
 fn fs_main(@builtin(position) pos: vec4f) -> GBufferOut {
     let px = vec2u(pos.xy);
     let f = (px.y * frame.size.x + px.x) * 5u;
-    let n = bitcast<vec4f>(features[f]);
+    let n = bitcast<vec4f>(edges[f]);
     let m = features[f + 4u];
     var o: GBufferOut;
     o.ids = m.zw;

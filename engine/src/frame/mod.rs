@@ -486,13 +486,13 @@ impl Renderer {
                 // The pre-filter stage (Moon et al. 2017) between the traced features and the
                 // G-buffer every later stage reads.
                 self.primaries.record_trace(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, p, size, self.timer.as_mut())?;
-                let mut features = &p.features;
+                let mut edges = None;
                 if let Some(pf) = t.prefilter.as_ref().filter(|_| prefilter) {
                     let offered = crate::passes::prefilter::bindings(&self.frame_buf, p, pf);
                     self.prefilter.record(gpu, &mut enc, key, size, &offered, self.timer.as_mut())?;
-                    features = &pf.features;
+                    edges = Some(&pf.features);
                 }
-                self.primaries.record_resolve(gpu, &mut enc, key, &self.frame_buf, features, prefilter, &t.gbuffer, self.timer.as_mut())?;
+                self.primaries.record_resolve(gpu, &mut enc, key, &self.frame_buf, p, edges, &t.gbuffer, self.timer.as_mut())?;
             }
         }
         let pass = crate::profile::scope(crate::passes::trace::LABEL);

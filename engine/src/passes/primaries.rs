@@ -1,9 +1,9 @@
 //! Traced primaries, for a camera with a thin lens (depth of field): `gbuffer/primaries` traces
 //! k lens rays per pixel (shaders/realtime/primaries.wgsl) and keeps the mean of their features
 //! and the statistics of their world positions (Moon et al. 2017 §4.2, appendix B);
-//! `gbuffer/resolve` writes those features (raw, or the pre-filter's, passes/prefilter.rs) into
-//! the G-buffer's targets and depth, so that the trace, the denoisers and TAA read the G-buffer
-//! they always read. Without a lens the raster draws the G-buffer and none of this exists.
+//! `gbuffer/resolve` writes those features into the G-buffer's targets and depth (the normal
+//! and depth pre-filtered where the pre-filter runs, passes/prefilter.rs), so that the trace,
+//! the denoisers and TAA read the G-buffer they always read. Without a lens the raster draws the G-buffer and none of this exists.
 //!
 //! Per pixel: 80 bytes of features and 64 of position moments (144 bytes).
 
@@ -82,11 +82,12 @@ impl Primaries {
         Ok(())
     }
 
-    /// Write `features` (primaries.wgsl's layout; `filtered` says which buffer it is, for the
-    /// bind-group cache) into the G-buffer targets.
+    /// Write the raw features of `t` into the G-buffer targets, the normal and depth from
+    /// `edges` where given (the pre-filter's, in the same layout).
     #[allow(clippy::too_many_arguments)]
-    pub fn record_resolve(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, frame: &wgpu::Buffer, features: &wgpu::Buffer, filtered: bool, g: &GBufferTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
-        let offered = Bindings::new().buffer("frame", frame).buffer("features", features);
+    pub fn record_resolve(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, frame: &wgpu::Buffer, t: &PrimaryTargets, edges: Option<&wgpu::Buffer>, g: &GBufferTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
+        let filtered = edges.is_some();
+        let offered = Bindings::new().buffer("frame", frame).buffer("features", &t.features).buffer("edges", edges.unwrap_or(&t.features));
         if self.resolve.is_none() {
             let modules = ["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"];
             let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
