@@ -129,7 +129,9 @@ fn run(pixels: &[Pixel]) -> Output {
     prefilter.record(&gpu, &mut enc, 1, size, &offered, None).unwrap();
     gpu.queue.submit([enc.finish()]);
     let read = |b: &wgpu::Buffer| -> Vec<f32> { bytemuck::cast_slice(&readback_buffer(d, &gpu.queue, b, b.size()).unwrap()).to_vec() };
-    let inverse = read(&targets.inverse).chunks(8).map(|c| c.try_into().unwrap()).collect();
+    let texels = |t: &wgpu::Texture| -> Vec<[f32; 4]> { bytemuck::cast_slice::<u8, f32>(&hush_engine::gpu::readback_texture(&gpu, t).unwrap()).chunks(4).map(|c| c.try_into().unwrap()).collect() };
+    let (a, b) = (texels(&targets.stats[0].0), texels(&targets.stats[1].0));
+    let inverse = (0..W * H).map(|i| [a[i][0], a[i][1], a[i][2], a[i][3], b[i][0], b[i][1], b[i][2], b[i][3]]).collect();
     let bandwidth = read(&targets.bandwidth)[..W * H].to_vec();
     let features = read(&targets.features).chunks(20).take(W * H).map(|c| [0, 1, 2, 3, 4].map(|w| c[w * 4..w * 4 + 4].try_into().unwrap())).collect();
     Output { inverse, bandwidth, features }
@@ -387,6 +389,9 @@ fn primaries_covariance_matches_the_thin_lens() {
         assert!((v - e).abs() < 0.02 * expected[0], "S {name} {v:.4e}, expected {e:.4e}");
     }
     assert!(zz.abs() < 1e-3 * expected[0], "S zz {zz:.3e}: the samples lie on the plane");
+    // Click-to-focus reads the G-buffer's (mean) view depth: the plane's distance.
+    let focus = renderer.view_depth_at(&gpu, (size / 2, size / 2)).unwrap().unwrap();
+    assert!((focus - z).abs() < 1e-3 * z, "view depth {focus}, plane at {z}");
 }
 
 /// G-buffer error (Moon et al. fig. 5): on cornell_dof (the walls and the box out of focus, the

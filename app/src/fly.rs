@@ -1,7 +1,7 @@
 //! Fly camera: WASD to move, Q/E down/up, right-drag to look, wheel for speed, shift to run.
 
 use glam::DVec3;
-use hush_engine::scene::Camera;
+use hush_engine::scene::{Camera, ThinLens};
 use std::collections::HashSet;
 use winit::keyboard::KeyCode;
 
@@ -15,6 +15,8 @@ pub struct FlyCamera {
     pub speed: f64,
     pub held: HashSet<KeyCode>,
     pub looking: bool,
+    /// Depth of field (the side panel sets it; None: a pinhole).
+    pub lens: Option<ThinLens>,
 }
 
 impl FlyCamera {
@@ -28,6 +30,7 @@ impl FlyCamera {
             speed: (extent * 0.1).max(1e-6),
             held: HashSet::new(),
             looking: false,
+            lens: c.lens,
         }
     }
 
@@ -36,7 +39,7 @@ impl FlyCamera {
     }
 
     pub fn camera(&self) -> Camera {
-        Camera::look_at(self.pos, self.pos + self.forward(), self.yfov.to_degrees())
+        Camera { lens: self.lens, ..Camera::look_at(self.pos, self.pos + self.forward(), self.yfov.to_degrees()) }
     }
 
     /// Right-drag: radians per pixel of mouse motion.

@@ -29,7 +29,8 @@ const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-
             [--preset SETTINGS.toml] [--shaders DIR] [--profiler] [--puffin-http [PORT]]
             [--limit NAME=VALUE[,NAME=VALUE...]]
   no scene: the default level. Keys: WASD move, Q/E down/up, right-drag look, wheel speed,
-  shift run, F12 screenshot (PNG + EXR), R record a camera path, P play it, F9 profiler,
+  shift run, middle-click focus the depth of field there, F12 screenshot (PNG + EXR),
+  R record a camera path, P play it, F9 profiler,
   F10 capture frames to a .puffin file, Esc quit. Drop a .gltf/.glb on the window to load it.
   Shaders reload when their files change: debug builds read the source tree's shaders/,
   release builds embed them unless --shaders DIR or $HUSH_SHADERS names a folder.
@@ -123,6 +124,7 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
         playing: false,
         preset_path: "presets/my.toml".into(),
         governor: ui::GovernorPanel { on: true, target_ms: default_target_ms(gpu), pin_scale: false, pin_fraction: false, choice: String::new() },
+        lens: ui::LensPanel::new(r.scene.camera_or_default().lens, r.prepared.extent),
     }
 }
 
@@ -225,6 +227,23 @@ impl Viewer {
 }
 
 impl Running {
+    /// Click-to-focus: the lens focuses on the surface under the cursor (the frame covers the
+    /// window, so the cursor maps to the frame's pixel by the ratio of their sizes).
+    fn focus_at_cursor(&mut self) {
+        let Some((x, y)) = self.cursor else { return };
+        let (w, h) = self.renderer.size();
+        let px = ((x / self.config.width.max(1) as f64 * w as f64) as u32, (y / self.config.height.max(1) as f64 * h as f64) as u32);
+        match self.renderer.view_depth_at(&self.gpu, px) {
+            Ok(Some(z)) => {
+                self.panel.lens.focus_distance = z as f32;
+                self.panel.lens.on = true;
+                self.panel.message = format!("focused at {z:.3}");
+            }
+            Ok(None) => self.panel.message = "nothing to focus on there".into(),
+            Err(e) => self.panel.message = format!("focus: {e:#}"),
+        }
+    }
+
     fn frame_size(&self) -> (u32, u32) {
         let s = self.panel.resolution_scale.clamp(0.25, 1.0);
         (((self.config.width as f32 * s) as u32).max(1), ((self.config.height as f32 * s) as u32).max(1))
@@ -392,6 +411,7 @@ impl Running {
         let dt = (now - self.last).as_secs_f64();
         self.last = now;
         self.panel.frame_ms = dt * 1e3;
+        self.fly.lens = self.panel.lens.lens();
         self.fly.update(dt);
         let accumulate = self.panel.settings.accumulate;
         if !self.panel.paused && !accumulate {
@@ -568,6 +588,7 @@ impl Running {
                 }
             }
             WindowEvent::MouseInput { state, button: MouseButton::Right, .. } => self.fly.looking = *state == ElementState::Pressed && !consumed,
+            WindowEvent::MouseInput { state: ElementState::Pressed, button: MouseButton::Middle, .. } if !consumed => self.focus_at_cursor(),
             WindowEvent::CursorMoved { position, .. } => {
                 if let (true, Some((x, y))) = (self.fly.looking, self.cursor) {
                     self.fly.look(position.x - x, position.y - y);

@@ -25,6 +25,31 @@ pub struct Panel {
     /// The frame-time governor (hush_engine::governor): on, its target, the knobs the user
     /// pinned, and what it chose for the last frame.
     pub governor: GovernorPanel,
+    pub lens: LensPanel,
+}
+
+/// The camera's thin lens (depth of field), in scene units.
+pub struct LensPanel {
+    pub on: bool,
+    pub aperture_radius: f32,
+    pub focus_distance: f32,
+    /// The scene's extent, which bounds both sliders.
+    pub extent: f32,
+}
+
+impl LensPanel {
+    /// The scene camera's lens, or (off) a small aperture focused at a quarter of the scene.
+    pub fn new(lens: Option<hush_engine::scene::ThinLens>, extent: f64) -> LensPanel {
+        let extent = (extent as f32).max(1e-6);
+        match lens {
+            Some(l) => LensPanel { on: true, aperture_radius: l.aperture_radius, focus_distance: l.focus_distance, extent },
+            None => LensPanel { on: false, aperture_radius: extent * 2e-3, focus_distance: extent * 0.25, extent },
+        }
+    }
+
+    pub fn lens(&self) -> Option<hush_engine::scene::ThinLens> {
+        self.on.then(|| hush_engine::scene::ThinLens::new(self.aperture_radius as f64, self.focus_distance as f64).ok()).flatten()
+    }
 }
 
 pub struct GovernorPanel {
@@ -69,6 +94,12 @@ impl Panel {
             let c1 = ui.add(egui::Slider::new(az, -180.0..=180.0).text("sun azimuth (deg)")).changed();
             let c2 = ui.add(egui::Slider::new(el, 1.0..=89.0).text("sun elevation (deg)")).changed();
             a.sun_changed = c1 || c2;
+        }
+        let l = &mut self.lens;
+        ui.checkbox(&mut l.on, "depth of field (thin lens)").on_hover_text("The frame then traces k primary rays per pixel through the lens (gbuffer/primaries) and pre-filters their features (prefilter). Middle-click the image to focus on the surface there.");
+        if l.on {
+            ui.add(egui::Slider::new(&mut l.aperture_radius, l.extent * 1e-5..=l.extent * 0.05).logarithmic(true).text("aperture radius"));
+            ui.add(egui::Slider::new(&mut l.focus_distance, l.extent * 1e-4..=l.extent * 2.0).logarithmic(true).text("focus distance"));
         }
         ui.horizontal(|ui| {
             ui.checkbox(&mut self.paused, "pause animation");

@@ -4,9 +4,6 @@
 
 var<storage, read> pr_features: array<vec4u>;
 var<storage, read> pr_moments: array<vec4u>;
-// Per pixel two vec4: the inverse of the smoothed, regularised covariance (xx, xy, xz, yy) and
-// (yz, zz, sigma^2 / n of eq. (6), hits n); written by prefilter/covariance.wgsl.
-var<storage, read_write> pf_inverse: array<vec4f>;
 
 // The filter window Omega_c: 7x7 (§5).
 const WINDOW_RADIUS: i32 = 3;
@@ -57,23 +54,23 @@ fn sym_mul(a: vec4f, b: vec2f, v: vec3f) -> vec3f {
     );
 }
 
-// The inverse covariance S^-1 of pixel i (prefilter/covariance.wgsl).
-struct Inverse {
+// What prefilter/covariance.wgsl keeps per pixel for the later steps, as textures (a texel
+// read is one load per lane on a CPU driver, a storage-buffer read a loop over the lanes):
+// the inverse of the smoothed, regularised covariance, sigma^2 / n of eq. (6), the hits n
+// (0: no usable surface), the mean position and the even samples' mean position.
+struct Stats {
+    // S^-1 as xx, xy, xz, yy and yz, zz.
     a: vec4f,
     b: vec2f,
     sigma2_n: f32,
     n: f32,
+    p: vec3f,
+    p_a: vec3f,
+    n_a: f32,
 }
-
-fn inverse_at(i: u32) -> Inverse {
-    let a = pf_inverse[i * 2u];
-    let b = pf_inverse[i * 2u + 1u];
-    return Inverse(a, b.xy, b.z, b.w);
-}
-
 // Eq. (4): the Mahalanobis distance of p_i from p_c under S_c^-1 + S_i^-1; d.xyz is
 // (S_c^-1 + S_i^-1) delta, d.w the distance.
-fn mahalanobis(c: Inverse, i: Inverse, delta: vec3f) -> vec4f {
+fn mahalanobis(c: Stats, i: Stats, delta: vec3f) -> vec4f {
     let ad = sym_mul(c.a + i.a, c.b + i.b, delta);
     return vec4f(ad, dot(delta, ad));
 }

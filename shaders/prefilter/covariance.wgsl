@@ -9,6 +9,11 @@
 // one standard deviation apart, so a depth step stops the filter while a plane does not.
 const REGULARISATION: f32 = 0.05;
 
+var pf_inv_a: texture_storage_2d<rgba32float, write>;
+var pf_inv_b: texture_storage_2d<rgba32float, write>;
+var pf_position: texture_storage_2d<rgba32float, write>;
+var pf_half: texture_storage_2d<rgba32float, write>;
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     let c = vec2i(gid.xy);
@@ -18,8 +23,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let ci = pixel_index(c);
     let mc = moments_at(ci);
     if mc.n < 1.0 {
-        pf_inverse[ci * 2u] = vec4f(0.0);
-        pf_inverse[ci * 2u + 1u] = vec4f(0.0);
+        textureStore(pf_inv_a, c, vec4f(0.0));
+        textureStore(pf_inv_b, c, vec4f(0.0));
+        textureStore(pf_position, c, vec4f(0.0));
+        textureStore(pf_half, c, vec4f(0.0));
         return;
     }
     var sa = vec4f(0.0);
@@ -67,6 +74,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // sigma^2(p~_c): the per-coordinate variance of the raw samples, the noise of the model
     // p~_c = p_c + eps_c I of §4.4; over n for the variance of their mean.
     let sigma2 = (mc.s_a.x + mc.s_a.w + mc.s_b.y) / 3.0;
-    pf_inverse[ci * 2u] = inv_a;
-    pf_inverse[ci * 2u + 1u] = vec4f(inv_b, sigma2 / mc.n, mc.n);
+    textureStore(pf_inv_a, c, inv_a);
+    textureStore(pf_inv_b, c, vec4f(inv_b, sigma2 / mc.n, mc.n));
+    textureStore(pf_position, c, vec4f(mc.p, 0.0));
+    textureStore(pf_half, c, vec4f(mc.p_a, mc.n_a));
 }

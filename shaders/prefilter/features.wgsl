@@ -1,9 +1,9 @@
 // Pre-filter step 3: the bandwidths SURE chose, smoothed by a Gaussian of 1.5 pixels (§5: they
 // "can be very noisy"), filter every feature with the same world-position weights (eq. (1), (3),
 // (4)): normal, view depth, base colour and metallic, F0 and roughness, emission and f90. Motion
-// and ids pass unchanged. The variance of the filtered normal and depth comes from dual buffers
-// (§5, after Rousselle et al. 2013): the features filtered once with the weights of the even
-// samples' positions and once with the odd samples', their squared difference over 4.
+// and ids pass unchanged. The variance of the filtered normal comes from dual buffers (§5, after
+// Rousselle et al. 2013): the features filtered once with the weights of the even samples'
+// positions and once with the odd samples', their squared difference over 4.
 
 var<storage, read> pf_bandwidth: array<f32>;
 var<storage, read_write> pf_features: array<vec4u>;
@@ -13,26 +13,25 @@ var pf_view: texture_storage_2d<rgba16float, write>;
 // xy the raw octahedral normal, zw the filtered one.
 var pf_normals: texture_storage_2d<rgba16float, write>;
 
+// A tap below this weight adds nothing visible (and its features are not read).
+const MIN_WEIGHT: f32 = 1e-4;
+
 fn feature(i: u32, w: u32) -> vec4f {
     return bitcast<vec4f>(pr_features[i * 5u + w]);
-}
-
-// A pixel the filter may take from: a surface, with finite statistics and features.
-fn usable(i: u32) -> bool {
-    var ok = moments_at(i).n >= 1.0;
-    for (var w = 0u; w < 4u; w++) {
-        ok = ok && finite4(feature(i, w));
-    }
-    return ok;
 }
 
 fn finite_or_zero(v: vec4f) -> vec4f {
     return select(vec4f(0.0), v, finite4(v));
 }
 
-fn odd_position(m: Moments) -> vec3f {
-    let n_b = m.n - m.n_a;
-    return select(m.p, (m.p * m.n - m.p_a * m.n_a) / max(n_b, 1.0), n_b >= 1.0);
+fn features_finite(i: u32) -> bool {
+    return finite4(feature(i, 0u)) && finite4(feature(i, 1u)) && finite4(feature(i, 2u)) && finite4(feature(i, 3u));
+}
+
+// The odd samples' mean position, from the mean of all and of the even ones.
+fn odd_position(s: Stats) -> vec3f {
+    let n_b = s.n - s.n_a;
+    return select(s.p, (s.p * s.n - s.p_a * s.n_a) / max(n_b, 1.0), n_b >= 1.0);
 }
 
 fn oct_of(n: vec3f) -> vec2f {
@@ -47,15 +46,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let ci = pixel_index(c);
-    // Unfiltered (and non-finite values zeroed) unless the filter below replaces them.
+    // Unfiltered (non-finite values zeroed) unless the filter below replaces them.
     for (var w = 0u; w < 4u; w++) {
         pf_features[ci * 5u + w] = bitcast<vec4u>(finite_or_zero(feature(ci, w)));
     }
     pf_features[ci * 5u + 4u] = pr_features[ci * 5u + 4u];
-    let mc = moments_at(ci);
-    let ic = inverse_at(ci);
+    let sc = stats_at(c);
     let raw_n = finite_or_zero(feature(ci, 0u));
-    if !usable(ci) || ic.n < 1.0 {
+    if sc.n < 1.0 || !features_finite(ci) {
         textureStore(pf_view, c, vec4f(0.0));
         textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), oct_of(raw_n.xyz)));
         return;
@@ -66,7 +64,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     for (var dy = -WINDOW_RADIUS; dy <= WINDOW_RADIUS; dy++) {
         for (var dx = -WINDOW_RADIUS; dx <= WINDOW_RADIUS; dx++) {
             let q = c + vec2i(dx, dy);
-            if !inside(q) || !usable(pixel_index(q)) {
+            if !inside(q) || textureLoad(pf_inv_b, q, 0).w < 1.0 {
                 continue;
             }
             let g = exp(-f32(dx * dx + dy * dy) / (2.0 * SMOOTH_SIGMA * SMOOTH_SIGMA));
@@ -75,7 +73,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
     }
     h /= g_sum;
-    let spread = sqrt(max(mc.s_a.x + mc.s_a.w + mc.s_b.y, 0.0)) / max(pixel_footprint(mc.p), 1e-30);
+    let cov_trace = 3.0 * sc.sigma2_n * sc.n;
+    let spread = sqrt(max(cov_trace, 0.0)) / max(pixel_footprint(sc.p), 1e-30);
     var variance = 0.0;
     if h >= 0.05 {
         var sum_w = 0.0;
@@ -87,28 +86,30 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var w_ab = vec2f(0.0);
         var nd_a = vec4f(0.0);
         var nd_b = vec4f(0.0);
-        let pb_c = odd_position(mc);
+        let pb_c = odd_position(sc);
         for (var dy = -WINDOW_RADIUS; dy <= WINDOW_RADIUS; dy++) {
             for (var dx = -WINDOW_RADIUS; dx <= WINDOW_RADIUS; dx++) {
                 let q = c + vec2i(dx, dy);
                 if !inside(q) {
                     continue;
                 }
-                let qi = pixel_index(q);
-                if !usable(qi) {
+                let sq = stats_at(q);
+                if sq.n < 1.0 {
                     continue;
                 }
-                let m = moments_at(qi);
-                let iq = inverse_at(qi);
-                let wi = weight(mahalanobis(ic, iq, m.p - mc.p).w, h);
+                let wi = weight(mahalanobis(sc, sq, sq.p - sc.p).w, h);
+                let wa = weight(mahalanobis(sc, sq, sq.p_a - sc.p_a).w, h);
+                let wb = weight(mahalanobis(sc, sq, odd_position(sq) - pb_c).w, h);
+                let qi = pixel_index(q);
+                if max(wi, max(wa, wb)) < MIN_WEIGHT || !features_finite(qi) {
+                    continue;
+                }
                 let nd = feature(qi, 0u);
                 sum_w += wi;
                 normal_depth += wi * nd;
                 base += wi * feature(qi, 1u);
                 spec += wi * feature(qi, 2u);
                 emission += wi * feature(qi, 3u);
-                let wa = weight(mahalanobis(ic, iq, m.p_a - mc.p_a).w, h);
-                let wb = weight(mahalanobis(ic, iq, odd_position(m) - pb_c).w, h);
                 w_ab += vec2f(wa, wb);
                 nd_a += wa * nd;
                 nd_b += wb * nd;
@@ -120,7 +121,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         pf_features[f + 1u] = bitcast<vec4u>(base * inv);
         pf_features[f + 2u] = bitcast<vec4u>(spec * inv);
         pf_features[f + 3u] = bitcast<vec4u>(emission * inv);
-        let diff = nd_a / w_ab.x - nd_b / w_ab.y;
+        let diff = nd_a / max(w_ab.x, 1e-30) - nd_b / max(w_ab.y, 1e-30);
         variance = dot(diff.xyz, diff.xyz) / 4.0;
     }
     let filtered = bitcast<vec4f>(pf_features[ci * 5u]);

@@ -22,9 +22,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let ci = pixel_index(c);
-    let mc = moments_at(ci);
-    let ic = inverse_at(ci);
-    if mc.n < 1.0 || ic.n < 1.0 {
+    let sc = stats_at(c);
+    if sc.n < 1.0 {
         pf_bandwidth[ci] = 0.0;
         return;
     }
@@ -38,13 +37,12 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             if !inside(q) {
                 continue;
             }
-            let qi = pixel_index(q);
-            let m = moments_at(qi);
-            if m.n < 1.0 {
+            let sq = stats_at(q);
+            if sq.n < 1.0 {
                 continue;
             }
-            let delta = m.p - mc.p;
-            let md = mahalanobis(ic, inverse_at(qi), delta);
+            let delta = sq.p - sc.p;
+            let md = mahalanobis(sc, sq, delta);
             for (var b = 0u; b < BANDWIDTHS; b++) {
                 let w = weight(md.w, bandwidth(b));
                 w_sum[b] += w;
@@ -56,13 +54,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     // h = 0: no filtering, the error is the input's variance.
     var best_h = 0.0;
-    var best = ic.sigma2_n;
+    var best = sc.sigma2_n;
     for (var b = 0u; b < BANDWIDTHS; b++) {
         let h = bandwidth(b);
         let inv_w = 1.0 / w_sum[b];
         let m = delta_sum[b] * inv_w;
         let div = (3.0 + (wd_sum[b] - dot(m, ad_sum[b])) / (h * h)) * inv_w;
-        let sure = dot(m, m) / 3.0 - ic.sigma2_n + 2.0 * ic.sigma2_n * div / 3.0;
+        let sure = dot(m, m) / 3.0 - sc.sigma2_n + 2.0 * sc.sigma2_n * div / 3.0;
         if sure < best {
             best = sure;
             best_h = h;

@@ -50,6 +50,10 @@ pub struct BenchArgs {
     /// passes) to this `.puffin` file (open it with puffin_viewer).
     #[arg(long)]
     pub profile: Option<std::path::PathBuf>,
+    /// Real-time mode: the camera, as `render --camera` takes it ("eye=x,y,z;target=x,y,z;fov=deg",
+    /// with ";aperture=r;focus=d" for a thin lens); default the scene's.
+    #[arg(long)]
+    pub camera: Option<String>,
     #[command(flatten)]
     pub load: crate::render::LoadArgs,
 }

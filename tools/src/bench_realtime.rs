@@ -75,7 +75,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Some(p) => FrameSettings { max_depth: crate::realtime::path_length(None, Some(p), r.scene.max_depth)?, ..crate::realtime::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)? },
         None => FrameSettings { max_depth: r.scene.max_depth, ..crate::realtime::denoiser_settings(a.denoiser.as_deref().unwrap_or("mara"), &[], "diamond")? },
     };
-    let camera = r.scene.camera_or_default();
+    let camera = match &a.camera {
+        Some(c) => crate::render::parse_camera(c)?,
+        None => r.scene.camera_or_default(),
+    };
     let mut per_pass: Vec<(&'static str, Vec<f64>)> = vec![];
     let (mut totals, mut cpu, mut record) = (vec![], vec![], vec![]);
     let mut capture = None;

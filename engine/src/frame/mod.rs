@@ -143,8 +143,9 @@ impl PreparedScene {
         // The supersampling's samples pass binds the trace's buffers and two of its own.
         r.max_storage_buffers_per_shader_stage += 2;
         r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
-        // matte, direct, and with a glossy lobe glossy, reflection, mirror and mirror hit.
-        r.max_storage_textures_per_shader_stage = if self.features.glossy { 6 } else { 2 };
+        // matte, direct, and with a glossy lobe glossy, reflection, mirror and mirror hit; the
+        // pre-filter's covariance step writes 4 (WebGPU's default).
+        r.max_storage_textures_per_shader_stage = if self.features.glossy { 6 } else { 4 };
         // TAA reads the most: the G-buffer (7), the trace's outputs (2, +4 glossy), its four
         // histories and the denoiser's light it follows (2, +3 glossy): 22 in a glossy scene
         // (WebGPU's default is 16; desktop Vulkan, Metal and D3D12 adapters offer far more).
@@ -284,7 +285,7 @@ impl Renderer {
     }
 
     /// Near plane: 2^-14 of the scene's extent (reversed Z keeps depth precise far beyond it).
-    fn near(&self) -> f32 {
+    pub(crate) fn near(&self) -> f32 {
         (self.prepared.extent * 2f64.powi(-14)) as f32
     }
 

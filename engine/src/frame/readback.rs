@@ -97,6 +97,21 @@ impl Renderer {
         Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
     }
 
+    /// The view depth (scene units along the view axis) of the last frame's surface at `pixel`,
+    /// from the G-buffer's depth (with a thin lens, the mean over the pixel's primary samples);
+    /// None where there is no surface. The viewer's click-to-focus.
+    pub fn view_depth_at(&self, gpu: &Gpu, pixel: (u32, u32)) -> Result<Option<f64>> {
+        let (w, h) = self.targets.size;
+        if pixel.0 >= w || pixel.1 >= h {
+            return Ok(None);
+        }
+        let (bytes, _) = self.read_texture(gpu, "gbuffer/depth")?;
+        let i = (pixel.1 * w + pixel.0) as usize * 4;
+        let d = f32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
+        // Reversed infinite Z: depth = near / view depth, 0 where nothing was drawn.
+        Ok((d > 0.0 && d.is_finite()).then(|| self.near() as f64 / d as f64))
+    }
+
     /// The bytes of the frame's buffer labelled `name` (`supersample/samples`, ...).
     pub fn read_buffer(&self, gpu: &Gpu, name: &str) -> Result<Vec<u8>> {
         let b = self.targets.memory.find_buffer(name).with_context(|| {

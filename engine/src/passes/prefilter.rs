@@ -5,8 +5,8 @@
 //! the bandwidths and filters the features with the world-position weights (eq. 1, 3, 4) into a
 //! buffer of the primaries' layout, which `gbuffer/resolve` writes as the G-buffer.
 //!
-//! Per pixel: 32 bytes of inverse covariances, 4 of bandwidths, 80 of filtered features and 16
-//! of debug views (132 bytes).
+//! Per pixel: 64 bytes of statistics, 4 of bandwidths, 80 of filtered features and 16 of debug
+//! views (164 bytes).
 
 use super::chain::ChainStage;
 use super::primaries::{FEATURE_WORDS, PrimaryTargets};
@@ -22,7 +22,9 @@ pub const FEATURES: &str = "prefilter/features";
 
 pub struct PrefilterTargets {
     pub epoch: u64,
-    pub inverse: wgpu::Buffer,
+    /// The covariance step's statistics for the later steps (prefilter/stats.wgsl): the inverse
+    /// covariance (two textures), the mean position and the even samples' mean position.
+    pub stats: [Tex; 4],
     pub bandwidth: wgpu::Buffer,
     /// The filtered features, in the primaries' layout.
     pub features: wgpu::Buffer,
@@ -42,7 +44,7 @@ impl PrefilterTargets {
         let tex = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
         PrefilterTargets {
             epoch,
-            inverse: mem.buffer(d, "prefilter/inverse covariance", pixels * 32, usage),
+            stats: ["prefilter/inverse covariance a", "prefilter/inverse covariance b", "prefilter/position", "prefilter/even position"].map(|l| mem.texture(d, l, size, wgpu::TextureFormat::Rgba32Float, tex)),
             bandwidth: mem.buffer(d, "prefilter/bandwidth", pixels * 4, usage),
             features: mem.buffer(d, "prefilter/features", pixels * FEATURE_WORDS * 16, usage),
             view: mem.texture(d, "prefilter/view", size, wgpu::TextureFormat::Rgba16Float, tex),
@@ -57,11 +59,24 @@ pub fn bindings<'a>(frame: &'a wgpu::Buffer, p: &'a PrimaryTargets, t: &'a Prefi
         .buffer("frame", frame)
         .buffer("pr_features", &p.features)
         .buffer("pr_moments", &p.moments)
-        .buffer("pf_inverse", &t.inverse)
+        .texture("pf_inv_a", &t.stats[0].1)
+        .texture("pf_inv_b", &t.stats[1].1)
+        .texture("pf_position", &t.stats[2].1)
+        .texture("pf_half", &t.stats[3].1)
         .buffer("pf_bandwidth", &t.bandwidth)
         .buffer("pf_features", &t.features)
         .texture("pf_view", &t.view.1)
         .texture("pf_normals", &t.normals.1)
+}
+
+/// The modules of a pre-filter step (`prefilter/covariance.wgsl`, `sure.wgsl`, `features.wgsl`).
+pub fn modules(step: &'static str) -> Vec<&'static str> {
+    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "prefilter/common.wgsl"];
+    if step != "prefilter/covariance.wgsl" {
+        m.push("prefilter/stats.wgsl");
+    }
+    m.push(step);
+    m
 }
 
 #[derive(Default)]
@@ -78,7 +93,7 @@ impl Prefilter {
     /// have been replaced.
     pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, size: (u32, u32), offered: &Bindings, mut timer: Option<&mut GpuTimer>) -> Result<()> {
         if self.stages.is_none() {
-            let stage = |label, file| ChainStage::new(gpu, label, &["common/math.wgsl", "realtime/frame.wgsl", "prefilter/common.wgsl", file], "main", offered);
+            let stage = |label, file| ChainStage::new(gpu, label, &modules(file), "main", offered);
             self.stages = Some([stage(COVARIANCE, "prefilter/covariance.wgsl")?, stage(SURE, "prefilter/sure.wgsl")?, stage(FEATURES, "prefilter/features.wgsl")?]);
         }
         for s in self.stages.as_mut().unwrap() {

@@ -82,6 +82,7 @@ embed!(
     "realtime/primaries_resolve.wgsl",
     "prefilter/common.wgsl",
     "prefilter/covariance.wgsl",
+    "prefilter/stats.wgsl",
     "prefilter/sure.wgsl",
     "prefilter/features.wgsl",
     "matte/common.wgsl",
@@ -322,7 +323,7 @@ mod tests {
         }
         v.push(compose("gbuffer/resolve", "", &["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"]).unwrap());
         for stage in ["prefilter/covariance.wgsl", "prefilter/sure.wgsl", "prefilter/features.wgsl"] {
-            v.push(compose(stage, "", &["common/math.wgsl", "realtime/frame.wgsl", "prefilter/common.wgsl", stage]).unwrap());
+            v.push(compose(stage, "", &crate::passes::prefilter::modules(stage)).unwrap());
         }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             // A scene sets the traversal's stack length (accel::traversal_stack).
