@@ -43,7 +43,7 @@ fn strafed(s: &FrameSettings, at: &impl Fn(u32) -> Camera, moving: u32) -> (hush
 
 fn frames(r: &mut Renderer, gpu: &hush_engine::gpu::Gpu, s: &FrameSettings, camera: Camera, n: u32) -> Image {
     for _ in 0..n {
-        r.render(gpu, &FrameInput { camera, time: 0.0 }, s, None).unwrap();
+        r.render(gpu, &FrameInput { camera, time: 0.0, shutter: None }, s, None).unwrap();
     }
     r.read_hdr(gpu).unwrap()
 }

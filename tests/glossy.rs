@@ -124,8 +124,8 @@ fn virtual_position_of_a_plane_mirror_is_analytic() {
     s.taa.enabled = false; // samples at pixel centres
     s.glossy.reflection_mv = ReflectionMv::Diamond;
     let (before, now) = (camera(-0.15), camera(0.15));
-    r.render(&gpu, &FrameInput { camera: before, time: 0.0 }, &s, None).unwrap();
-    r.render(&gpu, &FrameInput { camera: now, time: 0.0 }, &s, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: before, time: 0.0, shutter: None }, &s, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: now, time: 0.0, shutter: None }, &s, None).unwrap();
     let (motion, _) = r.read_texture(&gpu, "glossy/motion").unwrap();
     let motion: &[[f32; 4]] = bytemuck::cast_slice(&motion);
     let (glossy, _) = r.read_texture(&gpu, "trace/glossy").unwrap();
@@ -190,7 +190,7 @@ fn a_static_view_keeps_its_reflections_still() {
     let mut s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     s.glossy.reflection_mv = ReflectionMv::Diamond;
     for _ in 0..4 {
-        r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0 }, &s, None).unwrap();
+        r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0, shutter: None }, &s, None).unwrap();
     }
     let (motion, _) = r.read_texture(&gpu, "glossy/motion").unwrap();
     let motion: &[[f32; 4]] = bytemuck::cast_slice(&motion);
@@ -214,7 +214,7 @@ fn glossy_bilateral_sigma() {
     let size = (96u32, 54u32);
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
     let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
-    r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0 }, &s, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0, shutter: None }, &s, None).unwrap();
     let (scratch, _) = r.read_texture(&gpu, "glossy/scratch").unwrap();
     let (specular, _) = r.read_texture(&gpu, "gbuffer/specular").unwrap();
     let (ids, _) = r.read_texture(&gpu, "gbuffer/ids").unwrap();
@@ -261,11 +261,11 @@ fn glossy_history_stays_on_its_face() {
     let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     let warm = 7;
     for _ in 0..warm {
-        r.render(&gpu, &FrameInput { camera: cam, time: 0.0 }, &s, None).unwrap();
+        r.render(&gpu, &FrameInput { camera: cam, time: 0.0, shutter: None }, &s, None).unwrap();
     }
     let read = |r: &Renderer, n: &str| r.read_texture(&gpu, n).unwrap().0;
     let (depth0, normal0) = (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"));
-    r.render(&gpu, &FrameInput { camera: cam, time: 0.0 }, &s, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: cam, time: 0.0, shutter: None }, &s, None).unwrap();
     let (depth1, normal1, info) = (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"), read(&r, "glossy/info"));
     let setup = r.camera_setup(&cam);
     let (inv0, inv1) = (setup.jittered(halton_jitter(warm - 1), size).inverse(), setup.jittered(halton_jitter(warm), size).inverse());

@@ -368,7 +368,7 @@ fn primaries_covariance_matches_the_thin_lens() {
     let (gpu, mut renderer) = Renderer::headless(scene, hush_engine::accel::BvhKind::DEFAULT, (size, size)).unwrap();
     let n = 64u32;
     let settings = hush_engine::settings::FrameSettings { primary_samples: n, prefilter: false, ..Default::default() };
-    renderer.render(&gpu, &FrameInput { camera, time: 0.0 }, &settings, None).unwrap();
+    renderer.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, &settings, None).unwrap();
     let moments: Vec<f32> = bytemuck::cast_slice(&renderer.read_buffer(&gpu, "primaries/moments").unwrap()).to_vec();
     let pixels = (size * size) as usize;
     let mean = |k: usize| (0..pixels).map(|i| moments[i * 16 + k] as f64).sum::<f64>() / pixels as f64;
@@ -416,7 +416,7 @@ fn prefiltered_gbuffer_is_closer_to_the_converged_one() {
     // features and the positions' spread in pixels.
     let run = |settings: &FrameSettings| {
         let (gpu, mut r) = Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, size).unwrap();
-        r.render(&gpu, &FrameInput { camera, time: 0.0 }, settings, None).unwrap();
+        r.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, settings, None).unwrap();
         let floats = |b: Vec<u8>| -> Vec<f32> { bytemuck::cast_slice(&b).to_vec() };
         let raw = floats(r.read_buffer(&gpu, "primaries/features").unwrap());
         let filtered = r.read_buffer(&gpu, "prefilter/features").map(floats).unwrap_or_default();

@@ -37,7 +37,7 @@ fn light(r: &Renderer, gpu: &hush_engine::gpu::Gpu) -> Vec<[u8; 16]> {
 #[test]
 fn the_trace_writes_exactly_the_scheduled_pixels() {
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let input = FrameInput { camera: view(), time: 0.0 };
+    let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
     let mut index = 1u32;
     let mut before = light(&r, &gpu);
@@ -71,7 +71,7 @@ fn the_trace_writes_exactly_the_scheduled_pixels() {
 #[test]
 fn denoisers_that_need_every_pixel_refuse_fractions() {
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let input = FrameInput { camera: view(), time: 0.0 };
+    let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let quarter = SampleFraction::one_in(4).unwrap();
     for name in ["mara", "svgf"] {
         let s = FrameSettings { denoiser: Denoiser::named(name), sample_fraction: quarter, ..Default::default() };
@@ -114,7 +114,7 @@ fn progressive(period: u32, p: ProgressiveSettings) -> FrameSettings {
 #[test]
 fn missing_samples_leave_history_and_moments_unchanged() {
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let input = FrameInput { camera: view(), time: 0.0 };
+    let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     // a = 0.4 takes over from 1 / age at the third sample, within the test's 10 frames.
     let a = 0.4;
     let s = progressive(4, ProgressiveSettings { still_samples: 0.0, alpha: a as f32, ..Default::default() });
@@ -185,7 +185,7 @@ fn missing_samples_leave_history_and_moments_unchanged() {
 #[test]
 fn an_atrous_level_matches_a_cpu_implementation() {
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let input = FrameInput { camera: view(), time: 0.0 };
+    let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let p = ProgressiveSettings { levels: 1, ..Default::default() };
     let s = progressive(1, p.clone());
     for _ in 0..6 {
@@ -257,7 +257,7 @@ fn an_atrous_level_matches_a_cpu_implementation() {
 #[test]
 fn progressive_nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let input = FrameInput { camera: view(), time: 0.0 };
+    let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let mut cases = vec![];
     for period in [1, 4] {
         let base = FrameSettings { matte: MatteSettings { inject_nonfinite: true, ..Default::default() }, ..progressive(period, Default::default()) };

@@ -88,7 +88,7 @@ fn a_diffuse_only_scene_allocates_no_glossy_buffers() {
     }
     // G-buffer 36 + matte 8 + direct 8 + HDR 16 bytes per pixel.
     assert_eq!(r.bytes_per_pixel(), 68.0, "{}", r.report());
-    let input = FrameInput { camera: r.scene.camera_or_default(), time: 0.0 };
+    let input = FrameInput { camera: r.scene.camera_or_default(), time: 0.0, shutter: None };
     r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
     assert!(r.read_texture(&gpu, "trace/glossy").is_err());
     let img = r.read_hdr(&gpu).unwrap();
@@ -119,10 +119,10 @@ fn motion_vectors_follow_camera_and_object_motion() {
     let cam0 = Camera::look_at(DVec3::new(1.8, 1.6, 3.2), DVec3::new(0.0, 1.4, 0.0), 50.0);
     let cam1 = Camera::look_at(DVec3::new(1.6, 1.65, 3.0), DVec3::new(0.05, 1.45, 0.0), 50.0);
     let (t0, t1) = (0.30, 0.35);
-    r.render(&gpu, &FrameInput { camera: cam0, time: t0 }, &settings, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: cam0, time: t0, shutter: None }, &settings, None).unwrap();
     let ids0 = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
     let setup0 = r.camera_setup(&cam0);
-    r.render(&gpu, &FrameInput { camera: cam1, time: t1 }, &settings, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: cam1, time: t1, shutter: None }, &settings, None).unwrap();
     let ids1 = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
     let motion = r.read_texture(&gpu, "gbuffer/motion").unwrap().0;
     let setup1 = r.camera_setup(&cam1);
@@ -203,7 +203,7 @@ fn the_default_level_renders_without_nan() {
         // Off by default; on here so that the glossy/clipping view has something to show.
         denoised.glossy.clipping = true;
         for k in 0..3 {
-            let input = FrameInput { camera: r.scene.camera_or_default(), time: 1.0 + k as f64 / 60.0 };
+            let input = FrameInput { camera: r.scene.camera_or_default(), time: 1.0 + k as f64 / 60.0, shutter: None };
             r.render(&gpu, &input, &denoised, None).unwrap();
             let img = r.read_hdr(&gpu).unwrap();
             assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in the default level with {}", entry.name);
@@ -243,7 +243,7 @@ fn the_default_level_gltf_loads_and_renders_without_nan() {
     }
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (64, 36)).unwrap();
     for k in 0..3 {
-        let input = FrameInput { camera: r.scene.camera_or_default(), time: k as f64 * 0.5 };
+        let input = FrameInput { camera: r.scene.camera_or_default(), time: k as f64 * 0.5, shutter: None };
         r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
         let img = r.read_hdr(&gpu).unwrap();
         assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in frame {k}");
@@ -270,7 +270,7 @@ fn the_committed_level_matches_the_generator() {
 fn punctual_direct_light_carries_no_noise() {
     let scene = hush_engine::scene::default_level();
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (64, 36)).unwrap();
-    let input = FrameInput { camera: r.scene.camera_or_default(), time: 0.0 };
+    let input = FrameInput { camera: r.scene.camera_or_default(), time: 0.0, shutter: None };
     let s = FrameSettings::default();
     let mut direct = vec![];
     let mut matte = vec![];

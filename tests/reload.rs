@@ -42,7 +42,7 @@ fn renderer(shaders: &Path) -> (Gpu, Renderer) {
 fn frame(gpu: &Gpu, r: &mut Renderer) -> image::RgbaImage {
     let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     let camera = Camera::look_at(DVec3::new(0.0, 1.5, 4.0), DVec3::new(0.0, 0.5, 0.0), 60.0);
-    r.render(gpu, &FrameInput { camera, time: 0.0 }, &s, None).unwrap();
+    r.render(gpu, &FrameInput { camera, time: 0.0, shutter: None }, &s, None).unwrap();
     r.display_image(gpu, &s).unwrap()
 }
 
@@ -183,7 +183,7 @@ fn pass_times_arrive_without_waiting() {
     let camera = r.scene.camera_or_default();
     let mut got = vec![];
     for k in 0..6 {
-        r.render(&gpu, &FrameInput { camera, time: k as f64 / 60.0 }, &s, None).unwrap();
+        r.render(&gpu, &FrameInput { camera, time: k as f64 / 60.0, shutter: None }, &s, None).unwrap();
         got.extend(r.poll_pass_spans(&gpu));
     }
     let blocking: Vec<&str> = r.pass_spans(&gpu).unwrap().iter().map(|s| s.label).collect();

@@ -20,7 +20,7 @@ fn view() -> Camera {
 
 fn frames(r: &mut Renderer, gpu: &Gpu, s: &FrameSettings, n: u32) -> Image {
     for _ in 0..n {
-        r.render(gpu, &FrameInput { camera: view(), time: 0.0 }, s, None).unwrap();
+        r.render(gpu, &FrameInput { camera: view(), time: 0.0, shutter: None }, s, None).unwrap();
     }
     r.read_hdr(gpu).unwrap()
 }

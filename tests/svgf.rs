@@ -30,7 +30,7 @@ fn svgf() -> FrameSettings {
 
 fn frames(r: &mut Renderer, gpu: &Gpu, s: &FrameSettings, camera: Camera, n: u32) -> Image {
     for _ in 0..n {
-        r.render(gpu, &FrameInput { camera, time: 0.0 }, s, None).unwrap();
+        r.render(gpu, &FrameInput { camera, time: 0.0, shutter: None }, s, None).unwrap();
     }
     r.read_hdr(gpu).unwrap()
 }

@@ -417,10 +417,10 @@ impl Running {
         if !self.panel.paused && !accumulate {
             self.panel.time += dt;
         }
-        let mut input = FrameInput { camera: self.fly.camera(), time: self.panel.time };
+        let mut input = FrameInput { camera: self.fly.camera(), time: self.panel.time, shutter: None };
         if let (Some(i), Some(p)) = (self.playback, &self.path) {
             let key = p.frame(i);
-            input = FrameInput { camera: key.camera(), time: key.time };
+            input = FrameInput { camera: key.camera(), time: key.time, shutter: None };
             self.playback = if i + 1 < p.keys.len() { Some(i + 1) } else { None };
             self.panel.playing = self.playback.is_some();
         }

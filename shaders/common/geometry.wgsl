@@ -37,9 +37,9 @@ fn tri_material(slot: u32) -> u32 {
 // Möller-Trumbore, both faces (sidedness is decided by the shader that shades the hit).
 // Returns (t, b1, b2) with t = INF on a miss.
 fn intersect_triangle(o: vec3f, d: vec3f, slot: u32, tmax: f32) -> vec3f {
-    let v0 = tri_texel(slot * 3u).xyz;
-    let e1 = tri_texel(slot * 3u + 1u).xyz - v0;
-    let e2 = tri_texel(slot * 3u + 2u).xyz - v0;
+    let v0 = tri_vertex(slot * 3u);
+    let e1 = tri_vertex(slot * 3u + 1u) - v0;
+    let e2 = tri_vertex(slot * 3u + 2u) - v0;
     let pv = cross(d, e2);
     let det = dot(e1, pv);
     if abs(det) < 1e-30 {

@@ -26,6 +26,13 @@ struct Params {
     lens: vec4f,
     // x: samples per pixel this dispatch traces (the reference tracer), from sample_index on.
     batch: vec4u,
+    // The camera at the shutter's open (cam_* are at its close; the same without motion blur).
+    cam_open_pos: vec4f,
+    cam_open_right: vec4f,
+    cam_open_up: vec4f,
+    cam_open_fwd: vec4f,
+    // x: 1 where each path sees the scene at a random time in the shutter, 0: all at the close.
+    shutter: vec4f,
 }
 
 var<uniform> params: Params;

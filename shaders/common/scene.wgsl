@@ -66,9 +66,9 @@ struct Surface {
 
 fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     let slot = hit.tri;
-    let v0 = tri_texel(slot * 3u).xyz;
-    let e1 = tri_texel(slot * 3u + 1u).xyz - v0;
-    let e2 = tri_texel(slot * 3u + 2u).xyz - v0;
+    let v0 = tri_vertex(slot * 3u);
+    let e1 = tri_vertex(slot * 3u + 1u) - v0;
+    let e2 = tri_vertex(slot * 3u + 2u) - v0;
     var s: Surface;
     s.material = tri_material(slot);
     s.p = v0 + hit.b.x * e1 + hit.b.y * e2;
@@ -76,7 +76,8 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     s.front = dot(ng, rd) < 0.0;
     var ns = tri_normal(slot, hit.b);
     let len = length(ns);
-    ns = select(ng, ns / len, len > 1e-12 && len < 1e30);
+    let stored = len > 1e-12 && len < 1e30;
+    ns = select(ng, ns / len, stored);
     if !s.front {
         ng = -ng;
         ns = -ns;
@@ -84,6 +85,11 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     s.uv = tri_uv(slot, hit.b);
     s.ng = ng;
     s.ns = apply_normal_map(slot, hit.b, ns, s.uv, material(s.material));
+    if stored {
+        // The stored normals (and tangents) are the close's: the mapped normal turns with the
+        // triangle to the ray's time where objects move during the shutter.
+        s.ns = normal_at_ray_time(slot, s.ns);
+    }
     return s;
 }
 

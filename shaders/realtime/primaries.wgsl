@@ -5,7 +5,10 @@
 // the pre-filter needs (§4.2-4.3, appendix B). Sample 0's triangle is the pixel's id: the trace
 // continues its path from that hit (trace.wgsl re-derives it from the same ray).
 //
-// Without motion blur, M of eq. (2) is the identity: a world position sample is the hit point.
+// Eq. (2): a world position sample is the hit point carried by its object's motion to the
+// shutter's close (common/motion_*.wgsl: compensated_position; the hit itself without motion
+// blur), so that a moving object's samples spread along its motion only as far as the camera
+// and the lens spread them, and the covariance shows the motion's direction (§4.2).
 //
 // Per pixel, as u32 words (floats bitcast) so that ids pass unchanged:
 //   pr_features (the G-buffer, realtime/primaries_resolve.wgsl writes it into the targets):
@@ -72,7 +75,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if j == 0u {
             ids = vec2u(object, hit.tri);
         }
-        let p = s.p;
+        let p = compensated_position(hit.tri, hit.b, s.p);
         if n == 0.0 {
             origin = p;
         }

@@ -183,9 +183,9 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
 // The raster's hit of pixel px's camera ray rd: its triangle (slot), with exact barycentrics of
 // this frame's ray (no bounds test: at a silhouette the sample may sit a hair outside it).
 fn raster_hit(ro: vec3f, rd: vec3f, slot: u32) -> Hit {
-    let v0 = tris[slot * 3u].xyz;
-    let e1 = tris[slot * 3u + 1u].xyz - v0;
-    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    let v0 = tri_vertex(slot * 3u);
+    let e1 = tri_vertex(slot * 3u + 1u) - v0;
+    let e2 = tri_vertex(slot * 3u + 2u) - v0;
     let pv = cross(rd, e2);
     let inv = 1.0 / dot(e1, pv);
     let tv = ro - v0;

@@ -34,7 +34,7 @@ pub fn render_with(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32, kind: Bvh
     let prepared = PreparedScene::new(scene, kind)?;
     let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
-    let view = TraceView { camera: scene.camera_or_default(), width: w, height: h, max_depth: scene.max_depth, seed };
+    let view = TraceView { camera: scene.camera_or_default(), width: w, height: h, max_depth: scene.max_depth, seed, shutter_camera: None };
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     let mut done = 0;
     while done < spp {
@@ -58,7 +58,7 @@ pub fn realtime_accumulate(scene: &Scene, w: u32, h: u32, frames: u32, seed: u32
 pub fn realtime_frames(scene: &Scene, size: (u32, u32), settings: &hush_engine::settings::FrameSettings, frames: u32) -> Result<hush_engine::quality::Image> {
     use hush_engine::frame::{FrameInput, Renderer};
     let (gpu, mut r) = Renderer::headless(scene.clone(), BvhKind::DEFAULT, size)?;
-    let input = FrameInput { camera: scene.camera_or_default(), time: 0.0 };
+    let input = FrameInput { camera: scene.camera_or_default(), time: 0.0, shutter: None };
     for _ in 0..frames {
         r.render(&gpu, &input, settings, None)?;
     }

@@ -185,6 +185,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
             height: a.height,
             max_depth: scene.max_depth,
             seed: 0,
+            shutter_camera: None,
         };
         let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
         tracer.dispatch(&gpu, 1);

@@ -87,7 +87,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         if k == 2 && a.profile.is_some() {
             capture = Some(hush_engine::profile::Capture::start(a.frames as usize));
         }
-        let input = FrameInput { camera, time: k as f64 / 60.0 };
+        let input = FrameInput { camera, time: k as f64 / 60.0, shutter: None };
         let start = Instant::now();
         {
             puffin::profile_scope!("frame");

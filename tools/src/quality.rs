@@ -213,8 +213,8 @@ pub fn run(a: QualityArgs) -> Result<()> {
     };
     let inputs: Vec<FrameInput> = (0..a.frames as usize)
         .map(|k| match &path {
-            Some(p) => FrameInput { camera: p.frame(k).camera(), time: p.frame(k).time },
-            None => FrameInput { camera, time: if a.fps > 0.0 { k as f64 / a.fps } else { 0.0 } },
+            Some(p) => FrameInput { camera: p.frame(k).camera(), time: p.frame(k).time, shutter: None },
+            None => FrameInput { camera, time: if a.fps > 0.0 { k as f64 / a.fps } else { 0.0 }, shutter: None },
         })
         .collect();
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;

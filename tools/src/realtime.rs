@@ -53,6 +53,20 @@ fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[Strin
     Ok(s)
 }
 
+/// Frame `k`'s input: the camera path's key k (its time; the shutter a fraction of the interval
+/// since the key before, the camera at the open interpolated along the path), or the still
+/// `camera` at `time` (the interval 1 / fps).
+fn frame_input(path: Option<&CameraPath>, camera: hush_engine::scene::Camera, k: u32, time: f64, shutter: f64, fps: f64) -> FrameInput {
+    match path {
+        Some(p) => {
+            let key = p.frame(k as usize);
+            let dt = if k > 0 && (k as usize) < p.keys.len() { key.time - p.frame(k as usize - 1).time } else { 1.0 / fps };
+            FrameInput::exposed(|t| p.camera_at(t), key.time, shutter, dt)
+        }
+        None => FrameInput::exposed(|_| camera, time, shutter, 1.0 / fps),
+    }
+}
+
 pub fn run(a: RenderArgs) -> Result<()> {
     let chains = preset_settings(a.preset.as_deref(), a.denoiser.as_deref(), &a.disable, a.reflection_mv.as_deref())?;
     let frames = a.frames.unwrap_or(1);
@@ -65,9 +79,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
     {
         bail!("--spp {spp}: real-time mode takes at most {max_spp} samples per pixel per frame; use --frames (or --accumulate) for more");
     }
-    let fps = a.fps.unwrap_or(60.0);
-    if !(fps > 0.0 && fps.is_finite()) {
-        bail!("--fps must be a positive number");
+    let fps = crate::render::fps(&a)?;
+    let shutter = crate::render::shutter(&a)?;
+    if a.time.is_some() {
+        bail!("--time applies to reference mode; real-time mode's frames run at --fps (or the camera path's times)");
     }
     match (&a.out, &a.view) {
         (None, None) if a.out_dir.is_none() => bail!("real-time mode needs --out FILE (last frame) or --out-dir DIR (every frame)"),
@@ -125,13 +140,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     if let Some(target) = a.target_ms {
-        let inputs = (0..frames).map(|k| match &path {
-            Some(p) => {
-                let key = p.frame(k as usize);
-                FrameInput { camera: key.camera(), time: key.time }
-            }
-            None => FrameInput { camera, time: k as f64 / fps },
-        });
+        let inputs = (0..frames).map(|k| frame_input(path.as_ref(), camera, k, k as f64 / fps, shutter, fps));
         let pinned = a.spp.is_some().then_some(settings.sample_fraction);
         let rows = governed(&gpu, &mut r, &settings, inputs, target, a.min_scale.unwrap_or(0.25), pinned, size, a.out_dir.as_deref())?;
         let mut wall: Vec<f64> = rows.iter().map(|r| r.wall_ms).collect();
@@ -144,14 +153,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
         return Ok(());
     }
     for k in 0..frames {
-        let input = match &path {
-            Some(p) => {
-                let key = p.frame(k as usize);
-                FrameInput { camera: key.camera(), time: key.time }
-            }
-            // Accumulation needs a frozen clock; otherwise time advances at --fps.
-            None => FrameInput { camera, time: if a.accumulate { 0.0 } else { k as f64 / fps } },
-        };
+        // Accumulation needs a frozen clock; otherwise time advances at --fps.
+        let input = frame_input(path.as_ref(), camera, k, if a.accumulate { 0.0 } else { k as f64 / fps }, shutter, fps);
         r.render(&gpu, &input, &settings, None)?;
         if let Some(dir) = &a.out_dir {
             r.read_hdr(&gpu)?.save(&dir.join(format!("frame_{k:05}.exr")))?;

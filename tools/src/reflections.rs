@@ -173,7 +173,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
             let mut prev: Option<(Vec<f32>, Vec<f32>)> = None;
             let (mut chain_err, mut raw_err) = (vec![], vec![]);
             for _ in 0..a.frames {
-                r.render(&gpu, &FrameInput { camera, time: 0.0 }, &s, None)?;
+                r.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, &s, None)?;
                 let m = mask(&r, &gpu, threshold)?;
                 let y: Vec<f32> = if taa {
                     r.read_hdr(&gpu)?.data.iter().map(|v| luminance(*v)).collect()
@@ -206,7 +206,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     }
 
     // 2. Camera strafe: references, then each configuration.
-    let inputs: Vec<FrameInput> = (0..a.path_frames).map(|k| FrameInput { camera: strafed(camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step), time: k as f64 / 30.0 }).collect();
+    let inputs: Vec<FrameInput> = (0..a.path_frames).map(|k| FrameInput { camera: strafed(camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step), time: k as f64 / 30.0, shutter: None }).collect();
     let mut refr = new_renderer(&gpu, &scene, size)?;
     let acc = FrameSettings { accumulate: true, seed: 7919, ..Default::default() };
     let mut references: Vec<Image> = vec![];
@@ -262,7 +262,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
         // (sum of errors, within one pixel, count) for mirror and glossy pixels.
         let mut stats = [(0.0f64, 0usize, 0usize); 2];
         for k in 0..a.path_frames {
-            let input = FrameInput { camera: strafed(mv_camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step * 3.0), time: 0.0 };
+            let input = FrameInput { camera: strafed(mv_camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step * 3.0), time: 0.0, shutter: None };
             r.render(&gpu, &input, &s, None)?;
             if k == 0 {
                 continue;

@@ -122,10 +122,19 @@ pub struct RenderArgs {
     /// Real-time mode with --target-ms: the smallest resolution scale per side (default 0.25).
     #[arg(long)]
     pub min_scale: Option<f32>,
-    /// Real-time mode: frames per second of the animation clock when no camera path gives times
-    /// (default 60).
+    /// Frames per second of the animation clock when no camera path gives times (default 60);
+    /// the frame interval the shutter is a fraction of.
     #[arg(long)]
     pub fps: Option<f64>,
+    /// Motion blur: the shutter stays open for this fraction of the frame interval (0 to 1,
+    /// default 0: an instant), ending at the frame's time; each sample sees the camera and the
+    /// scene's animation at a random time in it. Both modes (real-time mode then traces its
+    /// primaries).
+    #[arg(long)]
+    pub shutter: Option<f64>,
+    /// Reference mode: the scene's animation time (seconds) of the image (default 0).
+    #[arg(long)]
+    pub time: Option<f64>,
     /// Real-time mode: write what the display shows for this view (final, gbuffer/normal,
     /// trace/matte, ...; see the viewer's list) to the --out PNG instead of the HDR image.
     #[arg(long)]
@@ -161,6 +170,24 @@ pub struct RenderArgs {
     /// last frame.
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+/// `--shutter` as a fraction of the frame interval (0 if not given).
+pub fn shutter(a: &RenderArgs) -> Result<f64> {
+    match a.shutter {
+        None => Ok(0.0),
+        Some(s) if (0.0..=1.0).contains(&s) => Ok(s),
+        Some(s) => bail!("--shutter {s}: give the fraction of the frame interval the shutter is open, 0 to 1"),
+    }
+}
+
+/// `--fps` (60 if not given).
+pub fn fps(a: &RenderArgs) -> Result<f64> {
+    let fps = a.fps.unwrap_or(60.0);
+    if !(fps > 0.0 && fps.is_finite()) {
+        bail!("--fps must be a positive number");
+    }
+    Ok(fps)
 }
 
 pub fn parse_camera(s: &str) -> Result<Camera> {
@@ -248,7 +275,6 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ("--accumulate", a.accumulate),
         ("--target-ms", a.target_ms.is_some()),
         ("--min-scale", a.min_scale.is_some()),
-        ("--fps", a.fps.is_some()),
         ("--view", a.view.is_some()),
         ("--out-dir", a.out_dir.is_some()),
     ];
@@ -270,8 +296,15 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let scene = load_scene(&a.scene, &a.load)?;
     let (w, h) = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
-    let view = TraceView { camera, width: w, height: h, max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed };
-    let prepared = PreparedScene::new(&scene, kind)?;
+    let view = TraceView { camera, width: w, height: h, max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, shutter_camera: None };
+    let mut prepared = PreparedScene::new(&scene, kind)?;
+    let time = a.time.unwrap_or(0.0);
+    let open = time - shutter(&a)? / fps(&a)?;
+    if !time.is_finite() {
+        bail!("--time must be a finite number of seconds");
+    }
+    prepared.animate(&scene, time);
+    prepared.set_shutter(&scene, (open < time).then_some(open));
     let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;

@@ -61,7 +61,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
         Some(c) => parse_camera(c)?,
         None => scene.camera_or_default(),
     };
-    let input = FrameInput { camera, time: 0.0 };
+    let input = FrameInput { camera, time: 0.0, shutter: None };
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(full))?;

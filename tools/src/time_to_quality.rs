@@ -193,7 +193,7 @@ pub fn run(a: TimeToQualityArgs) -> Result<()> {
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(full))?;
-    let input = FrameInput { camera: view, time: 0.0 };
+    let input = FrameInput { camera: view, time: 0.0, shutter: None };
     let acc = FrameSettings { accumulate: true, seed: a.seed.wrapping_add(7919), max_depth: scene.max_depth, ..Default::default() };
     let converged = {
         let mut r = new_renderer(&gpu, &scene, full)?;
@@ -256,20 +256,20 @@ fn follow(a: &TimeToQualityArgs, gpu: &Gpu, scene: &Scene, full: (u32, u32), run
         }
     };
     // One frame before the clock starts: it compiles the pipelines, which a viewer does once.
-    let first = FrameInput { camera: scenario.lead_camera(view, 0.0, a.lead_in, a.speed), time: 0.0 };
+    let first = FrameInput { camera: scenario.lead_camera(view, 0.0, a.lead_in, a.speed), time: 0.0, shutter: None };
     renderer.render(gpu, &first, &settings, None)?;
     renderer.pass_times(gpu)?;
     let mut runner = Runner { renderer, settings, governor, last_camera: Some(first.camera), full };
 
     let (mut elapsed, mut lead_frames) = (0.0, 0);
     while elapsed < a.lead_in || lead_frames < 2 {
-        let lead = FrameInput { camera: scenario.lead_camera(view, elapsed, a.lead_in, a.speed), time: 0.0 };
+        let lead = FrameInput { camera: scenario.lead_camera(view, elapsed, a.lead_in, a.speed), time: 0.0, shutter: None };
         elapsed += runner.frame(gpu, &lead)?.wall_ms / 1e3;
         lead_frames += 1;
     }
     let mut timeline = Timeline::new(compare(&runner.shown(gpu)?, reference)?.flip);
     let mut frames = vec![];
-    let stopped = FrameInput { camera: *view, time: 0.0 };
+    let stopped = FrameInput { camera: *view, time: 0.0, shutter: None };
     let mut t = 0.0;
     while t < a.seconds {
         let f = runner.frame(gpu, &stopped)?;

@@ -43,6 +43,34 @@ pub struct FrameInput {
     pub camera: Camera,
     /// Seconds into the scene's animation.
     pub time: f64,
+    /// Motion blur: where the shutter opened (`camera` and `time` are where it closes). Each
+    /// primary sample then sees the scene at a uniformly random time in between: the camera
+    /// blended linearly between the two, objects moving linearly from their open to their
+    /// close transforms (shaders/common/motion_blur.wgsl). None: an instant exposure.
+    pub shutter: Option<ShutterOpen>,
+}
+
+/// The camera and the scene time at the shutter's open.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShutterOpen {
+    pub camera: Camera,
+    pub time: f64,
+}
+
+impl FrameInput {
+    /// An instant exposure.
+    pub fn at(camera: Camera, time: f64) -> FrameInput {
+        FrameInput { camera, time, shutter: None }
+    }
+
+    /// The exposure over `shutter` of the frame interval `frame_dt` (seconds) ending at `time`,
+    /// the camera at the open given by `camera_at` (a camera path's interpolation; the same
+    /// camera for a still one). `shutter` = 0: an instant exposure.
+    pub fn exposed(camera_at: impl Fn(f64) -> Camera, time: f64, shutter: f64, frame_dt: f64) -> FrameInput {
+        let open = time - shutter.clamp(0.0, 1.0) * frame_dt.max(0.0);
+        let shutter = (open < time).then(|| ShutterOpen { camera: camera_at(open), time: open });
+        FrameInput { camera: camera_at(time), time, shutter }
+    }
 }
 
 /// Where the display pass draws: a surface texture or an offscreen image of any size (the frame
@@ -387,7 +415,7 @@ impl Renderer {
         let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
         let mut fp = FrameParams::new(cam, jittered, prev, jitter, size, self.frame_index, settings, self.accumulated, self.prepared.ray_epsilon(), representative);
         fp.primary_samples = primary_samples;
-        let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed };
+        let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed, shutter_camera: input.shutter.map(|s| s.camera) };
         let tp = make_params(&self.prepared, &trace_view);
         gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
         gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
@@ -400,7 +428,8 @@ impl Renderer {
         if self.prepared.features.animated {
             puffin::profile_scope!("animate");
             moved = self.prepared.animate(&self.scene, input.time);
-            self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
+            let swept = self.prepared.set_shutter(&self.scene, input.shutter.map(|s| s.time));
+            self.gpu_scene.update_geometry(gpu, &self.prepared, moved || swept);
         }
         let size = self.targets.size;
         let cam = self.camera_setup(&input.camera);
@@ -433,9 +462,11 @@ impl Renderer {
             t.supersample = Some(SupersampleTargets::new(&gpu.device, &mut t.memory, t.size, samples, self.prepared.features.glossy, t.epoch));
             t.generation += 1;
         }
-        // A thin lens: the G-buffer is traced (k lens rays per pixel), not rasterised; the
+        // A thin lens or motion blur (a stochastic primary hit): the G-buffer is traced (k rays
+        // per pixel, each through its own lens point at its own time), not rasterised; the
         // accumulate mode traces one, so that its mean over frames is exact.
-        let lens = input.camera.lens.is_some_and(|l| l.aperture_radius > 0.0);
+        let blurred = input.shutter.is_some_and(|s| s.camera != input.camera) || self.prepared.shutter_moves();
+        let lens = input.camera.lens.is_some_and(|l| l.aperture_radius > 0.0) || blurred;
         let primary_samples = match (lens, settings.accumulate) {
             (false, _) => 0,
             (true, true) => 1,
@@ -444,7 +475,7 @@ impl Renderer {
         let prefilter = lens && settings.prefilter && !settings.accumulate;
         if lens {
             if samples > 1 {
-                bail!("{samples} samples per pixel (guide rays) need the raster's G-buffer, which a thin-lens camera does not have: set samples per pixel to 1 (the lens traces {} primary samples per pixel)", settings.primary_samples);
+                bail!("{samples} samples per pixel (guide rays) need the raster's G-buffer, which depth of field and motion blur replace by traced primaries: set samples per pixel to 1 (they trace {} primary samples per pixel)", settings.primary_samples);
             }
             let t = &mut self.targets;
             if t.primaries.as_ref().is_none_or(|p| p.epoch != t.epoch) {

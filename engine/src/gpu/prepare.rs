@@ -97,6 +97,10 @@ pub struct PreparedScene {
     /// Length of the bounds' diagonal (scene units).
     pub extent: f64,
     pub tris: Vec<Vec4>,
+    /// Animated scenes: the vertices of `tris` where they are at the shutter's open
+    /// ([`PreparedScene::set_shutter`]; `tris` are at its close), the same as `tris` while the
+    /// shutter is closed (no motion blur).
+    pub tris_open: Vec<Vec4>,
     pub shading: Vec<Vec4>,
     pub tangents: Vec<Vec4>,
     pub materials: Vec<GpuMaterial>,
@@ -121,6 +125,11 @@ pub struct PreparedScene {
     pub prev_from_current: Vec<glam::Mat4>,
     flat: Vec<Flat>,
     pub time: f64,
+    /// Per object, the rebased transform from where a point is at the shutter's close (`time`)
+    /// to where it is at its open; empty while no object moves during the shutter.
+    open_from_close: Vec<glam::Mat4>,
+    /// The scene time at the shutter's open (None: no motion blur).
+    pub shutter_open: Option<f64>,
 }
 
 /// Triangle slots and node indices share 24 bits in the BVH2 traversal stack.
@@ -252,6 +261,7 @@ impl PreparedScene {
             origin,
             extent,
             tris: vec![],
+            tris_open: vec![],
             shading: vec![],
             tangents: vec![],
             materials,
@@ -269,6 +279,8 @@ impl PreparedScene {
             world,
             flat,
             time: 0.0,
+            open_from_close: vec![],
+            shutter_open: None,
         };
         p.assemble();
         p.traversal_stack = accel::traversal_stack(kind, p.accel.depth, count, p.features.animated);
@@ -302,6 +314,30 @@ impl PreparedScene {
         moved
     }
 
+    /// Open the shutter at scene time `open` (before `time`, the close, which [`animate`] set;
+    /// None: no motion blur). Objects whose transform differs between the two move linearly
+    /// between them during the exposure (shaders/common/motion_blur.wgsl): the BVH is rebuilt
+    /// over each triangle's box at both ends and `tris_open` holds the open ends. Returns
+    /// whether the geometry changed (call after [`animate`], before uploading).
+    ///
+    /// [`animate`]: PreparedScene::animate
+    pub fn set_shutter(&mut self, scene: &Scene, open: Option<f64>) -> bool {
+        let mut open_from_close = vec![];
+        if let Some(t) = open.filter(|_| self.features.animated) {
+            let moving = scene.objects.iter().enumerate().take(self.world.len()).any(|(i, o)| o.animation.is_some() && o.transform_at(t) != self.world[i]);
+            if moving {
+                open_from_close = scene.objects.iter().enumerate().take(self.world.len()).map(|(i, o)| rebased(o.transform_at(t), self.origin) * rebased(self.world[i], self.origin).inverse()).collect();
+            }
+        }
+        self.shutter_open = open;
+        let changed = open_from_close != self.open_from_close;
+        self.open_from_close = open_from_close;
+        if changed {
+            self.assemble();
+        }
+        changed
+    }
+
     /// BVH over every object's triangles, then the buffers in BVH leaf order and the emitter CDF.
     fn assemble(&mut self) {
         let kind = self.accel.kind;
@@ -309,19 +345,35 @@ impl PreparedScene {
         let mut attrs: Vec<&[Vec4; 4]> = vec![];
         let mut tans: Vec<&[Vec4; 3]> = vec![];
         let mut mats: Vec<u32> = vec![];
-        for f in &self.flat {
+        let mut open_in: Vec<Triangle> = vec![];
+        for (i, f) in self.flat.iter().enumerate() {
             tris_in.extend_from_slice(&f.tris);
             attrs.extend(f.attrs.iter());
             tans.extend(f.tans.iter());
             mats.extend_from_slice(&f.mats);
+            if let Some(m) = self.open_from_close.get(i) {
+                let to = |v: Vec3A| Vec3A::from(m.transform_point3(v.into()));
+                open_in.extend(f.tris.iter().map(|t| Triangle { v0: to(t.v0), v1: to(t.v1), v2: to(t.v2) }));
+            }
         }
-        let accel = accel::build_within(&tris_in, kind, self.traversal_stack as usize);
+        // With motion, the tree is built over each triangle's box at both ends of the shutter:
+        // a degenerate triangle from the box's min to its max has exactly that box.
+        let accel = if open_in.is_empty() {
+            accel::build_within(&tris_in, kind, self.traversal_stack as usize)
+        } else {
+            let swept: Vec<Triangle> = tris_in.iter().zip(&open_in).map(|(c, o)| {
+                let b = c.aabb().union(&o.aabb());
+                Triangle { v0: b.min, v1: b.max, v2: b.min }
+            }).collect();
+            accel::build_within(&swept, kind, self.traversal_stack as usize)
+        };
         if accel.depth > self.traversal_stack as usize {
             // Not reachable: the stack of an animated scene holds any median tree over its
             // triangles ([`accel::traversal_stack`]).
             log::error!("the rebuilt BVH is {} levels deep; the traversal holds {}: geometry will be missing", accel.depth, self.traversal_stack);
         }
         self.tris.clear();
+        self.tris_open.clear();
         self.shading.clear();
         self.tangents.clear();
         for &orig in &accel.order {
@@ -330,6 +382,10 @@ impl PreparedScene {
             self.tris.push(v(t.v0).extend(f32::from_bits(mats[i])));
             self.tris.push(v(t.v1).extend(f32::from_bits(orig)));
             self.tris.push(v(t.v2).extend(0.0));
+            if self.features.animated {
+                let o = open_in.get(i).unwrap_or(t);
+                self.tris_open.extend([v(o.v0).extend(0.0), v(o.v1).extend(0.0), v(o.v2).extend(0.0)]);
+            }
             self.shading.extend_from_slice(attrs[i]);
             if self.features.normal_maps {
                 self.tangents.extend_from_slice(tans[i]);
@@ -375,6 +431,11 @@ impl PreparedScene {
                 self.env_pdf_norm = env.pdf_norm;
             }
         }
+    }
+
+    /// Whether some object moves while the shutter is open ([`PreparedScene::set_shutter`]).
+    pub fn shutter_moves(&self) -> bool {
+        !self.open_from_close.is_empty()
     }
 
     pub fn triangle_count(&self) -> usize {

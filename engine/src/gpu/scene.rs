@@ -15,6 +15,8 @@ pub struct GpuScene {
     /// same as texel rows for the intersection tests.
     pub tris: wgpu::Buffer,
     pub tri_texels: Texels,
+    /// Animated scenes: the vertices at the shutter's open ([`PreparedScene::tris_open`]).
+    pub tri_open_texels: Option<Texels>,
     /// Per-triangle normals and UVs (four texels a triangle) and the materials (five texels
     /// each), as texel rows like the nodes.
     pub shading: Texels,
@@ -74,6 +76,7 @@ impl PreparedScene {
         let nodes = Texels::new(gpu, &mut mem, "scene/bvh nodes", &self.accel.nodes, wgpu::TextureFormat::Rgba32Uint);
         let tris = mem.buffer_init(d, "scene/triangles", b(&self.tris), s);
         let tri_texels = Texels::new(gpu, &mut mem, "scene/triangle texels", b(&self.tris), wgpu::TextureFormat::Rgba32Float);
+        let tri_open_texels = self.features.animated.then(|| Texels::new(gpu, &mut mem, "scene/triangle texels at shutter open", b(&self.tris_open), wgpu::TextureFormat::Rgba32Float));
         let shading = Texels::new(gpu, &mut mem, "scene/shading", b(&self.shading), wgpu::TextureFormat::Rgba32Float);
         let materials = Texels::new(gpu, &mut mem, "scene/materials", b(&self.materials), wgpu::TextureFormat::Rgba32Uint);
         let copy = s | wgpu::BufferUsages::COPY_DST;
@@ -100,6 +103,7 @@ impl PreparedScene {
             nodes,
             tris,
             tri_texels,
+            tri_open_texels,
             shading,
             materials,
             lights,
@@ -137,6 +141,9 @@ impl GpuScene {
         if moved {
             replaced |= self.nodes.write(gpu, mem, &p.accel.nodes);
             replaced |= self.tri_texels.write(gpu, mem, b(&p.tris));
+            if let Some(t) = self.tri_open_texels.as_mut() {
+                replaced |= t.write(gpu, mem, b(&p.tris_open));
+            }
             replaced |= self.shading.write(gpu, mem, b(&p.shading));
         }
         let mut put = |buf: &mut wgpu::Buffer, label: &str, data: &[u8]| {
@@ -178,6 +185,7 @@ impl GpuScene {
         Bindings::new()
             .texture("bvh_texels", &self.nodes.view)
             .texture("tri_texels", &self.tri_texels.view)
+            .texture_opt("tri_open_texels", self.tri_open_texels.as_ref().map(|t| &t.view))
             .buffer("tris", &self.tris)
             .texture("shading_texels", &self.shading.view)
             .texture("material_texels", &self.materials.view)
@@ -192,7 +200,7 @@ impl GpuScene {
     /// Program modules that match this scene's features, for a program that shades.
     pub fn shading_modules(&self) -> Vec<&'static str> {
         let f = &self.features;
-        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
+        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if f.animated { "common/motion_blur.wgsl" } else { "common/motion_none.wgsl" }, self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
         m.push(if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" });
         m.push(if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" });
         m.push(if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" });

@@ -78,6 +78,7 @@ impl GBufferPass {
         let modules = vec![
             "common/math.wgsl",
             "common/geometry.wgsl",
+            "common/motion_none.wgsl",
             "common/scene.wgsl",
             "common/bsdf.wgsl",
             if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" },

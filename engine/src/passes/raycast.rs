@@ -27,6 +27,7 @@ impl Raycaster {
         let modules = [
             "common/math.wgsl",
             "common/geometry.wgsl",
+            "common/motion_none.wgsl",
             scene.traversal_module(),
             "common/alpha_none.wgsl",
             "accel/raycast.wgsl",

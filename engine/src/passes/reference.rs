@@ -34,6 +34,15 @@ pub struct TraceParams {
     /// x: samples per pixel this dispatch traces (the reference tracer), from sample_index on;
     /// y, z, w unused.
     pub batch: [u32; 4],
+    /// The camera at the shutter's open, as cam_pos .. cam_fwd hold it at the close (the same
+    /// without motion blur).
+    pub cam_open_pos: [f32; 4],
+    pub cam_open_right: [f32; 4],
+    pub cam_open_up: [f32; 4],
+    pub cam_open_fwd: [f32; 4],
+    /// x: 1 where the shutter is open for a while (each path a random time in it), 0 for an
+    /// instant exposure (every ray at the close).
+    pub shutter: [f32; 4],
 }
 
 /// What to render: the camera, image size and path settings.
@@ -45,6 +54,9 @@ pub struct TraceView {
     /// Mitsuba's max_depth (-1 = unbounded).
     pub max_depth: i32,
     pub seed: u32,
+    /// Motion blur: the camera at the shutter's open (`camera` is at its close); objects move
+    /// as [`PreparedScene::set_shutter`] set them up.
+    pub shutter_camera: Option<Camera>,
 }
 
 /// Russian roulette starts after this many segments (Mitsuba's rr_depth).
@@ -124,6 +136,15 @@ impl ReferenceTracer {
         gpu.queue.submit([enc.finish()]);
     }
 
+    /// Go on accumulating under a new camera or scene state (same size, same GPU scene buffers):
+    /// the image becomes the mean over the states' samples, e.g. of stills over a shutter.
+    pub fn set_view(&mut self, prepared: &PreparedScene, view: &TraceView) {
+        let (w, h) = (self.params.width, self.params.height);
+        self.params = make_params(prepared, view);
+        self.params.width = w;
+        self.params.height = h;
+    }
+
     /// Record dispatches that add `count` samples per pixel; returns after submitting them. A
     /// dispatch traces up to [`BATCH`] samples per pixel and [`BATCH_PATHS`] paths.
     pub fn dispatch(&mut self, gpu: &Gpu, count: u32) {
@@ -179,17 +200,14 @@ impl ReferenceTracer {
 }
 
 pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
-    let cam = &view.camera;
-    let m = cam.world;
-    let pos = (m.transform_point3(DVec3::ZERO) - p.origin).as_vec3();
-    let x = m.transform_vector3(DVec3::X).normalize_or_zero().as_vec3();
-    let y = m.transform_vector3(DVec3::Y).normalize_or_zero().as_vec3();
-    let z = m.transform_vector3(DVec3::Z).normalize_or_zero().as_vec3();
-    let fov = if cam.yfov.is_finite() { cam.yfov.clamp(1e-4, 3.1) } else { 0.8 };
-    let th = (fov * 0.5).tan();
     let aspect = view.width as f32 / view.height as f32;
+    let (pos, right, up, fwd) = camera_frame(p, &view.camera, aspect);
+    let open = view.shutter_camera.map_or((pos, right, up, fwd), |c| camera_frame(p, &c, aspect));
+    let moving = view.shutter_camera.is_some_and(|c| c != view.camera) || p.shutter_moves();
     let rot = p.env_rotation_y_degrees.to_radians();
     let f = &p.features;
+    let cam = &view.camera;
+    let e = p.ray_epsilon();
     TraceParams {
         width: view.width,
         height: view.height,
@@ -199,15 +217,33 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
         rr_depth: RR_DEPTH,
         num_lights: p.lights.len() as u32,
         num_emitters: p.emitters.len() as u32,
-        cam_pos: pos.extend(p.ray_epsilon()).to_array(),
-        cam_right: (x * th * aspect).extend(0.0).to_array(),
-        cam_up: (y * th).extend(0.0).to_array(),
-        cam_fwd: (-z).extend(0.0).to_array(),
+        cam_pos: pos.extend(e).to_array(),
+        cam_right: right.extend(0.0).to_array(),
+        cam_up: up.extend(0.0).to_array(),
+        cam_fwd: fwd.extend(0.0).to_array(),
         env_radiance: p.env_radiance.extend(0.0).to_array(),
         env_rot: [rot.cos(), rot.sin(), p.env_pdf_norm, 0.0],
         env_size: p.env_size,
         emit: [if f.emitters { p.emit_inv_total } else { 0.0 }, 0.0, 0.0, 0.0],
         lens: cam.lens.map_or([0.0; 4], |l| [l.aperture_radius, l.focus_distance, 0.0, 0.0]),
         batch: [1, 0, 0, 0],
+        cam_open_pos: open.0.extend(e).to_array(),
+        cam_open_right: open.1.extend(0.0).to_array(),
+        cam_open_up: open.2.extend(0.0).to_array(),
+        cam_open_fwd: open.3.extend(0.0).to_array(),
+        shutter: [moving as u32 as f32, 0.0, 0.0, 0.0],
     }
+}
+
+/// A camera's position and ray frame in the GPU scene's rebased space: a pixel's direction is
+/// fwd + x right + y up for x, y in [-1, 1].
+fn camera_frame(p: &PreparedScene, cam: &Camera, aspect: f32) -> (Vec3, Vec3, Vec3, Vec3) {
+    let m = cam.world;
+    let pos = (m.transform_point3(DVec3::ZERO) - p.origin).as_vec3();
+    let x = m.transform_vector3(DVec3::X).normalize_or_zero().as_vec3();
+    let y = m.transform_vector3(DVec3::Y).normalize_or_zero().as_vec3();
+    let z = m.transform_vector3(DVec3::Z).normalize_or_zero().as_vec3();
+    let fov = if cam.yfov.is_finite() { cam.yfov.clamp(1e-4, 3.1) } else { 0.8 };
+    let th = (fov * 0.5).tan();
+    (pos, x * th * aspect, y * th, -z)
 }

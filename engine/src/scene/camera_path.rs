@@ -67,6 +67,20 @@ impl CameraPath {
         Ok(())
     }
 
+    /// The camera at `time`: eye, target and field of view interpolated linearly between the
+    /// two keys around it (held before the first and after the last). Motion blur asks for the
+    /// camera at the shutter's open, between keys.
+    pub fn camera_at(&self, time: f64) -> Camera {
+        let i = self.keys.partition_point(|k| k.time <= time);
+        if i == 0 || i == self.keys.len() {
+            return self.keys[i.min(self.keys.len() - 1)].camera();
+        }
+        let (a, b) = (&self.keys[i - 1], &self.keys[i]);
+        let t = if b.time > a.time { (time - a.time) / (b.time - a.time) } else { 1.0 };
+        let mix = |p: [f64; 3], q: [f64; 3]| DVec3::from_array(p).lerp(DVec3::from_array(q), t);
+        Camera::look_at(mix(a.eye, b.eye), mix(a.target, b.target), a.yfov_degrees + (b.yfov_degrees - a.yfov_degrees) * t as f32)
+    }
+
     /// The key for frame `i` (the last key holds once the path has ended).
     pub fn frame(&self, i: usize) -> &CameraKey {
         &self.keys[i.min(self.keys.len() - 1)]

@@ -45,6 +45,8 @@ embed!(
     "common/math.wgsl",
     "common/rng.wgsl",
     "common/geometry.wgsl",
+    "common/motion_none.wgsl",
+    "common/motion_blur.wgsl",
     "common/bvh2.wgsl",
     "common/cwbvh.wgsl",
     "common/alpha_none.wgsl",
@@ -275,7 +277,7 @@ mod tests {
         let mut v = vec![];
         for set in FEATURE_SETS {
             for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
-                let m = ["common/math.wgsl", "common/geometry.wgsl", "common/scene.wgsl", "common/bsdf.wgsl", set[1], set[2], set[0], "realtime/frame.wgsl", motion, "realtime/gbuffer.wgsl"];
+                let m = ["common/math.wgsl", "common/geometry.wgsl", "common/motion_none.wgsl", "common/scene.wgsl", "common/bsdf.wgsl", set[1], set[2], set[0], "realtime/frame.wgsl", motion, "realtime/gbuffer.wgsl"];
                 v.push(compose("gbuffer", "", &m).unwrap());
             }
         }
@@ -328,9 +330,9 @@ mod tests {
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             // A scene sets the traversal's stack length (accel::traversal_stack).
             let stack = "const TRAVERSAL_STACK: u32 = 16u;\n";
-            v.push(compose("raycast", stack, &["common/math.wgsl", "common/geometry.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
+            v.push(compose("raycast", stack, &["common/math.wgsl", "common/geometry.wgsl", "common/motion_none.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
             for (i, set) in FEATURE_SETS.iter().enumerate() {
-                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", bvh, "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
+                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if i % 2 == 0 { "common/motion_none.wgsl" } else { "common/motion_blur.wgsl" }, bvh, "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
                 m.extend(set.iter());
                 let prelude = format!("const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n{stack}", i % 2 == 1, i != 0);
                 let mut reference = m.clone();
