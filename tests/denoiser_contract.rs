@@ -106,7 +106,8 @@ const SIZE: (u32, u32) = (96, 54);
 
 /// The courtyard of the default level, with the animated cube out of view.
 fn view() -> FrameInput {
-    FrameInput { camera: Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0), time: 0.0 }, shutter: None }
+    FrameInput { camera: Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0), time: 0.0, shutter: None }
+}
 
 fn render(r: &mut Renderer, gpu: &Gpu, s: &FrameSettings, frames: u32) -> Image {
     for _ in 0..frames {

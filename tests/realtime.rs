@@ -209,13 +209,25 @@ fn the_default_level_renders_without_nan() {
             assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in the default level with {}", entry.name);
         }
         // Emission may be off screen; every other view shows something from the level's camera.
-        let own = hush_engine::settings::FRAME_VIEWS.iter().chain(entry.views);
+        let own = hush_engine::settings::FRAME_VIEWS.iter().filter(|v| !v.needs_traced_primaries()).chain(entry.views);
         let views: Vec<View> = std::iter::once(View::FINAL).chain(own.map(|v| View::named(v.name))).collect();
         for v in views.into_iter().filter(|v| v.name() != "gbuffer/emission") {
             let settings = FrameSettings { view: v.clone(), ..denoised.clone() };
             let shown = r.display_image(&gpu, &settings).unwrap();
             assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "view {} is black with {}", v.name(), entry.name);
         }
+    }
+    // Through a thin lens: the traced primaries and the pre-filter, and their views.
+    let lens = hush_engine::scene::ThinLens::new(0.2, 1.0).unwrap();
+    let camera = Camera { lens: Some(lens), ..r.scene.camera_or_default() };
+    let settings = FrameSettings { denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() };
+    for k in 0..2 {
+        r.render(&gpu, &FrameInput { camera, time: 1.0 + k as f64 / 60.0, shutter: None }, &settings, None).unwrap();
+        assert!(r.read_hdr(&gpu).unwrap().data.iter().all(|p| p.is_finite()), "NaN or Inf through a thin lens");
+    }
+    for v in hush_engine::settings::FRAME_VIEWS.iter().filter(|v| v.needs_traced_primaries()) {
+        let shown = r.display_image(&gpu, &FrameSettings { view: View::named(v.name), ..settings.clone() }).unwrap();
+        assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "view {} is black through a thin lens", v.name);
     }
 }
 

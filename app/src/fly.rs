@@ -42,6 +42,17 @@ impl FlyCamera {
         Camera { lens: self.lens, ..Camera::look_at(self.pos, self.pos + self.forward(), self.yfov.to_degrees()) }
     }
 
+    /// Position, yaw and pitch: what a frame's motion blur interpolates.
+    pub fn pose(&self) -> (DVec3, f64, f64) {
+        (self.pos, self.yaw, self.pitch)
+    }
+
+    /// The camera a fraction `s` of the way from `from` (an earlier pose) to this one.
+    pub fn camera_between(&self, from: (DVec3, f64, f64), s: f64) -> Camera {
+        let f = FlyCamera { pos: from.0.lerp(self.pos, s), yaw: from.1 + (self.yaw - from.1) * s, pitch: from.2 + (self.pitch - from.2) * s, yfov: self.yfov, speed: self.speed, held: HashSet::new(), looking: false, lens: self.lens };
+        f.camera()
+    }
+
     /// Right-drag: radians per pixel of mouse motion.
     pub fn look(&mut self, dx: f64, dy: f64) {
         self.yaw += dx * 0.003;

@@ -100,6 +100,9 @@ struct Running {
     governed: Option<(hush_engine::governor::Choice, hush_engine::scene::Camera)>,
     /// Budgets for scenes dropped on the window (`--limit`).
     load: hush_engine::scene::LoadOptions,
+    /// The fly camera's pose at the last frame: where a motion-blurred frame's shutter opens
+    /// from.
+    last_pose: Option<(glam::DVec3, f64, f64)>,
 }
 
 struct Viewer {
@@ -221,6 +224,7 @@ impl Viewer {
             governor: hush_engine::governor::Governor::new(100.0),
             governed: None,
             load: self.args.load,
+            last_pose: None,
         });
         Ok(())
     }
@@ -270,6 +274,7 @@ impl Running {
         match r {
             Ok((r, extent)) => {
                 self.fly = fly::FlyCamera::from_camera(&r.scene.camera_or_default(), extent);
+                self.last_pose = None;
                 self.panel = panel_for(&self.gpu, &r, format!("loaded {}", path.display()));
                 self.window.set_title(&format!("Hush: {}", r.scene.name));
                 self.renderer = r;
@@ -417,10 +422,22 @@ impl Running {
         if !self.panel.paused && !accumulate {
             self.panel.time += dt;
         }
-        let mut input = FrameInput { camera: self.fly.camera(), time: self.panel.time, shutter: None };
+        // Motion blur: the shutter opens a fraction of the way back to the last frame's pose and
+        // clock.
+        let shutter = self.panel.lens.shutter as f64;
+        let pose = self.last_pose.unwrap_or(self.fly.pose());
+        let clock = if !self.panel.paused && !accumulate { dt } else { 0.0 };
+        let mut input = FrameInput::exposed(|t| self.fly.camera_between(pose, 1.0 - (self.panel.time - t) / dt.max(1e-9)), self.panel.time, shutter, dt);
+        if clock == 0.0 && input.shutter.is_some_and(|s| s.camera == input.camera) {
+            input.shutter = None;
+        } else if let Some(open) = input.shutter.as_mut() {
+            open.time = self.panel.time - shutter * clock;
+        }
+        self.last_pose = Some(self.fly.pose());
         if let (Some(i), Some(p)) = (self.playback, &self.path) {
             let key = p.frame(i);
-            input = FrameInput { camera: key.camera(), time: key.time, shutter: None };
+            let spacing = if i > 0 { key.time - p.frame(i - 1).time } else { 0.0 };
+            input = FrameInput::exposed(|t| p.camera_at(t), key.time, shutter, if spacing > 0.0 { spacing } else { dt });
             self.playback = if i + 1 < p.keys.len() { Some(i + 1) } else { None };
             self.panel.playing = self.playback.is_some();
         }

@@ -30,6 +30,8 @@ pub struct Panel {
 
 /// The camera's thin lens (depth of field), in scene units.
 pub struct LensPanel {
+    /// Motion blur: the fraction of the frame interval the shutter stays open (0: none).
+    pub shutter: f32,
     pub on: bool,
     pub aperture_radius: f32,
     pub focus_distance: f32,
@@ -42,8 +44,8 @@ impl LensPanel {
     pub fn new(lens: Option<hush_engine::scene::ThinLens>, extent: f64) -> LensPanel {
         let extent = (extent as f32).max(1e-6);
         match lens {
-            Some(l) => LensPanel { on: true, aperture_radius: l.aperture_radius, focus_distance: l.focus_distance, extent },
-            None => LensPanel { on: false, aperture_radius: extent * 2e-3, focus_distance: extent * 0.25, extent },
+            Some(l) => LensPanel { shutter: 0.0, on: true, aperture_radius: l.aperture_radius, focus_distance: l.focus_distance, extent },
+            None => LensPanel { shutter: 0.0, on: false, aperture_radius: extent * 2e-3, focus_distance: extent * 0.25, extent },
         }
     }
 
@@ -96,6 +98,7 @@ impl Panel {
             a.sun_changed = c1 || c2;
         }
         let l = &mut self.lens;
+        ui.add(egui::Slider::new(&mut l.shutter, 0.0..=1.0).text("motion blur shutter")).on_hover_text("The fraction of the frame interval the shutter stays open: each primary sample sees the camera and the animation at a random time in it (the G-buffer is then traced, as with a lens).");
         ui.checkbox(&mut l.on, "depth of field (thin lens)").on_hover_text("The frame then traces k primary rays per pixel through the lens (gbuffer/primaries) and pre-filters their features (prefilter). Middle-click the image to focus on the surface there.");
         if l.on {
             ui.add(egui::Slider::new(&mut l.aperture_radius, l.extent * 1e-5..=l.extent * 0.05).logarithmic(true).text("aperture radius"));

@@ -54,13 +54,14 @@ fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[Strin
 }
 
 /// Frame `k`'s input: the camera path's key k (its time; the shutter a fraction of the interval
-/// since the key before, the camera at the open interpolated along the path), or the still
-/// `camera` at `time` (the interval 1 / fps).
+/// since the key before, or of 1 / fps where keys share a time, the camera at the open
+/// interpolated along the path), or the still `camera` at `time` (the interval 1 / fps).
 fn frame_input(path: Option<&CameraPath>, camera: hush_engine::scene::Camera, k: u32, time: f64, shutter: f64, fps: f64) -> FrameInput {
     match path {
         Some(p) => {
             let key = p.frame(k as usize);
-            let dt = if k > 0 && (k as usize) < p.keys.len() { key.time - p.frame(k as usize - 1).time } else { 1.0 / fps };
+            let spacing = if k > 0 && (k as usize) < p.keys.len() { key.time - p.frame(k as usize - 1).time } else { 0.0 };
+            let dt = if spacing > 0.0 { spacing } else { 1.0 / fps };
             FrameInput::exposed(|t| p.camera_at(t), key.time, shutter, dt)
         }
         None => FrameInput::exposed(|_| camera, time, shutter, 1.0 / fps),

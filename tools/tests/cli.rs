@@ -65,6 +65,12 @@ fn bad_arguments_are_clear_errors() {
         (vec!["time-to-quality", "level", "--run", "mara:1/4", "--width", "8", "--height", "8", "--reference-frames", "1", "--out-dir", &ttq], "sample fractions below 1"),
         (vec!["time-to-quality", "level", "--run", "mara", "--scenarios", "pan", "--out-dir", &ttq], "stop or cut"),
         (vec!["level", "--scene", "terrain:1", "--out", "x.gltf"], "terrain:N"),
+        (vec!["render", "level", "--shutter", "1.5", "--out", "x.exr"], "--shutter 1.5"),
+        (vec!["render", "level", "--shutter", "0.5", "--fps", "0", "--out", "x.exr"], "--fps"),
+        (vec!["render", "level", "--mode", "realtime", "--time", "1", "--out", "x.exr"], "--time"),
+        (vec!["render", "level", "--mode", "realtime", "--primary-samples", "0", "--out", "x.exr"], "--primary-samples 0"),
+        // Guide rays need the raster's G-buffer; an open shutter on the moving cube replaces it.
+        (vec!["render", "level", "--mode", "realtime", "--shutter", "1", "--spp", "2", "--width", "8", "--height", "8", "--out", "x.exr"], "samples per pixel to 1"),
         (vec!["level", "--scene", "nope", "--out", "x.gltf"], "no such built-in scene"),
         // A built-in scene has no file for Mitsuba to read (and CI has no Mitsuba either way).
         (vec!["bench", "default", "--mitsuba", "--width", "8", "--height", "8", "--spp", "1", "--rays", "64", "--bvh", "cwbvh"], "--mitsuba"),

@@ -109,6 +109,12 @@ pub struct ViewSpec {
 }
 
 impl ViewSpec {
+    /// Views of the pre-filter's textures, which exist once a thin lens or an open shutter has
+    /// been rendered.
+    pub fn needs_traced_primaries(&self) -> bool {
+        self.texture.starts_with("prefilter/")
+    }
+
     /// Views of buffers that exist only in scenes with a specular lobe.
     pub fn needs_glossy(&self) -> bool {
         self.texture.starts_with("glossy/") || self.texture.starts_with("svgf/glossy") || self.texture.starts_with("progressive/glossy") || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
