@@ -517,7 +517,7 @@ impl Renderer {
             Some(p) => {
                 // The pre-filter stage (Moon et al. 2017) between the traced features and the
                 // G-buffer every later stage reads.
-                self.primaries.record_trace(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, p, size, self.timer.as_mut())?;
+                self.primaries.record_trace(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, p, size, self.prepared.shutter_moves(), self.timer.as_mut())?;
                 let mut edges = None;
                 if let Some(pf) = t.prefilter.as_ref().filter(|_| prefilter) {
                     let offered = crate::passes::prefilter::bindings(&self.frame_buf, p, pf);
@@ -528,7 +528,7 @@ impl Renderer {
             }
         }
         let pass = crate::profile::scope(crate::passes::trace::LABEL);
-        self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, period, self.timer.as_mut())?;
+        self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, period, self.prepared.shutter_moves(), self.timer.as_mut())?;
         drop(pass);
         let mut io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
         let ss = t.supersample.as_ref().filter(|s| s.k == samples);

@@ -16,6 +16,9 @@ impl Renderer {
         v.extend(self.taa.pipelines());
         v.extend(self.supersample.pipelines());
         v.extend(self.primaries.pipelines());
+        if let Some((p, _)) = self.trace.moving.as_mut() {
+            v.push(p);
+        }
         v.extend(self.prefilter.pipelines());
         for d in &mut self.denoisers {
             v.extend(d.denoiser.pipelines());

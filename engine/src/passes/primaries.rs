@@ -40,7 +40,8 @@ impl PrimaryTargets {
 /// The trace and resolve programs, made on first use.
 #[derive(Default)]
 pub struct Primaries {
-    trace: Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>,
+    /// Without and with objects moving during the shutter.
+    trace: [Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>; 2],
     resolve: Option<(Reloadable<wgpu::RenderPipeline>, [BindCache; 2])>,
 }
 
@@ -51,7 +52,7 @@ fn trace_bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a 
 impl Primaries {
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
         let mut v: Vec<&mut dyn Reload> = vec![];
-        if let Some((p, _)) = self.trace.as_mut() {
+        for (p, _) in self.trace.iter_mut().flatten() {
             v.push(p);
         }
         if let Some((p, _)) = self.resolve.as_mut() {
@@ -60,19 +61,21 @@ impl Primaries {
         v
     }
 
-    /// Trace frame.primary_samples lens rays per pixel into `t`.
+    /// Trace frame.primary_samples lens rays per pixel into `t`; `moving`: objects move during
+    /// the shutter.
     #[allow(clippy::too_many_arguments)]
-    pub fn record_trace(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, t: &PrimaryTargets, size: (u32, u32), timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record_trace(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, t: &PrimaryTargets, size: (u32, u32), moving: bool, timer: Option<&mut GpuTimer>) -> Result<()> {
         let offered = trace_bindings(scene, params, frame, t);
-        if self.trace.is_none() {
-            let mut modules = scene.shading_modules();
+        let slot = &mut self.trace[moving as usize];
+        if slot.is_none() {
+            let mut modules = scene.shading_modules_for(moving);
             modules.push("realtime/frame.wgsl");
             modules.push(if scene.features.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
             modules.extend(["realtime/lens.wgsl", "realtime/primaries.wgsl"]);
             let p = Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, wgpu::ShaderStages::COMPUTE, &offered, |d, m, l| compute_pipeline(d, LABEL, m, l, "main"))?;
-            self.trace = Some((p, BindCache::default()));
+            *slot = Some((p, BindCache::default()));
         }
-        let (p, cache) = self.trace.as_mut().unwrap();
+        let (p, cache) = slot.as_mut().unwrap();
         let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(LABEL);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });

@@ -101,7 +101,7 @@ impl ReferenceTracer {
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
             bail!("image size {w}x{h} is out of range (1..={MAX_SIDE} per side)");
         }
-        let mut modules = scene.shading_modules();
+        let mut modules = scene.shading_modules_for(prepared.shutter_moves());
         modules.push("reference/trace.wgsl");
         let mut memory = GpuMemory::default();
         let accum = memory.buffer(

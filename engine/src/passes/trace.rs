@@ -53,6 +53,18 @@ impl TraceTargets {
 pub struct TracePass {
     pub pipeline: crate::shader::Reloadable<wgpu::ComputePipeline>,
     groups: BindCache,
+    /// The program for frames whose objects move during the shutter (motion blur), made on
+    /// first use.
+    pub moving: Option<(crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>,
+}
+
+fn program(gpu: &Gpu, scene: &GpuScene, offered: &Bindings, moving: bool) -> Result<crate::shader::Reloadable<wgpu::ComputePipeline>> {
+    let mut modules = scene.shading_modules_for(moving);
+    modules.push("realtime/frame.wgsl");
+    modules.push("realtime/lens.wgsl");
+    modules.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
+    modules.push("realtime/trace.wgsl");
+    crate::shader::Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, wgpu::ShaderStages::COMPUTE, offered, |d, m, l| compute_pipeline(d, LABEL, m, l, "main"))
 }
 
 /// What the trace (and the supersampling's samples pass, which shades as it does) binds.
@@ -66,23 +78,24 @@ pub fn bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wg
 
 impl TracePass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets) -> Result<TracePass> {
-        let mut modules = scene.shading_modules();
-        modules.push("realtime/frame.wgsl");
-        modules.push("realtime/lens.wgsl");
-        modules.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
-        modules.push("realtime/trace.wgsl");
-        let offered = bindings(scene, params, frame, g, t);
-        let pipeline = crate::shader::Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, wgpu::ShaderStages::COMPUTE, &offered, |d, m, l| compute_pipeline(d, LABEL, m, l, "main"))?;
-        Ok(TracePass { pipeline, groups: BindCache::default() })
+        let pipeline = program(gpu, scene, &bindings(scene, params, frame, g, t), false)?;
+        Ok(TracePass { pipeline, groups: BindCache::default(), moving: None })
     }
 
     /// `key`: (scene generation, frame target generation); bind groups are rebuilt when it changes.
-    /// `period`: 1 / f, the frames between two samples of a pixel.
+    /// `period`: 1 / f, the frames between two samples of a pixel. `moving`: objects move during
+    /// the shutter (the motion-blur program).
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), period: u32, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), period: u32, moving: bool, timer: Option<&mut GpuTimer>) -> Result<()> {
         use crate::shader::Reload;
-        let p = &self.pipeline;
-        let groups = self.groups.get(key.0 * 1_000_003 + key.1, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t)))?;
+        if moving && self.moving.is_none() {
+            self.moving = Some((program(gpu, scene, &bindings(scene, params, frame, g, t), true)?, BindCache::default()));
+        }
+        let (p, cache) = match self.moving.as_mut().filter(|_| moving) {
+            Some((p, c)) => (&*p, c),
+            None => (&self.pipeline, &mut self.groups),
+        };
+        let groups = cache.get(key.0 * 1_000_003 + key.1, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t)))?;
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
