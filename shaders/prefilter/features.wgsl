@@ -1,16 +1,17 @@
 // Pre-filter step 3: the bandwidths SURE chose, smoothed by a Gaussian of 1.5 pixels (§5: they
 // "can be very noisy"), filter every feature with the same world-position weights (eq. (1), (3),
 // (4)): normal, view depth, base colour and metallic, F0 and roughness, emission and f90. Motion
-// and ids pass unchanged. The variance of the filtered normal comes from dual buffers (§5, after
-// Rousselle et al. 2013): the features filtered once with the weights of the even samples'
-// positions and once with the odd samples', their squared difference over 4.
+// and ids pass unchanged. The variances of the filtered normal and view depth come from dual
+// buffers (§5, after Rousselle et al. 2013): the features filtered once with the weights of the
+// even samples' positions and once with the odd samples', their squared difference over 4.
 
 var<storage, read> pf_bandwidth: array<f32>;
 var<storage, read_write> pf_features: array<vec4u>;
 // Debug views: x the chosen bandwidth before smoothing, y after, z the world positions' spread
 // (RMS distance from their mean) in pixels, w the filtered normal's variance (dual buffers).
 var pf_view: texture_storage_2d<rgba16float, write>;
-// xy the raw octahedral normal, zw the filtered one.
+// xy the raw octahedral normal (the G-buffer holds the filtered one), z the filtered view
+// depth's relative variance (dual buffers), w unused.
 var pf_normals: texture_storage_2d<rgba16float, write>;
 
 // A tap below this weight adds nothing visible (and its features are not read).
@@ -55,7 +56,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let raw_n = finite_or_zero(feature(ci, 0u));
     if sc.n < 1.0 || !features_finite(ci) {
         textureStore(pf_view, c, vec4f(0.0));
-        textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), oct_of(raw_n.xyz)));
+        textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), 0.0, 0.0));
         return;
     }
     // The bandwidth, smoothed over the pixels with a surface.
@@ -76,6 +77,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let cov_trace = 3.0 * sc.sigma2_n * sc.n;
     let spread = sqrt(max(cov_trace, 0.0)) / max(pixel_footprint(sc.p), 1e-30);
     var variance = 0.0;
+    var depth_variance = 0.0;
     if h >= 0.05 {
         var sum_w = 0.0;
         var normal_depth = vec4f(0.0);
@@ -123,8 +125,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         pf_features[f + 3u] = bitcast<vec4u>(emission * inv);
         let diff = nd_a / max(w_ab.x, 1e-30) - nd_b / max(w_ab.y, 1e-30);
         variance = dot(diff.xyz, diff.xyz) / 4.0;
+        let z = max(abs(normal_depth.w * inv), 1e-30);
+        depth_variance = diff.w * diff.w / 4.0 / (z * z);
     }
-    let filtered = bitcast<vec4f>(pf_features[ci * 5u]);
     textureStore(pf_view, c, vec4f(pf_bandwidth[ci], h, min(spread, 65000.0), min(variance, 65000.0)));
-    textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), oct_of(filtered.xyz)));
+    textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), min(depth_variance, 65000.0), 0.0));
 }

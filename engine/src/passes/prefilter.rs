@@ -31,7 +31,7 @@ pub struct PrefilterTargets {
     /// Bandwidth before and after smoothing, the positions' spread in pixels, the normal's
     /// variance (the `prefilter/...` debug views).
     pub view: Tex,
-    /// Raw and filtered octahedral normals.
+    /// The raw octahedral normal and the filtered view depth's relative variance.
     pub normals: Tex,
 }
 

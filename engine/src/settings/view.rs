@@ -137,11 +137,13 @@ pub const FRAME_VIEWS: &[ViewSpec] = &[
     v("gbuffer/object id", "gbuffer/ids", ViewMap::Id),
     v("gbuffer/motion", "gbuffer/motion", ViewMap::Motion { channel: 0 }),
     // The pre-filter's (Moon et al. 2017), with a thin lens: the bandwidth after smoothing
-    // (white: h = 2), the world positions' spread (white: 8 pixels), the filtered normal's
-    // variance from dual buffers (white: 0.05), the raw normal (gbuffer/normal shows the filtered).
+    // (white: h = 2), the world positions' spread (white: 8 pixels), the filtered normal's and
+    // view depth's variances from dual buffers (white: 0.05, and 1e-4 relative), the raw normal
+    // (gbuffer/normal shows the filtered).
     v("prefilter/bandwidth", "prefilter/view", ViewMap::Grey { channel: 1, divisor: 2.0 }),
     v("prefilter/position spread", "prefilter/view", ViewMap::Grey { channel: 2, divisor: 8.0 }),
     v("prefilter/normal variance", "prefilter/view", ViewMap::Grey { channel: 3, divisor: 0.05 }),
+    v("prefilter/depth variance", "prefilter/normals", ViewMap::Grey { channel: 2, divisor: 1e-4 }),
     v("prefilter/raw normal", "prefilter/normals", ViewMap::Normal),
     v("trace/matte", "trace/matte", ViewMap::Light),
     v("trace/direct", "trace/direct", ViewMap::Light),
