@@ -102,16 +102,24 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 let wi = weight(mahalanobis(sc, sq, sq.p - sc.p).w, h);
                 let wa = weight(mahalanobis(sc, sq, sq.p_a - sc.p_a).w, h);
                 let wb = weight(mahalanobis(sc, sq, odd_position(sq) - pb_c).w, h);
-                let qi = pixel_index(q);
-                if max(wi, max(wa, wb)) < MIN_WEIGHT || !features_finite(qi) {
+                if max(wi, max(wa, wb)) < MIN_WEIGHT {
                     continue;
                 }
+                // Each feature read once (a storage-buffer read is a loop over the lanes on a
+                // CPU driver).
+                let qi = pixel_index(q);
                 let nd = feature(qi, 0u);
+                let fb = feature(qi, 1u);
+                let fs = feature(qi, 2u);
+                let fe = feature(qi, 3u);
+                if !(finite4(nd) && finite4(fb) && finite4(fs) && finite4(fe)) {
+                    continue;
+                }
                 sum_w += wi;
                 normal_depth += wi * nd;
-                base += wi * feature(qi, 1u);
-                spec += wi * feature(qi, 2u);
-                emission += wi * feature(qi, 3u);
+                base += wi * fb;
+                spec += wi * fs;
+                emission += wi * fe;
                 w_ab += vec2f(wa, wb);
                 nd_a += wa * nd;
                 nd_b += wb * nd;
