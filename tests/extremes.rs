@@ -56,7 +56,11 @@ fn extreme_scene(camera: Option<([f32; 3], [f32; 3])>) -> Scene {
     }
     // serde_json writes NaN as null, which a glTF float accessor cannot carry: the NaN travels
     // in the binary buffer instead (see GltfWriter::vec3_accessor).
-    load_gltf(&g.write("extreme")).unwrap()
+    // Tests run on parallel threads of one process: each scene gets a folder of its own, or
+    // one test reads the file while another rewrites it.
+    static SCENES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = SCENES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    load_gltf(&g.write(&format!("extreme-{n}"))).unwrap()
 }
 
 #[test]
