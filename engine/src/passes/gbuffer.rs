@@ -57,10 +57,54 @@ impl GBufferTargets {
         &self.color[i]
     }
 
+    /// A render pass writing every channel and the depth, cleared (ids to "no surface", depth to
+    /// 0, reversed Z's far): the raster's, and the traced primaries' resolve.
+    pub fn begin_pass<'e>(&self, enc: &'e mut wgpu::CommandEncoder, label: &'static str, timer: Option<&mut GpuTimer>) -> wgpu::RenderPass<'e> {
+        let clear_ids = wgpu::Color { r: u32::MAX as f64, g: u32::MAX as f64, b: 0.0, a: 0.0 };
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = self
+            .color
+            .iter()
+            .enumerate()
+            .map(|(i, (_, v))| {
+                let clear = if i == COLOR_FORMATS.len() - 1 { clear_ids } else { wgpu::Color::TRANSPARENT };
+                Some(wgpu::RenderPassColorAttachment { view: v, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store } })
+            })
+            .collect();
+        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth.1,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.and_then(|t| t.render(label)),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+
     /// A colour channel's format by name.
     pub fn format(name: &str) -> wgpu::TextureFormat {
         COLOR_FORMATS.iter().find(|(l, _)| l.strip_prefix("gbuffer/") == Some(name)).expect("G-buffer channel").1
     }
+}
+
+/// A pipeline that writes every G-buffer channel and the depth (entry points `vs_main` and
+/// `fs_main`, both faces drawn), depth compared by `depth_compare`.
+pub fn render_pipeline(d: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, depth_compare: wgpu::CompareFunction) -> wgpu::RenderPipeline {
+    let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
+    d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+        primitive: wgpu::PrimitiveState { cull_mode: None, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState { format: DEPTH_FORMAT, depth_write_enabled: Some(true), depth_compare: Some(depth_compare), stencil: Default::default(), bias: Default::default() }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 pub struct GBufferPass {
@@ -88,54 +132,16 @@ impl GBufferPass {
             if f.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" },
             "realtime/gbuffer.wgsl",
         ];
-        let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
         let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-        let pipeline = Reloadable::new(gpu, LABEL, "", &modules, visibility, &bindings(scene, frame), move |d, module, pl| d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(LABEL),
-            layout: Some(pl),
-            vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
-            primitive: wgpu::PrimitiveState { cull_mode: None, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                // Reversed Z: larger is nearer.
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
-            multiview_mask: None,
-            cache: None,
-        }))?;
+        // Reversed Z: larger is nearer.
+        let pipeline = Reloadable::new(gpu, LABEL, "", &modules, visibility, &bindings(scene, frame), |d, module, pl| render_pipeline(d, LABEL, module, pl, wgpu::CompareFunction::Greater))?;
         Ok(GBufferPass { pipeline, groups: BindCache::default() })
     }
 
     pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &wgpu::Buffer, t: &GBufferTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
         let p = &self.pipeline;
         let groups = self.groups.get(scene.generation, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, frame)))?;
-        let clear_ids = wgpu::Color { r: u32::MAX as f64, g: u32::MAX as f64, b: 0.0, a: 0.0 };
-        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = t
-            .color
-            .iter()
-            .enumerate()
-            .map(|(i, (_, v))| {
-                let clear = if i == COLOR_FORMATS.len() - 1 { clear_ids } else { wgpu::Color::TRANSPARENT };
-                Some(wgpu::RenderPassColorAttachment { view: v, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store } })
-            })
-            .collect();
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(LABEL),
-            color_attachments: &attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &t.depth.1,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timer.and_then(|t| t.render(LABEL)),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = t.begin_pass(enc, LABEL, timer);
         pass.set_pipeline(p.get());
         set_render_groups(&mut pass, groups);
         pass.draw(0..scene.triangle_count * 3, 0..1);

@@ -9,7 +9,7 @@
 
 use crate::gpu::scene::compute_pipeline;
 use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups, set_render_groups};
-use crate::passes::gbuffer::{COLOR_FORMATS, DEPTH_FORMAT, GBufferTargets};
+use crate::passes::gbuffer::{GBufferTargets, render_pipeline};
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
@@ -93,48 +93,14 @@ impl Primaries {
         let offered = Bindings::new().buffer("frame", frame).buffer("features", &t.features).buffer("edges", edges.unwrap_or(&t.features));
         if self.resolve.is_none() {
             let modules = ["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"];
-            let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
-            let p = Reloadable::new(gpu, RESOLVE, "", &modules, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT, &offered, move |d, module, pl| {
-                d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(RESOLVE),
-                    layout: Some(pl),
-                    vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
-                    primitive: Default::default(),
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: DEPTH_FORMAT,
-                        depth_write_enabled: Some(true),
-                        depth_compare: Some(wgpu::CompareFunction::Always),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
-                    multiview_mask: None,
-                    cache: None,
-                })
-            })?;
+            // Every pixel is written: the depth is the resolved one, not a nearest surface.
+            let p = Reloadable::new(gpu, RESOLVE, "", &modules, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT, &offered, |d, module, pl| render_pipeline(d, RESOLVE, module, pl, wgpu::CompareFunction::Always))?;
             self.resolve = Some((p, Default::default()));
         }
         let (p, caches) = self.resolve.as_mut().unwrap();
         let groups = caches[filtered as usize].get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(RESOLVE);
-        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = g
-            .color
-            .iter()
-            .map(|(_, v)| Some(wgpu::RenderPassColorAttachment { view: v, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store } }))
-            .collect();
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(RESOLVE),
-            color_attachments: &attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &g.depth.1,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timer.and_then(|t| t.render(RESOLVE)),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = g.begin_pass(enc, RESOLVE, timer);
         pass.set_pipeline(p.get());
         set_render_groups(&mut pass, groups);
         pass.draw(0..3, 0..1);
