@@ -5,41 +5,16 @@
 var<storage, read_write> accum: array<vec4f>;
 
 // Camera ray of one sample: a uniform position in the pixel's square (Mitsuba's box filter),
-// through the thin lens where there is one, at a random time in the shutter where it is open.
+// through the thin lens and at a time in the shutter where the camera has them
+// (common/camera.wgsl).
 fn camera_start(px: vec2u, rng: ptr<function, u32>) -> PathStart {
     let j = rand2(rng);
     let ndc = vec2f(
         (f32(px.x) + j.x) / f32(params.width) * 2.0 - 1.0,
         1.0 - (f32(px.y) + j.y) / f32(params.height) * 2.0,
     );
-    var pos = params.cam_pos.xyz;
-    var right = params.cam_right.xyz;
-    var up = params.cam_up.xyz;
-    var fwd = params.cam_fwd.xyz;
-    var time = 1.0;
-    if params.shutter.x > 0.0 {
-        // Motion blur: the whole path sees the scene at one uniformly random time in the
-        // shutter, the camera blended between its open and close frames (common/motion_*.wgsl).
-        time = rand(rng);
-        pos = mix(params.cam_open_pos.xyz, pos, time);
-        right = mix(params.cam_open_right.xyz, right, time);
-        up = mix(params.cam_open_up.xyz, up, time);
-        fwd = mix(params.cam_open_fwd.xyz, fwd, time);
-    }
-    set_ray_time(time);
-    let d = fwd + ndc.x * right + ndc.y * up;
-    var ro = pos;
-    var rd = normalize(d);
-    if params.lens.x > 0.0 {
-        // Thin lens (Mitsuba's thinlens): a uniform point on the aperture disk, aimed at where
-        // the pinhole ray meets the focus plane (d has unit length along fwd).
-        let u = rand2(rng);
-        let r = params.lens.x * sqrt(u.x);
-        let a = 6.283185307 * u.y;
-        ro += r * (cos(a) * normalize(right) + sin(a) * normalize(up));
-        rd = normalize(pos + d * params.lens.y - ro);
-    }
-    return camera_path(ro, rd);
+    let ray = camera_sample(ndc, rng);
+    return camera_path(ray.ro, ray.rd);
 }
 
 // params.batch.x samples of the pixel, each with its own random sequence (sample_index + k), as

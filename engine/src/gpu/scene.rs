@@ -208,7 +208,7 @@ impl GpuScene {
     /// 962-985 ms at 640x360), so programs use it only while something moves.
     pub fn shading_modules_for(&self, moving: bool) -> Vec<&'static str> {
         let f = &self.features;
-        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if moving && f.animated { "common/motion_blur.wgsl" } else { "common/motion_none.wgsl" }, self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
+        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if moving && f.animated { "common/motion_blur.wgsl" } else { "common/motion_none.wgsl" }, self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/camera.wgsl", "common/path.wgsl"];
         m.push(if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" });
         m.push(if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" });
         m.push(if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" });

@@ -65,6 +65,7 @@ embed!(
     "common/env_constant.wgsl",
     "common/env_map.wgsl",
     "common/params.wgsl",
+    "common/camera.wgsl",
     "common/path.wgsl",
     "reference/trace.wgsl",
     "realtime/frame.wgsl",
@@ -332,7 +333,7 @@ mod tests {
             let stack = "const TRAVERSAL_STACK: u32 = 16u;\n";
             v.push(compose("raycast", stack, &["common/math.wgsl", "common/geometry.wgsl", "common/motion_none.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
             for (i, set) in FEATURE_SETS.iter().enumerate() {
-                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if i % 2 == 0 { "common/motion_none.wgsl" } else { "common/motion_blur.wgsl" }, bvh, "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/path.wgsl"];
+                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if i % 2 == 0 { "common/motion_none.wgsl" } else { "common/motion_blur.wgsl" }, bvh, "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/camera.wgsl", "common/path.wgsl"];
                 m.extend(set.iter());
                 let prelude = format!("const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n{stack}", i % 2 == 1, i != 0);
                 let mut reference = m.clone();
