@@ -58,11 +58,6 @@ pub struct ShutterOpen {
 }
 
 impl FrameInput {
-    /// An instant exposure.
-    pub fn at(camera: Camera, time: f64) -> FrameInput {
-        FrameInput { camera, time, shutter: None }
-    }
-
     /// The exposure over `shutter` of the frame interval `frame_dt` (seconds) ending at `time`,
     /// the camera at the open given by `camera_at` (a camera path's interpolation; the same
     /// camera for a still one). `shutter` = 0: an instant exposure.
@@ -92,7 +87,7 @@ struct Targets {
     previous: Option<PreviousGBuffer>,
     /// Made for k > 1 samples per pixel (remade when k changes).
     supersample: Option<SupersampleTargets>,
-    /// Made when a camera with a thin lens is first rendered (traced primaries), and when the
+    /// Made when a thin lens or a moving shutter is first rendered (traced primaries), and when the
     /// pre-filter first runs.
     primaries: Option<PrimaryTargets>,
     prefilter: Option<PrefilterTargets>,
@@ -466,14 +461,14 @@ impl Renderer {
         // per pixel, each through its own lens point at its own time), not rasterised; the
         // accumulate mode traces one, so that its mean over frames is exact.
         let blurred = input.shutter.is_some_and(|s| s.camera != input.camera) || self.prepared.shutter_moves();
-        let lens = input.camera.lens.is_some_and(|l| l.aperture_radius > 0.0) || blurred;
-        let primary_samples = match (lens, settings.accumulate) {
+        let traced = input.camera.lens.is_some_and(|l| l.aperture_radius > 0.0) || blurred;
+        let primary_samples = match (traced, settings.accumulate) {
             (false, _) => 0,
             (true, true) => 1,
             (true, false) => settings.primary_samples.clamp(1, crate::settings::MAX_PRIMARY_SAMPLES),
         };
-        let prefilter = lens && settings.prefilter && !settings.accumulate;
-        if lens {
+        let prefilter = traced && settings.prefilter && !settings.accumulate;
+        if traced {
             if samples > 1 {
                 bail!("{samples} samples per pixel (guide rays) need the raster's G-buffer, which depth of field and motion blur replace by traced primaries: set samples per pixel to 1 (they trace {} primary samples per pixel)", settings.primary_samples);
             }
@@ -509,7 +504,7 @@ impl Renderer {
         let parity = (self.frame_index % 2) as usize;
         // gbuffer -> trace -> denoise -> composite -> TAA -> display (Mara et al. 2017, Figure 2).
         let t = &self.targets;
-        match t.primaries.as_ref().filter(|_| lens) {
+        match t.primaries.as_ref().filter(|_| traced) {
             None => {
                 let _pass = crate::profile::scope(gbuffer::LABEL);
                 self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &t.gbuffer, self.timer.as_mut())?;

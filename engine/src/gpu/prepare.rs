@@ -128,8 +128,6 @@ pub struct PreparedScene {
     /// Per object, the rebased transform from where a point is at the shutter's close (`time`)
     /// to where it is at its open; empty while no object moves during the shutter.
     open_from_close: Vec<glam::Mat4>,
-    /// The scene time at the shutter's open (None: no motion blur).
-    pub shutter_open: Option<f64>,
 }
 
 /// Triangle slots and node indices share 24 bits in the BVH2 traversal stack.
@@ -280,7 +278,6 @@ impl PreparedScene {
             flat,
             time: 0.0,
             open_from_close: vec![],
-            shutter_open: None,
         };
         p.assemble();
         p.traversal_stack = accel::traversal_stack(kind, p.accel.depth, count, p.features.animated);
@@ -329,7 +326,6 @@ impl PreparedScene {
                 open_from_close = scene.objects.iter().enumerate().take(self.world.len()).map(|(i, o)| rebased(o.transform_at(t), self.origin) * rebased(self.world[i], self.origin).inverse()).collect();
             }
         }
-        self.shutter_open = open;
         let changed = open_from_close != self.open_from_close;
         self.open_from_close = open_from_close;
         if changed {
