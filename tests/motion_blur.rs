@@ -1,4 +1,4 @@
-//! Motion blur (a shutter open over an interval: FrameInput::shutter, PreparedScene::set_shutter)
+//! Motion blur (a shutter open over an interval: FrameInput::shutter, PreparedScene::expose)
 //! in the default level, whose cube spins and rises: the reference tracer's blurred image equals
 //! the mean of still images over the shutter, and the real-time frame's accumulation converges
 //! to it.
@@ -35,8 +35,7 @@ fn view(camera: Camera, shutter_camera: Option<Camera>, seed: u32) -> TraceView 
 /// The reference tracer over the whole shutter, `spp` samples per pixel.
 fn blurred(scene: &Scene, spp: u32) -> Accumulation {
     let mut prepared = PreparedScene::new(scene, BvhKind::DEFAULT).unwrap();
-    prepared.animate(scene, CLOSE);
-    prepared.set_shutter(scene, Some(OPEN));
+    prepared.expose(scene, CLOSE, Some(OPEN));
     assert!(prepared.shutter_moves(), "the level's cube moves during the shutter");
     let gpu = Gpu::headless(&prepared.requirements((SIZE.0 * SIZE.1) as u64, 32)).unwrap();
     let gscene = prepared.upload(&gpu);

@@ -1,5 +1,5 @@
 // Objects may move while the shutter is open (an animated scene; engine/src/gpu/prepare.rs,
-// PreparedScene::set_shutter): each vertex moves linearly from where it is at the shutter's open
+// PreparedScene::expose): each vertex moves linearly from where it is at the shutter's open
 // (tri_open_texels) to where it is at its close (tri_texels), and a ray sees the scene at its own
 // time in [0, 1] (set_ray_time; 1, the close, is also what the raster, the motion vectors and
 // the emitter sampling use). The BVH bounds each triangle at both ends, so it holds it at every

@@ -303,8 +303,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if !time.is_finite() {
         bail!("--time must be a finite number of seconds");
     }
-    prepared.animate(&scene, time);
-    prepared.set_shutter(&scene, (open < time).then_some(open));
+    prepared.expose(&scene, time, (open < time).then_some(open));
     let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;

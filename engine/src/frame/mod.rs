@@ -422,9 +422,8 @@ impl Renderer {
         let mut moved = false;
         if self.prepared.features.animated {
             puffin::profile_scope!("animate");
-            moved = self.prepared.animate(&self.scene, input.time);
-            let swept = self.prepared.set_shutter(&self.scene, input.shutter.map(|s| s.time));
-            self.gpu_scene.update_geometry(gpu, &self.prepared, moved || swept);
+            moved = self.prepared.expose(&self.scene, input.time, input.shutter.map(|s| s.time));
+            self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
         }
         let size = self.targets.size;
         let cam = self.camera_setup(&input.camera);

@@ -98,7 +98,7 @@ pub struct PreparedScene {
     pub extent: f64,
     pub tris: Vec<Vec4>,
     /// Animated scenes: the vertices of `tris` where they are at the shutter's open
-    /// ([`PreparedScene::set_shutter`]; `tris` are at its close), the same as `tris` while the
+    /// ([`PreparedScene::expose`]; `tris` are at its close), the same as `tris` while the
     /// shutter is closed (no motion blur).
     pub tris_open: Vec<Vec4>,
     pub shading: Vec<Vec4>,
@@ -285,10 +285,30 @@ impl PreparedScene {
         Ok(p)
     }
 
-    /// Move animated objects to `time` seconds: re-flatten them, rebuild the BVH and the
-    /// per-object motion (`prev_from_current`) that the G-buffer's motion vectors read. Returns
-    /// false (and changes nothing) for a static scene.
+    /// Move animated objects to `time` seconds (an instant exposure): re-flatten them, rebuild
+    /// the BVH and the per-object motion (`prev_from_current`) that the G-buffer's motion vectors
+    /// read. Returns false (and changes nothing) for a static scene.
     pub fn animate(&mut self, scene: &Scene, time: f64) -> bool {
+        self.expose(scene, time, None)
+    }
+
+    /// [`animate`] to `time`, the shutter's close, with the shutter open since scene time
+    /// `open` (None: an instant). Objects whose transform differs between the two move linearly
+    /// between them during the exposure (shaders/common/motion_blur.wgsl): the BVH is built over
+    /// each triangle's box at both ends and `tris_open` holds the open ends. One rebuild, where
+    /// anything changed; returns whether it did.
+    ///
+    /// [`animate`]: PreparedScene::animate
+    pub fn expose(&mut self, scene: &Scene, time: f64, open: Option<f64>) -> bool {
+        let moved = self.move_objects(scene, time);
+        let swept = self.open_shutter(scene, open);
+        if moved || swept {
+            self.assemble();
+        }
+        moved || swept
+    }
+
+    fn move_objects(&mut self, scene: &Scene, time: f64) -> bool {
         let mut moved = false;
         for (i, o) in scene.objects.iter().enumerate().take(self.world.len()) {
             let now = o.transform_at(time);
@@ -305,20 +325,12 @@ impl PreparedScene {
             }
         }
         self.time = time;
-        if moved {
-            self.assemble();
-        }
         moved
     }
 
-    /// Open the shutter at scene time `open` (before `time`, the close, which [`animate`] set;
-    /// None: no motion blur). Objects whose transform differs between the two move linearly
-    /// between them during the exposure (shaders/common/motion_blur.wgsl): the BVH is rebuilt
-    /// over each triangle's box at both ends and `tris_open` holds the open ends. Returns
-    /// whether the geometry changed (call after [`animate`], before uploading).
-    ///
-    /// [`animate`]: PreparedScene::animate
-    pub fn set_shutter(&mut self, scene: &Scene, open: Option<f64>) -> bool {
+    /// The per-object transforms from the close to `open` (empty while nothing moves during the
+    /// shutter); whether they changed.
+    fn open_shutter(&mut self, scene: &Scene, open: Option<f64>) -> bool {
         let mut open_from_close = vec![];
         if let Some(t) = open.filter(|_| self.features.animated) {
             let moving = scene.objects.iter().enumerate().take(self.world.len()).any(|(i, o)| o.animation.is_some() && o.transform_at(t) != self.world[i]);
@@ -328,9 +340,6 @@ impl PreparedScene {
         }
         let changed = open_from_close != self.open_from_close;
         self.open_from_close = open_from_close;
-        if changed {
-            self.assemble();
-        }
         changed
     }
 
@@ -429,7 +438,7 @@ impl PreparedScene {
         }
     }
 
-    /// Whether some object moves while the shutter is open ([`PreparedScene::set_shutter`]).
+    /// Whether some object moves while the shutter is open ([`PreparedScene::expose`]).
     pub fn shutter_moves(&self) -> bool {
         !self.open_from_close.is_empty()
     }

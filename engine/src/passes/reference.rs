@@ -55,7 +55,7 @@ pub struct TraceView {
     pub max_depth: i32,
     pub seed: u32,
     /// Motion blur: the camera at the shutter's open (`camera` is at its close); objects move
-    /// as [`PreparedScene::set_shutter`] set them up.
+    /// as [`PreparedScene::expose`] set them up.
     pub shutter_camera: Option<Camera>,
 }
 
