@@ -74,6 +74,13 @@ fn scheduled_pixel(t: vec2u) -> vec2u {
     return t * schedule_tile() + c;
 }
 
+// A clip-space position in pixels of this frame's image (x right, y down): motion vectors
+// compare two of them.
+fn to_pixels(clip: vec4f) -> vec2f {
+    let ndc = clip.xy / clip.w;
+    return vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * vec2f(frame.size);
+}
+
 // The camera ray through this frame's sample position in pixel px.
 fn camera_ray(px: vec2u) -> vec3f {
     return camera_ray_at(vec2f(px) + frame.jitter);

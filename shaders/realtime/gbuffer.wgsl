@@ -42,11 +42,6 @@ struct GBufferOut {
     @location(5) ids: vec2u,
 }
 
-fn to_pixels(clip: vec4f) -> vec2f {
-    let ndc = clip.xy / clip.w;
-    return vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * vec2f(frame.size);
-}
-
 @fragment
 fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     let slot = v.slot;

@@ -27,11 +27,6 @@ var<storage, read_write> pr_moments: array<vec4u>;
 const FEATURE_WORDS: u32 = 5u;
 const MOMENT_WORDS: u32 = 4u;
 
-fn to_pixels(clip: vec4f) -> vec2f {
-    let ndc = clip.xy / clip.w;
-    return vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * vec2f(frame.size);
-}
-
 fn bits(v: vec4f) -> vec4u {
     return bitcast<vec4u>(v);
 }
