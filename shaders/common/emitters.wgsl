@@ -22,9 +22,11 @@ fn sample_emitter(p: vec3f, u: vec3f) -> LightSample {
         }
     }
     let slot = emitters[lo].y;
-    let v0 = tris[slot * 3u].xyz;
-    let e1 = tris[slot * 3u + 1u].xyz - v0;
-    let e2 = tris[slot * 3u + 2u].xyz - v0;
+    // The vertices as texels (at the shutter's close where objects move): one fetch a vertex
+    // instead of the storage buffer's per-word reads.
+    let v0 = tri_texel(slot * 3u).xyz;
+    let e1 = tri_texel(slot * 3u + 1u).xyz - v0;
+    let e2 = tri_texel(slot * 3u + 2u).xyz - v0;
     let su = sqrt(u.y);
     let b = vec2f(1.0 - su, u.z * su);
     let q = v0 + b.x * e1 + b.y * e2;
