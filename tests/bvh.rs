@@ -5,7 +5,11 @@ use hush_engine::accel::BvhKind;
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::passes::Raycaster;
 use hush_tests::shared;
-use obvhs::{BvhBuildParams, ray::{Ray, RayHit}, triangle::Triangle};
+use obvhs::{
+    BvhBuildParams,
+    ray::{Ray, RayHit},
+    triangle::Triangle,
+};
 
 struct Xorshift(u32);
 impl Xorshift {
@@ -36,7 +40,10 @@ fn barycentrics(t: &Triangle, p: DVec3) -> (f64, f64) {
 }
 
 #[test]
-#[cfg_attr(not(hush_shared_scenes), ignore = "needs ../shared/scenes/living-room, absent beside this checkout")]
+#[cfg_attr(
+    not(hush_shared_scenes),
+    ignore = "needs ../shared/scenes/living-room, absent beside this checkout"
+)]
 fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
     let path = shared().join("scenes/living-room/living-room.gltf");
     let scene = hush_engine::scene::load_gltf_with(&path, 16).expect("living room loads");
@@ -53,7 +60,11 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
         }
         // An independent CPU BVH over the same triangles.
         let mut t = std::time::Duration::ZERO;
-        let cpu = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut t);
+        let cpu = obvhs::bvh2::builder::build_bvh2_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut t,
+        );
 
         let gpu = Gpu::headless(&prepared.requirements(0, 0)).unwrap();
         let gscene = prepared.upload(&gpu);
@@ -65,7 +76,11 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
         // Half incoherent rays from random points in the bounds, half from the camera.
         let rays: Vec<(Vec3, Vec3, f32)> = (0..8192)
             .map(|i| {
-                let o = if i % 2 == 0 { lo + (hi - lo) * Vec3::new(rng.next(), rng.next(), rng.next()) } else { cam };
+                let o = if i % 2 == 0 {
+                    lo + (hi - lo) * Vec3::new(rng.next(), rng.next(), rng.next())
+                } else {
+                    cam
+                };
                 (o, rng.dir(), f32::MAX)
             })
             .collect();
@@ -77,9 +92,15 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
         for (i, (o, d, _)) in rays.iter().enumerate() {
             let ray = Ray::new_inf((*o).into(), (*d).into());
             let mut h = RayHit::none();
-            let cpu_hit = cpu.ray_traverse(ray, &mut h, |r, id| tris[cpu.primitive_indices[id] as usize].intersect(r));
+            let cpu_hit = cpu.ray_traverse(ray, &mut h, |r, id| {
+                tris[cpu.primitive_indices[id] as usize].intersect(r)
+            });
             let cpu_tri = cpu_hit.then(|| cpu.primitive_indices[h.primitive_id as usize]);
-            assert_eq!(any_hits[i].is_some(), gpu_hits[i].is_some(), "{kind:?}: any-hit and closest-hit disagree on ray {i}");
+            assert_eq!(
+                any_hits[i].is_some(),
+                gpu_hits[i].is_some(),
+                "{kind:?}: any-hit and closest-hit disagree on ray {i}"
+            );
             match (gpu_hits[i], cpu_tri) {
                 (Some(g), Some(ct)) => {
                     hits += 1;
@@ -115,8 +136,14 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
         // A ray through a shared edge or vertex may be given to either triangle (same t, checked
         // above); a ray grazing an edge may be a hit on one side and a miss on the other. Both are
         // rare: at most 0.2% of rays.
-        assert!(other_triangle * 500 <= rays.len(), "{kind:?}: {other_triangle} rays hit another triangle");
-        assert!(hit_miss_disagree * 500 <= rays.len(), "{kind:?}: {hit_miss_disagree} hit/miss disagreements");
+        assert!(
+            other_triangle * 500 <= rays.len(),
+            "{kind:?}: {other_triangle} rays hit another triangle"
+        );
+        assert!(
+            hit_miss_disagree * 500 <= rays.len(),
+            "{kind:?}: {hit_miss_disagree} hit/miss disagreements"
+        );
     }
 }
 
@@ -124,15 +151,21 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
 /// gets its hit, in order.
 #[test]
 fn casts_larger_than_a_binding_go_in_batches() {
-    let scene = hush_engine::scene::load_gltf(&hush_tests::oracle("cornell_diffuse").join("cornell_diffuse.gltf")).unwrap();
+    let scene = hush_engine::scene::load_gltf(
+        &hush_tests::oracle("cornell_diffuse").join("cornell_diffuse.gltf"),
+    )
+    .unwrap();
     let prepared = PreparedScene::new(&scene, BvhKind::Cwbvh).unwrap();
     let gpu = Gpu::headless(&prepared.requirements(0, 0)).unwrap();
     let gscene = prepared.upload(&gpu);
     let caster = Raycaster::new(&gpu, &gscene).unwrap();
     let most = gpu.device.limits().max_storage_buffer_binding_size as usize / 32;
     // From the box's centre: straight up hits the ceiling, the rest alternate down to the floor.
-    let centre = ((scene.bounds().unwrap().0 + scene.bounds().unwrap().1) * 0.5 - prepared.origin).as_vec3();
-    let rays: Vec<(Vec3, Vec3, f32)> = (0..most + 1000).map(|i| (centre, if i % 2 == 0 { Vec3::Y } else { Vec3::NEG_Y }, f32::MAX)).collect();
+    let centre =
+        ((scene.bounds().unwrap().0 + scene.bounds().unwrap().1) * 0.5 - prepared.origin).as_vec3();
+    let rays: Vec<(Vec3, Vec3, f32)> = (0..most + 1000)
+        .map(|i| (centre, if i % 2 == 0 { Vec3::Y } else { Vec3::NEG_Y }, f32::MAX))
+        .collect();
     let (hits, _) = caster.cast(&gpu, &gscene, &rays, false).unwrap();
     assert_eq!(hits.len(), rays.len());
     let (up, down) = (hits[0].unwrap().t, hits[1].unwrap().t);
@@ -141,4 +174,3 @@ fn casts_larger_than_a_binding_go_in_batches() {
         assert_eq!(t, if i % 2 == 0 { up } else { down }, "ray {i}");
     }
 }
-

@@ -43,7 +43,11 @@ fn shelf_scene() -> Scene {
 /// Mean luminance of each row over the middle half of the columns (the shelf spans them all).
 fn row_means(img: &Image) -> Vec<f32> {
     let (w, h) = (img.width as usize, img.height as usize);
-    (0..h).map(|y| (w / 4..3 * w / 4).map(|x| luminance(img.data[y * w + x])).sum::<f32>() / (w / 2) as f32).collect()
+    (0..h)
+        .map(|y| {
+            (w / 4..3 * w / 4).map(|x| luminance(img.data[y * w + x])).sum::<f32>() / (w / 2) as f32
+        })
+        .collect()
 }
 
 /// How much of the shadow's depth below the lit wall a denoised image keeps, against 256
@@ -64,19 +68,35 @@ fn final_bilateral_keeps_a_contact_shadow() {
     lower.sort_by(f32::total_cmp);
     let lit = lower[lower.len() / 2];
     // The shelf's front face sits at the view's centre row; the shadow starts under it.
-    let shadow: Vec<usize> = (h / 2..2 * h / 3).skip_while(|&y| reference[y] < 0.6 * lit).skip_while(|&y| reference[y] >= 0.6 * lit).take_while(|&y| reference[y] < 0.6 * lit).collect();
-    println!("reference rows {:?}, lit wall {lit:.4}, shadow rows {shadow:?}", &reference[h / 2 - 2..2 * h / 3]);
+    let shadow: Vec<usize> = (h / 2..2 * h / 3)
+        .skip_while(|&y| reference[y] < 0.6 * lit)
+        .skip_while(|&y| reference[y] >= 0.6 * lit)
+        .take_while(|&y| reference[y] < 0.6 * lit)
+        .collect();
+    println!(
+        "reference rows {:?}, lit wall {lit:.4}, shadow rows {shadow:?}",
+        &reference[h / 2 - 2..2 * h / 3]
+    );
     assert!((2..=5).contains(&shadow.len()), "the shadow covers rows {shadow:?}");
     let below: Vec<usize> = (shadow[shadow.len() - 1] + 2..shadow[shadow.len() - 1] + 5).collect();
     let depth = |rows: &[f32]| {
         let mean = |ys: &[usize]| ys.iter().map(|&y| rows[y]).sum::<f32>() / ys.len() as f32;
         mean(&below) - mean(&shadow)
     };
-    let mara = |k: f32| FrameSettings { denoiser: Denoiser::MARA, matte: MatteSettings { edge_stop_sigmas: k, ..Default::default() }, ..Default::default() };
-    let kept = |k: f32| depth(&row_means(&realtime_frames(&scene, SIZE, &mara(k), 30).unwrap())) / depth(&reference);
+    let mara = |k: f32| FrameSettings {
+        denoiser: Denoiser::MARA,
+        matte: MatteSettings { edge_stop_sigmas: k, ..Default::default() },
+        ..Default::default()
+    };
+    let kept = |k: f32| {
+        depth(&row_means(&realtime_frames(&scene, SIZE, &mara(k), 30).unwrap())) / depth(&reference)
+    };
     let (with_stop, without) = (kept(MatteSettings::default().edge_stop_sigmas), kept(0.0));
     println!("shadow depth kept: with the edge-stop {with_stop:.3}, without {without:.3}");
     assert!(with_stop > 0.76, "the edge-stop keeps {with_stop} of the shadow (no stop: {without})");
     // What the bound stands on: without the stop the bilateral blurs half the shadow away.
-    assert!(without < 0.6, "with no edge-stop the bilateral keeps {without} of the shadow: the scene no longer tests the stop");
+    assert!(
+        without < 0.6,
+        "with no edge-stop the bilateral keeps {without} of the shadow: the scene no longer tests the stop"
+    );
 }

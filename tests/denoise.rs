@@ -32,7 +32,11 @@ fn strafe(step: f64, moving: u32) -> impl Fn(u32) -> Camera {
 
 /// A fresh renderer after 10 still frames at at(0) and one frame at each of at(1)..=at(moving):
 /// the moment the camera stops.
-fn strafed(s: &FrameSettings, at: &impl Fn(u32) -> Camera, moving: u32) -> (hush_engine::gpu::Gpu, Renderer) {
+fn strafed(
+    s: &FrameSettings,
+    at: &impl Fn(u32) -> Camera,
+    moving: u32,
+) -> (hush_engine::gpu::Gpu, Renderer) {
     let (gpu, mut r) = level();
     frames(&mut r, &gpu, s, at(0), 10);
     for k in 1..=moving {
@@ -41,7 +45,13 @@ fn strafed(s: &FrameSettings, at: &impl Fn(u32) -> Camera, moving: u32) -> (hush
     (gpu, r)
 }
 
-fn frames(r: &mut Renderer, gpu: &hush_engine::gpu::Gpu, s: &FrameSettings, camera: Camera, n: u32) -> Image {
+fn frames(
+    r: &mut Renderer,
+    gpu: &hush_engine::gpu::Gpu,
+    s: &FrameSettings,
+    camera: Camera,
+    n: u32,
+) -> Image {
     for _ in 0..n {
         r.render(gpu, &FrameInput { camera, time: 0.0, shutter: None }, s, None).unwrap();
     }
@@ -61,35 +71,66 @@ fn mara() -> FrameSettings {
 /// (JSON of MatteSettings), HUSH_TEST_ACC64, HUSH_TEST_IMAGES (a folder for the images).
 #[test]
 fn denoised_frames_beat_raw_ones() {
-    let frames_env = |k: &str, d: u32| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    let frames_env =
+        |k: &str, d: u32| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
     let side = frames_env("HUSH_TEST_SIDE", 256);
-    let scene = hush_engine::scene::load_gltf(&hush_tests::oracle("cornell_diffuse").join("cornell_diffuse.gltf")).unwrap();
+    let scene = hush_engine::scene::load_gltf(
+        &hush_tests::oracle("cornell_diffuse").join("cornell_diffuse.gltf"),
+    )
+    .unwrap();
     let cam = scene.camera_or_default();
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (side, side)).unwrap();
-    let converged = frames(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, cam, frames_env("HUSH_TEST_CONVERGED", 256));
+    let converged = frames(
+        &mut r,
+        &gpu,
+        &FrameSettings { accumulate: true, ..Default::default() },
+        cam,
+        frames_env("HUSH_TEST_CONVERGED", 256),
+    );
     let raw = frames(&mut r, &gpu, &FrameSettings::default(), cam, 1);
     let mut s = mara();
     if let Ok(j) = std::env::var("HUSH_TEST_MATTE") {
         s.matte = serde_json::from_str(&j).unwrap();
     }
-    for stage in std::env::var("HUSH_TEST_DISABLE").unwrap_or_default().split(',').filter(|s| !s.is_empty()) {
+    for stage in
+        std::env::var("HUSH_TEST_DISABLE").unwrap_or_default().split(',').filter(|s| !s.is_empty())
+    {
         assert!(s.matte.disable(stage), "{stage}");
     }
     let denoised = frames(&mut r, &gpu, &s, cam, frames_env("HUSH_TEST_FRAMES", 30));
     if std::env::var("HUSH_TEST_ACC64").is_ok() {
-        let acc = frames(&mut r, &gpu, &FrameSettings { accumulate: true, seed: 9, ..Default::default() }, cam, 64);
+        let acc = frames(
+            &mut r,
+            &gpu,
+            &FrameSettings { accumulate: true, seed: 9, ..Default::default() },
+            cam,
+            64,
+        );
         println!("FLIP of 64 accumulated frames: {:.4}", compare(&acc, &converged).unwrap().flip);
     }
     let m_raw = compare(&raw, &converged).unwrap();
     let m_dn = compare(&denoised, &converged).unwrap();
-    println!("FLIP raw {:.4} denoised {:.4}; relMSE raw {:.4} denoised {:.4}", m_raw.flip, m_dn.flip, m_raw.relmse, m_dn.relmse);
+    println!(
+        "FLIP raw {:.4} denoised {:.4}; relMSE raw {:.4} denoised {:.4}",
+        m_raw.flip, m_dn.flip, m_raw.relmse, m_dn.relmse
+    );
     if let Ok(dir) = std::env::var("HUSH_TEST_IMAGES") {
         for (n, i) in [("converged", &converged), ("raw", &raw), ("denoised", &denoised)] {
             i.save(&std::path::Path::new(&dir).join(format!("{n}.png"))).unwrap();
         }
     }
-    assert!(m_dn.flip < 0.5 * m_raw.flip, "denoised FLIP {} is not under half the raw {}", m_dn.flip, m_raw.flip);
-    assert!(m_dn.relmse < 0.05 * m_raw.relmse, "denoised relMSE {} vs raw {}", m_dn.relmse, m_raw.relmse);
+    assert!(
+        m_dn.flip < 0.5 * m_raw.flip,
+        "denoised FLIP {} is not under half the raw {}",
+        m_dn.flip,
+        m_raw.flip
+    );
+    assert!(
+        m_dn.relmse < 0.05 * m_raw.relmse,
+        "denoised relMSE {} vs raw {}",
+        m_dn.relmse,
+        m_raw.relmse
+    );
 }
 
 /// NaN, +Inf and -Inf injected into the chain's input on 1 pixel in 7 never reach the history
@@ -98,7 +139,11 @@ fn denoised_frames_beat_raw_ones() {
 #[test]
 fn nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) = level();
-    let base = FrameSettings { denoiser: Denoiser::MARA, matte: MatteSettings { inject_nonfinite: true, ..Default::default() }, ..Default::default() };
+    let base = FrameSettings {
+        denoiser: Denoiser::MARA,
+        matte: MatteSettings { inject_nonfinite: true, ..Default::default() },
+        ..Default::default()
+    };
     let mut cases = vec![base.clone()];
     for stage in MatteSettings::STAGES.into_iter().chain([TaaSettings::STAGE]) {
         let mut s = base.clone();
@@ -109,15 +154,32 @@ fn nonfinite_input_never_reaches_history_or_screen() {
         let m = (&s.matte, &s.taa);
         let img = frames(&mut r, &gpu, &s, view(), 4);
         assert!(img.data.iter().all(|p| p.is_finite()), "non-finite pixel on screen with {m:?}");
-        let histories = ["matte/history 0", "matte/history 1", "matte/temporal", "matte/bilateral", "taa/history 0", "taa/history 1"];
+        let histories = [
+            "matte/history 0",
+            "matte/history 1",
+            "matte/temporal",
+            "matte/bilateral",
+            "taa/history 0",
+            "taa/history 1",
+        ];
         // TAA's averages of the matte and glossy factors and the residual
         // (TaaSettings::current_light, current_glossy).
-        let taa_averages = ["taa/material 0", "taa/material 1", "taa/residual 0", "taa/residual 1", "taa/glossy 0", "taa/glossy 1"];
+        let taa_averages = [
+            "taa/material 0",
+            "taa/material 1",
+            "taa/residual 0",
+            "taa/residual 1",
+            "taa/glossy 0",
+            "taa/glossy 1",
+        ];
         for name in histories.into_iter().chain(taa_averages) {
             let (bytes, format) = r.read_texture(&gpu, name).unwrap();
             // Histories are 32-bit floats, single-frame outputs halves.
             let bad = match format {
-                wgpu::TextureFormat::Rgba32Float => bytes.chunks_exact(4).filter(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite()).count(),
+                wgpu::TextureFormat::Rgba32Float => bytes
+                    .chunks_exact(4)
+                    .filter(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite())
+                    .count(),
                 _ => bytes.chunks_exact(2).filter(|h| !half(h).is_finite()).count(),
             };
             assert_eq!(bad, 0, "{name} holds {bad} NaN/Inf values with {m:?}");
@@ -136,13 +198,19 @@ fn nonfinite_input_never_reaches_history_or_screen() {
 fn still_view_keeps_its_history() {
     let (gpu, mut r) = level();
     frames(&mut r, &gpu, &mara(), view(), 8);
-    let (pixels, reason) = (SIZE.0 as usize * SIZE.1 as usize, r.read_texture(&gpu, "matte/reason").unwrap().0);
+    let (pixels, reason) =
+        (SIZE.0 as usize * SIZE.1 as usize, r.read_texture(&gpu, "matte/reason").unwrap().0);
     let (depth, _) = r.read_texture(&gpu, "gbuffer/depth").unwrap();
     let surface = |i: usize| f32::from_le_bytes(depth[i * 4..i * 4 + 4].try_into().unwrap()) > 0.0;
     let rejected = history_rejected(&reason);
     let reset: Vec<usize> = (0..pixels).filter(|&i| surface(i) && rejected[i]).collect();
     println!("still view, 8th frame: {} of {pixels} pixels reset their history", reset.len());
-    assert!(reset.len() * 1000 <= pixels, "{} pixels reset their history in a still view: {:?}", reset.len(), &reset[..reset.len().min(20)]);
+    assert!(
+        reset.len() * 1000 <= pixels,
+        "{} pixels reset their history in a still view: {:?}",
+        reset.len(),
+        &reset[..reset.len().min(20)]
+    );
 }
 
 /// Temporal error (Schied et al.: mean absolute luminance change between consecutive frames) of
@@ -168,17 +236,26 @@ fn still_view_flickers_at_a_tenth_of_raw() {
         }
         sum / PAIRS as f64
     };
-    let shown_as_is = |t: TaaSettings| FrameSettings { taa: TaaSettings { display_ratio: 0.0, ..t }, ..mara() };
+    let shown_as_is =
+        |t: TaaSettings| FrameSettings { taa: TaaSettings { display_ratio: 0.0, ..t }, ..mara() };
     let raw = flicker(&FrameSettings::default());
-    let exponential = flicker(&shown_as_is(TaaSettings { still_frames: 0.0, ..Default::default() }));
+    let exponential =
+        flicker(&shown_as_is(TaaSettings { still_frames: 0.0, ..Default::default() }));
     let equal_age = flicker(&shown_as_is(TaaSettings::default()));
     let settled = flicker(&mara());
-    println!("temporal error: raw {raw:.5}, exponential TAA {exponential:.5}, equal-age {equal_age:.5}, defaults {settled:.5}");
+    println!(
+        "temporal error: raw {raw:.5}, exponential TAA {exponential:.5}, equal-age {equal_age:.5}, defaults {settled:.5}"
+    );
     assert!(settled <= 0.1 * raw, "temporal error {settled} is over a tenth of raw's {raw}");
-    assert!(equal_age < 0.75 * exponential, "temporal error {equal_age} against {exponential} with the exponential TAA blend");
-    assert!(settled < 0.5 * equal_age, "temporal error {settled} against {equal_age} with the history shown as is");
+    assert!(
+        equal_age < 0.75 * exponential,
+        "temporal error {equal_age} against {exponential} with the exponential TAA blend"
+    );
+    assert!(
+        settled < 0.5 * equal_age,
+        "temporal error {settled} against {equal_age} with the history shown as is"
+    );
 }
-
 
 /// History resets where the surface was not visible in the previous frame. After a sideways
 /// step past the arcade's pillars, the test recomputes eq. (11)'s distance on the CPU for every
@@ -202,7 +279,14 @@ fn history_resets_on_disocclusion() {
     let setup1 = r.camera_setup(&moved);
     let inv1 = setup1.jittered(halton_jitter(warm), SIZE).inverse();
     let read = |n: &str| r.read_texture(&gpu, n).unwrap().0;
-    let (depth1, reason, motion, temporal, input, normal) = (read("gbuffer/depth"), read("matte/reason"), read("gbuffer/motion"), read("matte/temporal"), read("trace/matte"), read("gbuffer/normal"));
+    let (depth1, reason, motion, temporal, input, normal) = (
+        read("gbuffer/depth"),
+        read("matte/reason"),
+        read("gbuffer/motion"),
+        read("matte/temporal"),
+        read("trace/matte"),
+        read("gbuffer/normal"),
+    );
     let f32_at = |b: &[u8], i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size: SIZE };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
@@ -213,7 +297,10 @@ fn history_resets_on_disocclusion() {
             let Some(p) = now.world(x, y) else { continue };
             let i = now.index(x, y).unwrap();
             let surface = Surface::new(p, oct_normal(&normal[i * 4..]), &setup1, SIZE.1);
-            let q = (x as f32 + 0.5 + half(&motion[i * 4..]), y as f32 + 0.5 + half(&motion[i * 4 + 2..]));
+            let q = (
+                x as f32 + 0.5 + half(&motion[i * 4..]),
+                y as f32 + 0.5 + half(&motion[i * 4 + 2..]),
+            );
             let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
                 .filter_map(|(tx, ty)| before.world(tx, ty))
                 .map(|prev| surface.distance(prev))
@@ -225,11 +312,14 @@ fn history_resets_on_disocclusion() {
             let why = u32::from_le_bytes(reason[i * 4..i * 4 + 4].try_into().unwrap()) & 255;
             flagged += (why & 3 != 0) as u32;
             // The temporal output is 32-bit, the input half: the new sample converts exactly.
-            let same = (0..3).all(|k| f32_at(&temporal, i * 4 + k) == half(&input[i * 8 + k * 2..]));
+            let same =
+                (0..3).all(|k| f32_at(&temporal, i * 4 + k) == half(&input[i * 8 + k * 2..]));
             exact += (same && f32_at(&temporal, i * 4 + 3) == 0.0) as u32;
         }
     }
-    println!("after the step: {rejected} pixels without history, {flagged} flagged, {exact} restarted from the new sample");
+    println!(
+        "after the step: {rejected} pixels without history, {flagged} flagged, {exact} restarted from the new sample"
+    );
     assert!(rejected >= 50, "the step disoccludes only {rejected} pixels");
     assert_eq!(flagged, rejected, "disoccluded pixels kept their history");
     assert_eq!(exact, rejected, "disoccluded pixels did not restart from the new sample");
@@ -247,7 +337,13 @@ fn history_resets_on_disocclusion() {
 fn camera_stop_recovers_like_a_fresh_start() {
     let at = strafe(0.06, 10);
     let (gpu, mut r) = level();
-    let converged = frames(&mut r, &gpu, &FrameSettings { accumulate: true, seed: 5, ..Default::default() }, at(10), 128);
+    let converged = frames(
+        &mut r,
+        &gpu,
+        &FrameSettings { accumulate: true, seed: 5, ..Default::default() },
+        at(10),
+        128,
+    );
     let flip = |img: &Image| compare(img, &converged).unwrap().flip;
     let stopped = |s: &FrameSettings| {
         let (gpu, mut r) = strafed(s, &at, 10);
@@ -264,9 +360,17 @@ fn camera_stop_recovers_like_a_fresh_start() {
         ..mara()
     };
     let (capped, uncapped) = (stopped(&mara()), stopped(&uncapped));
-    println!("FLIP 10 frames after: a fresh start {fresh:.4}, the stop {capped:.4}, the stop with uncapped histories {uncapped:.4}");
-    assert!(capped <= 1.05 * fresh, "10 frames after the stop FLIP is {capped}, a fresh start's {fresh}");
-    assert!(capped < 0.95 * uncapped, "10 frames after the stop FLIP is {capped}, with uncapped histories {uncapped}");
+    println!(
+        "FLIP 10 frames after: a fresh start {fresh:.4}, the stop {capped:.4}, the stop with uncapped histories {uncapped:.4}"
+    );
+    assert!(
+        capped <= 1.05 * fresh,
+        "10 frames after the stop FLIP is {capped}, a fresh start's {fresh}"
+    );
+    assert!(
+        capped < 0.95 * uncapped,
+        "10 frames after the stop FLIP is {capped}, with uncapped histories {uncapped}"
+    );
 }
 
 /// What a fast move uncovers recovers as fast as a fresh start shows it. 10 still frames, a
@@ -288,8 +392,15 @@ fn camera_stop_recovers_like_a_fresh_start() {
 fn disoccluded_region_recovers_like_a_fresh_start() {
     let at = strafe(0.24, 5);
     let (gpu, mut r) = level();
-    let converged = frames(&mut r, &gpu, &FrameSettings { accumulate: true, seed: 5, ..Default::default() }, at(5), 128);
-    let region_flip = |img: &Image, region: &[bool]| flip_over(img, &converged, region).map_or(0.0, |(f, _)| f);
+    let converged = frames(
+        &mut r,
+        &gpu,
+        &FrameSettings { accumulate: true, seed: 5, ..Default::default() },
+        at(5),
+        128,
+    );
+    let region_flip =
+        |img: &Image, region: &[bool]| flip_over(img, &converged, region).map_or(0.0, |(f, _)| f);
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
     let jump = |s: &FrameSettings| {
         let (gpu, mut r) = strafed(s, &at, 5);
@@ -297,24 +408,45 @@ fn disoccluded_region_recovers_like_a_fresh_start() {
         let region: Vec<bool> = (0..w * h)
             .map(|i| {
                 let (x, y) = ((i % w) as i64, (i / w) as i64);
-                neighbours_3x3(x, y).any(|(tx, ty)| tx >= 0 && ty >= 0 && (tx as usize) < w && (ty as usize) < h && flagged[ty as usize * w + tx as usize])
+                neighbours_3x3(x, y).any(|(tx, ty)| {
+                    tx >= 0
+                        && ty >= 0
+                        && (tx as usize) < w
+                        && (ty as usize) < h
+                        && flagged[ty as usize * w + tx as usize]
+                })
             })
             .collect();
         (frames(&mut r, &gpu, s, at(5), 10), region)
     };
-    let cap = |frames: f32| FrameSettings { glossy: GlossySettings { resampled_history_frames: frames, ..Default::default() }, ..mara() };
-    let caps: Vec<f32> = std::env::var("HUSH_TEST_CAPS").ok().map(|v| v.split(',').map(|c| c.parse().unwrap()).collect()).unwrap_or_default();
+    let cap = |frames: f32| FrameSettings {
+        glossy: GlossySettings { resampled_history_frames: frames, ..Default::default() },
+        ..mara()
+    };
+    let caps: Vec<f32> = std::env::var("HUSH_TEST_CAPS")
+        .ok()
+        .map(|v| v.split(',').map(|c| c.parse().unwrap()).collect())
+        .unwrap_or_default();
     let (stopped, region) = jump(&mara());
     let fresh = {
         let (gpu, mut r) = level();
         region_flip(&frames(&mut r, &gpu, &mara(), at(5), 10), &region)
     };
     let after = region_flip(&stopped, &region);
-    println!("{} pixels uncovered; FLIP over them 10 frames after the stop {after:.4}, a fresh start's {fresh:.4}", region.iter().filter(|r| **r).count());
+    println!(
+        "{} pixels uncovered; FLIP over them 10 frames after the stop {after:.4}, a fresh start's {fresh:.4}",
+        region.iter().filter(|r| **r).count()
+    );
     for c in caps {
         let (img, reg) = jump(&cap(c));
         println!("glossy cap {c}: {:.4}", region_flip(&img, &reg));
     }
-    assert!(region.iter().filter(|r| **r).count() >= 100, "the move uncovered too little to measure");
-    assert!(after <= 1.05 * fresh, "10 frames after the stop the uncovered region's FLIP is {after}, a fresh start's {fresh}");
+    assert!(
+        region.iter().filter(|r| **r).count() >= 100,
+        "the move uncovered too little to measure"
+    );
+    assert!(
+        after <= 1.05 * fresh,
+        "10 frames after the stop the uncovered region's FLIP is {after}, a fresh start's {fresh}"
+    );
 }

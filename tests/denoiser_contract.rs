@@ -67,46 +67,92 @@ impl Denoiser for Accumulate {
     }
 
     fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
-        let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
-        let mut t = |l: &str| memory.texture(&gpu.device, l, size, wgpu::TextureFormat::Rgba32Float, usage);
+        let usage = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let mut t =
+            |l: &str| memory.texture(&gpu.device, l, size, wgpu::TextureFormat::Rgba32Float, usage);
         self.history = Some([t("accumulate/history 0"), t("accumulate/history 1")]);
     }
 
-    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, timer: Option<&mut GpuTimer>) -> anyhow::Result<()> {
+    fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        timer: Option<&mut GpuTimer>,
+    ) -> anyhow::Result<()> {
         if self.stage.is_none() {
-            let motion = if self.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" };
-            let modules = ["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", motion, MODULE];
-            self.stage = Some(ChainStage::new(gpu, "accumulate", &modules, "main", &self.bindings(io, 0))?);
+            let motion = if self.animated {
+                "realtime/motion_objects.wgsl"
+            } else {
+                "realtime/motion_static.wgsl"
+            };
+            let modules = [
+                "common/math.wgsl",
+                "realtime/frame.wgsl",
+                "realtime/gbuffer_in.wgsl",
+                motion,
+                MODULE,
+            ];
+            self.stage =
+                Some(ChainStage::new(gpu, "accumulate", &modules, "main", &self.bindings(io, 0))?);
         }
         let mut stage = self.stage.take().unwrap();
-        let result = stage.record(gpu, enc, cx.key, cx.parity, io.size, timer, |p| self.bindings(io, p));
+        let result =
+            stage.record(gpu, enc, cx.key, cx.parity, io.size, timer, |p| self.bindings(io, p));
         self.stage = Some(stage);
         result
     }
 
     fn output(&self, parity: usize) -> Denoised<'_> {
         // Written this frame: history[1 - parity].
-        Denoised { matte: self.history.as_ref().map(|h| &h[1 - parity].1), glossy: None, direct: None }
+        Denoised {
+            matte: self.history.as_ref().map(|h| &h[1 - parity].1),
+            glossy: None,
+            direct: None,
+        }
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn hush_engine::shader::Reload> {
-        self.stage.iter_mut().map(|s| &mut s.pipeline as &mut dyn hush_engine::shader::Reload).collect()
+        self.stage
+            .iter_mut()
+            .map(|s| &mut s.pipeline as &mut dyn hush_engine::shader::Reload)
+            .collect()
     }
 }
 
 /// Its one debug view: the history's length (32 frames white), with a map the display has.
-const VIEWS: &[ViewSpec] = &[ViewSpec { name: "accumulate/length", texture: "accumulate/history 0", map: ViewMap::Grey { channel: 3, divisor: 32.0 } }];
+const VIEWS: &[ViewSpec] = &[ViewSpec {
+    name: "accumulate/length",
+    texture: "accumulate/history 0",
+    map: ViewMap::Grey { channel: 3, divisor: 32.0 },
+}];
 
 fn register() {
     static ONCE: Once = Once::new();
-    ONCE.call_once(|| hush_engine::denoise::register(Entry { name: NAME, summary: "a running mean of the matte light (test only)", make: Some(make), views: VIEWS, fractions: false }).unwrap());
+    ONCE.call_once(|| {
+        hush_engine::denoise::register(Entry {
+            name: NAME,
+            summary: "a running mean of the matte light (test only)",
+            make: Some(make),
+            views: VIEWS,
+            fractions: false,
+        })
+        .unwrap()
+    });
 }
 
 const SIZE: (u32, u32) = (96, 54);
 
 /// The courtyard of the default level, with the animated cube out of view.
 fn view() -> FrameInput {
-    FrameInput { camera: Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0), time: 0.0, shutter: None }
+    FrameInput {
+        camera: Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0),
+        time: 0.0,
+        shutter: None,
+    }
 }
 
 fn render(r: &mut Renderer, gpu: &Gpu, s: &FrameSettings, frames: u32) -> Image {
@@ -127,23 +173,34 @@ fn a_denoiser_written_for_a_test_renders_through_the_contract_with_taa() {
     assert!(hush_engine::settings::denoiser_names().contains(&NAME));
     let preset: FrameSettings = toml_settings(&format!("denoiser = \"{NAME}\""));
     assert_eq!(preset.denoiser, DenoiserName::named(NAME));
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let reference = render(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, 128);
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let reference =
+        render(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, 128);
     let raw = render(&mut r, &gpu, &FrameSettings::default(), 1);
     let s = FrameSettings { denoiser: DenoiserName::named(NAME), ..Default::default() };
     let denoised = render(&mut r, &gpu, &s, 24);
-    let (e_raw, e_denoised) = (compare(&raw, &reference).unwrap().relmse, compare(&denoised, &reference).unwrap().relmse);
+    let (e_raw, e_denoised) =
+        (compare(&raw, &reference).unwrap().relmse, compare(&denoised, &reference).unwrap().relmse);
     println!("relMSE raw {e_raw:.4}, test denoiser + TAA {e_denoised:.4}");
-    assert!(e_denoised < 0.5 * e_raw, "the test denoiser's output did not reach the image: relMSE {e_denoised} against raw {e_raw}");
+    assert!(
+        e_denoised < 0.5 * e_raw,
+        "the test denoiser's output did not reach the image: relMSE {e_denoised} against raw {e_raw}"
+    );
     // Its history and TAA's are labelled textures of the frame.
     let (history, _) = r.read_texture(&gpu, "accumulate/history 0").unwrap();
     let n = f32::from_le_bytes(history[12..16].try_into().unwrap());
     assert!(n > 1.0, "history length {n}");
     r.read_texture(&gpu, "taa/history 0").expect("TAA ran after the test denoiser");
     // Its debug view is shown by name, from its texture's label.
-    let shown = r.display_image(&gpu, &FrameSettings { view: View::named("accumulate/length"), ..s.clone() }).unwrap();
+    let shown = r
+        .display_image(&gpu, &FrameSettings { view: View::named("accumulate/length"), ..s.clone() })
+        .unwrap();
     let grey = shown.pixels().map(|p| p.0[0] as u32).max().unwrap();
-    assert!(grey > 200, "the history-length view peaks at {grey}, expected near white after 24 frames");
+    assert!(
+        grey > 200,
+        "the history-length view peaks at {grey}, expected near white after 24 frames"
+    );
     let passes: Vec<&str> = r.pass_times(&gpu).unwrap().into_iter().map(|(l, _)| l).collect();
     if !passes.is_empty() {
         for p in ["accumulate", "composite", "taa"] {
@@ -164,11 +221,33 @@ fn a_denoisers_own_wgsl_joins_the_library() {
     gpu.shaders.add(MODULE, WGSL).unwrap();
     gpu.shaders.add(MODULE, WGSL).expect("adding the same text again is harmless");
     assert!(gpu.shaders.add(MODULE, "fn f() {}").is_err(), "a module path holds one text");
-    assert!(gpu.shaders.add("matte/temporal.wgsl", WGSL).is_err(), "a module of shaders/ cannot be replaced");
-    let p = gpu.shaders.compose("t", "", &["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "realtime/motion_static.wgsl", MODULE]).unwrap();
+    assert!(
+        gpu.shaders.add("matte/temporal.wgsl", WGSL).is_err(),
+        "a module of shaders/ cannot be replaced"
+    );
+    let p = gpu
+        .shaders
+        .compose(
+            "t",
+            "",
+            &[
+                "common/math.wgsl",
+                "realtime/frame.wgsl",
+                "realtime/gbuffer_in.wgsl",
+                "realtime/motion_static.wgsl",
+                MODULE,
+            ],
+        )
+        .unwrap();
     let names: Vec<String> = {
         let (m, info) = p.validate_with_info().unwrap();
         hush_engine::shader::reflect("t", &m, &info).unwrap()
-    }.names().map(str::to_string).collect();
-    assert!(names.contains(&"history".to_string()) && names.contains(&"frame".to_string()), "{names:?}");
+    }
+    .names()
+    .map(str::to_string)
+    .collect();
+    assert!(
+        names.contains(&"history".to_string()) && names.contains(&"frame".to_string()),
+        "{names:?}"
+    );
 }

@@ -23,12 +23,25 @@ fn extreme_scene(camera: Option<([f32; 3], [f32; 3])>) -> Scene {
     let mirror_m = g.metal([1.0, 1.0, 1.0], 0.0);
     let rough_m = g.metal([1.0, 1.0, 1.0], 1.0);
     let (fp, fi) = quad(0.0, 2.0, true);
-    let floor = g.mesh(Prim { positions: &fp, normals: Some(&[[0.0, 1.0, 0.0]; 4]), indices: Some(&fi), material: floor_m });
+    let floor = g.mesh(Prim {
+        positions: &fp,
+        normals: Some(&[[0.0, 1.0, 0.0]; 4]),
+        indices: Some(&fi),
+        material: floor_m,
+    });
     let (lp, li) = quad(1.5, 0.05, false);
-    let light = g.mesh(Prim { positions: &lp, normals: None, indices: Some(&li), material: light_m });
+    let light =
+        g.mesh(Prim { positions: &lp, normals: None, indices: Some(&li), material: light_m });
     // A mirror tilted 45 degrees and a rough metal panel, both without indices.
     let mirror = g.mesh(Prim {
-        positions: &[[-1.0, 0.0, -1.0], [0.0, 0.0, -1.0], [0.0, 1.0, -1.5], [-1.0, 0.0, -1.0], [0.0, 1.0, -1.5], [-1.0, 1.0, -1.5]],
+        positions: &[
+            [-1.0, 0.0, -1.0],
+            [0.0, 0.0, -1.0],
+            [0.0, 1.0, -1.5],
+            [-1.0, 0.0, -1.0],
+            [0.0, 1.0, -1.5],
+            [-1.0, 1.0, -1.5],
+        ],
         normals: None,
         indices: None,
         material: mirror_m,
@@ -41,7 +54,17 @@ fn extreme_scene(camera: Option<([f32; 3], [f32; 3])>) -> Scene {
     });
     // Degenerate triangles (a repeated vertex, collinear vertices) and one with a NaN vertex.
     let junk = g.mesh(Prim {
-        positions: &[[0.0, 0.5, 0.0], [0.0, 0.5, 0.0], [0.1, 0.6, 0.0], [0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0], [f32::NAN, 0.0, 0.0], [0.3, 0.3, 0.3], [0.3, 0.4, 0.3]],
+        positions: &[
+            [0.0, 0.5, 0.0],
+            [0.0, 0.5, 0.0],
+            [0.1, 0.6, 0.0],
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 1.0],
+            [2.0, 2.0, 2.0],
+            [f32::NAN, 0.0, 0.0],
+            [0.3, 0.3, 0.3],
+            [0.3, 0.4, 0.3],
+        ],
         normals: None,
         indices: None,
         material: floor_m,
@@ -67,7 +90,10 @@ fn extreme_scene(camera: Option<([f32; 3], [f32; 3])>) -> Scene {
 fn extreme_values_render_without_nan() {
     let scene = extreme_scene(None);
     let prepared = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
-    assert_eq!(prepared.dropped_triangles, 3, "the zero-area, collinear and NaN triangles are dropped");
+    assert_eq!(
+        prepared.dropped_triangles, 3,
+        "the zero-area, collinear and NaN triangles are dropped"
+    );
     for (w, h) in [(17, 9), (1, 1), (3, 64)] {
         let acc = render(&scene, w, h, 16, 1).unwrap();
         assert_eq!(acc.nonfinite_samples, 0, "{w}x{h}: NaN/Inf samples");
@@ -79,9 +105,9 @@ fn extreme_values_render_without_nan() {
 #[test]
 fn grazing_cameras_render_without_nan() {
     for (eye, target) in [
-        ([0.0, 0.0, 3.0], [0.0, 0.0, -1.0]),    // exactly in the floor's plane
-        ([0.0, 1e-6, 3.0], [0.0, 1e-6, -1.0]),  // a hair above it
-        ([0.0, 1.5, 0.0], [0.0, 1.5, -1.0]),    // in the emitter's plane
+        ([0.0, 0.0, 3.0], [0.0, 0.0, -1.0]), // exactly in the floor's plane
+        ([0.0, 1e-6, 3.0], [0.0, 1e-6, -1.0]), // a hair above it
+        ([0.0, 1.5, 0.0], [0.0, 1.5, -1.0]), // in the emitter's plane
         ([0.0, 3.0, 0.0], [0.0, -1.0, 0.0001]), // straight down
     ] {
         let scene = extreme_scene(Some((eye, target)));
@@ -112,13 +138,25 @@ fn load_err(name: &str, doc: serde_json::Value) -> String {
 
 #[test]
 fn unusable_input_is_a_clear_error() {
-    let e = load_err("req", json!({"asset": {"version": "2.0"}, "extensionsRequired": ["KHR_draco_mesh_compression"], "extensionsUsed": ["KHR_draco_mesh_compression"], "scenes": [{}]}));
+    let e = load_err(
+        "req",
+        json!({"asset": {"version": "2.0"}, "extensionsRequired": ["KHR_draco_mesh_compression"], "extensionsUsed": ["KHR_draco_mesh_compression"], "scenes": [{}]}),
+    );
     assert!(e.contains("KHR_draco_mesh_compression") && e.contains("does not support"), "{e}");
-    let e = load_err("abs", json!({"asset": {"version": "2.0"}, "scenes": [{}], "buffers": [{"byteLength": 4, "uri": "/etc/passwd"}]}));
+    let e = load_err(
+        "abs",
+        json!({"asset": {"version": "2.0"}, "scenes": [{}], "buffers": [{"byteLength": 4, "uri": "/etc/passwd"}]}),
+    );
     assert!(e.contains("refusing"), "{e}");
-    let e = load_err("escape", json!({"asset": {"version": "2.0"}, "scenes": [{}], "buffers": [{"byteLength": 4, "uri": "../../x.bin"}]}));
+    let e = load_err(
+        "escape",
+        json!({"asset": {"version": "2.0"}, "scenes": [{}], "buffers": [{"byteLength": 4, "uri": "../../x.bin"}]}),
+    );
     assert!(e.contains("leaves the scene's folder"), "{e}");
-    let e = load_err("res", json!({"asset": {"version": "2.0"}, "scenes": [{"extras": {"resolution": [0, 10]}}]}));
+    let e = load_err(
+        "res",
+        json!({"asset": {"version": "2.0"}, "scenes": [{"extras": {"resolution": [0, 10]}}]}),
+    );
     assert!(e.contains("resolution"), "{e}");
     // A thin lens needs both numbers, each finite and positive.
     for (name, extras, needle) in [
@@ -133,13 +171,19 @@ fn unusable_input_is_a_clear_error() {
     }
     let e = format!("{:#}", load_gltf(std::path::Path::new("/nonexistent/x.gltf")).unwrap_err());
     assert!(e.contains("/nonexistent/x.gltf"), "{e}");
-    std::fs::write(hush_tests::gltf_writer::temp_dir("garbage").join("g.gltf"), b"{not json").unwrap();
+    std::fs::write(hush_tests::gltf_writer::temp_dir("garbage").join("g.gltf"), b"{not json")
+        .unwrap();
     assert!(load_gltf(&hush_tests::gltf_writer::temp_dir("garbage").join("g.gltf")).is_err());
 
     // An index past the end of the vertex list.
     let mut g = GltfWriter::default();
     let m = g.lambert([0.5; 3]);
-    let mesh = g.mesh(Prim { positions: &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], normals: None, indices: Some(&[0, 1, 7]), material: m });
+    let mesh = g.mesh(Prim {
+        positions: &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        normals: None,
+        indices: Some(&[0, 1, 7]),
+        material: m,
+    });
     g.node(json!({"mesh": mesh}));
     let e = format!("{:#}", load_gltf(&g.write("badindex")).unwrap_err());
     assert!(e.contains("out of range"), "{e}");
@@ -150,8 +194,18 @@ fn unusable_input_is_a_clear_error() {
     let gpu = Gpu::headless(&prepared.requirements(0, 0)).unwrap();
     let gs = prepared.upload(&gpu);
     for (w, h) in [(0, 10), (10, 0), (20000, 10)] {
-        let view = TraceView { camera: scene.camera_or_default(), width: w, height: h, max_depth: 6, seed: 0, shutter_camera: None };
-        let e = ReferenceTracer::new(&gpu, &prepared, &gs, &view).err().map(|e| e.to_string()).unwrap_or_default();
+        let view = TraceView {
+            camera: scene.camera_or_default(),
+            width: w,
+            height: h,
+            max_depth: 6,
+            seed: 0,
+            shutter_camera: None,
+        };
+        let e = ReferenceTracer::new(&gpu, &prepared, &gs, &view)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
         assert!(e.contains("out of range"), "{w}x{h}: {e}");
     }
 }

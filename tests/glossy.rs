@@ -51,18 +51,43 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 /// (motion found, iterations, distance) per pixel.
 fn run_diamond(gpu: &Gpu, size: (u32, u32), motion: Vec2, initial_step: u32) -> Vec<Vec4> {
     use wgpu::util::DeviceExt;
-    let program = hush_engine::shader::compose("diamond test", DIAMOND_TEST, &["common/math.wgsl", "glossy/diamond.wgsl"]).unwrap();
+    let program = hush_engine::shader::compose(
+        "diamond test",
+        DIAMOND_TEST,
+        &["common/math.wgsl", "glossy/diamond.wgsl"],
+    )
+    .unwrap();
     let module = program.create(&gpu.device).unwrap();
     let d = &gpu.device;
-    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor { label: Some("diamond test"), layout: None, module: &module, entry_point: Some("main"), compilation_options: Default::default(), cache: None });
-    let params: [u32; 8] = [motion.x.to_bits(), motion.y.to_bits(), size.0, size.1, initial_step, 64, 0, 0];
-    let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::cast_slice(&params), usage: wgpu::BufferUsages::UNIFORM });
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("diamond test"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let params: [u32; 8] =
+        [motion.x.to_bits(), motion.y.to_bits(), size.0, size.1, initial_step, 64, 0, 0];
+    let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::cast_slice(&params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
     let n = (size.0 * size.1) as u64 * 16;
-    let out = d.create_buffer(&wgpu::BufferDescriptor { label: None, size: n, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
+    let out = d.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: n,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
     let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
         layout: &pipeline.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() }],
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() },
+        ],
     });
     let mut enc = d.create_command_encoder(&Default::default());
     {
@@ -83,7 +108,13 @@ fn run_diamond(gpu: &Gpu, size: (u32, u32), motion: Vec2, initial_step: u32) -> 
 fn diamond_search_finds_a_known_motion() {
     let gpu = Gpu::headless(&GpuRequirements::default()).unwrap();
     let size = (64u32, 48u32);
-    for (motion, exact) in [(Vec2::ZERO, true), (Vec2::new(3.0, -2.0), true), (Vec2::new(13.0, 7.0), true), (Vec2::new(-21.0, 5.0), true), (Vec2::new(2.25, -1.5), false)] {
+    for (motion, exact) in [
+        (Vec2::ZERO, true),
+        (Vec2::new(3.0, -2.0), true),
+        (Vec2::new(13.0, 7.0), true),
+        (Vec2::new(-21.0, 5.0), true),
+        (Vec2::new(2.25, -1.5), false),
+    ] {
         for initial_step in [4, 1] {
             let out = run_diamond(&gpu, size, motion, initial_step);
             let mut worst = 0.0f32;
@@ -92,7 +123,11 @@ fn diamond_search_finds_a_known_motion() {
                 for x in 0..size.0 {
                     let target = Vec2::new(x as f32, y as f32) + 0.5 + motion;
                     // Pixels whose answer lies on screen with a margin for the 2x2 refinement.
-                    if target.x < 1.0 || target.y < 1.0 || target.x > size.0 as f32 - 1.0 || target.y > size.1 as f32 - 1.0 {
+                    if target.x < 1.0
+                        || target.y < 1.0
+                        || target.x > size.0 as f32 - 1.0
+                        || target.y > size.1 as f32 - 1.0
+                    {
                         continue;
                     }
                     let v = out[(y * size.0 + x) as usize];
@@ -102,7 +137,10 @@ fn diamond_search_finds_a_known_motion() {
             }
             assert!(checked > 500, "{checked}");
             let bound = if exact { 1e-4 } else { 0.5 };
-            assert!(worst <= bound, "motion {motion}, first step {initial_step}: worst error {worst} px (bound {bound})");
+            assert!(
+                worst <= bound,
+                "motion {motion}, first step {initial_step}: worst error {worst} px (bound {bound})"
+            );
         }
     }
 }
@@ -119,7 +157,9 @@ fn camera(x: f64) -> Camera {
 #[test]
 fn virtual_position_of_a_plane_mirror_is_analytic() {
     let size = (96u32, 54u32);
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size)
+            .unwrap();
     let mut s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     s.taa.enabled = false; // samples at pixel centres
     s.glossy.reflection_mv = ReflectionMv::Diamond;
@@ -135,7 +175,10 @@ fn virtual_position_of_a_plane_mirror_is_analytic() {
     let (mut n, mut worst, mut diamond_err, mut within) = (0, 0.0f32, 0.0f32, 0);
     for y in 0..size.1 {
         for x in 0..size.0 {
-            let ndc = Vec2::new((x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0);
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0,
+            );
             let d = (cur.fwd + ndc.x * cur.right + ndc.y * cur.up).normalize();
             let c = cur.pos + origin;
             if d.y >= 0.0 {
@@ -148,16 +191,28 @@ fn virtual_position_of_a_plane_mirror_is_analytic() {
             let t = half(&glossy[i * 8 + 6..i * 8 + 8]);
             // Floor pixels whose mirror ray reaches the wall unobstructed (its secondary distance,
             // stored as a half float, is the analytic one), away from the wall's top edge.
-            if s_wall <= s_floor || !(0.1..3.8).contains(&wall_y) || ((s_wall - s_floor) - t).abs() > 4e-3 {
+            if s_wall <= s_floor
+                || !(0.1..3.8).contains(&wall_y)
+                || ((s_wall - s_floor) - t).abs() > 4e-3
+            {
                 continue;
             }
             let v = c + d * s_wall - origin;
             let clip = prev.view_proj * v.extend(1.0);
             let ndc_prev = clip.truncate().truncate() / clip.w;
-            let expected = Vec2::new((ndc_prev.x * 0.5 + 0.5) * size.0 as f32, (0.5 - ndc_prev.y * 0.5) * size.1 as f32) - Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let expected = Vec2::new(
+                (ndc_prev.x * 0.5 + 0.5) * size.0 as f32,
+                (0.5 - ndc_prev.y * 0.5) * size.1 as f32,
+            ) - Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
             let m = motion[i];
-            if std::env::var("HUSH_TEST_VERBOSE").is_ok() && (Vec2::new(m[2], m[3]) - expected).length() > 0.05 {
-                println!("({x},{y}) expected {expected} virtual {:?} diamond {:?} t {t} s_floor {s_floor} s_wall {s_wall}", (m[2], m[3]), (m[0], m[1]));
+            if std::env::var("HUSH_TEST_VERBOSE").is_ok()
+                && (Vec2::new(m[2], m[3]) - expected).length() > 0.05
+            {
+                println!(
+                    "({x},{y}) expected {expected} virtual {:?} diamond {:?} t {t} s_floor {s_floor} s_wall {s_wall}",
+                    (m[2], m[3]),
+                    (m[0], m[1])
+                );
             }
             worst = worst.max((Vec2::new(m[2], m[3]) - expected).length());
             let e = (Vec2::new(m[0], m[1]) - expected).length();
@@ -173,8 +228,14 @@ fn virtual_position_of_a_plane_mirror_is_analytic() {
     // distance products, which is not linear interpolation (measured: 0.53 px mean here).
     let mean = diamond_err / n as f32;
     let share = within as f32 / n as f32;
-    println!("diamond vs analytic: mean {mean:.3} px, {:.1}% within 1 px, {n} pixels", share * 100.0);
-    assert!(mean < 0.75 && share > 0.9, "diamond search {mean} px from the analytic motion on average, {share} within 1 px ({n} pixels)");
+    println!(
+        "diamond vs analytic: mean {mean:.3} px, {:.1}% within 1 px, {n} pixels",
+        share * 100.0
+    );
+    assert!(
+        mean < 0.75 && share > 0.9,
+        "diamond search {mean} px from the analytic motion on average, {share} within 1 px ({n} pixels)"
+    );
 }
 
 /// In a static view (no camera or object motion) reflections stand still: every pixel's
@@ -186,16 +247,24 @@ fn virtual_position_of_a_plane_mirror_is_analytic() {
 #[test]
 fn a_static_view_keeps_its_reflections_still() {
     let size = (96u32, 54u32);
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size)
+            .unwrap();
     let mut s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     s.glossy.reflection_mv = ReflectionMv::Diamond;
     for _ in 0..4 {
-        r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0, shutter: None }, &s, None).unwrap();
+        r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0, shutter: None }, &s, None)
+            .unwrap();
     }
     let (motion, _) = r.read_texture(&gpu, "glossy/motion").unwrap();
     let motion: &[[f32; 4]] = bytemuck::cast_slice(&motion);
     let moving = motion.iter().filter(|m| m[0] != 0.0 || m[1] != 0.0).count();
-    assert_eq!(moving, 0, "{moving} of {} pixels have reflection motion in a static view", motion.len());
+    assert_eq!(
+        moving,
+        0,
+        "{moving} of {} pixels have reflection motion in a static view",
+        motion.len()
+    );
 }
 
 /// Sigma = 7 r^0.1 + epsilon (Mara §3.4): exact on rough surfaces (no ray-differential term
@@ -207,14 +276,19 @@ fn glossy_bilateral_sigma() {
     let g = GlossySettings::default();
     assert!((g.sigma_px(1.0, 0.0) - 8.0).abs() < 1e-5);
     assert!((g.sigma_px(0.2, 0.0) - (7.0 * 0.2f32.powf(0.1) + 1.0)).abs() < 1e-5);
-    assert!((g.sigma_px(0.2, 16.0) - (7.0 * 0.2f32.powf(0.1) + 1.0) * (-1.0f32).exp()).abs() < 1e-5);
+    assert!(
+        (g.sigma_px(0.2, 16.0) - (7.0 * 0.2f32.powf(0.1) + 1.0) * (-1.0f32).exp()).abs() < 1e-5
+    );
     assert_eq!(g.sigma_px(0.6, 16.0), g.sigma_px(0.6, 0.0));
     assert!((g.sigma_px(0.0, 0.0) - 1.0).abs() < 1e-6);
 
     let size = (96u32, 54u32);
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size)
+            .unwrap();
     let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
-    r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0, shutter: None }, &s, None).unwrap();
+    r.render(&gpu, &FrameInput { camera: camera(0.0), time: 0.0, shutter: None }, &s, None)
+        .unwrap();
     let (scratch, _) = r.read_texture(&gpu, "glossy/scratch").unwrap();
     let (specular, _) = r.read_texture(&gpu, "gbuffer/specular").unwrap();
     let (ids, _) = r.read_texture(&gpu, "gbuffer/ids").unwrap();
@@ -229,13 +303,28 @@ fn glossy_bilateral_sigma() {
         // Object 0 is the floor (scene::reflection_scene).
         let most = if object == 0 || roughness >= g.roughness_threshold { 12.0 } else { 1e4 };
         let (lo, hi) = (g.sigma_px(roughness, most), g.sigma_px(roughness, 0.0));
-        if std::env::var("HUSH_TEST_VERBOSE").is_ok() && !(sigma >= lo - 0.01 * hi - 1e-3 && sigma <= hi * 1.01 + 1e-3) {
-            println!("pixel ({}, {}) roughness {roughness} sigma {sigma} [{lo}, {hi}]", i % size.0 as usize, i / size.0 as usize);
+        if std::env::var("HUSH_TEST_VERBOSE").is_ok()
+            && !(sigma >= lo - 0.01 * hi - 1e-3 && sigma <= hi * 1.01 + 1e-3)
+        {
+            println!(
+                "pixel ({}, {}) roughness {roughness} sigma {sigma} [{lo}, {hi}]",
+                i % size.0 as usize,
+                i / size.0 as usize
+            );
             continue;
         }
         let tol = 0.01 * hi + 1e-3; // half-float storage
-        assert!(sigma >= lo - tol && sigma <= hi + tol, "pixel {i}: roughness {roughness}, sigma {sigma} outside [{lo}, {hi}]");
-        seen[if roughness >= g.roughness_threshold { 0 } else if roughness > g.mirror_roughness { 1 } else { 2 }] += 1;
+        assert!(
+            sigma >= lo - tol && sigma <= hi + tol,
+            "pixel {i}: roughness {roughness}, sigma {sigma} outside [{lo}, {hi}]"
+        );
+        seen[if roughness >= g.roughness_threshold {
+            0
+        } else if roughness > g.mirror_roughness {
+            1
+        } else {
+            2
+        }] += 1;
     }
     assert!(seen.iter().all(|&k| k > 20), "rough, glossy, mirror pixels: {seen:?}");
 }
@@ -256,7 +345,8 @@ fn glossy_history_stays_on_its_face() {
     use hush_engine::frame::halton_jitter;
     use hush_engine::settings::MatteSettings;
     let size = (96u32, 54u32);
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, size).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, size).unwrap();
     let cam = Camera::look_at(DVec3::new(-3.0, 1.7, 4.0), DVec3::new(-2.0, 1.2, -6.0), 60.0);
     let s = FrameSettings { denoiser: Denoiser::MARA, ..Default::default() };
     let warm = 7;
@@ -266,12 +356,19 @@ fn glossy_history_stays_on_its_face() {
     let read = |r: &Renderer, n: &str| r.read_texture(&gpu, n).unwrap().0;
     let (depth0, normal0) = (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"));
     r.render(&gpu, &FrameInput { camera: cam, time: 0.0, shutter: None }, &s, None).unwrap();
-    let (depth1, normal1, info) = (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"), read(&r, "glossy/info"));
+    let (depth1, normal1, info) =
+        (read(&r, "gbuffer/depth"), read(&r, "gbuffer/normal"), read(&r, "glossy/info"));
     let setup = r.camera_setup(&cam);
-    let (inv0, inv1) = (setup.jittered(halton_jitter(warm - 1), size).inverse(), setup.jittered(halton_jitter(warm), size).inverse());
+    let (inv0, inv1) = (
+        setup.jittered(halton_jitter(warm - 1), size).inverse(),
+        setup.jittered(halton_jitter(warm), size).inverse(),
+    );
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size };
-    let (m, cos_max) = (MatteSettings::default(), GlossySettings::default().reprojection_normal_degrees.to_radians().cos());
+    let (m, cos_max) = (
+        MatteSettings::default(),
+        GlossySettings::default().reprojection_normal_degrees.to_radians().cos(),
+    );
     let (mut creases, mut kept) = (0, Vec::new());
     for y in 0..size.1 as i64 {
         for x in 0..size.0 as i64 {
@@ -281,11 +378,14 @@ fn glossy_history_stays_on_its_face() {
             // (distance in footprints, cosine to this normal) of each previous texel with a surface.
             let texels: Vec<(f32, f32)> = neighbours_3x3(x, y)
                 .filter_map(|(tx, ty)| Some((before.world(tx, ty)?, before.index(tx, ty)?)))
-                .map(|(prev, t)| (surface.distance(prev), surface.n.dot(oct_normal(&normal0[t * 4..]))))
+                .map(|(prev, t)| {
+                    (surface.distance(prev), surface.n.dot(oct_normal(&normal0[t * 4..])))
+                })
                 .collect();
             // Margins around d0, d1 and the angle keep float rounding from deciding a pixel.
             let position_only = texels.iter().any(|&(dist, _)| dist < 0.9 * m.d0_px);
-            let same_face = texels.iter().any(|&(dist, cos)| dist < 1.1 * m.d1_px && cos >= cos_max - 0.02);
+            let same_face =
+                texels.iter().any(|&(dist, cos)| dist < 1.1 * m.d1_px && cos >= cos_max - 0.02);
             if position_only && !same_face {
                 creases += 1;
                 let c = half(&info[i * 8..]);
@@ -297,6 +397,9 @@ fn glossy_history_stays_on_its_face() {
     }
     println!("{creases} crease pixels, {} kept another face's glossy history", kept.len());
     assert!(creases >= 10, "the view has only {creases} crease pixels");
-    assert!(kept.is_empty(), "crease pixels kept another face's glossy history (x, y, confidence): {:?}", &kept[..kept.len().min(20)]);
+    assert!(
+        kept.is_empty(),
+        "crease pixels kept another face's glossy history (x, y, confidence): {:?}",
+        &kept[..kept.len().min(20)]
+    );
 }
-

@@ -7,14 +7,21 @@ use hush_tests::{render, shared};
 use serde_json::json;
 
 #[test]
-#[cfg_attr(not(hush_shared_scenes), ignore = "needs ../shared/scenes (FlightHelmet, Lantern), absent beside this checkout")]
+#[cfg_attr(
+    not(hush_shared_scenes),
+    ignore = "needs ../shared/scenes (FlightHelmet, Lantern), absent beside this checkout"
+)]
 fn scenes_with_missing_textures_warn_and_render() {
     for (path, missing) in [
         ("scenes/FlightHelmet/glTF/FlightHelmet.gltf", "LeatherPartsMat"),
         ("scenes/Lantern/glTF/Lantern.gltf", "Lantern_baseColor"),
     ] {
         let scene = load_gltf_with(&shared().join(path), 64).unwrap();
-        assert!(scene.warnings.iter().any(|w| w.contains(missing)), "{path}: warnings {:?}", scene.warnings);
+        assert!(
+            scene.warnings.iter().any(|w| w.contains(missing)),
+            "{path}: warnings {:?}",
+            scene.warnings
+        );
         assert!(!scene.textures.is_empty() && scene.triangle_count() > 1000);
         // Normal maps present: every mesh that uses one has tangents (read or generated).
         for o in &scene.objects {
@@ -32,13 +39,21 @@ fn scenes_with_missing_textures_warn_and_render() {
 }
 
 #[test]
-#[cfg_attr(not(hush_shared_scenes), ignore = "needs ../shared/scenes (living-room, staircase), absent beside this checkout")]
+#[cfg_attr(
+    not(hush_shared_scenes),
+    ignore = "needs ../shared/scenes (living-room, staircase), absent beside this checkout"
+)]
 fn bitterli_scenes_load_with_their_extras() {
     let lr = load_gltf_with(&shared().join("scenes/living-room/living-room.gltf"), 16).unwrap();
     assert_eq!(lr.resolution, Some((1280, 720)));
     assert_eq!(lr.max_depth, 65);
-    assert!(matches!(lr.environment, hush_engine::scene::Environment::Map(ref m) if m.rotation_y_degrees == 90.0 && m.width > 0));
-    assert!(lr.warnings.iter().any(|w| w.contains("KHR_materials_transmission")), "optional extensions are warned about");
+    assert!(
+        matches!(lr.environment, hush_engine::scene::Environment::Map(ref m) if m.rotation_y_degrees == 90.0 && m.width > 0)
+    );
+    assert!(
+        lr.warnings.iter().any(|w| w.contains("KHR_materials_transmission")),
+        "optional extensions are warned about"
+    );
     assert!(lr.camera.is_some());
     let st = load_gltf_with(&shared().join("scenes/staircase/staircase.gltf"), 16).unwrap();
     assert_eq!(st.resolution, Some((720, 1280)));
@@ -51,9 +66,21 @@ fn bitterli_scenes_load_with_their_extras() {
 fn punctual_lights_follow_the_radiometric_conventions() {
     let rho = 0.5f32;
     for (name, light, expected) in [
-        ("point", json!({"type": "point", "intensity": 8.0, "color": [1.0, 1.0, 1.0]}), rho / std::f32::consts::PI * 8.0 / 4.0),
-        ("sun", json!({"type": "directional", "intensity": 3.0, "color": [1.0, 1.0, 1.0]}), rho / std::f32::consts::PI * 3.0 * 0.5),
-        ("spot", json!({"type": "spot", "intensity": 8.0, "color": [1.0, 1.0, 1.0], "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}}), rho / std::f32::consts::PI * 8.0 / 4.0),
+        (
+            "point",
+            json!({"type": "point", "intensity": 8.0, "color": [1.0, 1.0, 1.0]}),
+            rho / std::f32::consts::PI * 8.0 / 4.0,
+        ),
+        (
+            "sun",
+            json!({"type": "directional", "intensity": 3.0, "color": [1.0, 1.0, 1.0]}),
+            rho / std::f32::consts::PI * 3.0 * 0.5,
+        ),
+        (
+            "spot",
+            json!({"type": "spot", "intensity": 8.0, "color": [1.0, 1.0, 1.0], "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}}),
+            rho / std::f32::consts::PI * 8.0 / 4.0,
+        ),
     ] {
         let mut g = GltfWriter::default();
         let m = g.lambert([rho; 3]);
@@ -68,8 +95,18 @@ fn punctual_lights_follow_the_radiometric_conventions() {
         g.lights.push(light);
         // Point and spot: 2 m above the floor under a parent node (hierarchy composes). The sun
         // travels along its node's -Z, rotated to come down at 60 degrees from the zenith.
-        let rot60 = [-(0.5f32 * 1.0472 + 0.5 * std::f32::consts::FRAC_PI_2).sin(), 0.0, 0.0, (0.5f32 * 1.0472 + 0.5 * std::f32::consts::FRAC_PI_2).cos()];
-        let down = [-(0.5f32 * std::f32::consts::FRAC_PI_2).sin(), 0.0, 0.0, (0.5f32 * std::f32::consts::FRAC_PI_2).cos()];
+        let rot60 = [
+            -(0.5f32 * 1.0472 + 0.5 * std::f32::consts::FRAC_PI_2).sin(),
+            0.0,
+            0.0,
+            (0.5f32 * 1.0472 + 0.5 * std::f32::consts::FRAC_PI_2).cos(),
+        ];
+        let down = [
+            -(0.5f32 * std::f32::consts::FRAC_PI_2).sin(),
+            0.0,
+            0.0,
+            (0.5f32 * std::f32::consts::FRAC_PI_2).cos(),
+        ];
         let child = if name == "sun" {
             g.node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}, "rotation": rot60}))
         } else {
@@ -83,14 +120,19 @@ fn punctual_lights_follow_the_radiometric_conventions() {
             Light::Point { position, .. } | Light::Spot { position, .. } => {
                 assert!((position - DVec3::new(0.0, 2.0, 0.0)).length() < 1e-6, "{position}")
             }
-            Light::Directional { direction, .. } => assert!((direction.y + 0.5).abs() < 1e-3, "{direction}"),
+            Light::Directional { direction, .. } => {
+                assert!((direction.y + 0.5).abs() < 1e-3, "{direction}")
+            }
         }
         let acc = render(&scene, 4, 4, 16, 0).unwrap();
         let got = acc.mean.mean();
         println!("{name}: floor radiance {got} (expected {expected})");
         // Direct light only and a narrow view straight down: every sample sees the same value,
         // up to the light's 1/d² variation across the 0.05 rad view (< 0.1%).
-        assert!((got - Vec3::splat(expected)).abs().max_element() < 2e-3 * expected, "{name}: {got} vs {expected}");
+        assert!(
+            (got - Vec3::splat(expected)).abs().max_element() < 2e-3 * expected,
+            "{name}: {got} vs {expected}"
+        );
     }
 }
 
@@ -115,7 +157,9 @@ fn mirrored_transforms_keep_front_faces_counter_clockwise() {
 /// A thin-lens camera survives Hush's own glTF export.
 #[test]
 fn a_thin_lens_round_trips_through_export() {
-    let scene = hush_engine::scene::load_gltf(&hush_tests::oracle("cornell_dof").join("cornell_dof.gltf")).unwrap();
+    let scene =
+        hush_engine::scene::load_gltf(&hush_tests::oracle("cornell_dof").join("cornell_dof.gltf"))
+            .unwrap();
     let path = hush_tests::gltf_writer::temp_dir("lens_export").join("dof.gltf");
     hush_engine::scene::save_gltf(&scene, &path).unwrap();
     let back = hush_engine::scene::load_gltf(&path).unwrap();

@@ -52,9 +52,18 @@ fn scaled_and_far_away_scenes_render_the_same_image() {
         // parted would add independent noise, so 1e-3 of the independent-seed relMSE allows a few
         // parted paths per image and no systematic difference; leaking or self-shadowing
         // offsets would show up as a bias of percents.
-        assert!(m.relmse < 1e-3 * noise, "{name}: relMSE {} vs independent-noise {}", m.relmse, noise);
+        assert!(
+            m.relmse < 1e-3 * noise,
+            "{name}: relMSE {} vs independent-noise {}",
+            m.relmse,
+            noise
+        );
         for k in 0..3 {
-            assert!(m.mean_rel_bias[k].abs() < 1e-4, "{name}: channel {k} mean differs by {}", m.mean_rel_bias[k]);
+            assert!(
+                m.mean_rel_bias[k].abs() < 1e-4,
+                "{name}: channel {k} mean differs by {}",
+                m.mean_rel_bias[k]
+            );
         }
     }
 }

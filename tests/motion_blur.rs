@@ -39,7 +39,13 @@ fn blurred(scene: &Scene, spp: u32) -> Accumulation {
     assert!(prepared.shutter_moves(), "the level's cube moves during the shutter");
     let gpu = Gpu::headless(&prepared.requirements((SIZE.0 * SIZE.1) as u64, 32)).unwrap();
     let gscene = prepared.upload(&gpu);
-    let mut t = ReferenceTracer::new(&gpu, &prepared, &gscene, &view(camera_at(1.0), Some(camera_at(0.0)), 1)).unwrap();
+    let mut t = ReferenceTracer::new(
+        &gpu,
+        &prepared,
+        &gscene,
+        &view(camera_at(1.0), Some(camera_at(0.0)), 1),
+    )
+    .unwrap();
     t.dispatch(&gpu, spp);
     t.readback(&gpu).unwrap()
 }
@@ -66,7 +72,13 @@ fn stills(scene: &Scene, spp: u32) -> (Accumulation, Accumulation) {
                 let mut t = ReferenceTracer::new(&gpu, &prepared, &gscene, &v).unwrap();
                 if let Some(old) = old {
                     let mut enc = gpu.device.create_command_encoder(&Default::default());
-                    enc.copy_buffer_to_buffer(old.accumulation_buffer(), 0, t.accumulation_buffer(), 0, old.accumulation_buffer().size());
+                    enc.copy_buffer_to_buffer(
+                        old.accumulation_buffer(),
+                        0,
+                        t.accumulation_buffer(),
+                        0,
+                        old.accumulation_buffer().size(),
+                    );
                     gpu.queue.submit([enc.finish()]);
                     t.samples = old.samples;
                 }
@@ -79,7 +91,8 @@ fn stills(scene: &Scene, spp: u32) -> (Accumulation, Accumulation) {
     let mean = tracer.unwrap().readback(&gpu).unwrap();
     prepared.animate(scene, CLOSE);
     let gscene = prepared.upload(&gpu);
-    let mut t = ReferenceTracer::new(&gpu, &prepared, &gscene, &view(camera_at(1.0), None, 3)).unwrap();
+    let mut t =
+        ReferenceTracer::new(&gpu, &prepared, &gscene, &view(camera_at(1.0), None, 3)).unwrap();
     t.dispatch(&gpu, spp);
     (mean, t.readback(&gpu).unwrap())
 }
@@ -119,13 +132,25 @@ fn reference_motion_blur_is_the_mean_of_stills_over_the_shutter() {
     let var = |i: usize, k: usize| blur.variance_of_mean.data[i][k] as f64;
     let (e, predicted) = relmse(&blur.mean, &var, &mean);
     let (e_still, predicted_still) = relmse(&blur.mean, &var, &still);
-    let (bias, allowed) = trimmed_bias(&blur.mean, &mean.mean, |i, k| var(i, k) + mean.variance_of_mean.data[i][k] as f64);
-    println!("blurred vs mean of {SLICES} stills: relMSE {e:.5} (noise predicts {predicted:.5}), bias {bias:?} (allowed {allowed:?}); vs the still at the close: {e_still:.5} (noise {predicted_still:.5})");
+    let (bias, allowed) = trimmed_bias(&blur.mean, &mean.mean, |i, k| {
+        var(i, k) + mean.variance_of_mean.data[i][k] as f64
+    });
+    println!(
+        "blurred vs mean of {SLICES} stills: relMSE {e:.5} (noise predicts {predicted:.5}), bias {bias:?} (allowed {allowed:?}); vs the still at the close: {e_still:.5} (noise {predicted_still:.5})"
+    );
     assert!(e <= 2.0 * predicted, "relMSE {e} > 2 x {predicted}");
     for k in 0..3 {
-        assert!(bias[k].abs() <= allowed[k], "channel {k} biased by {:+.4} (allowed {:.4})", bias[k], allowed[k]);
+        assert!(
+            bias[k].abs() <= allowed[k],
+            "channel {k} biased by {:+.4} (allowed {:.4})",
+            bias[k],
+            allowed[k]
+        );
     }
-    assert!(e_still >= 10.0 * predicted_still, "the blurred image is as close to the still at the close ({e_still}) as noise ({predicted_still}): nothing moved");
+    assert!(
+        e_still >= 10.0 * predicted_still,
+        "the blurred image is as close to the still at the close ({e_still}) as noise ({predicted_still}): nothing moved"
+    );
     assert_eq!(blur.nonfinite_samples, 0);
 }
 
@@ -136,10 +161,15 @@ fn reference_motion_blur_is_the_mean_of_stills_over_the_shutter() {
 fn realtime_accumulation_converges_to_the_reference_motion_blur() {
     let scene = hush_engine::scene::default_level();
     let reference = blurred(&scene, 512);
-    let input = FrameInput { camera: camera_at(1.0), time: CLOSE, shutter: Some(ShutterOpen { camera: camera_at(0.0), time: OPEN }) };
+    let input = FrameInput {
+        camera: camera_at(1.0),
+        time: CLOSE,
+        shutter: Some(ShutterOpen { camera: camera_at(0.0), time: OPEN }),
+    };
     let half = |seed: u32| {
         let (gpu, mut r) = Renderer::headless(scene.clone(), BvhKind::DEFAULT, SIZE).unwrap();
-        let settings = FrameSettings { max_depth: MAX_DEPTH, seed, accumulate: true, ..Default::default() };
+        let settings =
+            FrameSettings { max_depth: MAX_DEPTH, seed, accumulate: true, ..Default::default() };
         for _ in 0..128 {
             r.render(&gpu, &input, &settings, None).unwrap();
         }
@@ -153,10 +183,19 @@ fn realtime_accumulation_converges_to_the_reference_motion_blur() {
     }
     let var = |i: usize, k: usize| ((a.data[i][k] - b.data[i][k]) as f64).powi(2) / 4.0;
     let (e, predicted) = relmse(&rt, &var, &reference);
-    let (bias, allowed) = trimmed_bias(&rt, &reference.mean, |i, k| var(i, k) + reference.variance_of_mean.data[i][k] as f64);
-    println!("real-time accumulation (256 frames) vs reference (512 spp), motion blur: relMSE {e:.5} (noise predicts {predicted:.5}), bias {bias:?} (allowed {allowed:?})");
+    let (bias, allowed) = trimmed_bias(&rt, &reference.mean, |i, k| {
+        var(i, k) + reference.variance_of_mean.data[i][k] as f64
+    });
+    println!(
+        "real-time accumulation (256 frames) vs reference (512 spp), motion blur: relMSE {e:.5} (noise predicts {predicted:.5}), bias {bias:?} (allowed {allowed:?})"
+    );
     assert!(e <= 2.0 * predicted, "relMSE {e} > 2 x {predicted}");
     for k in 0..3 {
-        assert!(bias[k].abs() <= allowed[k], "channel {k} biased by {:+.4} (allowed {:.4})", bias[k], allowed[k]);
+        assert!(
+            bias[k].abs() <= allowed[k],
+            "channel {k} biased by {:+.4} (allowed {:.4})",
+            bias[k],
+            allowed[k]
+        );
     }
 }

@@ -33,7 +33,8 @@ struct Case {
 fn parity(c: Case) {
     let dir = oracle(c.name);
     let scene = load_gltf(&dir.join(format!("{}.gltf", c.name))).unwrap();
-    let reference = Image::load(&dir.join("reference.exr")).unwrap().box_downsample(c.factor).unwrap();
+    let reference =
+        Image::load(&dir.join("reference.exr")).unwrap().box_downsample(c.factor).unwrap();
     let (w, h) = (reference.width, reference.height);
     let acc = render(&scene, w, h, c.spp, 7).unwrap();
     assert_eq!(acc.nonfinite_samples, 0, "{}: NaN/Inf samples", c.name);
@@ -51,33 +52,84 @@ fn parity(c: Case) {
     expected /= (3 * reference.data.len()) as f64;
 
     // Trimmed per-channel bias and its standard error; never tighter than the oracle's own bias.
-    let (bias, five_se) = trimmed_bias(&acc.mean, &reference, |i, k| acc.variance_of_mean.data[i][k] as f64 * (1.0 + ref_share));
+    let (bias, five_se) = trimmed_bias(&acc.mean, &reference, |i, k| {
+        acc.variance_of_mean.data[i][k] as f64 * (1.0 + ref_share)
+    });
     let allowed = five_se.map(|a| a.max(c.mitsuba_bias_256));
     println!(
         "{}: {}x{} {} spp (reference {} spp, box /{}): relMSE {:.5} (noise predicts {:.5}), FLIP {:.4}, SSIM {:.4}, \
          RMSE {:.4}, mean bias {:+.4} {:+.4} {:+.4}, trimmed bias {:+.4} {:+.4} {:+.4} (allowed {:.4} {:.4} {:.4})",
-        c.name, w, h, c.spp, c.ref_spp, c.factor, m.relmse, expected, m.flip, m.ssim, m.rmse,
-        m.mean_rel_bias[0], m.mean_rel_bias[1], m.mean_rel_bias[2], bias[0], bias[1], bias[2], allowed[0], allowed[1], allowed[2]
+        c.name,
+        w,
+        h,
+        c.spp,
+        c.ref_spp,
+        c.factor,
+        m.relmse,
+        expected,
+        m.flip,
+        m.ssim,
+        m.rmse,
+        m.mean_rel_bias[0],
+        m.mean_rel_bias[1],
+        m.mean_rel_bias[2],
+        bias[0],
+        bias[1],
+        bias[2],
+        allowed[0],
+        allowed[1],
+        allowed[2]
     );
-    assert!(m.relmse <= RELMSE_SLACK * expected, "{}: relMSE {} > {} x predicted {}", c.name, m.relmse, RELMSE_SLACK, expected);
+    assert!(
+        m.relmse <= RELMSE_SLACK * expected,
+        "{}: relMSE {} > {} x predicted {}",
+        c.name,
+        m.relmse,
+        RELMSE_SLACK,
+        expected
+    );
     for k in 0..3 {
-        assert!(bias[k].abs() <= allowed[k], "{}: channel {k} biased by {:+.4} (allowed {:.4})", c.name, bias[k], allowed[k]);
+        assert!(
+            bias[k].abs() <= allowed[k],
+            "{}: channel {k} biased by {:+.4} (allowed {:.4})",
+            c.name,
+            bias[k],
+            allowed[k]
+        );
     }
 }
 
 #[test]
 fn cornell_diffuse_matches_mitsuba() {
-    parity(Case { name: "cornell_diffuse", factor: 4, spp: 256, ref_spp: 1024, mitsuba_bias_256: 0.0 });
+    parity(Case {
+        name: "cornell_diffuse",
+        factor: 4,
+        spp: 256,
+        ref_spp: 1024,
+        mitsuba_bias_256: 0.0,
+    });
 }
 
 #[test]
 fn cornell_mirror_matches_mitsuba() {
-    parity(Case { name: "cornell_mirror", factor: 4, spp: 512, ref_spp: 4096, mitsuba_bias_256: 0.001 });
+    parity(Case {
+        name: "cornell_mirror",
+        factor: 4,
+        spp: 512,
+        ref_spp: 4096,
+        mitsuba_bias_256: 0.001,
+    });
 }
 
 #[test]
 fn point_glossy_matches_mitsuba() {
-    parity(Case { name: "point_glossy", factor: 2, spp: 256, ref_spp: 4096, mitsuba_bias_256: 0.015 });
+    parity(Case {
+        name: "point_glossy",
+        factor: 2,
+        spp: 256,
+        ref_spp: 4096,
+        mitsuba_bias_256: 0.015,
+    });
 }
 
 /// Thin lens (aperture 0.15 m, focus 3.2 m). relMSE alone cannot tell depth of field from a
@@ -87,18 +139,28 @@ fn point_glossy_matches_mitsuba() {
 /// predicts 0.00620; mean bias +0.23%, +0.15%, +0.12%).
 #[test]
 fn cornell_dof_matches_mitsuba() {
-    parity(Case { name: "cornell_dof", factor: 4, spp: 512, ref_spp: 4096, mitsuba_bias_256: 0.001 });
+    parity(Case {
+        name: "cornell_dof",
+        factor: 4,
+        spp: 512,
+        ref_spp: 4096,
+        mitsuba_bias_256: 0.001,
+    });
     let dir = oracle("cornell_dof");
     let reference = Image::load(&dir.join("reference.exr")).unwrap().box_downsample(4).unwrap();
     let mut scene = load_gltf(&dir.join("cornell_dof.gltf")).unwrap();
-    let lens = scene.camera.as_ref().and_then(|c| c.lens).expect("cornell_dof's camera has a thin lens");
+    let lens =
+        scene.camera.as_ref().and_then(|c| c.lens).expect("cornell_dof's camera has a thin lens");
     assert_eq!((lens.aperture_radius, lens.focus_distance), (0.15, 3.2));
     let (w, h) = (reference.width, reference.height);
     let with_lens = compare(&render(&scene, w, h, 512, 7).unwrap().mean, &reference).unwrap().flip;
     scene.camera.as_mut().unwrap().lens = None;
     let pinhole = compare(&render(&scene, w, h, 512, 7).unwrap().mean, &reference).unwrap().flip;
     println!("cornell_dof FLIP: thin lens {with_lens:.4}, pinhole {pinhole:.4}");
-    assert!(pinhole >= 1.2 * with_lens, "the pinhole's FLIP {pinhole} is not clearly worse than the lens's {with_lens}");
+    assert!(
+        pinhole >= 1.2 * with_lens,
+        "the pinhole's FLIP {pinhole} is not clearly worse than the lens's {with_lens}"
+    );
 }
 
 #[test]
@@ -119,7 +181,9 @@ fn white_furnace_is_one() {
     // Sphere pixels: every pixel whose first-hit normal is set, less a 1-pixel rim whose
     // footprint straddles the silhouette (those mix sphere and sky, both 1 anyway).
     let (w, hgt) = (normals.width as i32, normals.height as i32);
-    let on = |x: i32, y: i32| x >= 0 && y >= 0 && x < w && y < hgt && normals.at(x as u32, y as u32).length() > 0.5;
+    let on = |x: i32, y: i32| {
+        x >= 0 && y >= 0 && x < w && y < hgt && normals.at(x as u32, y as u32).length() > 0.5
+    };
     let mut sum = 0f64;
     let mut count = 0usize;
     let mut worst_z = 0f64;
@@ -145,7 +209,9 @@ fn white_furnace_is_one() {
         }
     }
     let mean = sum / count as f64;
-    println!("furnace: {count} sphere pixels at {spp} spp, mean {mean:.5}, worst pixel |x-1| {worst_dev:.4} = {worst_z:.2} standard errors");
+    println!(
+        "furnace: {count} sphere pixels at {spp} spp, mean {mean:.5}, worst pixel |x-1| {worst_dev:.4} = {worst_z:.2} standard errors"
+    );
     assert!(count > 20_000, "sphere mask too small: {count}");
     // Mitsuba measured 0.99967 (the tessellated sphere loses 0.03%); the issue's bound is 0.5%.
     assert!((mean - 1.0).abs() < 0.005, "furnace sphere mean {mean}");

@@ -64,12 +64,22 @@ fn synthetic() -> Vec<Pixel> {
             // uniform disk) plus the pixel's own square (1 / 12).
             let var = if defocused { 4.0 * 4.0 / 4.0 + 1.0 / 12.0 } else { 1.0 / 12.0 } * fp * fp;
             let sd = (var / K as f64).sqrt();
-            let truth = [(x as f64 + 0.5 - W as f64 / 2.0) * fp, (H as f64 / 2.0 - y as f64 - 0.5) * fp, -z];
+            let truth = [
+                (x as f64 + 0.5 - W as f64 / 2.0) * fp,
+                (H as f64 / 2.0 - y as f64 - 0.5) * fp,
+                -z,
+            ];
             let p = [truth[0] + sd * rng.normal(), truth[1] + sd * rng.normal(), truth[2]];
             let p_a = [p[0] + sd * rng.normal(), p[1] + sd * rng.normal(), p[2]];
             let noise = if defocused { 0.3 } else { 0.0 };
             let nrm = [noise * rng.normal(), noise * rng.normal(), 1.0];
-            let base = if x >= EDGE { 0.9 } else if defocused { 0.5 + 0.2 * rng.normal() } else { 0.1 + 0.1 * ((x + y) % 2) as f64 };
+            let base = if x >= EDGE {
+                0.9
+            } else if defocused {
+                0.5 + 0.2 * rng.normal()
+            } else {
+                0.1 + 0.1 * ((x + y) % 2) as f64
+            };
             px[y * W + x] = Pixel {
                 normal_depth: [nrm[0] as f32, nrm[1] as f32, nrm[2] as f32, z as f32],
                 base: [base as f32, base as f32, base as f32, 0.0],
@@ -107,7 +117,12 @@ fn run(pixels: &[Pixel]) -> Output {
     fp.cam_fwd = [0.0, 0.0, -1.0, 0.0];
     fp.cam_up = [0.0, TH, 0.0, 0.0];
     fp.cam_right = [TH * W as f32 / H as f32, 0.0, 0.0, 0.0];
-    let frame = mem.buffer(d, "frame", size_of::<FrameParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+    let frame = mem.buffer(
+        d,
+        "frame",
+        size_of::<FrameParams>() as u64,
+        wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    );
     gpu.queue.write_buffer(&frame, 0, bytemuck::bytes_of(&fp));
     let mut features: Vec<f32> = vec![];
     let mut moments: Vec<f32> = vec![];
@@ -128,12 +143,25 @@ fn run(pixels: &[Pixel]) -> Output {
     let offered = bindings(&frame, &primaries, &targets);
     prefilter.record(&gpu, &mut enc, 1, size, &offered, None).unwrap();
     gpu.queue.submit([enc.finish()]);
-    let read = |b: &wgpu::Buffer| -> Vec<f32> { bytemuck::cast_slice(&readback_buffer(d, &gpu.queue, b, b.size()).unwrap()).to_vec() };
-    let texels = |t: &wgpu::Texture| -> Vec<[f32; 4]> { bytemuck::cast_slice::<u8, f32>(&hush_engine::gpu::readback_texture(&gpu, t).unwrap()).chunks(4).map(|c| c.try_into().unwrap()).collect() };
+    let read = |b: &wgpu::Buffer| -> Vec<f32> {
+        bytemuck::cast_slice(&readback_buffer(d, &gpu.queue, b, b.size()).unwrap()).to_vec()
+    };
+    let texels = |t: &wgpu::Texture| -> Vec<[f32; 4]> {
+        bytemuck::cast_slice::<u8, f32>(&hush_engine::gpu::readback_texture(&gpu, t).unwrap())
+            .chunks(4)
+            .map(|c| c.try_into().unwrap())
+            .collect()
+    };
     let (a, b) = (texels(&targets.stats[0].0), texels(&targets.stats[1].0));
-    let inverse = (0..W * H).map(|i| [a[i][0], a[i][1], a[i][2], a[i][3], b[i][0], b[i][1], b[i][2], b[i][3]]).collect();
+    let inverse = (0..W * H)
+        .map(|i| [a[i][0], a[i][1], a[i][2], a[i][3], b[i][0], b[i][1], b[i][2], b[i][3]])
+        .collect();
     let bandwidth = read(&targets.bandwidth)[..W * H].to_vec();
-    let features = read(&targets.features).chunks(20).take(W * H).map(|c| [0, 1, 2, 3, 4].map(|w| c[w * 4..w * 4 + 4].try_into().unwrap())).collect();
+    let features = read(&targets.features)
+        .chunks(20)
+        .take(W * H)
+        .map(|c| [0, 1, 2, 3, 4].map(|w| c[w * 4..w * 4 + 4].try_into().unwrap()))
+        .collect();
     Output { inverse, bandwidth, features }
 }
 
@@ -144,10 +172,13 @@ fn gauss(dx: i64, dy: i64) -> f64 {
 }
 
 fn window(x: usize, y: usize) -> impl Iterator<Item = (i64, i64, usize)> {
-    (-3i64..=3).flat_map(move |dy| (-3i64..=3).map(move |dx| (dx, dy))).filter_map(move |(dx, dy)| {
-        let (qx, qy) = (x as i64 + dx, y as i64 + dy);
-        (qx >= 0 && qy >= 0 && qx < W as i64 && qy < H as i64).then(|| (dx, dy, qy as usize * W + qx as usize))
-    })
+    (-3i64..=3).flat_map(move |dy| (-3i64..=3).map(move |dx| (dx, dy))).filter_map(
+        move |(dx, dy)| {
+            let (qx, qy) = (x as i64 + dx, y as i64 + dy);
+            (qx >= 0 && qy >= 0 && qx < W as i64 && qy < H as i64)
+                .then(|| (dx, dy, qy as usize * W + qx as usize))
+        },
+    )
 }
 
 type Sym = [f64; 6]; // xx, xy, xz, yy, yz, zz
@@ -158,11 +189,22 @@ fn invert(s: Sym) -> Sym {
     let c01 = xz * yz - xy * zz;
     let c02 = xy * yz - xz * yy;
     let det = xx * c00 + xy * c01 + xz * c02;
-    [c00 / det, c01 / det, c02 / det, (xx * zz - xz * xz) / det, (xy * xz - xx * yz) / det, (xx * yy - xy * xy) / det]
+    [
+        c00 / det,
+        c01 / det,
+        c02 / det,
+        (xx * zz - xz * xz) / det,
+        (xy * xz - xx * yz) / det,
+        (xx * yy - xy * xy) / det,
+    ]
 }
 
 fn mul(a: Sym, v: [f64; 3]) -> [f64; 3] {
-    [a[0] * v[0] + a[1] * v[1] + a[2] * v[2], a[1] * v[0] + a[3] * v[1] + a[4] * v[2], a[2] * v[0] + a[4] * v[1] + a[5] * v[2]]
+    [
+        a[0] * v[0] + a[1] * v[1] + a[2] * v[2],
+        a[1] * v[0] + a[3] * v[1] + a[4] * v[2],
+        a[2] * v[0] + a[4] * v[1] + a[5] * v[2],
+    ]
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -183,7 +225,9 @@ fn cpu_inverse(px: &[Pixel]) -> Vec<Sym> {
             for (dx, dy, q) in window(x, y) {
                 let g = gauss(dx, dy);
                 let p = &px[q];
-                for (k, v) in [p.s_a[0], p.s_a[1], p.s_a[2], p.s_a[3], p.s_b[0], p.s_b[1]].iter().enumerate() {
+                for (k, v) in
+                    [p.s_a[0], p.s_a[1], p.s_a[2], p.s_a[3], p.s_b[0], p.s_b[1]].iter().enumerate()
+                {
                     s[k] += g * *v as f64;
                 }
                 wsum += g;
@@ -271,7 +315,12 @@ fn sure_and_world_position_weights_match_a_cpu_computation() {
         let g = [gpu[0], gpu[1], gpu[2], gpu[3], gpu[4], gpu[5]];
         let scale = inv[c].iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for k in 0..6 {
-            assert!((g[k] as f64 - inv[c][k]).abs() <= 1e-3 * scale, "pixel {c}: S^-1[{k}] {} vs CPU {}", g[k], inv[c][k]);
+            assert!(
+                (g[k] as f64 - inv[c][k]).abs() <= 1e-3 * scale,
+                "pixel {c}: S^-1[{k}] {} vs CPU {}",
+                g[k],
+                inv[c][k]
+            );
         }
         assert_eq!(gpu[7], K, "hits");
     }
@@ -280,44 +329,95 @@ fn sure_and_world_position_weights_match_a_cpu_computation() {
         let (h, margin) = cpu_sure(&px, &inv, c);
         if margin > 1e-3 {
             compared_out_of_focus += (c % W < W / 2) as usize;
-            assert!((out.bandwidth[c] as f64 - h).abs() < 1e-6, "pixel ({}, {}): GPU chose h = {}, CPU {h} (margin {margin:.4})", c % W, c / W, out.bandwidth[c]);
+            assert!(
+                (out.bandwidth[c] as f64 - h).abs() < 1e-6,
+                "pixel ({}, {}): GPU chose h = {}, CPU {h} (margin {margin:.4})",
+                c % W,
+                c / W,
+                out.bandwidth[c]
+            );
             compared += 1;
         }
     }
-    let in_focus: Vec<f32> = (0..W * H).filter(|c| c % W >= W / 2).map(|c| out.bandwidth[c]).collect();
-    let hist_focus: Vec<usize> = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0].iter().map(|h| in_focus.iter().filter(|b| (**b - *h as f32).abs() < 1e-6).count()).collect();
-    println!("{compared} of {} pixels had a clear SURE choice ({compared_out_of_focus} out of focus); in focus, bandwidths 0..2: {hist_focus:?}", W * H);
-    assert!(compared_out_of_focus * 10 >= W * H / 2 * 9, "out of focus only {compared_out_of_focus} pixels had a clear SURE choice");
+    let in_focus: Vec<f32> =
+        (0..W * H).filter(|c| c % W >= W / 2).map(|c| out.bandwidth[c]).collect();
+    let hist_focus: Vec<usize> = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0]
+        .iter()
+        .map(|h| in_focus.iter().filter(|b| (**b - *h as f32).abs() < 1e-6).count())
+        .collect();
+    println!(
+        "{compared} of {} pixels had a clear SURE choice ({compared_out_of_focus} out of focus); in focus, bandwidths 0..2: {hist_focus:?}",
+        W * H
+    );
+    assert!(
+        compared_out_of_focus * 10 >= W * H / 2 * 9,
+        "out of focus only {compared_out_of_focus} pixels had a clear SURE choice"
+    );
     // In focus no neighbour has weight at h <= 0.8, so SURE ties h = 0, 0.4 and 0.8 (eq. (6) is
     // then sigma^2 / n for each) and the smallest wins: the in-focus half, its depth step
     // included, stays unfiltered.
-    assert!(hist_focus[0] * 100 >= in_focus.len() * 95, "in focus only {} of {} pixels chose h = 0", hist_focus[0], in_focus.len());
+    assert!(
+        hist_focus[0] * 100 >= in_focus.len() * 95,
+        "in focus only {} of {} pixels chose h = 0",
+        hist_focus[0],
+        in_focus.len()
+    );
     for y in 0..H {
         for x in [EDGE - 1, EDGE] {
-            assert!(out.bandwidth[y * W + x] <= 0.4 + 1e-6, "in-focus step at ({x}, {y}) chose h = {}", out.bandwidth[y * W + x]);
+            assert!(
+                out.bandwidth[y * W + x] <= 0.4 + 1e-6,
+                "in-focus step at ({x}, {y}) chose h = {}",
+                out.bandwidth[y * W + x]
+            );
         }
     }
     for c in 0..W * H {
         let cpu = cpu_base(&px, &inv, &out.bandwidth, c);
-        assert!((out.features[c][1][0] as f64 - cpu).abs() < 1e-4, "pixel {c}: filtered base {} vs CPU {cpu}", out.features[c][1][0]);
+        assert!(
+            (out.features[c][1][0] as f64 - cpu).abs() < 1e-4,
+            "pixel {c}: filtered base {} vs CPU {cpu}",
+            out.features[c][1][0]
+        );
     }
     // The out-of-focus wall, 4 pixels from its borders.
-    let interior: Vec<usize> = (4..H - 4).flat_map(|y| (4..W / 2 - 4).map(move |x| y * W + x)).collect();
+    let interior: Vec<usize> =
+        (4..H - 4).flat_map(|y| (4..W / 2 - 4).map(move |x| y * W + x)).collect();
     let wide = interior.iter().filter(|&&c| out.bandwidth[c] >= 1.2).count();
     let (mut raw, mut filtered) = (0.0, 0.0);
     for &c in &interior {
         raw += (px[c].normal_depth[0].powi(2) + px[c].normal_depth[1].powi(2)) as f64;
         filtered += (out.features[c][0][0].powi(2) + out.features[c][0][1].powi(2)) as f64;
     }
-    let hist: Vec<usize> = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0].iter().map(|h| out.bandwidth.iter().enumerate().filter(|(c, b)| (**b - *h as f32).abs() < 1e-6 && c % W < W / 2).count()).collect();
-    println!("out of focus: {wide} of {} interior pixels chose h >= 1.2 (bandwidth histogram 0..2: {hist:?}); normal noise {raw:.3} -> {filtered:.3} ({:.1}x)", interior.len(), raw / filtered);
-    assert!(wide * 10 >= interior.len() * 9, "out of focus, only {wide} of {} pixels chose a wide bandwidth", interior.len());
+    let hist: Vec<usize> = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0]
+        .iter()
+        .map(|h| {
+            out.bandwidth
+                .iter()
+                .enumerate()
+                .filter(|(c, b)| (**b - *h as f32).abs() < 1e-6 && c % W < W / 2)
+                .count()
+        })
+        .collect();
+    println!(
+        "out of focus: {wide} of {} interior pixels chose h >= 1.2 (bandwidth histogram 0..2: {hist:?}); normal noise {raw:.3} -> {filtered:.3} ({:.1}x)",
+        interior.len(),
+        raw / filtered
+    );
+    assert!(
+        wide * 10 >= interior.len() * 9,
+        "out of focus, only {wide} of {} pixels chose a wide bandwidth",
+        interior.len()
+    );
     assert!(raw >= 4.0 * filtered, "normal noise only {raw} -> {filtered}");
     for y in 0..H {
         for x in [EDGE - 1, EDGE] {
             let c = y * W + x;
             let moved = (out.features[c][1][0] - px[c].base[0]).abs();
-            assert!(moved <= 0.01, "in-focus step at ({x}, {y}): base colour moved by {moved} (h = {})", out.bandwidth[c]);
+            assert!(
+                moved <= 0.01,
+                "in-focus step at ({x}, {y}): base colour moved by {moved} (h = {})",
+                out.bandwidth[c]
+            );
         }
     }
 }
@@ -336,9 +436,19 @@ fn nan_and_inf_never_leave_the_prefilter() {
     let out = run(&px);
     for c in 0..W * H {
         assert!(out.bandwidth[c].is_finite(), "bandwidth at {c}");
-        assert!(out.inverse[c].iter().all(|v| v.is_finite()), "inverse at {c}: {:?}", out.inverse[c]);
+        assert!(
+            out.inverse[c].iter().all(|v| v.is_finite()),
+            "inverse at {c}: {:?}",
+            out.inverse[c]
+        );
         for w in 0..4 {
-            assert!(out.features[c][w].iter().all(|v| v.is_finite()), "feature {w} at ({}, {}): {:?}", c % W, c / W, out.features[c][w]);
+            assert!(
+                out.features[c][w].iter().all(|v| v.is_finite()),
+                "feature {w} at ({}, {}): {:?}",
+                c % W,
+                c / W,
+                out.features[c][w]
+            );
         }
     }
 }
@@ -358,34 +468,64 @@ fn primaries_covariance_matches_the_thin_lens() {
     use hush_tests::gltf_writer::{GltfWriter, Prim};
     let mut g = GltfWriter::default();
     let grey = g.lambert([0.5; 3]);
-    let positions = [[-50.0, -50.0, 0.0], [50.0, -50.0, 0.0], [50.0, 50.0, 0.0], [-50.0, 50.0, 0.0]];
-    let mesh = g.mesh(Prim { positions: &positions, normals: None, indices: Some(&[0, 1, 2, 0, 2, 3]), material: grey });
+    let positions =
+        [[-50.0, -50.0, 0.0], [50.0, -50.0, 0.0], [50.0, 50.0, 0.0], [-50.0, 50.0, 0.0]];
+    let mesh = g.mesh(Prim {
+        positions: &positions,
+        normals: None,
+        indices: Some(&[0, 1, 2, 0, 2, 3]),
+        material: grey,
+    });
     g.node(serde_json::json!({"mesh": mesh}));
     let scene = load_gltf(&g.write("lens_plane")).unwrap();
     let (z, f, r, fov) = (4.0f64, 2.0f64, 0.05f64, 40.0f64);
-    let camera = Camera { lens: Some(ThinLens::new(r, f).unwrap()), ..Camera::look_at(glam::DVec3::new(0.0, 0.0, z), glam::DVec3::ZERO, fov as f32) };
+    let camera = Camera {
+        lens: Some(ThinLens::new(r, f).unwrap()),
+        ..Camera::look_at(glam::DVec3::new(0.0, 0.0, z), glam::DVec3::ZERO, fov as f32)
+    };
     let size = 64u32;
-    let (gpu, mut renderer) = Renderer::headless(scene, hush_engine::accel::BvhKind::DEFAULT, (size, size)).unwrap();
+    let (gpu, mut renderer) =
+        Renderer::headless(scene, hush_engine::accel::BvhKind::DEFAULT, (size, size)).unwrap();
     let n = 64u32;
-    let settings = hush_engine::settings::FrameSettings { primary_samples: n, prefilter: false, ..Default::default() };
-    renderer.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, &settings, None).unwrap();
-    let moments: Vec<f32> = bytemuck::cast_slice(&renderer.read_buffer(&gpu, "primaries/moments").unwrap()).to_vec();
+    let settings = hush_engine::settings::FrameSettings {
+        primary_samples: n,
+        prefilter: false,
+        ..Default::default()
+    };
+    renderer
+        .render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, &settings, None)
+        .unwrap();
+    let moments: Vec<f32> =
+        bytemuck::cast_slice(&renderer.read_buffer(&gpu, "primaries/moments").unwrap()).to_vec();
     let pixels = (size * size) as usize;
-    let mean = |k: usize| (0..pixels).map(|i| moments[i * 16 + k] as f64).sum::<f64>() / pixels as f64;
+    let mean =
+        |k: usize| (0..pixels).map(|i| moments[i * 16 + k] as f64).sum::<f64>() / pixels as f64;
     let (xx, xy, yy, zz, hits) = (mean(4), mean(5), mean(7), mean(9), mean(3));
     let footprint = z * 2.0 * (fov.to_radians() / 2.0).tan() / size as f64;
     let radius = r * (1.0 - z / f).abs();
     // Every pixel samples the same n positions (realtime/lens.wgsl: the R2 sequence from the
     // frame's jitter, 0.5 without TAA): their own covariance, image y pointing down the world's.
-    let offsets: Vec<(f64, f64)> = (0..n).map(|j| ((0.5 + j as f64 * 0.7548776662).fract(), (0.5 + j as f64 * 0.5698402910).fract())).collect();
+    let offsets: Vec<(f64, f64)> = (0..n)
+        .map(|j| ((0.5 + j as f64 * 0.7548776662).fract(), (0.5 + j as f64 * 0.5698402910).fract()))
+        .collect();
     let m = offsets.iter().fold((0.0, 0.0), |a, o| (a.0 + o.0 / n as f64, a.1 + o.1 / n as f64));
-    let cov = |f: &dyn Fn(&(f64, f64)) -> f64| offsets.iter().map(f).sum::<f64>() / n as f64 * footprint * footprint;
-    let jitter = [cov(&|o| (o.0 - m.0).powi(2)), -cov(&|o| (o.0 - m.0) * (o.1 - m.1)), cov(&|o| (o.1 - m.1).powi(2))];
+    let cov = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        offsets.iter().map(f).sum::<f64>() / n as f64 * footprint * footprint
+    };
+    let jitter = [
+        cov(&|o| (o.0 - m.0).powi(2)),
+        -cov(&|o| (o.0 - m.0) * (o.1 - m.1)),
+        cov(&|o| (o.1 - m.1).powi(2)),
+    ];
     let lens = (n as f64 - 1.0) / n as f64 * radius * radius / 4.0;
     let expected = [lens + jitter[0], jitter[1], lens + jitter[2]];
-    println!("S xx {xx:.4e} xy {xy:.3e} yy {yy:.4e} (expected {:.4e} {:.3e} {:.4e}), zz {zz:.2e}, hits {hits}", expected[0], expected[1], expected[2]);
+    println!(
+        "S xx {xx:.4e} xy {xy:.3e} yy {yy:.4e} (expected {:.4e} {:.3e} {:.4e}), zz {zz:.2e}, hits {hits}",
+        expected[0], expected[1], expected[2]
+    );
     assert_eq!(hits, n as f64);
-    for (name, v, e) in [("xx", xx, expected[0]), ("xy", xy, expected[1]), ("yy", yy, expected[2])] {
+    for (name, v, e) in [("xx", xx, expected[0]), ("xy", xy, expected[1]), ("yy", yy, expected[2])]
+    {
         assert!((v - e).abs() < 0.02 * expected[0], "S {name} {v:.4e}, expected {e:.4e}");
     }
     assert!(zz.abs() < 1e-3 * expected[0], "S zz {zz:.3e}: the samples lie on the plane");
@@ -415,18 +555,30 @@ fn prefiltered_gbuffer_is_closer_to_the_converged_one() {
     // Per pixel the features (primaries.wgsl's layout, as f32) and, with the pre-filter, its
     // features and the positions' spread in pixels.
     let run = |settings: &FrameSettings| {
-        let (gpu, mut r) = Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, size).unwrap();
+        let (gpu, mut r) =
+            Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, size).unwrap();
         r.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, settings, None).unwrap();
         let floats = |b: Vec<u8>| -> Vec<f32> { bytemuck::cast_slice(&b).to_vec() };
         let raw = floats(r.read_buffer(&gpu, "primaries/features").unwrap());
         let filtered = r.read_buffer(&gpu, "prefilter/features").map(floats).unwrap_or_default();
-        let spread: Vec<f32> = r.read_texture(&gpu, "prefilter/view").map(|t| (0..pixels).map(|i| hush_tests::half(&t.0[i * 8 + 4..])).collect()).unwrap_or_default();
+        let spread: Vec<f32> = r
+            .read_texture(&gpu, "prefilter/view")
+            .map(|t| (0..pixels).map(|i| hush_tests::half(&t.0[i * 8 + 4..])).collect())
+            .unwrap_or_default();
         (raw, filtered, spread)
     };
-    let (reference, _, _) = run(&FrameSettings { primary_samples: 256, prefilter: false, seed: 9, ..Default::default() });
-    let (raw, filtered, spread) = run(&FrameSettings { primary_samples: 4, prefilter: true, ..Default::default() });
+    let (reference, _, _) = run(&FrameSettings {
+        primary_samples: 256,
+        prefilter: false,
+        seed: 9,
+        ..Default::default()
+    });
+    let (raw, filtered, spread) =
+        run(&FrameSettings { primary_samples: 4, prefilter: true, ..Default::default() });
     let surface = |f: &[f32], i: usize| f[i * 20 + 19].to_bits() != u32::MAX;
-    let normal = |f: &[f32], i: usize| glam::Vec3::new(f[i * 20], f[i * 20 + 1], f[i * 20 + 2]).normalize_or_zero();
+    let normal = |f: &[f32], i: usize| {
+        glam::Vec3::new(f[i * 20], f[i * 20 + 1], f[i * 20 + 2]).normalize_or_zero()
+    };
     // Normal, base colour (linear) and view depth (relative) squared errors, over the pixels
     // with a surface in both; `in_focus`: only where the positions spread over less than a pixel.
     let mse = |f: &[f32], in_focus: bool| {
@@ -436,7 +588,9 @@ fn prefiltered_gbuffer_is_closer_to_the_converged_one() {
                 continue;
             }
             n += (normal(f, i) - normal(&reference, i)).length_squared() as f64;
-            b += (4..7).map(|k| (f[i * 20 + k] - reference[i * 20 + k]).powi(2) as f64).sum::<f64>() / 3.0;
+            b +=
+                (4..7).map(|k| (f[i * 20 + k] - reference[i * 20 + k]).powi(2) as f64).sum::<f64>()
+                    / 3.0;
             d += (f[i * 20 + 3] as f64 / reference[i * 20 + 3] as f64 - 1.0).powi(2);
             count += 1;
         }
@@ -447,7 +601,12 @@ fn prefiltered_gbuffer_is_closer_to_the_converged_one() {
     let (fnm, fb, fd, _) = mse(&filtered, false);
     let (rn_focus, _, _, focus_count) = mse(&raw, true);
     let (fn_focus, _, _, _) = mse(&filtered, true);
-    println!("G-buffer MSE against 256 samples over {rc} pixels, raw 4 samples -> pre-filtered: normal {rn:.5} -> {fnm:.5} ({:.2}x), base colour {rb:.6} -> {fb:.6} ({:.2}x), relative depth {rd:.6} -> {fd:.6} ({:.2}x); in focus ({focus_count} pixels) normal {rn_focus:.6} -> {fn_focus:.6}", rn / fnm, rb / fb, rd / fd);
+    println!(
+        "G-buffer MSE against 256 samples over {rc} pixels, raw 4 samples -> pre-filtered: normal {rn:.5} -> {fnm:.5} ({:.2}x), base colour {rb:.6} -> {fb:.6} ({:.2}x), relative depth {rd:.6} -> {fd:.6} ({:.2}x); in focus ({focus_count} pixels) normal {rn_focus:.6} -> {fn_focus:.6}",
+        rn / fnm,
+        rb / fb,
+        rd / fd
+    );
     assert!(fnm * 1.4 <= rn, "normal MSE {rn} -> {fnm}");
     assert!(fb * 1.4 <= rb, "base colour MSE {rb} -> {fb}");
     assert!(fd <= 1.1 * rd, "depth MSE {rd} -> {fd}");

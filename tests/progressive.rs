@@ -9,7 +9,9 @@ use hush_engine::accel::BvhKind;
 use hush_engine::frame::schedule::{scheduled_pixel, tile};
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::scene::Camera;
-use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings, ProgressiveSettings, SampleFraction, TaaSettings};
+use hush_engine::settings::{
+    Denoiser, FrameSettings, MatteSettings, ProgressiveSettings, SampleFraction, TaaSettings,
+};
 use hush_tests::{half, oct_normal};
 
 const SIZE: (u32, u32) = (61, 35);
@@ -22,12 +24,14 @@ fn view() -> Camera {
 fn light(r: &Renderer, gpu: &hush_engine::gpu::Gpu) -> Vec<[u8; 16]> {
     let (m, _) = r.read_texture(gpu, "trace/matte").unwrap();
     let (d, _) = r.read_texture(gpu, "trace/direct").unwrap();
-    (0..(SIZE.0 * SIZE.1) as usize).map(|i| {
-        let mut px = [0u8; 16];
-        px[..8].copy_from_slice(&m[i * 8..i * 8 + 8]);
-        px[8..].copy_from_slice(&d[i * 8..i * 8 + 8]);
-        px
-    }).collect()
+    (0..(SIZE.0 * SIZE.1) as usize)
+        .map(|i| {
+            let mut px = [0u8; 16];
+            px[..8].copy_from_slice(&m[i * 8..i * 8 + 8]);
+            px[8..].copy_from_slice(&d[i * 8..i * 8 + 8]);
+            px
+        })
+        .collect()
 }
 
 /// Frame k of a renderer has index k. A full frame first, then at each period a frame whose
@@ -36,14 +40,18 @@ fn light(r: &Renderer, gpu: &hush_engine::gpu::Gpu) -> Vec<[u8; 16]> {
 /// outside the schedule fails the test at once.
 #[test]
 fn the_trace_writes_exactly_the_scheduled_pixels() {
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
     let mut index = 1u32;
     let mut before = light(&r, &gpu);
     for period in [2u32, 4, 16, 128] {
         for _ in 0..3 {
-            let s = FrameSettings { sample_fraction: SampleFraction::one_in(period).unwrap(), ..Default::default() };
+            let s = FrameSettings {
+                sample_fraction: SampleFraction::one_in(period).unwrap(),
+                ..Default::default()
+            };
             r.render(&gpu, &input, &s, None).unwrap();
             let after = light(&r, &gpu);
             let (tw, th) = tile(period);
@@ -58,10 +66,20 @@ fn the_trace_writes_exactly_the_scheduled_pixels() {
             }
             let changed: Vec<usize> = (0..after.len()).filter(|&i| after[i] != before[i]).collect();
             let stray: Vec<usize> = changed.iter().copied().filter(|&i| !scheduled[i]).collect();
-            assert!(stray.is_empty(), "period {period}, frame {index}: pixels {stray:?} changed outside the schedule");
+            assert!(
+                stray.is_empty(),
+                "period {period}, frame {index}: pixels {stray:?} changed outside the schedule"
+            );
             let n = scheduled.iter().filter(|&&s| s).count();
-            println!("period {period}, frame {index}: {} of {n} scheduled pixels changed", changed.len());
-            assert!(changed.len() * 2 > n, "period {period}: only {} of {n} scheduled pixels were traced", changed.len());
+            println!(
+                "period {period}, frame {index}: {} of {n} scheduled pixels changed",
+                changed.len()
+            );
+            assert!(
+                changed.len() * 2 > n,
+                "period {period}: only {} of {n} scheduled pixels were traced",
+                changed.len()
+            );
             before = after;
             index += 1;
         }
@@ -70,11 +88,16 @@ fn the_trace_writes_exactly_the_scheduled_pixels() {
 
 #[test]
 fn denoisers_that_need_every_pixel_refuse_fractions() {
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let quarter = SampleFraction::one_in(4).unwrap();
     for name in ["mara", "svgf"] {
-        let s = FrameSettings { denoiser: Denoiser::named(name), sample_fraction: quarter, ..Default::default() };
+        let s = FrameSettings {
+            denoiser: Denoiser::named(name),
+            sample_fraction: quarter,
+            ..Default::default()
+        };
         let e = format!("{:#}", r.render(&gpu, &input, &s, None).unwrap_err());
         assert!(e.contains(name) && e.contains("1/4") && e.contains("progressive"), "{e}");
     }
@@ -82,7 +105,8 @@ fn denoisers_that_need_every_pixel_refuse_fractions() {
     let e = format!("{:#}", r.render(&gpu, &input, &s, None).unwrap_err());
     assert!(e.contains("1/4") && e.contains("4 samples per pixel"), "{e}");
     // The renderer still renders after refusing.
-    r.render(&gpu, &input, &FrameSettings { sample_fraction: quarter, ..Default::default() }, None).unwrap();
+    r.render(&gpu, &input, &FrameSettings { sample_fraction: quarter, ..Default::default() }, None)
+        .unwrap();
     assert!(r.read_hdr(&gpu).unwrap().data.iter().all(|v| v.is_finite()));
 }
 
@@ -113,11 +137,15 @@ fn progressive(period: u32, p: ProgressiveSettings) -> FrameSettings {
 /// surface pixels (measured: all of them).
 #[test]
 fn missing_samples_leave_history_and_moments_unchanged() {
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     // a = 0.4 takes over from 1 / age at the third sample, within the test's 10 frames.
     let a = 0.4;
-    let s = progressive(4, ProgressiveSettings { still_samples: 0.0, alpha: a as f32, ..Default::default() });
+    let s = progressive(
+        4,
+        ProgressiveSettings { still_samples: 0.0, alpha: a as f32, ..Default::default() },
+    );
     let n = (SIZE.0 * SIZE.1) as usize;
     // Per pixel: light, m1, m2, age.
     let mut cpu = vec![([0f64; 3], 0f64, 0f64, 0f64); n];
@@ -126,8 +154,10 @@ fn missing_samples_leave_history_and_moments_unchanged() {
     for frame in 0..10u32 {
         r.render(&gpu, &input, &s, None).unwrap();
         let written = 1 - (frame % 2) as usize;
-        let moments = r.read_texture(&gpu, &format!("progressive/matte moments {written}")).unwrap().0;
-        let history = r.read_texture(&gpu, &format!("progressive/matte history {written}")).unwrap().0;
+        let moments =
+            r.read_texture(&gpu, &format!("progressive/matte moments {written}")).unwrap().0;
+        let history =
+            r.read_texture(&gpu, &format!("progressive/matte history {written}")).unwrap().0;
         let sample = r.read_texture(&gpu, "trace/matte").unwrap().0;
         let ids = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
         let (tw, th) = tile(4);
@@ -160,7 +190,8 @@ fn missing_samples_leave_history_and_moments_unchanged() {
                         && close(f32_at(&moments, i * 4 + 1) as f64, c.2, 1e-5)
                         && (0..3).all(|k| close(g[k], c.0[k], 2e-3))
                 } else {
-                    moments[i * 16..i * 16 + 16] == before_m[i * 16..i * 16 + 16] && history[i * 8..i * 8 + 8] == before_h[i * 8..i * 8 + 8]
+                    moments[i * 16..i * 16 + 16] == before_m[i * 16..i * 16 + 16]
+                        && history[i * 8..i * 8 + 8] == before_h[i * 8..i * 8 + 8]
                 };
                 // The CPU's light drifts from the half-float history it does not round: resync.
                 if ok {
@@ -184,7 +215,8 @@ fn missing_samples_leave_history_and_moments_unchanged() {
 /// 2e-3 relative (half-float output) on 99% of the surface pixels.
 #[test]
 fn an_atrous_level_matches_a_cpu_implementation() {
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let p = ProgressiveSettings { levels: 1, ..Default::default() };
     let s = progressive(1, p.clone());
@@ -211,7 +243,8 @@ fn an_atrous_level_matches_a_cpu_implementation() {
             }
             surface += 1;
             let lc = luma([c[0], c[1], c[2]]);
-            let (mut sum, mut sum_var, mut wsum) = ([c[0] * 0.25, c[1] * 0.25, c[2] * 0.25], c[3] * 0.0625, 0.25);
+            let (mut sum, mut sum_var, mut wsum) =
+                ([c[0] * 0.25, c[1] * 0.25, c[2] * 0.25], c[3] * 0.0625, 0.25);
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     let (qx, qy) = (x + dx, y + dy);
@@ -224,11 +257,19 @@ fn an_atrous_level_matches_a_cpu_implementation() {
                     if t[3] < 0.0 || zq < 0.0 {
                         continue;
                     }
-                    let hk = 0.25 * if dx == 0 { 1.0 } else { 0.5 } * if dy == 0 { 1.0 } else { 0.5 };
+                    let hk =
+                        0.25 * if dx == 0 { 1.0 } else { 0.5 } * if dy == 0 { 1.0 } else { 0.5 };
                     let offset = ((dx * dx + dy * dy) as f64).sqrt();
                     let w_n = normal(i).dot(normal(j)).max(0.0).powf(p.sigma_n as f64);
-                    let w_d = if dzc < 0.1 * zc { (-(zc - zq).abs() / ((p.sigma_d as f64 * dzc * offset).abs() + 0.005 * zc)).exp() } else { 1.0 };
-                    let w_l = (-(lc - luma([t[0], t[1], t[2]])).abs() / (p.sigma_l as f64 * c[3].max(0.0) + p.epsilon_l as f64)).exp();
+                    let w_d = if dzc < 0.1 * zc {
+                        (-(zc - zq).abs() / ((p.sigma_d as f64 * dzc * offset).abs() + 0.005 * zc))
+                            .exp()
+                    } else {
+                        1.0
+                    };
+                    let w_l = (-(lc - luma([t[0], t[1], t[2]])).abs()
+                        / (p.sigma_l as f64 * c[3].max(0.0) + p.epsilon_l as f64))
+                        .exp();
                     let wt = hk * w_n * w_d * w_l;
                     for k in 0..3 {
                         sum[k] += wt * t[k];
@@ -237,7 +278,12 @@ fn an_atrous_level_matches_a_cpu_implementation() {
                     wsum += wt;
                 }
             }
-            let want = [sum[0] / wsum, sum[1] / wsum, sum[2] / wsum, (sum_var / (wsum * wsum)).clamp(0.0, 60000.0)];
+            let want = [
+                sum[0] / wsum,
+                sum[1] / wsum,
+                sum[2] / wsum,
+                (sum_var / (wsum * wsum)).clamp(0.0, 60000.0),
+            ];
             let got = [0, 1, 2, 3].map(|k| half(&out[i * 8 + k * 2..]) as f64);
             let ok = (0..4).all(|k| (got[k] - want[k]).abs() <= 2e-3 * want[k].abs().max(1e-2));
             if std::env::var("HUSH_TEST_VERBOSE").is_ok() && !ok {
@@ -256,11 +302,15 @@ fn an_atrous_level_matches_a_cpu_implementation() {
 /// off.
 #[test]
 fn progressive_nonfinite_input_never_reaches_history_or_screen() {
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let mut cases = vec![];
     for period in [1, 4] {
-        let base = FrameSettings { matte: MatteSettings { inject_nonfinite: true, ..Default::default() }, ..progressive(period, Default::default()) };
+        let base = FrameSettings {
+            matte: MatteSettings { inject_nonfinite: true, ..Default::default() },
+            ..progressive(period, Default::default())
+        };
         cases.push(base.clone());
         for stage in ProgressiveSettings::STAGES {
             let mut s = base.clone();
@@ -272,13 +322,22 @@ fn progressive_nonfinite_input_never_reaches_history_or_screen() {
         for _ in 0..5 {
             r.render(&gpu, &input, &s, None).unwrap();
         }
-        assert!(r.read_hdr(&gpu).unwrap().data.iter().all(|p| p.is_finite()), "non-finite pixel on screen with {:?}", s.progressive);
+        assert!(
+            r.read_hdr(&gpu).unwrap().data.iter().all(|p| p.is_finite()),
+            "non-finite pixel on screen with {:?}",
+            s.progressive
+        );
         for signal in ["matte", "glossy", "direct"] {
-            for t in ["history 0", "history 1", "moments 0", "moments 1", "variance", "ping", "pong"] {
+            for t in
+                ["history 0", "history 1", "moments 0", "moments 1", "variance", "ping", "pong"]
+            {
                 let name = format!("progressive/{signal} {t}");
                 let (bytes, format) = r.read_texture(&gpu, &name).unwrap();
                 let bad = match format {
-                    wgpu::TextureFormat::Rgba32Float => bytes.chunks_exact(4).filter(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite()).count(),
+                    wgpu::TextureFormat::Rgba32Float => bytes
+                        .chunks_exact(4)
+                        .filter(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite())
+                        .count(),
                     _ => bytes.chunks_exact(2).filter(|h| !half(h).is_finite()).count(),
                 };
                 assert_eq!(bad, 0, "{name} holds {bad} NaN/Inf values with {:?}", s.progressive);

@@ -43,7 +43,10 @@ fn converges(name: &str, size: u32, frames: u32, spp: u32) {
     }
     relmse /= (3 * n) as f64;
     expected /= (3 * n) as f64;
-    let (bias, allowed) = trimmed_bias(&rt, &reference.mean, |i, k| ((a.data[i][k] - b.data[i][k]) as f64).powi(2) / 4.0 + reference.variance_of_mean.data[i][k] as f64);
+    let (bias, allowed) = trimmed_bias(&rt, &reference.mean, |i, k| {
+        ((a.data[i][k] - b.data[i][k]) as f64).powi(2) / 4.0
+            + reference.variance_of_mean.data[i][k] as f64
+    });
     println!(
         "{name}: {size}x{size}, {frames} real-time frames vs {spp} reference spp: relMSE {relmse:.5} (noise predicts {expected:.5}), \
          trimmed bias {:+.4} {:+.4} {:+.4} (allowed {:.4} {:.4} {:.4})",
@@ -51,7 +54,12 @@ fn converges(name: &str, size: u32, frames: u32, spp: u32) {
     );
     assert!(relmse <= SLACK * expected, "{name}: relMSE {relmse} > {SLACK} x predicted {expected}");
     for k in 0..3 {
-        assert!(bias[k].abs() <= allowed[k], "{name}: channel {k} biased by {:+.4} (allowed {:.4})", bias[k], allowed[k]);
+        assert!(
+            bias[k].abs() <= allowed[k],
+            "{name}: channel {k} biased by {:+.4} (allowed {:.4})",
+            bias[k],
+            allowed[k]
+        );
     }
 }
 
@@ -83,7 +91,13 @@ fn a_diffuse_only_scene_allocates_no_glossy_buffers() {
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (32, 32)).unwrap();
     assert!(!r.prepared.features.glossy, "cornell_diffuse has only Lambertian materials");
     let labels: Vec<String> = r.allocations().into_iter().map(|(l, _)| l).collect();
-    for forbidden in ["trace/glossy", "trace/reflection", "trace/mirror", "scene/object motion", "composite/accumulation"] {
+    for forbidden in [
+        "trace/glossy",
+        "trace/reflection",
+        "trace/mirror",
+        "scene/object motion",
+        "composite/accumulation",
+    ] {
         assert!(!labels.iter().any(|l| l == forbidden), "{forbidden} allocated: {labels:?}");
     }
     // G-buffer 36 + matte 8 + direct 8 + HDR 16 bytes per pixel.
@@ -92,7 +106,9 @@ fn a_diffuse_only_scene_allocates_no_glossy_buffers() {
     r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
     assert!(r.read_texture(&gpu, "trace/glossy").is_err());
     let img = r.read_hdr(&gpu).unwrap();
-    assert!(img.data.iter().all(|p| p.is_finite()) && img.data.iter().any(|p| p.max_element() > 0.0));
+    assert!(
+        img.data.iter().all(|p| p.is_finite()) && img.data.iter().any(|p| p.max_element() > 0.0)
+    );
 }
 
 fn project(vp: &Mat4, p: Vec3, size: (u32, u32)) -> Vec2 {
@@ -130,7 +146,10 @@ fn motion_vectors_follow_camera_and_object_motion() {
 
     let id_at = |ids: &[u8], x: usize, y: usize| -> (u32, u32) {
         let o = (y * size.0 as usize + x) * 8;
-        (u32::from_le_bytes(ids[o..o + 4].try_into().unwrap()), u32::from_le_bytes(ids[o + 4..o + 8].try_into().unwrap()))
+        (
+            u32::from_le_bytes(ids[o..o + 4].try_into().unwrap()),
+            u32::from_le_bytes(ids[o + 4..o + 8].try_into().unwrap()),
+        )
     };
     let tris = &r.prepared.tris;
     let (mut worst, mut checked, mut on_cube, mut matched, mut comparable) = (0f32, 0, 0, 0, 0);
@@ -141,19 +160,26 @@ fn motion_vectors_follow_camera_and_object_motion() {
                 continue;
             }
             // The exact hit of the ray through the pixel centre on the stored triangle.
-            let ndc = Vec2::new((x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0);
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0,
+            );
             let d = (setup1.fwd + ndc.x * setup1.right + ndc.y * setup1.up).normalize();
             let v = |k: usize| tris[slot as usize * 3 + k].truncate();
             let n = (v(1) - v(0)).cross(v(2) - v(0));
             let t = (v(0) - setup1.pos).dot(n) / d.dot(n);
             let p = setup1.pos + d * t;
             let prev = r.prepared.prev_from_current[obj as usize] * Vec4::from((p, 1.0));
-            let expected = project(&setup0.view_proj, prev.truncate() / prev.w, size) - project(&setup1.view_proj, p, size);
+            let expected = project(&setup0.view_proj, prev.truncate() / prev.w, size)
+                - project(&setup1.view_proj, p, size);
             let o = (y * size.0 as usize + x) * 4;
             let got = Vec2::new(half(&motion[o..]), half(&motion[o + 2..]));
             let err = (got - expected).length();
             let bound = 0.02 + expected.length() / 1024.0;
-            assert!(err <= bound, "pixel ({x}, {y}) object {obj}: motion {got} expected {expected} (error {err} > {bound})");
+            assert!(
+                err <= bound,
+                "pixel ({x}, {y}) object {obj}: motion {got} expected {expected} (error {err} > {bound})"
+            );
             worst = worst.max(err);
             checked += 1;
             if obj == cube {
@@ -164,7 +190,10 @@ fn motion_vectors_follow_camera_and_object_motion() {
             let q = q - Vec2::splat(0.5);
             let (qx, qy) = (q.x.floor() as i64, q.y.floor() as i64);
             if qx >= 0 && qy >= 0 && qx + 1 < size.0 as i64 && qy + 1 < size.1 as i64 {
-                let around: Vec<u32> = [(0, 0), (1, 0), (0, 1), (1, 1)].iter().map(|(dx, dy)| id_at(&ids0, (qx + dx) as usize, (qy + dy) as usize).0).collect();
+                let around: Vec<u32> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                    .iter()
+                    .map(|(dx, dy)| id_at(&ids0, (qx + dx) as usize, (qy + dy) as usize).0)
+                    .collect();
                 if around.iter().all(|&i| i == around[0]) {
                     comparable += 1;
                     matched += (around[0] == obj) as u32;
@@ -173,7 +202,10 @@ fn motion_vectors_follow_camera_and_object_motion() {
         }
     }
     let rate = matched as f64 / comparable as f64;
-    println!("motion vectors: {checked} pixels ({on_cube} on the moving cube), worst error {worst:.4} px; previous ids match at {:.2}% of {comparable}", rate * 100.0);
+    println!(
+        "motion vectors: {checked} pixels ({on_cube} on the moving cube), worst error {worst:.4} px; previous ids match at {:.2}% of {comparable}",
+        rate * 100.0
+    );
     assert!(on_cube > 100, "the moving cube covers only {on_cube} pixels");
     assert!(rate >= 0.98, "reprojected object ids match at only {:.2}%", rate * 100.0);
 }
@@ -186,48 +218,93 @@ fn the_default_level_renders_without_nan() {
     let scene = hush_engine::scene::default_level();
     let prepared = hush_engine::gpu::PreparedScene::new(&scene, BvhKind::DEFAULT).unwrap();
     let load = start.elapsed();
-    println!("default level: {} triangles, built and prepared in {:.1} ms", prepared.triangle_count(), load.as_secs_f64() * 1e3);
+    println!(
+        "default level: {} triangles, built and prepared in {:.1} ms",
+        prepared.triangle_count(),
+        load.as_secs_f64() * 1e3
+    );
     // What animation costs on the CPU per frame: re-flatten the cube, rebuild the BVH.
     let mut p2 = hush_engine::gpu::PreparedScene::new(&scene, BvhKind::DEFAULT).unwrap();
     let t = std::time::Instant::now();
     for k in 1..=10 {
         assert!(p2.animate(&scene, k as f64 / 60.0));
     }
-    println!("animation: BVH rebuild and re-flatten {:.2} ms per frame", t.elapsed().as_secs_f64() * 100.0);
+    println!(
+        "animation: BVH rebuild and re-flatten {:.2} ms per frame",
+        t.elapsed().as_secs_f64() * 100.0
+    );
     let gpu = hush_engine::gpu::Gpu::headless(&prepared.realtime_requirements((80, 45))).unwrap();
     let mut r = Renderer::new(&gpu, scene, prepared, (80, 45)).unwrap();
-    assert!(r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures);
+    assert!(
+        r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures
+    );
     // Each built-in denoiser in turn: the frame's views and its own.
     for entry in hush_engine::denoise::BUILT_IN.iter().filter(|e| e.make.is_some()) {
-        let mut denoised = FrameSettings { denoiser: hush_engine::settings::Denoiser::named(entry.name), ..Default::default() };
+        let mut denoised = FrameSettings {
+            denoiser: hush_engine::settings::Denoiser::named(entry.name),
+            ..Default::default()
+        };
         // Off by default; on here so that the glossy/clipping view has something to show.
         denoised.glossy.clipping = true;
         for k in 0..3 {
-            let input = FrameInput { camera: r.scene.camera_or_default(), time: 1.0 + k as f64 / 60.0, shutter: None };
+            let input = FrameInput {
+                camera: r.scene.camera_or_default(),
+                time: 1.0 + k as f64 / 60.0,
+                shutter: None,
+            };
             r.render(&gpu, &input, &denoised, None).unwrap();
             let img = r.read_hdr(&gpu).unwrap();
-            assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in the default level with {}", entry.name);
+            assert!(
+                img.data.iter().all(|p| p.is_finite()),
+                "NaN or Inf in the default level with {}",
+                entry.name
+            );
         }
         // Emission may be off screen; every other view shows something from the level's camera.
-        let own = hush_engine::settings::FRAME_VIEWS.iter().filter(|v| !v.needs_traced_primaries()).chain(entry.views);
-        let views: Vec<View> = std::iter::once(View::FINAL).chain(own.map(|v| View::named(v.name))).collect();
+        let own = hush_engine::settings::FRAME_VIEWS
+            .iter()
+            .filter(|v| !v.needs_traced_primaries())
+            .chain(entry.views);
+        let views: Vec<View> =
+            std::iter::once(View::FINAL).chain(own.map(|v| View::named(v.name))).collect();
         for v in views.into_iter().filter(|v| v.name() != "gbuffer/emission") {
             let settings = FrameSettings { view: v.clone(), ..denoised.clone() };
             let shown = r.display_image(&gpu, &settings).unwrap();
-            assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "view {} is black with {}", v.name(), entry.name);
+            assert!(
+                shown.pixels().any(|p| p.0[..3] != [0, 0, 0]),
+                "view {} is black with {}",
+                v.name(),
+                entry.name
+            );
         }
     }
     // Through a thin lens: the traced primaries and the pre-filter, and their views.
     let lens = hush_engine::scene::ThinLens::new(0.2, 1.0).unwrap();
     let camera = Camera { lens: Some(lens), ..r.scene.camera_or_default() };
-    let settings = FrameSettings { denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() };
+    let settings =
+        FrameSettings { denoiser: hush_engine::settings::Denoiser::MARA, ..Default::default() };
     for k in 0..2 {
-        r.render(&gpu, &FrameInput { camera, time: 1.0 + k as f64 / 60.0, shutter: None }, &settings, None).unwrap();
-        assert!(r.read_hdr(&gpu).unwrap().data.iter().all(|p| p.is_finite()), "NaN or Inf through a thin lens");
+        r.render(
+            &gpu,
+            &FrameInput { camera, time: 1.0 + k as f64 / 60.0, shutter: None },
+            &settings,
+            None,
+        )
+        .unwrap();
+        assert!(
+            r.read_hdr(&gpu).unwrap().data.iter().all(|p| p.is_finite()),
+            "NaN or Inf through a thin lens"
+        );
     }
     for v in hush_engine::settings::FRAME_VIEWS.iter().filter(|v| v.needs_traced_primaries()) {
-        let shown = r.display_image(&gpu, &FrameSettings { view: View::named(v.name), ..settings.clone() }).unwrap();
-        assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "view {} is black through a thin lens", v.name);
+        let shown = r
+            .display_image(&gpu, &FrameSettings { view: View::named(v.name), ..settings.clone() })
+            .unwrap();
+        assert!(
+            shown.pixels().any(|p| p.0[..3] != [0, 0, 0]),
+            "view {} is black through a thin lens",
+            v.name
+        );
     }
 }
 
@@ -245,17 +322,31 @@ fn the_default_level_gltf_loads_and_renders_without_nan() {
     assert_eq!(scene.triangle_count(), built.triangle_count());
     assert_eq!(scene.objects.len(), built.objects.len());
     assert_eq!(scene.lights.len(), 1);
-    assert!(scene.procedural_sky && matches!(scene.environment, hush_engine::scene::Environment::Map(_)));
+    assert!(
+        scene.procedural_sky
+            && matches!(scene.environment, hush_engine::scene::Environment::Map(_))
+    );
     // The animated cube follows the same motion after the round trip.
     let a = built.objects.iter().find(|o| o.animation.is_some()).unwrap();
-    let b = scene.objects.iter().find(|o| o.animation.is_some()).expect("the animation survives export");
+    let b = scene
+        .objects
+        .iter()
+        .find(|o| o.animation.is_some())
+        .expect("the animation survives export");
     for t in [0.0, 0.7, 2.5, 5.1] {
-        let d = a.transform_at(t).to_cols_array().iter().zip(b.transform_at(t).to_cols_array()).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let d = a
+            .transform_at(t)
+            .to_cols_array()
+            .iter()
+            .zip(b.transform_at(t).to_cols_array())
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
         assert!(d < 1e-5, "transform at t = {t} differs by {d}");
     }
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (64, 36)).unwrap();
     for k in 0..3 {
-        let input = FrameInput { camera: r.scene.camera_or_default(), time: k as f64 * 0.5, shutter: None };
+        let input =
+            FrameInput { camera: r.scene.camera_or_default(), time: k as f64 * 0.5, shutter: None };
         r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
         let img = r.read_hdr(&gpu).unwrap();
         assert!(img.data.iter().all(|p| p.is_finite()), "NaN or Inf in frame {k}");
@@ -269,9 +360,21 @@ fn the_committed_level_matches_the_generator() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/level/level.gltf");
     let committed = load_gltf(&path).unwrap();
     let built = hush_engine::scene::default_level();
-    assert_eq!(committed.triangle_count(), built.triangle_count(), "run `hush-cli level` to refresh assets/level");
-    assert_eq!(committed.objects.len(), built.objects.len(), "run `hush-cli level` to refresh assets/level");
-    assert_eq!(committed.materials.len(), built.materials.len() + 1, "the importer appends its default material");
+    assert_eq!(
+        committed.triangle_count(),
+        built.triangle_count(),
+        "run `hush-cli level` to refresh assets/level"
+    );
+    assert_eq!(
+        committed.objects.len(),
+        built.objects.len(),
+        "run `hush-cli level` to refresh assets/level"
+    );
+    assert_eq!(
+        committed.materials.len(),
+        built.materials.len() + 1,
+        "the importer appends its default material"
+    );
 }
 
 /// Why punctual lights bypass the filters: evaluated exhaustively at the primary hit, their
@@ -294,8 +397,14 @@ fn punctual_direct_light_carries_no_noise() {
     assert!(direct[0].iter().any(|b| *b != 0), "the sun lights part of the view");
     assert_eq!(direct[0], direct[1], "punctual direct light differs between frames");
     assert_ne!(matte[0], matte[1], "the matte light should be a new sample each frame");
-    let lum = |b: &[u8], i: usize| (0..3).map(|k| half(&b[i * 8 + k * 2..])).sum::<f32>() as f64 / 3.0;
+    let lum =
+        |b: &[u8], i: usize| (0..3).map(|k| half(&b[i * 8 + k * 2..])).sum::<f32>() as f64 / 3.0;
     let n = matte[0].len() / 8;
-    let rel = (0..n).map(|i| (lum(&matte[0], i) - lum(&matte[1], i)).powi(2) / (lum(&matte[1], i).powi(2) + 0.01)).sum::<f64>() / n as f64;
+    let rel = (0..n)
+        .map(|i| {
+            (lum(&matte[0], i) - lum(&matte[1], i)).powi(2) / (lum(&matte[1], i).powi(2) + 0.01)
+        })
+        .sum::<f64>()
+        / n as f64;
     println!("frame-to-frame relMSE: trace/direct 0 (bitwise equal), trace/matte {rel:.3}");
 }

@@ -77,11 +77,25 @@ fn reload_rebuilds_dependents_keeps_last_good_and_recovers() {
 
     // 1. A shared module: the denoisers' colour-space and NaN helpers.
     let shared = "matte/common.wgsl";
-    let users: Vec<String> = r.pipelines().iter().filter(|p| p.modules().contains(&shared)).map(|p| p.label().to_string()).collect();
-    assert!(!users.is_empty() && users.len() < before.len(), "{shared} should feed some pipelines, not all: {users:?}");
+    let users: Vec<String> = r
+        .pipelines()
+        .iter()
+        .filter(|p| p.modules().contains(&shared))
+        .map(|p| p.label().to_string())
+        .collect();
+    assert!(
+        !users.is_empty() && users.len() < before.len(),
+        "{shared} should feed some pipelines, not all: {users:?}"
+    );
     let path = dir.join(shared);
     let good = std::fs::read_to_string(&path).unwrap();
-    std::fs::write(&path, format!("{good}\n// edited while running\nfn hot_reload_probe() -> f32 {{ return 1.0; }}\n")).unwrap();
+    std::fs::write(
+        &path,
+        format!(
+            "{good}\n// edited while running\nfn hot_reload_probe() -> f32 {{ return 1.0; }}\n"
+        ),
+    )
+    .unwrap();
     let seen = wait_for(&watcher, &gpu.shaders, shared);
     let (changed, errors) = gpu.shaders.refresh(&seen);
     assert!(errors.is_empty(), "{errors:?}");
@@ -109,17 +123,23 @@ fn reload_rebuilds_dependents_keeps_last_good_and_recovers() {
     let outcomes = r.reload_shaders(&gpu, &changed);
     let ms: Vec<String> = outcomes.iter().map(|o| format!("{} {:.1} ms", o.label, o.ms)).collect();
     println!("reloading {bsdf}: {}", ms.join(", "));
-    assert!(outcomes.iter().any(|o| o.label == "trace") && outcomes.iter().all(|o| o.error.is_none()), "{outcomes:?}");
+    assert!(
+        outcomes.iter().any(|o| o.label == "trace") && outcomes.iter().all(|o| o.error.is_none()),
+        "{outcomes:?}"
+    );
     // Where a reload's time goes, for the trace (the largest program): composing the text and
     // naga's validation against the driver's pipeline compile.
     let t = Instant::now();
-    let program = r.pipelines().iter().find(|p| p.label() == "trace").unwrap().program(&gpu).unwrap();
+    let program =
+        r.pipelines().iter().find(|p| p.label() == "trace").unwrap().program(&gpu).unwrap();
     let compose_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
     program.validate().unwrap();
     let validate_ms = t.elapsed().as_secs_f64() * 1e3;
     let total = outcomes.iter().find(|o| o.label == "trace").unwrap().ms;
-    println!("trace reload {total:.1} ms: compose {compose_ms:.3} ms, naga parse + validate {validate_ms:.1} ms, the rest in the driver");
+    println!(
+        "trace reload {total:.1} ms: compose {compose_ms:.3} ms, naga parse + validate {validate_ms:.1} ms, the rest in the driver"
+    );
     let after = builds(&mut r);
 
     // 2. A syntax error: the composite keeps its last good pipeline; the error names the file
@@ -129,29 +149,45 @@ fn reload_rebuilds_dependents_keeps_last_good_and_recovers() {
     let good = std::fs::read_to_string(&path).unwrap();
     // `good` ends in a newline: one blank line, then `fn broken`, then the bad line.
     let broken_line = good.lines().count() + 3;
-    std::fs::write(&path, format!("{good}\nfn broken() -> f32 {{\n    return 1.0 +;\n}}\n")).unwrap();
+    std::fs::write(&path, format!("{good}\nfn broken() -> f32 {{\n    return 1.0 +;\n}}\n"))
+        .unwrap();
     let (changed, _) = gpu.shaders.refresh(&[composite]);
     let outcomes = r.reload_shaders(&gpu, &changed);
     assert_eq!(outcomes.len(), 1, "{outcomes:?}");
     let e = outcomes[0].error.clone().expect("a broken shader must report an error");
-    assert!(e.contains(&format!("{composite}:{broken_line}")), "the error names {composite} line {broken_line}: {e}");
+    assert!(
+        e.contains(&format!("{composite}:{broken_line}")),
+        "the error names {composite} line {broken_line}: {e}"
+    );
     assert_eq!(r.shader_errors().len(), 1);
     let kept = frame(&gpu, &mut r);
     assert_eq!(builds(&mut r)["composite"], after["composite"], "the last good pipeline stays");
     assert_eq!(kept.dimensions(), first.dimensions());
-    assert!(kept.pixels().any(|p| p.0[..3] != [0, 0, 0]), "the frame still renders with the last good pipeline");
+    assert!(
+        kept.pixels().any(|p| p.0[..3] != [0, 0, 0]),
+        "the frame still renders with the last good pipeline"
+    );
 
     // 3. Valid WGSL that binds a resource its stage does not offer: naga accepts it, the
     // reload names the resource and keeps the last good pipeline.
     let header = "fn main(@builtin(global_invocation_id) gid: vec3u) {";
     assert!(good.contains(header));
-    let unbound = format!("{}\nvar<uniform> not_in_layout: vec4f;\n", good.replacen(header, &format!("{header}\n    if not_in_layout.x > 1e30 {{ return; }}"), 1));
-    hush_engine::shader::compose_with("probe", "", &["realtime/composite.wgsl"], |_| Ok(unbound.clone().into())).unwrap();
+    let unbound = format!(
+        "{}\nvar<uniform> not_in_layout: vec4f;\n",
+        good.replacen(header, &format!("{header}\n    if not_in_layout.x > 1e30 {{ return; }}"), 1)
+    );
+    hush_engine::shader::compose_with("probe", "", &["realtime/composite.wgsl"], |_| {
+        Ok(unbound.clone().into())
+    })
+    .unwrap();
     std::fs::write(&path, &unbound).unwrap();
     let (changed, _) = gpu.shaders.refresh(&[composite]);
     let outcomes = r.reload_shaders(&gpu, &changed);
     let e = outcomes[0].error.clone().expect("a pipeline the layout rejects must report an error");
-    assert!(e.contains("composite binds not_in_layout, which the stage does not offer"), "the reload names the resource: {e}");
+    assert!(
+        e.contains("composite binds not_in_layout, which the stage does not offer"),
+        "the reload names the resource: {e}"
+    );
     println!("unoffered resource: {e}");
     assert_eq!(builds(&mut r)["composite"], after["composite"]);
     frame(&gpu, &mut r);
@@ -183,7 +219,8 @@ fn pass_times_arrive_without_waiting() {
     let camera = r.scene.camera_or_default();
     let mut got = vec![];
     for k in 0..6 {
-        r.render(&gpu, &FrameInput { camera, time: k as f64 / 60.0, shutter: None }, &s, None).unwrap();
+        r.render(&gpu, &FrameInput { camera, time: k as f64 / 60.0, shutter: None }, &s, None)
+            .unwrap();
         got.extend(r.poll_pass_spans(&gpu));
     }
     let blocking: Vec<&str> = r.pass_spans(&gpu).unwrap().iter().map(|s| s.label).collect();

@@ -39,7 +39,11 @@ fn oct(packed: u32) -> Vec3 {
     let (x, y) = (c(packed as u16), c((packed >> 16) as u16));
     let mut n = Vec3::new(x, y, 1.0 - x.abs() - y.abs());
     if n.z < 0.0 {
-        n = Vec3::new((1.0 - y.abs()) * if x >= 0.0 { 1.0 } else { -1.0 }, (1.0 - x.abs()) * if y >= 0.0 { 1.0 } else { -1.0 }, n.z);
+        n = Vec3::new(
+            (1.0 - y.abs()) * if x >= 0.0 { 1.0 } else { -1.0 },
+            (1.0 - x.abs()) * if y >= 0.0 { 1.0 } else { -1.0 },
+            n.z,
+        );
     }
     n.normalize()
 }
@@ -79,7 +83,8 @@ fn record(b: &[u8], i: usize) -> Record {
 #[test]
 fn guides_and_mixing_match_a_cpu_implementation() {
     let k = 4;
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
     let s = FrameSettings { samples_per_pixel: k, ..Default::default() };
     frames(&mut r, &gpu, &s, 1);
     let (w, h) = (SIZE.0 as i64, SIZE.1 as i64);
@@ -107,7 +112,8 @@ fn guides_and_mixing_match_a_cpu_implementation() {
     let (mut agree, mut total) = (0, 0);
     let mut sums = vec![(Vec3::ZERO, 1.0f32); pixels];
     for p in 0..pixels {
-        sums[p].0 = Vec3::new(half(&raw[p * 8..]), half(&raw[p * 8 + 2..]), half(&raw[p * 8 + 4..]));
+        sums[p].0 =
+            Vec3::new(half(&raw[p * 8..]), half(&raw[p * 8 + 2..]), half(&raw[p * 8 + 4..]));
     }
     for p in 0..pixels {
         let (px, py) = ((p as i64 % w) as f32, (p as i64 / w) as f32);
@@ -135,13 +141,23 @@ fn guides_and_mixing_match_a_cpu_implementation() {
     let mut mixed_in = 0;
     for p in 0..pixels {
         let want = sums[p].0 / sums[p].1;
-        let got = Vec3::new(half(&mixed[p * 8..]), half(&mixed[p * 8 + 2..]), half(&mixed[p * 8 + 4..]));
+        let got =
+            Vec3::new(half(&mixed[p * 8..]), half(&mixed[p * 8 + 2..]), half(&mixed[p * 8 + 4..]));
         mixed_in += (sums[p].1 > 1.0) as u32;
-        good += ((got - want).abs().max_element() <= 2e-3 * want.abs().max_element().max(1e-3)) as u32;
+        good +=
+            ((got - want).abs().max_element() <= 2e-3 * want.abs().max_element().max(1e-3)) as u32;
     }
-    println!("{agree} of {total} samples chose the CPU's guide; {good} of {pixels} guides hold eq. (7)'s mean ({mixed_in} took samples in)");
-    assert!(agree as f64 >= 0.995 * total as f64, "only {agree} of {total} samples chose the CPU's guide");
-    assert!(good as f64 >= 0.999 * pixels as f64, "only {good} of {pixels} guides hold eq. (7)'s mean");
+    println!(
+        "{agree} of {total} samples chose the CPU's guide; {good} of {pixels} guides hold eq. (7)'s mean ({mixed_in} took samples in)"
+    );
+    assert!(
+        agree as f64 >= 0.995 * total as f64,
+        "only {agree} of {total} samples chose the CPU's guide"
+    );
+    assert!(
+        good as f64 >= 0.999 * pixels as f64,
+        "only {good} of {pixels} guides hold eq. (7)'s mean"
+    );
     assert!(mixed_in as usize > pixels / 2, "only {mixed_in} guides took samples in");
 }
 
@@ -153,24 +169,44 @@ fn guides_and_mixing_match_a_cpu_implementation() {
 /// guide on average, the edges gain the rest).
 #[test]
 fn extra_samples_antialias_without_taa() {
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let converged = frames(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, 256);
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let converged =
+        frames(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, 256);
     let no_taa = TaaSettings { enabled: false, ..Default::default() };
     let one = frames(&mut r, &gpu, &FrameSettings { taa: no_taa.clone(), ..Default::default() }, 1);
-    let four = frames(&mut r, &gpu, &FrameSettings { taa: no_taa, samples_per_pixel: 4, ..Default::default() }, 1);
+    let four = frames(
+        &mut r,
+        &gpu,
+        &FrameSettings { taa: no_taa, samples_per_pixel: 4, ..Default::default() },
+        1,
+    );
     let (m1, m4) = (compare(&one, &converged).unwrap(), compare(&four, &converged).unwrap());
-    println!("k = 1: FLIP {:.4} relMSE {:.4}; k = 4: FLIP {:.4} relMSE {:.4}", m1.flip, m1.relmse, m4.flip, m4.relmse);
+    println!(
+        "k = 1: FLIP {:.4} relMSE {:.4}; k = 4: FLIP {:.4} relMSE {:.4}",
+        m1.flip, m1.relmse, m4.flip, m4.relmse
+    );
     assert!(four.data.iter().all(|p| p.is_finite()));
     assert!(m4.flip < 0.8 * m1.flip, "k = 4 FLIP {} against k = 1's {}", m4.flip, m1.flip);
-    assert!(m4.relmse < 0.5 * m1.relmse, "k = 4 relMSE {} against k = 1's {}", m4.relmse, m1.relmse);
+    assert!(
+        m4.relmse < 0.5 * m1.relmse,
+        "k = 4 relMSE {} against k = 1's {}",
+        m4.relmse,
+        m1.relmse
+    );
 }
 
 /// The heaviest frame Hush records (SVGF on both signals, k = 4, TAA) times every pass: none
 /// finds the timestamp query set full, and a-trous levels add up under their stage's label.
 #[test]
 fn heaviest_frame_times_every_pass() {
-    let (gpu, mut r) = Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
-    let s = FrameSettings { denoiser: hush_engine::settings::Denoiser::named("svgf"), samples_per_pixel: 4, ..Default::default() };
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let s = FrameSettings {
+        denoiser: hush_engine::settings::Denoiser::named("svgf"),
+        samples_per_pixel: 4,
+        ..Default::default()
+    };
     frames(&mut r, &gpu, &s, 2);
     assert_eq!(r.untimed_passes(), 0);
     let spans = r.pass_spans(&gpu).unwrap();
@@ -183,7 +219,14 @@ fn heaviest_frame_times_every_pass() {
     let summed: f64 = spans.iter().filter(|s| s.label == "svgf/matte atrous").map(|s| s.ms).sum();
     let merged = times.iter().find(|t| t.0 == "svgf/matte atrous").unwrap().1;
     assert!((merged - summed).abs() < 1e-9, "{merged} vs {summed}");
-    for p in ["trace", "supersample/samples", "svgf/glossy atrous", "composite", "supersample/resolve", "taa"] {
+    for p in [
+        "trace",
+        "supersample/samples",
+        "svgf/glossy atrous",
+        "composite",
+        "supersample/resolve",
+        "taa",
+    ] {
         assert!(times.iter().any(|t| t.0 == p), "{p} has no time: {times:?}");
     }
 }

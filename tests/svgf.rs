@@ -47,18 +47,40 @@ fn f32_at(b: &[u8], i: usize) -> f32 {
 /// leave room for another driver's rounding.
 #[test]
 fn svgf_frames_beat_raw_ones() {
-    let scene = hush_engine::scene::load_gltf(&hush_tests::oracle("cornell_diffuse").join("cornell_diffuse.gltf")).unwrap();
+    let scene = hush_engine::scene::load_gltf(
+        &hush_tests::oracle("cornell_diffuse").join("cornell_diffuse.gltf"),
+    )
+    .unwrap();
     let cam = scene.camera_or_default();
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (128, 128)).unwrap();
-    let converged = frames(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, cam, 256);
+    let converged =
+        frames(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, cam, 256);
     let raw = frames(&mut r, &gpu, &FrameSettings::default(), cam, 1);
     let denoised = frames(&mut r, &gpu, &svgf(), cam, 30);
-    let schied = frames(&mut r, &gpu, &FrameSettings { svgf: SvgfSettings::schied(), ..svgf() }, cam, 30);
-    let (m_raw, m_dn, m_schied) = (compare(&raw, &converged).unwrap(), compare(&denoised, &converged).unwrap(), compare(&schied, &converged).unwrap());
-    println!("FLIP raw {:.4} svgf {:.4} schied {:.4}; relMSE raw {:.4} svgf {:.4} schied {:.4}", m_raw.flip, m_dn.flip, m_schied.flip, m_raw.relmse, m_dn.relmse, m_schied.relmse);
+    let schied =
+        frames(&mut r, &gpu, &FrameSettings { svgf: SvgfSettings::schied(), ..svgf() }, cam, 30);
+    let (m_raw, m_dn, m_schied) = (
+        compare(&raw, &converged).unwrap(),
+        compare(&denoised, &converged).unwrap(),
+        compare(&schied, &converged).unwrap(),
+    );
+    println!(
+        "FLIP raw {:.4} svgf {:.4} schied {:.4}; relMSE raw {:.4} svgf {:.4} schied {:.4}",
+        m_raw.flip, m_dn.flip, m_schied.flip, m_raw.relmse, m_dn.relmse, m_schied.relmse
+    );
     for (name, m) in [("svgf", &m_dn), ("schied", &m_schied)] {
-        assert!(m.flip < 0.5 * m_raw.flip, "{name}: FLIP {} is not under half the raw {}", m.flip, m_raw.flip);
-        assert!(m.relmse < 0.03 * m_raw.relmse, "{name}: relMSE {} vs raw {}", m.relmse, m_raw.relmse);
+        assert!(
+            m.flip < 0.5 * m_raw.flip,
+            "{name}: FLIP {} is not under half the raw {}",
+            m.flip,
+            m_raw.flip
+        );
+        assert!(
+            m.relmse < 0.03 * m_raw.relmse,
+            "{name}: relMSE {} vs raw {}",
+            m.relmse,
+            m_raw.relmse
+        );
     }
 }
 
@@ -107,8 +129,14 @@ fn svgf_history_resets_on_disocclusion() {
     let read = |n: &str| r.read_texture(&gpu, n).unwrap().0;
     // Frame `warm` (parity warm % 2) wrote moments[1 - parity].
     let written = 1 - warm as usize % 2;
-    let (depth1, motion, normal, input) = (read("gbuffer/depth"), read("gbuffer/motion"), read("gbuffer/normal"), read("trace/matte"));
-    let (moments, integrated) = (read(&format!("svgf/matte moments {written}")), read("svgf/matte integrated"));
+    let (depth1, motion, normal, input) = (
+        read("gbuffer/depth"),
+        read("gbuffer/motion"),
+        read("gbuffer/normal"),
+        read("trace/matte"),
+    );
+    let (moments, integrated) =
+        (read(&format!("svgf/matte moments {written}")), read("svgf/matte integrated"));
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size: SIZE };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
     let d1 = MatteSettings::default().d1_px;
@@ -118,8 +146,14 @@ fn svgf_history_resets_on_disocclusion() {
             let Some(p) = now.world(x, y) else { continue };
             let i = now.index(x, y).unwrap();
             let surface = Surface::new(p, oct_normal(&normal[i * 4..]), &setup1, SIZE.1);
-            let q = (x as f32 + 0.5 + half(&motion[i * 4..]), y as f32 + 0.5 + half(&motion[i * 4 + 2..]));
-            let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64).filter_map(|(tx, ty)| before.world(tx, ty)).map(|prev| surface.distance(prev)).fold(f32::INFINITY, f32::min);
+            let q = (
+                x as f32 + 0.5 + half(&motion[i * 4..]),
+                y as f32 + 0.5 + half(&motion[i * 4 + 2..]),
+            );
+            let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
+                .filter_map(|(tx, ty)| before.world(tx, ty))
+                .map(|prev| surface.distance(prev))
+                .fold(f32::INFINITY, f32::min);
             let h = f32_at(&moments, i * 4 + 2);
             if closest <= 0.5 {
                 kept += (h > 1.0) as u32;
@@ -131,11 +165,15 @@ fn svgf_history_resets_on_disocclusion() {
             let sample: Vec<f32> = (0..3).map(|k| half(&input[i * 8 + k * 2..])).collect();
             let l = luminance(glam::Vec3::new(sample[0], sample[1], sample[2]));
             let same_light = (0..3).all(|k| half(&integrated[i * 8 + k * 2..]) == sample[k]);
-            let same_moments = h == 1.0 && f32_at(&moments, i * 4) == l && (f32_at(&moments, i * 4 + 1) - l * l).abs() <= 1e-6 * (l * l).max(1.0);
+            let same_moments = h == 1.0
+                && f32_at(&moments, i * 4) == l
+                && (f32_at(&moments, i * 4 + 1) - l * l).abs() <= 1e-6 * (l * l).max(1.0);
             restarted += (same_light && same_moments) as u32;
         }
     }
-    println!("after the step: {rejected} pixels without history, {restarted} restarted; {kept} pixels on seen surfaces kept theirs");
+    println!(
+        "after the step: {rejected} pixels without history, {restarted} restarted; {kept} pixels on seen surfaces kept theirs"
+    );
     assert!(rejected >= 50, "the step disoccludes only {rejected} pixels");
     assert_eq!(restarted, rejected, "disoccluded pixels did not restart from the new sample");
     assert!(kept > 1000, "only {kept} pixels kept their history after a small step");
@@ -155,7 +193,11 @@ fn svgf_variance_matches_cpu_moments() {
     let (gpu, mut r) = level();
     // Without TAA the raster samples pixel centres: every still frame sees the same surface
     // points, so each pixel's history is its own texel's.
-    let s = FrameSettings { svgf: SvgfSettings { still_frames: 1024.0, ..Default::default() }, taa: TaaSettings { enabled: false, ..Default::default() }, ..svgf() };
+    let s = FrameSettings {
+        svgf: SvgfSettings { still_frames: 1024.0, ..Default::default() },
+        taa: TaaSettings { enabled: false, ..Default::default() },
+        ..svgf()
+    };
     let n = 6;
     let pixels = (SIZE.0 * SIZE.1) as usize;
     let (mut m1, mut m2) = (vec![0f64; pixels], vec![0f64; pixels]);
@@ -183,15 +225,25 @@ fn svgf_variance_matches_cpu_moments() {
         let (g1, g2) = (f32_at(&moments, i * 4) as f64, f32_at(&moments, i * 4 + 1) as f64);
         let var = (m2[i] - m1[i] * m1[i]).max(0.0) / n as f64;
         let gv = half(&variance[i * 8 + 6..]) as f64;
-        let ok = (h == n as f32, close(g1, m1[i], 1e-4) && close(g2, m2[i], 1e-4), (gv - var).abs() <= 2e-3 * var.max(1e-4));
+        let ok = (
+            h == n as f32,
+            close(g1, m1[i], 1e-4) && close(g2, m2[i], 1e-4),
+            (gv - var).abs() <= 2e-3 * var.max(1e-4),
+        );
         if std::env::var("HUSH_TEST_VERBOSE").is_ok() && !(ok.0 && ok.1 && ok.2) {
-            println!("pixel {i}: h {h} ok {ok:?} m1 {g1} vs {} m2 {g2} vs {} var {gv} vs {var}", m1[i], m2[i]);
+            println!(
+                "pixel {i}: h {h} ok {ok:?} m1 {g1} vs {} m2 {g2} vs {} var {gv} vs {var}",
+                m1[i], m2[i]
+            );
         }
         agree += (ok.0 && ok.1 && ok.2) as u32;
     }
     println!("{agree} of {surface} surface pixels hold the CPU's moments and variance");
     assert!(surface as usize > pixels / 2);
-    assert!(agree * 100 >= surface * 99, "only {agree} of {surface} pixels agree with the CPU's moments");
+    assert!(
+        agree * 100 >= surface * 99,
+        "only {agree} of {surface} pixels agree with the CPU's moments"
+    );
 }
 
 /// NaN, +Inf and -Inf injected into the matte input on 1 pixel in 7 never reach SVGF's
@@ -200,22 +252,46 @@ fn svgf_variance_matches_cpu_moments() {
 #[test]
 fn svgf_nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) = level();
-    let base = FrameSettings { matte: MatteSettings { inject_nonfinite: true, ..Default::default() }, ..svgf() };
-    let mut cases = vec![base.clone(), FrameSettings { svgf: SvgfSettings::schied(), ..base.clone() }];
+    let base = FrameSettings {
+        matte: MatteSettings { inject_nonfinite: true, ..Default::default() },
+        ..svgf()
+    };
+    let mut cases =
+        vec![base.clone(), FrameSettings { svgf: SvgfSettings::schied(), ..base.clone() }];
     for stage in SvgfSettings::STAGES.into_iter().chain([TaaSettings::STAGE]) {
         let mut s = base.clone();
         assert!(hush_engine::settings::disable_stage(&mut s, stage));
         cases.push(s);
     }
-    let textures = ["history 0", "history 1", "moments 0", "moments 1", "integrated", "variance", "ping", "pong", "out"];
+    let textures = [
+        "history 0",
+        "history 1",
+        "moments 0",
+        "moments 1",
+        "integrated",
+        "variance",
+        "ping",
+        "pong",
+        "out",
+    ];
     for s in cases {
         let img = frames(&mut r, &gpu, &s, view(), 4);
-        assert!(img.data.iter().all(|p| p.is_finite()), "non-finite pixel on screen with {:?}", s.svgf);
-        let names = textures.iter().flat_map(|t| ["matte", "glossy"].map(|g| format!("svgf/{g} {t}"))).chain(["taa/history 0".into(), "taa/history 1".into()]);
+        assert!(
+            img.data.iter().all(|p| p.is_finite()),
+            "non-finite pixel on screen with {:?}",
+            s.svgf
+        );
+        let names = textures
+            .iter()
+            .flat_map(|t| ["matte", "glossy"].map(|g| format!("svgf/{g} {t}")))
+            .chain(["taa/history 0".into(), "taa/history 1".into()]);
         for name in names {
             let (bytes, format) = r.read_texture(&gpu, &name).unwrap();
             let bad = match format {
-                wgpu::TextureFormat::Rgba32Float => bytes.chunks_exact(4).filter(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite()).count(),
+                wgpu::TextureFormat::Rgba32Float => bytes
+                    .chunks_exact(4)
+                    .filter(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite())
+                    .count(),
                 _ => bytes.chunks_exact(2).filter(|h| !half(h).is_finite()).count(),
             };
             assert_eq!(bad, 0, "{name} holds {bad} NaN/Inf values with {:?}", s.svgf);

@@ -35,11 +35,18 @@ impl FlyCamera {
     }
 
     pub fn forward(&self) -> DVec3 {
-        DVec3::new(self.yaw.sin() * self.pitch.cos(), self.pitch.sin(), -self.yaw.cos() * self.pitch.cos())
+        DVec3::new(
+            self.yaw.sin() * self.pitch.cos(),
+            self.pitch.sin(),
+            -self.yaw.cos() * self.pitch.cos(),
+        )
     }
 
     pub fn camera(&self) -> Camera {
-        Camera { lens: self.lens, ..Camera::look_at(self.pos, self.pos + self.forward(), self.yfov.to_degrees()) }
+        Camera {
+            lens: self.lens,
+            ..Camera::look_at(self.pos, self.pos + self.forward(), self.yfov.to_degrees())
+        }
     }
 
     /// Position, yaw and pitch: what a frame's motion blur interpolates.
@@ -49,7 +56,16 @@ impl FlyCamera {
 
     /// The camera a fraction `s` of the way from `from` (an earlier pose) to this one.
     pub fn camera_between(&self, from: (DVec3, f64, f64), s: f64) -> Camera {
-        let f = FlyCamera { pos: from.0.lerp(self.pos, s), yaw: from.1 + (self.yaw - from.1) * s, pitch: from.2 + (self.pitch - from.2) * s, yfov: self.yfov, speed: self.speed, held: HashSet::new(), looking: false, lens: self.lens };
+        let f = FlyCamera {
+            pos: from.0.lerp(self.pos, s),
+            yaw: from.1 + (self.yaw - from.1) * s,
+            pitch: from.2 + (self.pitch - from.2) * s,
+            yfov: self.yfov,
+            speed: self.speed,
+            held: HashSet::new(),
+            looking: false,
+            lens: self.lens,
+        };
         f.camera()
     }
 
@@ -68,11 +84,19 @@ impl FlyCamera {
         let k = |c: KeyCode| if self.held.contains(&c) { 1.0 } else { 0.0 };
         let f = self.forward();
         let right = f.cross(DVec3::Y).normalize_or(DVec3::X);
-        let dir = f * (k(KeyCode::KeyW) - k(KeyCode::KeyS)) + right * (k(KeyCode::KeyD) - k(KeyCode::KeyA)) + DVec3::Y * (k(KeyCode::KeyE) - k(KeyCode::KeyQ));
+        let dir = f * (k(KeyCode::KeyW) - k(KeyCode::KeyS))
+            + right * (k(KeyCode::KeyD) - k(KeyCode::KeyA))
+            + DVec3::Y * (k(KeyCode::KeyE) - k(KeyCode::KeyQ));
         if dir == DVec3::ZERO {
             return false;
         }
-        let run = if self.held.contains(&KeyCode::ShiftLeft) || self.held.contains(&KeyCode::ShiftRight) { 4.0 } else { 1.0 };
+        let run = if self.held.contains(&KeyCode::ShiftLeft)
+            || self.held.contains(&KeyCode::ShiftRight)
+        {
+            4.0
+        } else {
+            1.0
+        };
         self.pos += dir.normalize() * self.speed * run * dt.min(0.25);
         true
     }

@@ -10,11 +10,11 @@ use anyhow::{Context, Result};
 use hush_engine::accel::BvhKind;
 use hush_engine::frame::{DisplayTarget, FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
+use hush_engine::profile::puffin;
 use hush_engine::scene::{CameraKey, CameraPath, Scene};
 use hush_engine::shader::{ShaderLibrary, ShaderWatcher, source_tree_dir};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use hush_engine::profile::puffin;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -69,7 +69,10 @@ fn load_scene(path: &str, load: &hush_engine::scene::LoadOptions) -> Result<Scen
 }
 
 fn unix_seconds() -> u64 {
-    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0)
 }
 
 struct Running {
@@ -113,7 +116,11 @@ struct Viewer {
 
 fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
     ui::Panel {
-        settings: hush_engine::settings::FrameSettings { max_depth: r.scene.max_depth.max(2), denoiser: default_denoiser(gpu), ..Default::default() },
+        settings: hush_engine::settings::FrameSettings {
+            max_depth: r.scene.max_depth.max(2),
+            denoiser: default_denoiser(gpu),
+            ..Default::default()
+        },
         resolution_scale: 1.0,
         sun: r.scene.sun_direction().map(ui::sun_angles),
         paused: false,
@@ -126,7 +133,13 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
         recording: false,
         playing: false,
         preset_path: "presets/my.toml".into(),
-        governor: ui::GovernorPanel { on: true, target_ms: default_target_ms(gpu), pin_scale: false, pin_fraction: false, choice: String::new() },
+        governor: ui::GovernorPanel {
+            on: true,
+            target_ms: default_target_ms(gpu),
+            pin_scale: false,
+            pin_fraction: false,
+            choice: String::new(),
+        },
         lens: ui::LensPanel::new(r.scene.camera_or_default().lens, r.prepared.extent),
     }
 }
@@ -135,7 +148,11 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
 /// sample fractions below 1 let the governor hold its target at a larger scale than a filter
 /// that needs every pixel each frame; on a GPU Mara's chains.
 fn default_denoiser(gpu: &Gpu) -> hush_engine::settings::Denoiser {
-    if gpu.info.device_type == wgpu::DeviceType::Cpu { hush_engine::settings::Denoiser::named("progressive") } else { hush_engine::settings::Denoiser::MARA }
+    if gpu.info.device_type == wgpu::DeviceType::Cpu {
+        hush_engine::settings::Denoiser::named("progressive")
+    } else {
+        hush_engine::settings::Denoiser::MARA
+    }
 }
 
 /// The governor's starting target: 10 frames a second on a software rasterizer (a CPU device,
@@ -150,10 +167,14 @@ impl Viewer {
         let scene = load_scene(&self.args.scene, &self.args.load)?;
         let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
         let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let attrs = Window::default_attributes().with_title(format!("Hush: {}", scene.name)).with_inner_size(winit::dpi::LogicalSize::new(1280.0, 720.0));
+        let attrs = Window::default_attributes()
+            .with_title(format!("Hush: {}", scene.name))
+            .with_inner_size(winit::dpi::LogicalSize::new(1280.0, 720.0));
         let window = Arc::new(el.create_window(attrs).context("creating the window")?);
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let surface = instance.create_surface(window.clone()).context("creating the window surface")?;
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let surface =
+            instance.create_surface(window.clone()).context("creating the window surface")?;
         let size = window.inner_size();
         let (w, h) = (size.width.max(1), size.height.max(1));
         // The viewer asks for the adapter's own limits: scenes dropped on it later may be larger.
@@ -170,7 +191,13 @@ impl Viewer {
         };
         let caps = surface.get_capabilities(&gpu.adapter);
         // egui blends in gamma space: prefer a non-sRGB surface (the display pass then encodes sRGB).
-        let format = caps.formats.iter().copied().find(|f| !f.is_srgb()).or(caps.formats.first().copied()).context("the surface offers no format")?;
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb())
+            .or(caps.formats.first().copied())
+            .context("the surface offers no format")?;
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
             format,
@@ -197,8 +224,16 @@ impl Viewer {
             profiler.toggle();
         }
         let egui_ctx = egui::Context::default();
-        let egui_state = egui_winit::State::new(egui_ctx.clone(), egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), None, Some(gpu.device.limits().max_texture_dimension_2d as usize));
-        let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(gpu.device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer =
+            egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
         let path = self.args.camera_path.as_deref().map(CameraPath::load).transpose()?;
         let playback = path.as_ref().map(|_| 0);
         self.state = Some(Running {
@@ -236,7 +271,10 @@ impl Running {
     fn focus_at_cursor(&mut self) {
         let Some((x, y)) = self.cursor else { return };
         let (w, h) = self.renderer.size();
-        let px = ((x / self.config.width.max(1) as f64 * w as f64) as u32, (y / self.config.height.max(1) as f64 * h as f64) as u32);
+        let px = (
+            (x / self.config.width.max(1) as f64 * w as f64) as u32,
+            (y / self.config.height.max(1) as f64 * h as f64) as u32,
+        );
         match self.renderer.view_depth_at(&self.gpu, px) {
             Ok(Some(z)) => {
                 self.panel.lens.focus_distance = z as f32;
@@ -250,7 +288,10 @@ impl Running {
 
     fn frame_size(&self) -> (u32, u32) {
         let s = self.panel.resolution_scale.clamp(0.25, 1.0);
-        (((self.config.width as f32 * s) as u32).max(1), ((self.config.height as f32 * s) as u32).max(1))
+        (
+            ((self.config.width as f32 * s) as u32).max(1),
+            ((self.config.height as f32 * s) as u32).max(1),
+        )
     }
 
     fn resize(&mut self, w: u32, h: u32) {
@@ -320,7 +361,8 @@ impl Running {
         self.playback = match (self.playback, &self.path) {
             (None, Some(_)) => Some(0),
             (None, None) => {
-                self.panel.message = "no camera path: record one with R or pass --camera-path".into();
+                self.panel.message =
+                    "no camera path: record one with R or pass --camera-path".into();
                 None
             }
             (Some(_), _) => None,
@@ -343,7 +385,17 @@ impl Running {
         let outcomes = self.renderer.reload_shaders(&self.gpu, &changed);
         let ms: f64 = outcomes.iter().map(|o| o.ms).sum();
         let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
-        self.panel.message = format!("{}: rebuilt {} of {} pipelines in {ms:.0} ms{}", changed.join(", "), outcomes.len() - failed, outcomes.len(), if failed > 0 { format!(", {failed} kept their last good version") } else { String::new() });
+        self.panel.message = format!(
+            "{}: rebuilt {} of {} pipelines in {ms:.0} ms{}",
+            changed.join(", "),
+            outcomes.len() - failed,
+            outcomes.len(),
+            if failed > 0 {
+                format!(", {failed} kept their last good version")
+            } else {
+                String::new()
+            }
+        );
         log::warn!("{}", self.panel.message);
         // A pass made after a failed reload (the display, the chains) may have failed for the
         // same reason; let the next frame try again.
@@ -355,18 +407,30 @@ impl Running {
         if errors.is_empty() {
             return;
         }
-        egui::Area::new(egui::Id::unique("hush error overlay")).anchor(egui::Align2::LEFT_TOP, egui::vec2(8.0, 8.0)).show(ctx, |ui| {
-            egui::Frame::popup(ui.style()).fill(egui::Color32::from_black_alpha(220)).show(ui, |ui| {
-                ui.set_max_width(720.0);
-                for e in errors {
-                    ui.label(egui::RichText::new(e).color(egui::Color32::from_rgb(255, 110, 100)).monospace());
-                }
+        egui::Area::new(egui::Id::unique("hush error overlay"))
+            .anchor(egui::Align2::LEFT_TOP, egui::vec2(8.0, 8.0))
+            .show(ctx, |ui| {
+                egui::Frame::popup(ui.style()).fill(egui::Color32::from_black_alpha(220)).show(
+                    ui,
+                    |ui| {
+                        ui.set_max_width(720.0);
+                        for e in errors {
+                            ui.label(
+                                egui::RichText::new(e)
+                                    .color(egui::Color32::from_rgb(255, 110, 100))
+                                    .monospace(),
+                            );
+                        }
+                    },
+                );
             });
-        });
     }
 
     fn frame(&mut self) -> Result<()> {
-        if self.config.width == 0 || self.config.height == 0 || self.window.is_minimized() == Some(true) {
+        if self.config.width == 0
+            || self.config.height == 0
+            || self.window.is_minimized() == Some(true)
+        {
             return Ok(());
         }
         {
@@ -395,18 +459,30 @@ impl Running {
         g.target_ms = p.governor.target_ms;
         g.pinned_scale = p.governor.pin_scale.then_some(p.resolution_scale);
         g.pinned_fraction = p.governor.pin_fraction.then_some(p.settings.sample_fraction);
-        g.fractions_allowed = self.renderer.fills_untraced_pixels(&self.gpu, &p.settings).unwrap_or(false);
+        g.fractions_allowed =
+            self.renderer.fills_untraced_pixels(&self.gpu, &p.settings).unwrap_or(false);
         let choice = match self.governed {
             Some((last, camera)) => {
-                let trace_ms = p.pass_ms.iter().filter(|(l, _)| *l == hush_engine::passes::trace::LABEL).map(|(_, ms)| ms).sum();
-                g.record(hush_engine::governor::FrameCost { wall_ms: dt * 1e3, trace_ms, choice: last, moving: camera != input.camera })
+                let trace_ms = p
+                    .pass_ms
+                    .iter()
+                    .filter(|(l, _)| *l == hush_engine::passes::trace::LABEL)
+                    .map(|(_, ms)| ms)
+                    .sum();
+                g.record(hush_engine::governor::FrameCost {
+                    wall_ms: dt * 1e3,
+                    trace_ms,
+                    choice: last,
+                    moving: camera != input.camera,
+                })
             }
             None => g.choice(),
         };
         p.resolution_scale = choice.scale;
         p.settings.sample_fraction = choice.fraction;
         let predicted = g.predict(choice).map_or(String::new(), |t| format!(", about {t:.0} ms"));
-        p.governor.choice = format!("scale {:.3}, {} spp{predicted}", choice.scale, choice.fraction);
+        p.governor.choice =
+            format!("scale {:.3}, {} spp{predicted}", choice.scale, choice.fraction);
         self.governed = Some((choice, input.camera));
     }
 
@@ -427,7 +503,12 @@ impl Running {
         let shutter = self.panel.lens.shutter as f64;
         let pose = self.last_pose.unwrap_or(self.fly.pose());
         let clock = if !self.panel.paused && !accumulate { dt } else { 0.0 };
-        let mut input = FrameInput::exposed(|t| self.fly.camera_between(pose, 1.0 - (self.panel.time - t) / dt.max(1e-9)), self.panel.time, shutter, dt);
+        let mut input = FrameInput::exposed(
+            |t| self.fly.camera_between(pose, 1.0 - (self.panel.time - t) / dt.max(1e-9)),
+            self.panel.time,
+            shutter,
+            dt,
+        );
         if clock == 0.0 && input.shutter.is_some_and(|s| s.camera == input.camera) {
             input.shutter = None;
         } else if let Some(open) = input.shutter.as_mut() {
@@ -437,7 +518,12 @@ impl Running {
         if let (Some(i), Some(p)) = (self.playback, &self.path) {
             let key = p.frame(i);
             let spacing = if i > 0 { key.time - p.frame(i - 1).time } else { 0.0 };
-            input = FrameInput::exposed(|t| p.camera_at(t), key.time, shutter, if spacing > 0.0 { spacing } else { dt });
+            input = FrameInput::exposed(
+                |t| p.camera_at(t),
+                key.time,
+                shutter,
+                if spacing > 0.0 { spacing } else { dt },
+            );
             self.playback = if i + 1 < p.keys.len() { Some(i + 1) } else { None };
             self.panel.playing = self.playback.is_some();
         }
@@ -449,7 +535,8 @@ impl Running {
         self.renderer.resize(&self.gpu, size)?;
 
         let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface.configure(&self.gpu.device, &self.config);
                 return Ok(());
@@ -460,7 +547,11 @@ impl Running {
             }
         };
         let view = frame.texture.create_view(&Default::default());
-        let target = DisplayTarget { view: &view, format: self.config.format, size: (self.config.width, self.config.height) };
+        let target = DisplayTarget {
+            view: &view,
+            format: self.config.format,
+            size: (self.config.width, self.config.height),
+        };
         if self.render_error.is_none() {
             // A failed frame (a pass that cannot be made while a shader is broken) stays on
             // screen as an error until a reload or a settings change lets it through.
@@ -482,7 +573,8 @@ impl Running {
         let mut actions = ui::Actions::default();
         let panel = &mut self.panel;
         let profiler = &mut self.profiler;
-        let mut errors: Vec<String> = self.renderer.shader_errors().into_iter().map(|(_, e)| e).collect();
+        let mut errors: Vec<String> =
+            self.renderer.shader_errors().into_iter().map(|(_, e)| e).collect();
         errors.extend(self.shader_read_errors.iter().cloned());
         errors.extend(self.render_error.iter().cloned());
         let settings_before = panel.settings.clone();
@@ -510,14 +602,26 @@ impl Running {
                 self.egui_renderer.update_texture(d, q, id, delta);
             }
         }
-        let sd = egui_wgpu::ScreenDescriptor { size_in_pixels: [self.config.width, self.config.height], pixels_per_point: out.pixels_per_point };
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("egui") });
+        let sd = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: out.pixels_per_point,
+        };
+        let mut enc =
+            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("egui") });
         let extra = self.egui_renderer.update_buffers(d, q, &mut enc, &jobs, &sd);
         {
             let mut pass = enc
                 .begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("egui"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: &view, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store } })],
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
                     depth_stencil_attachment: None,
                     timestamp_writes: None,
                     occlusion_query_set: None,
@@ -583,7 +687,9 @@ impl Running {
             WindowEvent::Resized(s) => self.resize(s.width, s.height),
             WindowEvent::RedrawRequested => self.frame()?,
             WindowEvent::DroppedFile(p) => self.load(p),
-            WindowEvent::KeyboardInput { event, .. } if !consumed || event.state == ElementState::Released => {
+            WindowEvent::KeyboardInput { event, .. }
+                if !consumed || event.state == ElementState::Released =>
+            {
                 if let PhysicalKey::Code(code) = event.physical_key {
                     let pressed = event.state == ElementState::Pressed;
                     if pressed {
@@ -604,8 +710,14 @@ impl Running {
                     }
                 }
             }
-            WindowEvent::MouseInput { state, button: MouseButton::Right, .. } => self.fly.looking = *state == ElementState::Pressed && !consumed,
-            WindowEvent::MouseInput { state: ElementState::Pressed, button: MouseButton::Middle, .. } if !consumed => self.focus_at_cursor(),
+            WindowEvent::MouseInput { state, button: MouseButton::Right, .. } => {
+                self.fly.looking = *state == ElementState::Pressed && !consumed
+            }
+            WindowEvent::MouseInput {
+                state: ElementState::Pressed,
+                button: MouseButton::Middle,
+                ..
+            } if !consumed => self.focus_at_cursor(),
             WindowEvent::CursorMoved { position, .. } => {
                 if let (true, Some((x, y))) = (self.fly.looking, self.cursor) {
                     self.fly.look(position.x - x, position.y - y);
@@ -649,22 +761,29 @@ impl ApplicationHandler for Viewer {
 
 fn has_display() -> bool {
     if cfg!(target_os = "linux") || cfg!(target_os = "freebsd") {
-        return ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"].iter().any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));
+        return ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+            .iter()
+            .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));
     }
     true
 }
 
 fn parse_args() -> Result<Option<Args>> {
     let mut scene = None;
-    let (mut camera_path, mut preset, mut shaders, mut puffin_http, mut profiler) = (None, None, None, None, false);
+    let (mut camera_path, mut preset, mut shaders, mut puffin_http, mut profiler) =
+        (None, None, None, None, false);
     let mut load = hush_engine::scene::LoadOptions::default();
     let mut it = std::env::args().skip(1).peekable();
     while let Some(a) = it.next() {
         match a.as_str() {
             "-h" | "--help" => return Ok(None),
-            "--camera-path" => camera_path = Some(PathBuf::from(it.next().context("--camera-path needs a file")?)),
+            "--camera-path" => {
+                camera_path = Some(PathBuf::from(it.next().context("--camera-path needs a file")?))
+            }
             "--preset" => preset = Some(PathBuf::from(it.next().context("--preset needs a file")?)),
-            "--shaders" => shaders = Some(PathBuf::from(it.next().context("--shaders needs a folder")?)),
+            "--shaders" => {
+                shaders = Some(PathBuf::from(it.next().context("--shaders needs a folder")?))
+            }
             "--profiler" => profiler = true,
             "--limit" => load.limits.apply(&it.next().context("--limit needs NAME=VALUE")?)?,
             "--puffin-http" => {
@@ -681,7 +800,15 @@ fn parse_args() -> Result<Option<Args>> {
             s => scene = Some(s.to_string()),
         }
     }
-    Ok(Some(Args { scene: scene.unwrap_or_else(|| "level".into()), camera_path, preset, shaders, puffin_http, profiler, load }))
+    Ok(Some(Args {
+        scene: scene.unwrap_or_else(|| "level".into()),
+        camera_path,
+        preset,
+        shaders,
+        puffin_http,
+        profiler,
+        load,
+    }))
 }
 
 fn run() -> Result<()> {

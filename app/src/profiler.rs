@@ -22,13 +22,21 @@ impl Profiler {
         let server = match http {
             Some(port) => {
                 let addr = format!("127.0.0.1:{port}");
-                let s = puffin_http::Server::new(&addr).map_err(|e| anyhow::anyhow!("starting the puffin server on {addr}: {e}"))?;
+                let s = puffin_http::Server::new(&addr)
+                    .map_err(|e| anyhow::anyhow!("starting the puffin server on {addr}: {e}"))?;
                 log::warn!("puffin server on {addr} (connect with puffin_viewer --url {addr})");
                 Some(s)
             }
             None => None,
         };
-        let mut p = Profiler { open: false, capture_frames: 60, capture: None, view: None, _server: server, message: String::new() };
+        let mut p = Profiler {
+            open: false,
+            capture_frames: 60,
+            capture: None,
+            view: None,
+            _server: server,
+            message: String::new(),
+        };
         p.update_scopes();
         Ok(p)
     }
@@ -118,7 +126,8 @@ fn flame_graph(ui: &mut egui::Ui, view: &puffin::FrameView) {
     for (thread, info) in &unpacked.thread_streams {
         ui.label(egui::RichText::new(&thread.name).strong());
         let height = ROW * info.depth.max(1) as f32;
-        let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width(), height), egui::Sense::hover());
+        let (rect, _) =
+            ui.allocate_exact_size(egui::vec2(ui.available_width(), height), egui::Sense::hover());
         let painter = ui.painter_at(rect);
         let x = |ns: i64| rect.left() + rect.width() * ((ns - t0) as f32 / span);
         let mut stack = vec![];
@@ -127,18 +136,39 @@ fn flame_graph(ui: &mut egui::Ui, view: &puffin::FrameView) {
         }
         let pointer = ui.ctx().pointer_hover_pos();
         while let Some((s, depth)) = stack.pop() {
-            let r = egui::Rect::from_min_max(egui::pos2(x(s.record.start_ns), rect.top() + depth as f32 * ROW), egui::pos2(x(s.record.stop_ns()).max(x(s.record.start_ns) + 1.0), rect.top() + (depth + 1) as f32 * ROW - 1.0));
+            let r = egui::Rect::from_min_max(
+                egui::pos2(x(s.record.start_ns), rect.top() + depth as f32 * ROW),
+                egui::pos2(
+                    x(s.record.stop_ns()).max(x(s.record.start_ns) + 1.0),
+                    rect.top() + (depth + 1) as f32 * ROW - 1.0,
+                ),
+            );
             let name = names.fetch_by_id(&s.id).map_or("?".to_string(), |d| d.name().to_string());
-            let hue = (name.bytes().fold(0u32, |h, b| h.wrapping_mul(31).wrapping_add(b as u32)) % 360) as f32 / 360.0;
+            let hue = (name.bytes().fold(0u32, |h, b| h.wrapping_mul(31).wrapping_add(b as u32))
+                % 360) as f32
+                / 360.0;
             painter.rect_filled(r, 2.0, egui::ecolor::Hsva::new(hue, 0.45, 0.75, 1.0));
             let ms = s.record.duration_ns as f64 * 1e-6;
             if r.width() > 40.0 {
-                painter.with_clip_rect(r).text(r.left_center() + egui::vec2(2.0, 0.0), egui::Align2::LEFT_CENTER, format!("{name} {ms:.2}"), egui::FontId::monospace(10.0), egui::Color32::BLACK);
+                painter.with_clip_rect(r).text(
+                    r.left_center() + egui::vec2(2.0, 0.0),
+                    egui::Align2::LEFT_CENTER,
+                    format!("{name} {ms:.2}"),
+                    egui::FontId::monospace(10.0),
+                    egui::Color32::BLACK,
+                );
             }
             if pointer.is_some_and(|p| r.contains(p)) {
-                egui::Tooltip::always_open(ui.ctx().clone(), ui.layer_id(), egui::Id::unique("hush profiler scope tip"), egui::PopupAnchor::Pointer).show(|ui| ui.label(format!("{}: {name}, {ms:.3} ms", thread.name)));
+                egui::Tooltip::always_open(
+                    ui.ctx().clone(),
+                    ui.layer_id(),
+                    egui::Id::unique("hush profiler scope tip"),
+                    egui::PopupAnchor::Pointer,
+                )
+                .show(|ui| ui.label(format!("{}: {name}, {ms:.3} ms", thread.name)));
             }
-            if let Ok(children) = puffin::Reader::with_offset(&info.stream, s.child_begin_position) {
+            if let Ok(children) = puffin::Reader::with_offset(&info.stream, s.child_begin_position)
+            {
                 stack.extend(children.flatten().map(|c| (c, depth + 1)));
             }
         }

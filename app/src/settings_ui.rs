@@ -13,7 +13,10 @@ fn name(f: &Field) -> &'static str {
 
 fn show(v: &Value) -> String {
     match v {
-        Value::Number(n) if n.is_f64() => format!("{:.4}", n.as_f64().unwrap_or(0.0)).trim_end_matches('0').trim_end_matches('.').to_string(),
+        Value::Number(n) if n.is_f64() => format!("{:.4}", n.as_f64().unwrap_or(0.0))
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string(),
         Value::String(s) => s.clone(),
         v => v.to_string(),
     }
@@ -23,9 +26,21 @@ fn show(v: &Value) -> String {
 pub type Offered<'a> = &'a dyn Fn(&str, &str) -> bool;
 
 /// One field's row; true when the value changed.
-fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value, offered: Offered) -> bool {
+fn field_row(
+    ui: &mut egui::Ui,
+    f: &Field,
+    value: &mut Value,
+    default: &Value,
+    offered: Offered,
+) -> bool {
     let mut changed = false;
-    let hover = format!("{}\n{}: default {}{}", f.help, f.path, show(default), if f.unit.is_empty() { String::new() } else { format!(" {}", f.unit) });
+    let hover = format!(
+        "{}\n{}: default {}{}",
+        f.help,
+        f.path,
+        show(default),
+        if f.unit.is_empty() { String::new() } else { format!(" {}", f.unit) }
+    );
     ui.horizontal(|ui| {
         let r = match f.kind {
             Kind::Bool => {
@@ -47,7 +62,8 @@ fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value, o
             }
             Kind::Float(lo, hi, speed) => {
                 let mut x = value.as_f64().unwrap_or(lo);
-                let r = ui.add(egui::DragValue::new(&mut x).range(lo..=hi).speed(speed).max_decimals(4));
+                let r = ui
+                    .add(egui::DragValue::new(&mut x).range(lo..=hi).speed(speed).max_decimals(4));
                 if r.changed() {
                     *value = serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number);
                 }
@@ -78,7 +94,9 @@ fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value, o
             (Some(a), Some(b)) => (a - b).abs() > 1e-6 * b.abs().max(1e-6),
             _ => value != default,
         };
-        if differs && ui.small_button("↺").on_hover_text(format!("reset to {}", show(default))).clicked() {
+        if differs
+            && ui.small_button("↺").on_hover_text(format!("reset to {}", show(default))).clicked()
+        {
             *value = default.clone();
             changed = true;
         }
@@ -87,10 +105,18 @@ fn field_row(ui: &mut egui::Ui, f: &Field, value: &mut Value, default: &Value, o
 }
 
 /// The fields of `group`; returns true when one changed. `v` is the settings' serde form.
-pub fn group(ui: &mut egui::Ui, group: &str, v: &mut Value, defaults: &Value, offered: Offered) -> bool {
+pub fn group(
+    ui: &mut egui::Ui,
+    group: &str,
+    v: &mut Value,
+    defaults: &Value,
+    offered: Offered,
+) -> bool {
     let mut changed = false;
     for f in fields().filter(|f| f.group == group) {
-        if let (Some(value), Some(default)) = (get_field_mut(v, f.path), get_field(defaults, f.path)) {
+        if let (Some(value), Some(default)) =
+            (get_field_mut(v, f.path), get_field(defaults, f.path))
+        {
             changed |= field_row(ui, f, value, default, offered);
         }
     }

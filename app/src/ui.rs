@@ -44,13 +44,33 @@ impl LensPanel {
     pub fn new(lens: Option<hush_engine::scene::ThinLens>, extent: f64) -> LensPanel {
         let extent = (extent as f32).max(1e-6);
         match lens {
-            Some(l) => LensPanel { shutter: 0.0, on: true, aperture_radius: l.aperture_radius, focus_distance: l.focus_distance, extent },
-            None => LensPanel { shutter: 0.0, on: false, aperture_radius: extent * 2e-3, focus_distance: extent * 0.25, extent },
+            Some(l) => LensPanel {
+                shutter: 0.0,
+                on: true,
+                aperture_radius: l.aperture_radius,
+                focus_distance: l.focus_distance,
+                extent,
+            },
+            None => LensPanel {
+                shutter: 0.0,
+                on: false,
+                aperture_radius: extent * 2e-3,
+                focus_distance: extent * 0.25,
+                extent,
+            },
         }
     }
 
     pub fn lens(&self) -> Option<hush_engine::scene::ThinLens> {
-        self.on.then(|| hush_engine::scene::ThinLens::new(self.aperture_radius as f64, self.focus_distance as f64).ok()).flatten()
+        self.on
+            .then(|| {
+                hush_engine::scene::ThinLens::new(
+                    self.aperture_radius as f64,
+                    self.focus_distance as f64,
+                )
+                .ok()
+            })
+            .flatten()
     }
 }
 
@@ -81,7 +101,9 @@ impl Panel {
         let g = &mut self.governor;
         ui.horizontal(|ui| {
             ui.checkbox(&mut g.on, "frame-time governor");
-            ui.add(egui::DragValue::new(&mut g.target_ms).range(5.0..=2000.0).speed(1.0).suffix(" ms"));
+            ui.add(
+                egui::DragValue::new(&mut g.target_ms).range(5.0..=2000.0).speed(1.0).suffix(" ms"),
+            );
         });
         if g.on {
             ui.label(&g.choice).on_hover_text("The resolution scale and sample fraction the governor chose to hold the target; pin either to keep it and let the governor turn the other.");
@@ -91,18 +113,31 @@ impl Panel {
             });
         }
         let governed = g.on && !g.pin_scale;
-        ui.add_enabled(!governed, egui::Slider::new(&mut self.resolution_scale, 0.25..=1.0).text("resolution scale"));
+        ui.add_enabled(
+            !governed,
+            egui::Slider::new(&mut self.resolution_scale, 0.25..=1.0).text("resolution scale"),
+        );
         if let Some((az, el)) = &mut self.sun {
-            let c1 = ui.add(egui::Slider::new(az, -180.0..=180.0).text("sun azimuth (deg)")).changed();
-            let c2 = ui.add(egui::Slider::new(el, 1.0..=89.0).text("sun elevation (deg)")).changed();
+            let c1 =
+                ui.add(egui::Slider::new(az, -180.0..=180.0).text("sun azimuth (deg)")).changed();
+            let c2 =
+                ui.add(egui::Slider::new(el, 1.0..=89.0).text("sun elevation (deg)")).changed();
             a.sun_changed = c1 || c2;
         }
         let l = &mut self.lens;
         ui.add(egui::Slider::new(&mut l.shutter, 0.0..=1.0).text("motion blur shutter")).on_hover_text("The fraction of the frame interval the shutter stays open: each primary sample sees the camera and the animation at a random time in it (the G-buffer is then traced, as with a lens).");
         ui.checkbox(&mut l.on, "depth of field (thin lens)").on_hover_text("The frame then traces k primary rays per pixel through the lens (gbuffer/primaries) and pre-filters their features (prefilter). Middle-click the image to focus on the surface there.");
         if l.on {
-            ui.add(egui::Slider::new(&mut l.aperture_radius, l.extent * 1e-5..=l.extent * 0.05).logarithmic(true).text("aperture radius"));
-            ui.add(egui::Slider::new(&mut l.focus_distance, l.extent * 1e-4..=l.extent * 2.0).logarithmic(true).text("focus distance"));
+            ui.add(
+                egui::Slider::new(&mut l.aperture_radius, l.extent * 1e-5..=l.extent * 0.05)
+                    .logarithmic(true)
+                    .text("aperture radius"),
+            );
+            ui.add(
+                egui::Slider::new(&mut l.focus_distance, l.extent * 1e-4..=l.extent * 2.0)
+                    .logarithmic(true)
+                    .text("focus distance"),
+            );
         }
         ui.horizontal(|ui| {
             ui.checkbox(&mut self.paused, "pause animation");
@@ -148,15 +183,23 @@ impl Panel {
         let glossy = self.glossy;
         let relevant = |g: &str| glossy || !g.starts_with("glossy/");
         // Scenes without a glossy lobe have no glossy buffers to show.
-        let offered = |path: &str, choice: &str| path != "view" || glossy || View::named(choice).spec().is_none_or(|v| !v.needs_glossy());
-        let group_of = |pass: &str| groups.iter().copied().find(|g| pass == *g || pass.strip_prefix(*g).is_some_and(|r| r.starts_with('_')));
+        let offered = |path: &str, choice: &str| {
+            path != "view" || glossy || View::named(choice).spec().is_none_or(|v| !v.needs_glossy())
+        };
+        let group_of = |pass: &str| {
+            groups
+                .iter()
+                .copied()
+                .find(|g| pass == *g || pass.strip_prefix(*g).is_some_and(|r| r.starts_with('_')))
+        };
         let mut shown: Vec<&str> = vec![];
         let mut rows: Vec<(String, f64, Option<&'static str>)> = vec![];
         for (pass, ms) in &self.pass_ms {
             match group_of(pass) {
                 Some(g) if shown.contains(&g) => {
                     if let Some(row) = rows.iter_mut().find(|r| r.2 == Some(g)) {
-                        row.0 = format!("{g} ({})", pass.trim_start_matches(g).trim_start_matches('_'));
+                        row.0 =
+                            format!("{g} ({})", pass.trim_start_matches(g).trim_start_matches('_'));
                         row.1 += ms;
                     }
                 }
@@ -172,7 +215,9 @@ impl Panel {
             let title = format!("{label}  {ms:.2} ms");
             match g {
                 Some(g) => {
-                    egui::CollapsingHeader::new(title).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, defaults, &offered));
+                    egui::CollapsingHeader::new(title).id_salt(*g).show(ui, |ui| {
+                        changed |= settings_ui::group(ui, g, &mut v, defaults, &offered)
+                    });
                 }
                 None => {
                     ui.label(title);
@@ -181,7 +226,9 @@ impl Panel {
             ui.add(egui::ProgressBar::new(frac).desired_height(3.0));
         }
         for g in groups.iter().filter(|g| !shown.contains(g) && relevant(g)) {
-            egui::CollapsingHeader::new(*g).id_salt(*g).show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, defaults, &offered));
+            egui::CollapsingHeader::new(*g)
+                .id_salt(*g)
+                .show(ui, |ui| changed |= settings_ui::group(ui, g, &mut v, defaults, &offered));
         }
         if changed && let Err(e) = settings_ui::apply(&mut self.settings, &v) {
             self.message = e;

@@ -93,7 +93,8 @@ pub fn image(data: &[u8]) -> Result<()> {
     if data.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
         let map = crate::scene::EnvMap::from_exr("fuzz.exr", data, 1.0, 0.0, &mut budget)?;
         // The environment's importance-sampling tables, as the GPU scene builds them.
-        let scene = Scene { environment: crate::scene::Environment::Map(map), ..Default::default() };
+        let scene =
+            Scene { environment: crate::scene::Environment::Map(map), ..Default::default() };
         crate::gpu::PreparedScene::new(&scene, crate::accel::BvhKind::DEFAULT)?;
     } else {
         crate::scene::Texture::decode("fuzz.png", data, true, 64, &mut budget)?;
@@ -122,15 +123,25 @@ mod tests {
     fn fuzz_corpus_and_regressions_replay_without_panics() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz");
         let mut replayed = 0;
-        for (dir, target) in [("corpus/scene", 0), ("regressions/scene", 0), ("corpus/image", 1), ("regressions/image", 1)] {
+        for (dir, target) in [
+            ("corpus/scene", 0),
+            ("regressions/scene", 0),
+            ("corpus/image", 1),
+            ("regressions/image", 1),
+        ] {
             let Ok(entries) = std::fs::read_dir(root.join(dir)) else { continue };
             for e in entries {
                 let path = e.unwrap().path();
                 let data = std::fs::read(&path).unwrap();
-                let outcome = std::panic::catch_unwind(|| if target == 0 { scene(&data).map(|_| ()) } else { image(&data) });
+                let outcome = std::panic::catch_unwind(|| {
+                    if target == 0 { scene(&data).map(|_| ()) } else { image(&data) }
+                });
                 let name = path.file_name().unwrap().to_string_lossy().to_string();
                 let r = outcome.unwrap_or_else(|_| panic!("{dir}/{name} panics"));
-                eprintln!("{dir}/{name}: {:?}", r.as_ref().map(|_| ()).map_err(|e| format!("{e:#}")));
+                eprintln!(
+                    "{dir}/{name}: {:?}",
+                    r.as_ref().map(|_| ()).map_err(|e| format!("{e:#}"))
+                );
                 // Seeds named ok-* load; the others are refused.
                 if dir.starts_with("corpus") {
                     assert_eq!(r.is_ok(), name.starts_with("ok-"), "{dir}/{name}: {r:?}");

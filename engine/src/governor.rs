@@ -91,7 +91,10 @@ impl Governor {
 
     /// The choice for the next frame (before any frame: full scale, every pixel, or the pins).
     pub fn choice(&self) -> Choice {
-        Choice { scale: self.pinned_scale.unwrap_or(self.current.scale), fraction: self.pinned_fraction.unwrap_or(self.current.fraction) }
+        Choice {
+            scale: self.pinned_scale.unwrap_or(self.current.scale),
+            fraction: self.pinned_fraction.unwrap_or(self.current.fraction),
+        }
     }
 
     /// Predicted frame time (ms) of `c` from the current estimate; None before any frame.
@@ -105,7 +108,8 @@ impl Governor {
     pub fn record(&mut self, f: FrameCost) -> Choice {
         let area = (f.choice.scale * f.choice.scale).max(1e-6) as f64;
         let period = f.choice.fraction.period() as f64;
-        let (wall, trace) = (finite_or(f.wall_ms, 0.0).max(0.0), finite_or(f.trace_ms, 0.0).max(0.0));
+        let (wall, trace) =
+            (finite_or(f.wall_ms, 0.0).max(0.0), finite_or(f.trace_ms, 0.0).max(0.0));
         let trace = trace.min(wall);
         self.costs.push(((wall - trace) / area, trace * period / area));
         if self.costs.len() > WINDOW {
@@ -119,7 +123,11 @@ impl Governor {
             let n = self.costs.len();
             self.costs.drain(..n.saturating_sub(2));
         }
-        self.scale_frames = if f.choice.scale == self.current.scale { self.scale_frames.saturating_add(1) } else { 1 };
+        self.scale_frames = if f.choice.scale == self.current.scale {
+            self.scale_frames.saturating_add(1)
+        } else {
+            1
+        };
         self.current = self.pick(f.moving);
         self.choice()
     }
@@ -133,7 +141,10 @@ impl Governor {
             v.sort_by(f64::total_cmp);
             v[v.len() / 2]
         };
-        Some((median(self.costs.iter().map(|c| c.0).collect()), median(self.costs.iter().map(|c| c.1).collect())))
+        Some((
+            median(self.costs.iter().map(|c| c.0).collect()),
+            median(self.costs.iter().map(|c| c.1).collect()),
+        ))
     }
 
     fn fractions(&self) -> Vec<SampleFraction> {
@@ -153,7 +164,9 @@ impl Governor {
 
     /// The largest fraction at scale `s` predicted within `budget` ms, none below 1 / `floor`.
     fn best_fraction(&self, s: f32, budget: f64, floor: u32) -> Option<SampleFraction> {
-        self.fractions().into_iter().filter(|f| f.period() <= floor).find(|&fraction| self.predict(Choice { scale: s, fraction }).is_some_and(|t| t <= budget))
+        self.fractions().into_iter().filter(|f| f.period() <= floor).find(|&fraction| {
+            self.predict(Choice { scale: s, fraction }).is_some_and(|t| t <= budget)
+        })
     }
 
     fn pick(&mut self, moving: bool) -> Choice {
@@ -168,7 +181,10 @@ impl Governor {
             }
             None
         };
-        let smallest = Choice { scale: *scales.last().unwrap_or(&1.0), fraction: *self.fractions().last().unwrap_or(&SampleFraction::ONE) };
+        let smallest = Choice {
+            scale: *scales.last().unwrap_or(&1.0),
+            fraction: *self.fractions().last().unwrap_or(&SampleFraction::ONE),
+        };
         let want = fits(self, self.target_ms).unwrap_or(smallest);
         let cur = self.current;
         if want.scale > cur.scale {
@@ -178,10 +194,14 @@ impl Governor {
             // (time-to-quality, level 320x180: FLIP 0.156 -> 0.499 at a rise 0.84 s after a
             // stop, back to 0.156 only after 3.6 s), while a scale chosen from the first
             // frames (a shader compile) must not stay until the camera moves.
-            let roomy = (moving || self.scale_frames < YOUNG_FRAMES) && fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
+            let roomy = (moving || self.scale_frames < YOUNG_FRAMES)
+                && fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
             self.room_frames = if roomy { self.room_frames + 1 } else { 0 };
             if self.room_frames < RISE_FRAMES {
-                let fraction = self.best_fraction(cur.scale, self.target_ms, floor(moving)).or_else(|| self.best_fraction(cur.scale, self.target_ms, u32::MAX)).unwrap_or(smallest.fraction);
+                let fraction = self
+                    .best_fraction(cur.scale, self.target_ms, floor(moving))
+                    .or_else(|| self.best_fraction(cur.scale, self.target_ms, u32::MAX))
+                    .unwrap_or(smallest.fraction);
                 return Choice { scale: cur.scale, fraction };
             }
         }
@@ -208,7 +228,13 @@ mod tests {
     use super::*;
 
     /// A device whose frame costs `area * (rest + trace f)` ms.
-    fn run(g: &mut Governor, rest: f64, trace: f64, frames: usize, moving: bool) -> Vec<(Choice, f64)> {
+    fn run(
+        g: &mut Governor,
+        rest: f64,
+        trace: f64,
+        frames: usize,
+        moving: bool,
+    ) -> Vec<(Choice, f64)> {
         let mut out = vec![];
         for _ in 0..frames {
             let c = g.choice();
@@ -329,7 +355,8 @@ mod tests {
         assert_eq!(g.choice().fraction, SampleFraction::ONE);
         for wall in [f64::NAN, f64::INFINITY, -5.0, 0.0] {
             let c = g.choice();
-            let next = g.record(FrameCost { wall_ms: wall, trace_ms: f64::NAN, choice: c, moving: false });
+            let next =
+                g.record(FrameCost { wall_ms: wall, trace_ms: f64::NAN, choice: c, moving: false });
             assert!(next.scale > 0.0 && next.scale <= 1.0);
         }
     }

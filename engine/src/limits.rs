@@ -54,7 +54,15 @@ impl Default for Limits {
 
 impl Limits {
     /// The `--limit` names.
-    pub const NAMES: [&'static str; 7] = ["file-bytes", "json-bytes", "image-pixels", "decoded-bytes", "nodes", "hierarchy-depth", "triangles"];
+    pub const NAMES: [&'static str; 7] = [
+        "file-bytes",
+        "json-bytes",
+        "image-pixels",
+        "decoded-bytes",
+        "nodes",
+        "hierarchy-depth",
+        "triangles",
+    ];
 
     fn slot(&mut self, name: &str) -> Option<&mut u64> {
         Some(match name {
@@ -72,7 +80,8 @@ impl Limits {
     /// Apply `NAME=VALUE[,NAME=VALUE...]` (the `--limit` flag's argument).
     pub fn apply(&mut self, assignments: &str) -> Result<()> {
         for a in assignments.split(',').map(str::trim).filter(|a| !a.is_empty()) {
-            let (name, value) = a.split_once('=').ok_or_else(|| anyhow!("--limit {a:?}: expected NAME=VALUE"))?;
+            let (name, value) =
+                a.split_once('=').ok_or_else(|| anyhow!("--limit {a:?}: expected NAME=VALUE"))?;
             let value: u64 = value
                 .trim()
                 .replace('_', "")
@@ -81,13 +90,17 @@ impl Limits {
             if value == 0 {
                 bail!("--limit {a:?}: a budget must be at least 1");
             }
-            let slot = self
-                .slot(name.trim())
-                .ok_or_else(|| anyhow!("--limit {a:?}: unknown budget; the budgets are {}", Self::NAMES.join(", ")))?;
+            let slot = self.slot(name.trim()).ok_or_else(|| {
+                anyhow!("--limit {a:?}: unknown budget; the budgets are {}", Self::NAMES.join(", "))
+            })?;
             *slot = value;
         }
         if self.triangles >= crate::gpu::prepare::MAX_TRIANGLES as u64 {
-            bail!("--limit triangles={}: the GPU addresses at most {} triangles", self.triangles, crate::gpu::prepare::MAX_TRIANGLES - 1);
+            bail!(
+                "--limit triangles={}: the GPU addresses at most {} triangles",
+                self.triangles,
+                crate::gpu::prepare::MAX_TRIANGLES - 1
+            );
         }
         Ok(())
     }
@@ -107,14 +120,23 @@ pub struct OverBudget {
 impl std::fmt::Display for OverBudget {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
         let (name, need, limit) = (self.budget, self.need, self.limit);
-        write!(f, "{} needs {need} against the {name} budget of {limit}; if the file is trusted, raise it with --limit {name}={need}", self.what)
+        write!(
+            f,
+            "{} needs {need} against the {name} budget of {limit}; if the file is trusted, raise it with --limit {name}={need}",
+            self.what
+        )
     }
 }
 
 impl std::error::Error for OverBudget {}
 
 /// The error for `what` needing `need` of the budget `name` whose value is `limit`.
-pub fn over_budget(name: &'static str, what: impl std::fmt::Display, need: u64, limit: u64) -> anyhow::Error {
+pub fn over_budget(
+    name: &'static str,
+    what: impl std::fmt::Display,
+    need: u64,
+    limit: u64,
+) -> anyhow::Error {
     anyhow::Error::new(OverBudget { budget: name, what: what.to_string(), need, limit })
 }
 
@@ -139,17 +161,33 @@ impl Budget {
     pub fn decode(&mut self, bytes: u64, what: impl std::fmt::Display) -> Result<()> {
         let total = self.decoded.saturating_add(bytes);
         if total > self.limits.decoded_bytes {
-            return Err(over_budget("decoded-bytes", format_args!("{what} (with what was decoded before it)"), total, self.limits.decoded_bytes));
+            return Err(over_budget(
+                "decoded-bytes",
+                format_args!("{what} (with what was decoded before it)"),
+                total,
+                self.limits.decoded_bytes,
+            ));
         }
         self.decoded = total;
         Ok(())
     }
 
     /// Refuse an image of `w` x `h` pixels before it is decoded.
-    pub fn image(&mut self, w: u64, h: u64, bytes_per_pixel: u64, what: impl std::fmt::Display) -> Result<()> {
+    pub fn image(
+        &mut self,
+        w: u64,
+        h: u64,
+        bytes_per_pixel: u64,
+        what: impl std::fmt::Display,
+    ) -> Result<()> {
         let px = w.saturating_mul(h);
         if px > self.limits.image_pixels {
-            return Err(over_budget("image-pixels", format_args!("{what} ({w}x{h})"), px, self.limits.image_pixels));
+            return Err(over_budget(
+                "image-pixels",
+                format_args!("{what} ({w}x{h})"),
+                px,
+                self.limits.image_pixels,
+            ));
         }
         self.decode(px * bytes_per_pixel, what)
     }
@@ -161,7 +199,11 @@ impl Budget {
 pub fn read_regular_file(path: &Path, limit: u64) -> Result<Vec<u8>> {
     let meta = std::fs::metadata(path).map_err(|e| anyhow!("reading {}: {e}", path.display()))?;
     if !meta.is_file() {
-        bail!("{} is {}, not a regular file; refused", path.display(), file_kind(&meta.file_type()));
+        bail!(
+            "{} is {}, not a regular file; refused",
+            path.display(),
+            file_kind(&meta.file_type())
+        );
     }
     if meta.len() > limit {
         return Err(over_budget("file-bytes", path.display(), meta.len(), limit));
@@ -170,10 +212,16 @@ pub fn read_regular_file(path: &Path, limit: u64) -> Result<Vec<u8>> {
     // What was opened may not be what was checked (a file swapped in between).
     let opened = file.metadata().map_err(|e| anyhow!("reading {}: {e}", path.display()))?;
     if !opened.is_file() {
-        bail!("{} is {}, not a regular file; refused", path.display(), file_kind(&opened.file_type()));
+        bail!(
+            "{} is {}, not a regular file; refused",
+            path.display(),
+            file_kind(&opened.file_type())
+        );
     }
     let mut bytes = Vec::with_capacity(opened.len().min(limit) as usize);
-    file.take(limit.saturating_add(1)).read_to_end(&mut bytes).map_err(|e| anyhow!("reading {}: {e}", path.display()))?;
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(|e| anyhow!("reading {}: {e}", path.display()))?;
     if bytes.len() as u64 > limit {
         return Err(over_budget("file-bytes", path.display(), bytes.len() as u64, limit));
     }
@@ -213,12 +261,23 @@ mod tests {
         let mut l = Limits::default();
         l.apply("triangles=1000, image-pixels=4_096").unwrap();
         assert_eq!((l.triangles, l.image_pixels), (1000, 4096));
-        for (bad, needle) in [("triangle=3", "unknown budget"), ("nodes", "NAME=VALUE"), ("nodes=-1", "whole number"), ("nodes=0", "at least 1"), ("triangles=16777216", "at most")] {
+        for (bad, needle) in [
+            ("triangle=3", "unknown budget"),
+            ("nodes", "NAME=VALUE"),
+            ("nodes=-1", "whole number"),
+            ("nodes=0", "at least 1"),
+            ("triangles=16777216", "at most"),
+        ] {
             let e = Limits::default().apply(bad).unwrap_err().to_string();
             assert!(e.contains(needle), "{bad}: {e}");
         }
         let mut b = Budget::new(l);
         let e = b.image(100, 100, 4, "texture a.png").unwrap_err().to_string();
-        assert!(e.contains("image-pixels") && e.contains("--limit image-pixels=10000") && e.contains("100x100"), "{e}");
+        assert!(
+            e.contains("image-pixels")
+                && e.contains("--limit image-pixels=10000")
+                && e.contains("100x100"),
+            "{e}"
+        );
     }
 }

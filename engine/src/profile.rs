@@ -10,7 +10,10 @@
 pub use puffin;
 
 use anyhow::{Context, Result};
-use puffin::{FrameData, FrameSinkId, FrameView, GlobalProfiler, ScopeDetails, ScopeId, StreamInfo, ThreadInfo};
+use puffin::{
+    FrameData, FrameSinkId, FrameView, GlobalProfiler, ScopeDetails, ScopeId, StreamInfo,
+    ThreadInfo,
+};
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -62,7 +65,9 @@ pub fn report_gpu(submit_ns: i64, spans: &[PassSpan]) {
         return;
     }
     let mut details = vec![ScopeDetails::from_scope_name(GPU_FRAME)];
-    details.extend(spans.iter().map(|s| ScopeDetails::from_scope_name(s.label).with_function_name("gpu pass")));
+    details.extend(
+        spans.iter().map(|s| ScopeDetails::from_scope_name(s.label).with_function_name("gpu pass")),
+    );
     let mut profiler = GlobalProfiler::lock();
     let ids = profiler.register_user_scopes(&details);
     let ns = |ms: f64| (ms * 1e6).round() as i64;
@@ -75,8 +80,12 @@ pub fn report_gpu(submit_ns: i64, spans: &[PassSpan]) {
         stream.end_scope(offset, start + ns(s.ms).max(1));
     }
     stream.end_scope(frame, end);
-    let info = StreamInfo { stream, num_scopes: spans.len() + 1, depth: 2, range_ns: (submit_ns, end) };
-    profiler.report_user_scopes(ThreadInfo { start_time_ns: None, name: GPU_THREAD.into() }, &info.as_stream_into_ref());
+    let info =
+        StreamInfo { stream, num_scopes: spans.len() + 1, depth: 2, range_ns: (submit_ns, end) };
+    profiler.report_user_scopes(
+        ThreadInfo { start_time_ns: None, name: GPU_THREAD.into() },
+        &info.as_stream_into_ref(),
+    );
 }
 
 /// Close the current puffin frame (call once per rendered frame, after its scopes ended).
@@ -123,7 +132,8 @@ impl Capture {
         for f in frames.iter().take(self.want) {
             view.add_frame(f.clone());
         }
-        let file = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        let file =
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
         let mut w = std::io::BufWriter::new(file);
         view.write(&mut w).with_context(|| format!("writing the profile {}", path.display()))?;
         Ok(frames.len().min(self.want))
@@ -132,20 +142,28 @@ impl Capture {
 
 /// Every scope of a `.puffin` file: (timeline, scope name, total ns over all frames, count).
 pub fn read_capture(path: &Path) -> Result<Vec<(String, String, i64, usize)>> {
-    let mut file = std::io::BufReader::new(std::fs::File::open(path).with_context(|| format!("opening {}", path.display()))?);
-    let view = FrameView::read(&mut file).with_context(|| format!("reading the profile {}", path.display()))?;
+    let mut file = std::io::BufReader::new(
+        std::fs::File::open(path).with_context(|| format!("opening {}", path.display()))?,
+    );
+    let view = FrameView::read(&mut file)
+        .with_context(|| format!("reading the profile {}", path.display()))?;
     let names = view.scope_collection();
     let mut totals: HashMap<(String, String), (i64, usize)> = HashMap::new();
     for frame in view.recent_frames() {
         let unpacked = frame.unpacked().map_err(|e| anyhow::anyhow!("{e}"))?;
         for (thread, info) in &unpacked.thread_streams {
-            let mut stack = puffin::Reader::from_start(&info.stream).read_top_scopes().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+            let mut stack = puffin::Reader::from_start(&info.stream)
+                .read_top_scopes()
+                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
             while let Some(s) = stack.pop() {
-                let name = names.fetch_by_id(&s.id).map_or(format!("{:?}", s.id), |d| d.name().to_string());
+                let name = names
+                    .fetch_by_id(&s.id)
+                    .map_or(format!("{:?}", s.id), |d| d.name().to_string());
                 let t = totals.entry((thread.name.clone(), name)).or_default();
                 t.0 += s.record.duration_ns;
                 t.1 += 1;
-                let children = puffin::Reader::with_offset(&info.stream, s.child_begin_position).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+                let children = puffin::Reader::with_offset(&info.stream, s.child_begin_position)
+                    .map_err(|e| anyhow::anyhow!("{e:?}"))?;
                 for c in children {
                     let c = c.map_err(|e| anyhow::anyhow!("{e:?}"))?;
                     stack.push(c);

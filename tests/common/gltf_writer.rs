@@ -32,7 +32,9 @@ impl GltfWriter {
         }
         let off = self.bin.len();
         self.bin.extend_from_slice(bytes);
-        self.views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": bytes.len(), "target": target}));
+        self.views.push(
+            json!({"buffer": 0, "byteOffset": off, "byteLength": bytes.len(), "target": target}),
+        );
         self.views.len() - 1
     }
 
@@ -78,7 +80,12 @@ impl GltfWriter {
     /// normals and indices, with `material` of this file.
     pub fn engine_mesh(&mut self, m: &hush_engine::scene::Mesh, material: usize) -> usize {
         let arrays = |v: &[glam::Vec3]| v.iter().map(|p| p.to_array()).collect::<Vec<_>>();
-        self.mesh(Prim { positions: &arrays(&m.positions), normals: Some(&arrays(&m.normals)), indices: Some(&m.indices), material })
+        self.mesh(Prim {
+            positions: &arrays(&m.positions),
+            normals: Some(&arrays(&m.normals)),
+            indices: Some(&m.indices),
+            material,
+        })
     }
 
     pub fn lambert(&mut self, c: [f32; 3]) -> usize {
@@ -122,8 +129,18 @@ impl GltfWriter {
     }
 
     pub fn to_json(&self) -> Value {
-        let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&self.bin));
-        let roots: Vec<usize> = (0..self.nodes.len()).filter(|i| !self.nodes.iter().any(|n| n["children"].as_array().is_some_and(|c| c.contains(&json!(i))))).collect();
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&self.bin)
+        );
+        let roots: Vec<usize> = (0..self.nodes.len())
+            .filter(|i| {
+                !self
+                    .nodes
+                    .iter()
+                    .any(|n| n["children"].as_array().is_some_and(|c| c.contains(&json!(i))))
+            })
+            .collect();
         let mut j = json!({
             "asset": {"version": "2.0"},
             "scene": 0,

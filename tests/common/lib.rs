@@ -30,11 +30,25 @@ pub fn render(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32) -> Result<Accu
     render_with(scene, w, h, spp, seed, BvhKind::DEFAULT)
 }
 
-pub fn render_with(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32, kind: BvhKind) -> Result<Accumulation> {
+pub fn render_with(
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    spp: u32,
+    seed: u32,
+    kind: BvhKind,
+) -> Result<Accumulation> {
     let prepared = PreparedScene::new(scene, kind)?;
     let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
-    let view = TraceView { camera: scene.camera_or_default(), width: w, height: h, max_depth: scene.max_depth, seed, shutter_camera: None };
+    let view = TraceView {
+        camera: scene.camera_or_default(),
+        width: w,
+        height: h,
+        max_depth: scene.max_depth,
+        seed,
+        shutter_camera: None,
+    };
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     let mut done = 0;
     while done < spp {
@@ -48,14 +62,30 @@ pub fn render_with(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32, kind: Bvh
 
 /// Render `frames` real-time frames of `scene` in accumulate mode (still camera) and return
 /// their mean, linear HDR.
-pub fn realtime_accumulate(scene: &Scene, w: u32, h: u32, frames: u32, seed: u32) -> Result<hush_engine::quality::Image> {
-    let settings = hush_engine::settings::FrameSettings { max_depth: scene.max_depth, seed, accumulate: true, ..Default::default() };
+pub fn realtime_accumulate(
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    frames: u32,
+    seed: u32,
+) -> Result<hush_engine::quality::Image> {
+    let settings = hush_engine::settings::FrameSettings {
+        max_depth: scene.max_depth,
+        seed,
+        accumulate: true,
+        ..Default::default()
+    };
     realtime_frames(scene, (w, h), &settings, frames)
 }
 
 /// Render `frames` real-time frames of `scene` from its camera with `settings` and return the
 /// last one shown, linear HDR.
-pub fn realtime_frames(scene: &Scene, size: (u32, u32), settings: &hush_engine::settings::FrameSettings, frames: u32) -> Result<hush_engine::quality::Image> {
+pub fn realtime_frames(
+    scene: &Scene,
+    size: (u32, u32),
+    settings: &hush_engine::settings::FrameSettings,
+    frames: u32,
+) -> Result<hush_engine::quality::Image> {
     use hush_engine::frame::{FrameInput, Renderer};
     let (gpu, mut r) = Renderer::headless(scene.clone(), BvhKind::DEFAULT, size)?;
     let input = FrameInput { camera: scene.camera_or_default(), time: 0.0, shutter: None };
@@ -69,10 +99,16 @@ pub fn realtime_frames(scene: &Scene, size: (u32, u32), settings: &hush_engine::
 /// pixels whose luminances differ most (caustic and highlight pixels whose means a few rare
 /// samples dominate), and 5 standard errors of it: `variance(i, k)` is the variance of pixel
 /// i's difference in channel k.
-pub fn trimmed_bias(test: &hush_engine::quality::Image, reference: &hush_engine::quality::Image, variance: impl Fn(usize, usize) -> f64) -> ([f64; 3], [f64; 3]) {
+pub fn trimmed_bias(
+    test: &hush_engine::quality::Image,
+    reference: &hush_engine::quality::Image,
+    variance: impl Fn(usize, usize) -> f64,
+) -> ([f64; 3], [f64; 3]) {
     use hush_engine::quality::luminance;
     let n = reference.data.len();
-    let mut diffs: Vec<(f32, usize)> = (0..n).map(|i| ((luminance(test.data[i]) - luminance(reference.data[i])).abs(), i)).collect();
+    let mut diffs: Vec<(f32, usize)> = (0..n)
+        .map(|i| ((luminance(test.data[i]) - luminance(reference.data[i])).abs(), i))
+        .collect();
     diffs.sort_by(|a, b| a.0.total_cmp(&b.0));
     let keep: Vec<usize> = diffs[..n - n / 1000 - 1].iter().map(|d| d.1).collect();
     let mut bias = [0f64; 3];
@@ -110,5 +146,10 @@ pub fn oct_normal(texel: &[u8]) -> glam::Vec3 {
 /// luminance per pixel.
 pub fn luminance_change(a: &hush_engine::quality::Image, b: &hush_engine::quality::Image) -> f64 {
     use hush_engine::quality::luminance;
-    a.data.iter().zip(&b.data).map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64).sum::<f64>() / a.data.len() as f64
+    a.data
+        .iter()
+        .zip(&b.data)
+        .map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64)
+        .sum::<f64>()
+        / a.data.len() as f64
 }

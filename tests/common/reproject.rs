@@ -15,7 +15,8 @@ pub struct DepthFrame<'a> {
 impl DepthFrame<'_> {
     /// The texel index of (x, y), None outside the frame.
     pub fn index(&self, x: i64, y: i64) -> Option<usize> {
-        (x >= 0 && y >= 0 && x < self.size.0 as i64 && y < self.size.1 as i64).then(|| (y * self.size.0 as i64 + x) as usize)
+        (x >= 0 && y >= 0 && x < self.size.0 as i64 && y < self.size.1 as i64)
+            .then(|| (y * self.size.0 as i64 + x) as usize)
     }
 
     /// The rebased world position of the sample at (x, y); None outside the frame or without a surface.
@@ -26,7 +27,8 @@ impl DepthFrame<'_> {
             return None;
         }
         let (w, h) = (self.size.0 as f32, self.size.1 as f32);
-        let p = self.inv_view_proj * Vec4::new((x as f32 + 0.5) / w * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h * 2.0, d, 1.0);
+        let p = self.inv_view_proj
+            * Vec4::new((x as f32 + 0.5) / w * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h * 2.0, d, 1.0);
         Some(p.truncate() / p.w)
     }
 }

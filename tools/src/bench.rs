@@ -104,11 +104,19 @@ fn time_mitsuba(scene: &str, width: u32, height: u32, spp: u32) -> Result<Mitsub
     let dir = std::env::temp_dir().join(format!("hush-mitsuba-{}", std::process::id()));
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let script = dir.join("mitsuba_time.py");
-    std::fs::write(&script, MITSUBA_SCRIPT).with_context(|| format!("writing {}", script.display()))?;
+    std::fs::write(&script, MITSUBA_SCRIPT)
+        .with_context(|| format!("writing {}", script.display()))?;
     let out = std::process::Command::new("python3")
         .arg(&script)
         .arg(scene)
-        .args(["--width", &width.to_string(), "--height", &height.to_string(), "--spp", &spp.to_string()])
+        .args([
+            "--width",
+            &width.to_string(),
+            "--height",
+            &height.to_string(),
+            "--spp",
+            &spp.to_string(),
+        ])
         .output()
         .context("running python3 for --mitsuba");
     let _ = std::fs::remove_dir_all(&dir);
@@ -124,13 +132,18 @@ fn time_mitsuba(scene: &str, width: u32, height: u32, spp: u32) -> Result<Mitsub
         }
     }
     let err = String::from_utf8_lossy(&out.stderr);
-    anyhow::bail!("--mitsuba: python3 failed ({}): {}", out.status, err.lines().last().unwrap_or("no output"))
+    anyhow::bail!(
+        "--mitsuba: python3 failed ({}): {}",
+        out.status,
+        err.lines().last().unwrap_or("no output")
+    )
 }
 
 /// Mitsuba's samples per second from `render_info.json` next to an oracle scene.
 fn mitsuba_rate(scene: &str) -> Option<f64> {
     let dir = std::path::Path::new(scene).parent()?;
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("render_info.json")).ok()?).ok()?;
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("render_info.json")).ok()?).ok()?;
     let r = v.get("reference.exr")?;
     let res = r.get("resolution")?.as_array()?;
     let px = res[0].as_f64()? * res[1].as_f64()?;
@@ -159,7 +172,8 @@ pub fn run(a: BenchArgs) -> Result<()> {
         let gscene = prepared.upload(&gpu);
         // Traversal: random rays from inside the bounds in uniformly random directions.
         let caster = Raycaster::new(&gpu, &gscene)?;
-        let half = (scene.bounds().map(|(lo, hi)| (hi - lo) * 0.5).unwrap_or(glam::DVec3::ONE)).as_vec3();
+        let half =
+            (scene.bounds().map(|(lo, hi)| (hi - lo) * 0.5).unwrap_or(glam::DVec3::ONE)).as_vec3();
         let mut rng = 0x9e3779b9u32;
         let mut r = move || {
             rng ^= rng << 13;
@@ -213,7 +227,11 @@ pub fn run(a: BenchArgs) -> Result<()> {
         spp: a.spp,
         layouts,
         mitsuba_samples_per_second: mitsuba_rate(&a.scene),
-        mitsuba_measured: if a.mitsuba { Some(time_mitsuba(&a.scene, a.width, a.height, a.spp)?) } else { None },
+        mitsuba_measured: if a.mitsuba {
+            Some(time_mitsuba(&a.scene, a.width, a.height, a.spp)?)
+        } else {
+            None
+        },
     };
     if a.json {
         println!("{}", serde_json::to_string_pretty(&res)?);
@@ -222,15 +240,29 @@ pub fn run(a: BenchArgs) -> Result<()> {
         for l in &res.layouts {
             println!(
                 "  {:6} build {:.3} s, {} nodes (depth {}), {:.2} M rays/s, {:.3} M samples/s, {:.1} MiB",
-                l.bvh, l.bvh_build_seconds, l.bvh_nodes, l.bvh_depth, l.rays_per_second / 1e6, l.samples_per_second / 1e6, l.gpu_bytes as f64 / 1048576.0
+                l.bvh,
+                l.bvh_build_seconds,
+                l.bvh_nodes,
+                l.bvh_depth,
+                l.rays_per_second / 1e6,
+                l.samples_per_second / 1e6,
+                l.gpu_bytes as f64 / 1048576.0
             );
         }
         if let Some(m) = res.mitsuba_samples_per_second {
-            println!("  Mitsuba 3 (scalar_rgb, CPU): {:.3} M samples/s (render_info.json)", m / 1e6);
+            println!(
+                "  Mitsuba 3 (scalar_rgb, CPU): {:.3} M samples/s (render_info.json)",
+                m / 1e6
+            );
         }
         if let Some(m) = &res.mitsuba_measured {
             let ours = res.layouts.iter().map(|l| l.samples_per_second).fold(0.0, f64::max);
-            println!("  Mitsuba 3 (scalar_rgb, CPU) in this run: {:.3} M samples/s ({:.2} s); Hush / Mitsuba {:.2}", m.samples_per_second / 1e6, m.seconds, ours / m.samples_per_second);
+            println!(
+                "  Mitsuba 3 (scalar_rgb, CPU) in this run: {:.3} M samples/s ({:.2} s); Hush / Mitsuba {:.2}",
+                m.samples_per_second / 1e6,
+                m.seconds,
+                ours / m.samples_per_second
+            );
         }
     }
     Ok(())

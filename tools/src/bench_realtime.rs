@@ -56,7 +56,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let size = (a.width, a.height);
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
     if !gpu.timestamps {
-        bail!("adapter {} has no timestamp queries; per-pass GPU times are not available", gpu.info.name);
+        bail!(
+            "adapter {} has no timestamp queries; per-pass GPU times are not available",
+            gpu.info.name
+        );
     }
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
@@ -72,8 +75,18 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let view = tex.create_view(&Default::default());
     let target = DisplayTarget { view: &view, format, size };
     let settings = match &a.preset {
-        Some(p) => FrameSettings { max_depth: crate::realtime::path_length(None, Some(p), r.scene.max_depth)?, ..crate::realtime::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)? },
-        None => FrameSettings { max_depth: r.scene.max_depth, ..crate::realtime::denoiser_settings(a.denoiser.as_deref().unwrap_or("mara"), &[], "diamond")? },
+        Some(p) => FrameSettings {
+            max_depth: crate::realtime::path_length(None, Some(p), r.scene.max_depth)?,
+            ..crate::realtime::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)?
+        },
+        None => FrameSettings {
+            max_depth: r.scene.max_depth,
+            ..crate::realtime::denoiser_settings(
+                a.denoiser.as_deref().unwrap_or("mara"),
+                &[],
+                "diamond",
+            )?
+        },
     };
     let camera = match &a.camera {
         Some(c) => crate::render::parse_camera(c)?,
@@ -96,7 +109,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         let recorded = start.elapsed();
         let spans = r.pass_spans(&gpu)?;
         if r.untimed_passes() > 0 {
-            bail!("{} passes of the frame found no timestamp slot; their time would be missing from the totals", r.untimed_passes());
+            bail!(
+                "{} passes of the frame found no timestamp slot; their time would be missing from the totals",
+                r.untimed_passes()
+            );
         }
         let closing = Instant::now();
         hush_engine::profile::end_frame();
@@ -119,7 +135,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let passes = per_pass
         .into_iter()
-        .map(|(pass, mut v)| PassTime { pass, min_ms: v.iter().cloned().fold(f64::MAX, f64::min), median_ms: median(&mut v) })
+        .map(|(pass, mut v)| PassTime {
+            pass,
+            min_ms: v.iter().cloned().fold(f64::MAX, f64::min),
+            median_ms: median(&mut v),
+        })
         .collect();
     if let (Some(c), Some(path)) = (capture, &a.profile) {
         let n = c.write(path)?;
@@ -142,11 +162,20 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&res)?);
     } else {
-        println!("{} ({} triangles) at {}x{} on {}, median of {} frames", res.scene, res.triangles, res.width, res.height, res.adapter, res.frames);
+        println!(
+            "{} ({} triangles) at {}x{} on {}, median of {} frames",
+            res.scene, res.triangles, res.width, res.height, res.adapter, res.frames
+        );
         for p in &res.passes {
             println!("  {:10} {:8.3} ms (min {:.3})", p.pass, p.median_ms, p.min_ms);
         }
-        println!("  GPU frame  {:8.3} ms; CPU frame {:.3} ms (recording {:.3} ms); {:.0} bytes/pixel", res.gpu_frame_median_ms, res.cpu_frame_median_ms, res.cpu_record_median_ms, res.bytes_per_pixel);
+        println!(
+            "  GPU frame  {:8.3} ms; CPU frame {:.3} ms (recording {:.3} ms); {:.0} bytes/pixel",
+            res.gpu_frame_median_ms,
+            res.cpu_frame_median_ms,
+            res.cpu_record_median_ms,
+            res.bytes_per_pixel
+        );
     }
     Ok(())
 }

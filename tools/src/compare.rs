@@ -19,17 +19,23 @@ pub struct CompareArgs {
 
 pub fn run(a: CompareArgs) -> Result<()> {
     let x = Image::load(&a.test).with_context(|| format!("test image {}", a.test.display()))?;
-    let mut y = Image::load(&a.reference).with_context(|| format!("reference image {}", a.reference.display()))?;
+    let mut y = Image::load(&a.reference)
+        .with_context(|| format!("reference image {}", a.reference.display()))?;
     // A render made at a fraction of the reference's resolution is compared with the
     // reference box-downsampled by that factor (each pixel is the mean over its footprint).
-    if y.width > x.width && x.width > 0 && y.width % x.width == 0 && y.height == x.height * (y.width / x.width) {
+    if y.width > x.width
+        && x.width > 0
+        && y.width % x.width == 0
+        && y.height == x.height * (y.width / x.width)
+    {
         let f = y.width / x.width;
         eprintln!("reference box-downsampled by {f} to {}x{}", x.width, x.height);
         y = y.box_downsample(f)?;
     }
     let m = compare(&x, &y)?;
     if let Some(path) = &a.flip_map {
-        hush_engine::quality::save_flip_heatmap(&x, &y, path).with_context(|| format!("writing {}", path.display()))?;
+        hush_engine::quality::save_flip_heatmap(&x, &y, path)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&m)?);
@@ -37,7 +43,10 @@ pub fn run(a: CompareArgs) -> Result<()> {
         println!("rmse              {:.6}", m.rmse);
         println!("relmse            {:.6}", m.relmse);
         println!("mae               {:.6}", m.mae);
-        println!("mean_rel_bias     {:+.4} {:+.4} {:+.4}", m.mean_rel_bias[0], m.mean_rel_bias[1], m.mean_rel_bias[2]);
+        println!(
+            "mean_rel_bias     {:+.4} {:+.4} {:+.4}",
+            m.mean_rel_bias[0], m.mean_rel_bias[1], m.mean_rel_bias[2]
+        );
         println!("ssim              {:.4}", m.ssim);
         println!("flip              {:.4}", m.flip);
         println!("nonfinite_pixels  {}", m.nonfinite_pixels);

@@ -55,11 +55,24 @@ struct LevelArgs {
 
 fn level(a: LevelArgs) -> Result<()> {
     if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
     }
-    let scene = hush_engine::scene::builtin_scene(&a.scene).ok_or_else(|| anyhow::anyhow!("--scene {:?}: no such built-in scene (one of {:?}, or terrain:N with N from 2 to {})", a.scene, hush_engine::scene::BUILTIN_SCENES, hush_engine::scene::MAX_TERRAIN_TRIANGLES))?;
+    let scene = hush_engine::scene::builtin_scene(&a.scene).ok_or_else(|| {
+        anyhow::anyhow!(
+            "--scene {:?}: no such built-in scene (one of {:?}, or terrain:N with N from 2 to {})",
+            a.scene,
+            hush_engine::scene::BUILTIN_SCENES,
+            hush_engine::scene::MAX_TERRAIN_TRIANGLES
+        )
+    })?;
     hush_engine::scene::save_gltf(&scene, &a.out)?;
-    eprintln!("wrote {} ({} triangles, {} objects)", a.out.display(), scene.triangle_count(), scene.objects.len());
+    eprintln!(
+        "wrote {} ({} triangles, {} objects)",
+        a.out.display(),
+        scene.triangle_count(),
+        scene.objects.len()
+    );
     Ok(())
 }
 

@@ -15,7 +15,9 @@ use clap::Args;
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::passes::matte::history_rejected;
-use hush_engine::quality::{Image, compare, compare_with_flip_map, luminance, region_mean, save_flip_heatmap};
+use hush_engine::quality::{
+    Image, compare, compare_with_flip_map, luminance, region_mean, save_flip_heatmap,
+};
 use hush_engine::scene::{CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings, stage_names};
 use std::io::Write;
@@ -109,14 +111,26 @@ impl Uncovered {
     /// Age the pixels by a frame and restart those whose matte history restarted in this one:
     /// the Mara matte temporal's flags (hush_engine::passes::matte::history_rejected), or
     /// SVGF's history length (h = 1 in the moments it wrote this frame, frame `index`).
-    fn update(&mut self, r: &Renderer, gpu: &Gpu, denoiser: &Denoiser, index: usize) -> Result<Vec<bool>> {
+    fn update(
+        &mut self,
+        r: &Renderer,
+        gpu: &Gpu,
+        denoiser: &Denoiser,
+        index: usize,
+    ) -> Result<Vec<bool>> {
         let rejected: Vec<bool> = if *denoiser == Denoiser::MARA {
-            let (reason, _) = r.read_texture(gpu, "matte/reason").context("reading the matte temporal's flags")?;
+            let (reason, _) = r
+                .read_texture(gpu, "matte/reason")
+                .context("reading the matte temporal's flags")?;
             history_rejected(&reason)
         } else {
             let name = format!("svgf/matte moments {}", 1 - index % 2);
-            let (moments, _) = r.read_texture(gpu, &name).with_context(|| format!("reading {name}"))?;
-            moments.chunks_exact(16).map(|m| f32::from_le_bytes(m[8..12].try_into().unwrap()) == 1.0).collect()
+            let (moments, _) =
+                r.read_texture(gpu, &name).with_context(|| format!("reading {name}"))?;
+            moments
+                .chunks_exact(16)
+                .map(|m| f32::from_le_bytes(m[8..12].try_into().unwrap()) == 1.0)
+                .collect()
         };
         for (age, rejected) in self.age.iter_mut().zip(rejected) {
             *age = if rejected { 0 } else { age.saturating_add(1) };
@@ -126,7 +140,14 @@ impl Uncovered {
 }
 
 impl Scores {
-    fn push(&mut self, img: &Image, prev: Option<&Image>, reference: &Image, ms: f64, uncovered: Option<&[bool]>) -> Result<()> {
+    fn push(
+        &mut self,
+        img: &Image,
+        prev: Option<&Image>,
+        reference: &Image,
+        ms: f64,
+        uncovered: Option<&[bool]>,
+    ) -> Result<()> {
         // With a region to score, the frame's FLIP map is kept rather than computed again.
         let (m, region) = match uncovered {
             Some(mask) => {
@@ -154,7 +175,12 @@ impl Scores {
 }
 
 pub fn temporal_error(a: &Image, b: &Image) -> f64 {
-    a.data.iter().zip(&b.data).map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64).sum::<f64>() / a.data.len() as f64
+    a.data
+        .iter()
+        .zip(&b.data)
+        .map(|(x, y)| (luminance(*x) - luminance(*y)).abs() as f64)
+        .sum::<f64>()
+        / a.data.len() as f64
 }
 
 struct Setup {
@@ -175,7 +201,11 @@ pub fn new_renderer(gpu: &Gpu, scene: &Scene, size: (u32, u32)) -> Result<Render
 }
 
 /// Render the stream with `settings`, scoring every frame against `references`.
-fn stream(s: &Setup, settings: &FrameSettings, references: &[Image]) -> Result<(Scores, Vec<Image>)> {
+fn stream(
+    s: &Setup,
+    settings: &FrameSettings,
+    references: &[Image],
+) -> Result<(Scores, Vec<Image>)> {
     let mut r = renderer(s)?;
     let mut scores = Scores::default();
     let mut prev: Option<Image> = None;
@@ -185,8 +215,10 @@ fn stream(s: &Setup, settings: &FrameSettings, references: &[Image]) -> Result<(
         r.render(&s.gpu, input, settings, None)?;
         let ms: f64 = r.pass_times(&s.gpu)?.iter().map(|p| p.1).sum();
         let img = r.read_hdr(&s.gpu)?;
-        let tracked = (settings.denoiser == Denoiser::MARA && settings.matte.temporal) || (settings.denoiser.name() == "svgf" && settings.svgf.temporal);
-        let mask = if tracked { Some(uncovered.update(&r, &s.gpu, &settings.denoiser, k)?) } else { None };
+        let tracked = (settings.denoiser == Denoiser::MARA && settings.matte.temporal)
+            || (settings.denoiser.name() == "svgf" && settings.svgf.temporal);
+        let mask =
+            if tracked { Some(uncovered.update(&r, &s.gpu, &settings.denoiser, k)?) } else { None };
         scores.push(&img, prev.as_ref(), &references[k], ms, mask.as_deref())?;
         if k + 1 == s.inputs.len() {
             last.push(img.clone());
@@ -202,7 +234,8 @@ pub fn run(a: QualityArgs) -> Result<()> {
         bail!("--frames and --reference-frames must be at least 1");
     }
     let denoiser = a.denoiser.as_deref().or(if a.preset.is_none() { Some("mara") } else { None });
-    let chains = preset_settings(a.preset.as_deref(), denoiser, &a.disable, a.reflection_mv.as_deref())?;
+    let chains =
+        preset_settings(a.preset.as_deref(), denoiser, &a.disable, a.reflection_mv.as_deref())?;
     let denoiser = chains.denoiser.clone();
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, Some(a.width), a.height);
@@ -213,25 +246,45 @@ pub fn run(a: QualityArgs) -> Result<()> {
     };
     let inputs: Vec<FrameInput> = (0..a.frames as usize)
         .map(|k| match &path {
-            Some(p) => FrameInput { camera: p.frame(k).camera(), time: p.frame(k).time, shutter: None },
-            None => FrameInput { camera, time: if a.fps > 0.0 { k as f64 / a.fps } else { 0.0 }, shutter: None },
+            Some(p) => {
+                FrameInput { camera: p.frame(k).camera(), time: p.frame(k).time, shutter: None }
+            }
+            None => FrameInput {
+                camera,
+                time: if a.fps > 0.0 { k as f64 / a.fps } else { 0.0 },
+                shutter: None,
+            },
         })
         .collect();
-    std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
+    std::fs::create_dir_all(&a.out_dir)
+        .with_context(|| format!("creating {}", a.out_dir.display()))?;
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
     let s = Setup { gpu, scene, size, inputs };
 
     // References: one accumulation per distinct (camera, time).
     let mut refr = renderer(&s)?;
-    let acc = FrameSettings { accumulate: true, seed: a.seed.wrapping_add(7919), max_depth: s.scene.max_depth, ..Default::default() };
+    let acc = FrameSettings {
+        accumulate: true,
+        seed: a.seed.wrapping_add(7919),
+        max_depth: s.scene.max_depth,
+        ..Default::default()
+    };
     let mut references: Vec<Image> = vec![];
     for (k, input) in s.inputs.iter().enumerate() {
         if k > 0 && s.inputs[k - 1] == *input {
             references.push(references[k - 1].clone());
             continue;
         }
-        let img = reference(&s.gpu, &mut refr, &a.scene, input, a.reference_frames, &acc, a.reference_cache.as_deref())?;
+        let img = reference(
+            &s.gpu,
+            &mut refr,
+            &a.scene,
+            input,
+            a.reference_frames,
+            &acc,
+            a.reference_cache.as_deref(),
+        )?;
         references.push(img);
     }
     // The yardstick: the last frame's view accumulated over 64 frames, raw, as the mean
@@ -246,7 +299,10 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let mut flips64 = vec![];
     let mut accumulated64 = None;
     for j in 0..a.yardstick_seeds.max(1) {
-        let yardstick = FrameSettings { seed: a.seed.wrapping_add(104729).wrapping_add(j.wrapping_mul(7)), ..acc.clone() };
+        let yardstick = FrameSettings {
+            seed: a.seed.wrapping_add(104729).wrapping_add(j.wrapping_mul(7)),
+            ..acc.clone()
+        };
         for _ in 0..64 {
             accumulator.render(&s.gpu, &last_input, &yardstick, None)?;
         }
@@ -256,17 +312,21 @@ pub fn run(a: QualityArgs) -> Result<()> {
     }
     let accumulated64 = accumulated64.expect("at least one yardstick accumulation");
     let flip64 = flips64.iter().sum::<f64>() / flips64.len() as f64;
-    let (lo64, hi64) = flips64.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &f| (l.min(f), h.max(f)));
+    let (lo64, hi64) =
+        flips64.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &f| (l.min(f), h.max(f)));
     drop(accumulator);
 
     let max_depth = crate::realtime::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
     let (den, last) = stream(&s, &base, &references)?;
-    let (raw, last_raw) = stream(&s, &FrameSettings { denoiser: Denoiser::NONE, ..base.clone() }, &references)?;
+    let (raw, last_raw) =
+        stream(&s, &FrameSettings { denoiser: Denoiser::NONE, ..base.clone() }, &references)?;
     if let (Some(d), Some(r), Some(f)) = (last.first(), last_raw.first(), references.last()) {
         // The last frame as seen and in linear HDR, and where FLIP sees the error (denoised and
         // the 64-spp yardstick side by side show whether the denoiser's error is noise or bias).
-        for (name, img) in [("denoised", d), ("raw", r), ("reference", f), ("accumulated64", &accumulated64)] {
+        for (name, img) in
+            [("denoised", d), ("raw", r), ("reference", f), ("accumulated64", &accumulated64)]
+        {
             img.save(&a.out_dir.join(format!("last_{name}.png")))?;
             img.save(&a.out_dir.join(format!("last_{name}.exr")))?;
         }
@@ -275,8 +335,13 @@ pub fn run(a: QualityArgs) -> Result<()> {
     }
     write_csv(&a.out_dir.join("quality.csv"), &s.inputs, &den, &raw)?;
     plot(&a.out_dir.join("quality.png"), &den, &raw, &a.scene)?;
-    println!("{} at {}x{}, {} frames ({} reference frames each), on {}", a.scene, size.0, size.1, a.frames, a.reference_frames, s.gpu.info.name);
-    println!("  stream     mean FLIP  mean relMSE  mean SSIM  temporal error  GPU ms/frame   (second half of the stream)");
+    println!(
+        "{} at {}x{}, {} frames ({} reference frames each), on {}",
+        a.scene, size.0, size.1, a.frames, a.reference_frames, s.gpu.info.name
+    );
+    println!(
+        "  stream     mean FLIP  mean relMSE  mean SSIM  temporal error  GPU ms/frame   (second half of the stream)"
+    );
     for (name, sc) in [("denoised", &den), ("raw", &raw)] {
         println!(
             "  {name:9}  {:9.4}  {:11.5}  {:9.4}  {:14.5}  {:12.2}",
@@ -295,21 +360,46 @@ pub fn run(a: QualityArgs) -> Result<()> {
         flips64.len()
     );
     let per_seed: Vec<String> = flips64.iter().map(|f| format!("{f:.5}")).collect();
-    std::fs::write(a.out_dir.join("accumulated64_flip.txt"), format!("{flip64:.5}\n{}\n", per_seed.join(",")))?;
+    std::fs::write(
+        a.out_dir.join("accumulated64_flip.txt"),
+        format!("{flip64:.5}\n{}\n", per_seed.join(",")),
+    )?;
 
     if a.ablations && denoiser != Denoiser::NONE {
         let mut f = std::fs::File::create(a.out_dir.join("ablations.csv"))?;
         writeln!(f, "disabled,flip,relmse,ssim,temporal_error,gpu_ms")?;
         let mut row = |name: &str, sc: &Scores| -> Result<()> {
-            writeln!(f, "{name},{:.5},{:.6},{:.5},{:.6},{:.3}", Scores::settled(&sc.flip), Scores::settled(&sc.relmse), Scores::settled(&sc.ssim), Scores::settled(&sc.temporal), Scores::settled(&sc.gpu_ms))?;
-            println!("  without {name:24} FLIP {:.4} temporal error {:.5} GPU {:.2} ms", Scores::settled(&sc.flip), Scores::settled(&sc.temporal), Scores::settled(&sc.gpu_ms));
+            writeln!(
+                f,
+                "{name},{:.5},{:.6},{:.5},{:.6},{:.3}",
+                Scores::settled(&sc.flip),
+                Scores::settled(&sc.relmse),
+                Scores::settled(&sc.ssim),
+                Scores::settled(&sc.temporal),
+                Scores::settled(&sc.gpu_ms)
+            )?;
+            println!(
+                "  without {name:24} FLIP {:.4} temporal error {:.5} GPU {:.2} ms",
+                Scores::settled(&sc.flip),
+                Scores::settled(&sc.temporal),
+                Scores::settled(&sc.gpu_ms)
+            );
             Ok(())
         };
         row("nothing", &den)?;
         // The stages of the denoiser under test, and TAA.
         let prefix = format!("{}.", if denoiser == Denoiser::MARA { "" } else { denoiser.name() });
-        let own = |stage: &str| if denoiser == Denoiser::MARA { stage.starts_with("matte.") || stage.starts_with("glossy.") } else { stage.starts_with(&prefix) };
-        for stage in stage_names().into_iter().filter(|s| own(s) || *s == hush_engine::settings::TaaSettings::STAGE) {
+        let own = |stage: &str| {
+            if denoiser == Denoiser::MARA {
+                stage.starts_with("matte.") || stage.starts_with("glossy.")
+            } else {
+                stage.starts_with(&prefix)
+            }
+        };
+        for stage in stage_names()
+            .into_iter()
+            .filter(|s| own(s) || *s == hush_engine::settings::TaaSettings::STAGE)
+        {
             let mut settings = base.clone();
             hush_engine::settings::disable_stage(&mut settings, stage);
             let (sc, _) = stream(&s, &settings, &references)?;
@@ -321,7 +411,13 @@ pub fn run(a: QualityArgs) -> Result<()> {
 
 /// What a reference depends on, hashed with FNV-1a: the standard library's hasher may change
 /// between Rust releases, and a cache key has to outlive the build that wrote it.
-pub fn reference_cache_key(scene: &str, size: (u32, u32), input: &FrameInput, frames: u32, acc: &FrameSettings) -> u64 {
+pub fn reference_cache_key(
+    scene: &str,
+    size: (u32, u32),
+    input: &FrameInput,
+    frames: u32,
+    acc: &FrameSettings,
+) -> u64 {
     // A scene file's size and modification time stand for its content. `default` and `level`
     // are built in: their key changes with Hush's version only, so clear the cache after
     // editing them.
@@ -329,20 +425,43 @@ pub fn reference_cache_key(scene: &str, size: (u32, u32), input: &FrameInput, fr
         Ok(m) => format!("{} {:?}", m.len(), m.modified().ok()),
         Err(_) => format!("built-in {}", env!("CARGO_PKG_VERSION")),
     };
-    let key = format!("{scene} {stamp} {size:?} {input:?} {frames} {} {:?}", acc.seed, acc.max_depth);
-    key.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
+    let key =
+        format!("{scene} {stamp} {size:?} {input:?} {frames} {} {:?}", acc.seed, acc.max_depth);
+    key.bytes()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
 }
 
 /// The real-time frame of `input` accumulated over `frames` frames with `acc` (the converged
 /// image every stream is scored against), from `cache` when it holds it, else rendered and
 /// kept there.
-pub fn reference(gpu: &Gpu, r: &mut Renderer, scene: &str, input: &FrameInput, frames: u32, acc: &FrameSettings, cache: Option<&Path>) -> Result<Image> {
+pub fn reference(
+    gpu: &Gpu,
+    r: &mut Renderer,
+    scene: &str,
+    input: &FrameInput,
+    frames: u32,
+    acc: &FrameSettings,
+    cache: Option<&Path>,
+) -> Result<Image> {
     let size = r.size();
-    let cached = cache.map(|dir| dir.join(format!("reference_{:016x}.exr", reference_cache_key(scene, size, input, frames, acc))));
+    let cached = cache.map(|dir| {
+        dir.join(format!(
+            "reference_{:016x}.exr",
+            reference_cache_key(scene, size, input, frames, acc)
+        ))
+    });
     if let Some(path) = cached.as_ref().filter(|p| p.exists()) {
-        let img = Image::load(path).with_context(|| format!("reading the cached reference {}", path.display()))?;
+        let img = Image::load(path)
+            .with_context(|| format!("reading the cached reference {}", path.display()))?;
         if (img.width, img.height) != size {
-            bail!("cached reference {} is {}x{}, not {}x{}", path.display(), img.width, img.height, size.0, size.1);
+            bail!(
+                "cached reference {} is {}x{}, not {}x{}",
+                path.display(),
+                img.width,
+                img.height,
+                size.0,
+                size.1
+            );
         }
         return Ok(img);
     }
@@ -354,18 +473,27 @@ pub fn reference(gpu: &Gpu, r: &mut Renderer, scene: &str, input: &FrameInput, f
     }
     let img = r.read_hdr(gpu)?;
     if let Some(path) = &cached {
-        std::fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).with_context(|| format!("creating the folder of {}", path.display()))?;
+        std::fs::create_dir_all(path.parent().unwrap_or(Path::new(".")))
+            .with_context(|| format!("creating the folder of {}", path.display()))?;
         img.save(path)?;
     }
     Ok(img)
 }
 
 fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> Result<()> {
-    let mut f = std::fs::File::create(path).with_context(|| format!("writing {}", path.display()))?;
-    writeln!(f, "frame,time,flip,relmse,ssim,temporal_error,gpu_ms,raw_flip,raw_relmse,raw_ssim,raw_temporal_error,raw_gpu_ms,uncovered_flip,uncovered_pixels")?;
+    let mut f =
+        std::fs::File::create(path).with_context(|| format!("writing {}", path.display()))?;
+    writeln!(
+        f,
+        "frame,time,flip,relmse,ssim,temporal_error,gpu_ms,raw_flip,raw_relmse,raw_ssim,raw_temporal_error,raw_gpu_ms,uncovered_flip,uncovered_pixels"
+    )?;
     for k in 0..inputs.len() {
         // The denoised stream's uncovered pixels; blank where there are none.
-        let uncovered = if den.uncovered_pixels[k] > 0 { format!("{:.5}", den.uncovered_flip[k]) } else { String::new() };
+        let uncovered = if den.uncovered_pixels[k] > 0 {
+            format!("{:.5}", den.uncovered_flip[k])
+        } else {
+            String::new()
+        };
         writeln!(
             f,
             "{k},{:.4},{:.5},{:.6},{:.5},{:.6},{:.3},{:.5},{:.6},{:.5},{:.6},{:.3},{uncovered},{}",
@@ -390,11 +518,18 @@ fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> 
 fn plot(path: &Path, den: &Scores, raw: &Scores, title: &str) -> Result<()> {
     use plotters::prelude::*;
     // Text needs a font; egui's default font is a crate away and always the same.
-    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+    let _ = plotters::style::register_font(
+        "sans-serif",
+        FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    );
     let root = BitMapBackend::new(path, (960, 720)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| anyhow::anyhow!("plot: {e}"))?;
     let panels = root.split_evenly((2, 1));
-    let series = [("FLIP", &den.flip, &raw.flip), ("temporal error (mean |dY|)", &den.temporal, &raw.temporal)];
+    let series = [
+        ("FLIP", &den.flip, &raw.flip),
+        ("temporal error (mean |dY|)", &den.temporal, &raw.temporal),
+    ];
     for (area, (name, d, r)) in panels.iter().zip(series) {
         let n = d.len().max(2);
         let hi = d.iter().chain(r.iter()).cloned().fold(0.0f64, f64::max).max(1e-6) * 1.05;
@@ -416,7 +551,12 @@ fn plot(path: &Path, den: &Scores, raw: &Scores, title: &str) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("plot: {e}"))?
             .label("raw")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
     }
     root.present().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
     Ok(())

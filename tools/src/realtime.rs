@@ -1,10 +1,15 @@
 //! `hush-cli render --mode realtime`: the hybrid frame, headless and deterministic.
 
-use crate::render::{RenderArgs, bvh_kind, check_output, check_output_dir, check_sides, image_size, load_scene, parse_camera};
+use crate::render::{
+    RenderArgs, bvh_kind, check_output, check_output_dir, check_sides, image_size, load_scene,
+    parse_camera,
+};
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::scene::CameraPath;
-use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv, SampleFraction, disable_stage, stage_names};
+use hush_engine::settings::{
+    Denoiser, FrameSettings, ReflectionMv, SampleFraction, disable_stage, stage_names,
+};
 
 pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
     match hush_engine::denoise::find(s) {
@@ -14,13 +19,22 @@ pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
 }
 
 /// `--denoiser`, `--disable` and `--reflection-mv` applied to default settings.
-pub fn denoiser_settings(denoiser: &str, disable: &[String], reflection_mv: &str) -> Result<FrameSettings> {
+pub fn denoiser_settings(
+    denoiser: &str,
+    disable: &[String],
+    reflection_mv: &str,
+) -> Result<FrameSettings> {
     chain_settings(FrameSettings::default(), Some(denoiser), disable, Some(reflection_mv))
 }
 
 /// The settings of `--preset` (or the defaults) with `--denoiser`, `--disable` and
 /// `--reflection-mv` applied where given.
-pub fn preset_settings(preset: Option<&std::path::Path>, denoiser: Option<&str>, disable: &[String], reflection_mv: Option<&str>) -> Result<FrameSettings> {
+pub fn preset_settings(
+    preset: Option<&std::path::Path>,
+    denoiser: Option<&str>,
+    disable: &[String],
+    reflection_mv: Option<&str>,
+) -> Result<FrameSettings> {
     let base = preset.map(FrameSettings::load_preset).transpose()?.unwrap_or_default();
     chain_settings(base, denoiser, disable, reflection_mv)
 }
@@ -28,7 +42,11 @@ pub fn preset_settings(preset: Option<&std::path::Path>, denoiser: Option<&str>,
 /// The path length of a run: --max-depth, else the preset's if it names one, else the scene's
 /// (a preset that leaves it out must not fall back to the default's, which is not the scene's
 /// and not what its references are rendered with).
-pub fn path_length(max_depth: Option<i32>, preset: Option<&std::path::Path>, scene_depth: i32) -> Result<i32> {
+pub fn path_length(
+    max_depth: Option<i32>,
+    preset: Option<&std::path::Path>,
+    scene_depth: i32,
+) -> Result<i32> {
     if let Some(d) = max_depth {
         return Ok(d);
     }
@@ -38,7 +56,12 @@ pub fn path_length(max_depth: Option<i32>, preset: Option<&std::path::Path>, sce
     })
 }
 
-fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[String], reflection_mv: Option<&str>) -> Result<FrameSettings> {
+fn chain_settings(
+    mut s: FrameSettings,
+    denoiser: Option<&str>,
+    disable: &[String],
+    reflection_mv: Option<&str>,
+) -> Result<FrameSettings> {
     if let Some(d) = denoiser {
         s.denoiser = parse_denoiser(d)?;
     }
@@ -48,7 +71,8 @@ fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[Strin
         }
     }
     if let Some(mv) = reflection_mv {
-        s.glossy.reflection_mv = ReflectionMv::parse(mv).with_context(|| format!("--reflection-mv {mv:?}: use diamond, virtual or primary"))?;
+        s.glossy.reflection_mv = ReflectionMv::parse(mv)
+            .with_context(|| format!("--reflection-mv {mv:?}: use diamond, virtual or primary"))?;
     }
     Ok(s)
 }
@@ -56,11 +80,22 @@ fn chain_settings(mut s: FrameSettings, denoiser: Option<&str>, disable: &[Strin
 /// Frame `k`'s input: the camera path's key k (its time; the shutter a fraction of the interval
 /// since the key before, or of 1 / fps where keys share a time, the camera at the open
 /// interpolated along the path), or the still `camera` at `time` (the interval 1 / fps).
-fn frame_input(path: Option<&CameraPath>, camera: hush_engine::scene::Camera, k: u32, time: f64, shutter: f64, fps: f64) -> FrameInput {
+fn frame_input(
+    path: Option<&CameraPath>,
+    camera: hush_engine::scene::Camera,
+    k: u32,
+    time: f64,
+    shutter: f64,
+    fps: f64,
+) -> FrameInput {
     match path {
         Some(p) => {
             let key = p.frame(k as usize);
-            let spacing = if k > 0 && (k as usize) < p.keys.len() { key.time - p.frame(k as usize - 1).time } else { 0.0 };
+            let spacing = if k > 0 && (k as usize) < p.keys.len() {
+                key.time - p.frame(k as usize - 1).time
+            } else {
+                0.0
+            };
             let dt = if spacing > 0.0 { spacing } else { 1.0 / fps };
             FrameInput::exposed(|t| p.camera_at(t), key.time, shutter, dt)
         }
@@ -69,7 +104,12 @@ fn frame_input(path: Option<&CameraPath>, camera: hush_engine::scene::Camera, k:
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    let chains = preset_settings(a.preset.as_deref(), a.denoiser.as_deref(), &a.disable, a.reflection_mv.as_deref())?;
+    let chains = preset_settings(
+        a.preset.as_deref(),
+        a.denoiser.as_deref(),
+        &a.disable,
+        a.reflection_mv.as_deref(),
+    )?;
     let frames = a.frames.unwrap_or(1);
     if frames == 0 {
         bail!("--frames must be at least 1");
@@ -78,15 +118,21 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let Some(crate::render::Spp::Samples(spp)) = a.spp
         && spp > max_spp
     {
-        bail!("--spp {spp}: real-time mode takes at most {max_spp} samples per pixel per frame; use --frames (or --accumulate) for more");
+        bail!(
+            "--spp {spp}: real-time mode takes at most {max_spp} samples per pixel per frame; use --frames (or --accumulate) for more"
+        );
     }
     let fps = crate::render::fps(&a)?;
     let shutter = crate::render::shutter(&a)?;
     if a.time.is_some() {
-        bail!("--time applies to reference mode; real-time mode's frames run at --fps (or the camera path's times)");
+        bail!(
+            "--time applies to reference mode; real-time mode's frames run at --fps (or the camera path's times)"
+        );
     }
     match (&a.out, &a.view) {
-        (None, None) if a.out_dir.is_none() => bail!("real-time mode needs --out FILE (last frame) or --out-dir DIR (every frame)"),
+        (None, None) if a.out_dir.is_none() => {
+            bail!("real-time mode needs --out FILE (last frame) or --out-dir DIR (every frame)")
+        }
         (None, Some(_)) => bail!("--view needs --out FILE.png"),
         (Some(out), Some(_)) => check_output(out, &["png"], "--out (what --view shows)")?,
         (Some(out), None) => check_output(out, &["exr", "png"], "--out")?,
@@ -98,7 +144,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         .map(|name| {
             let v = View::named(name);
             if !v.is_final() && v.spec().is_none() {
-                let names: Vec<&str> = std::iter::once(View::FINAL.name()).chain(hush_engine::settings::all_views().iter().map(|v| v.name)).collect();
+                let names: Vec<&str> = std::iter::once(View::FINAL.name())
+                    .chain(hush_engine::settings::all_views().iter().map(|v| v.name))
+                    .collect();
                 bail!("--view {name:?}: use one of {}", names.join(", "));
             }
             Ok(v)
@@ -117,7 +165,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let size = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
     if let Some(v) = &view {
-        if v.spec().is_some_and(|s| s.needs_glossy()) && !hush_engine::gpu::PreparedScene::glossy_materials(&scene) {
+        if v.spec().is_some_and(|s| s.needs_glossy())
+            && !hush_engine::gpu::PreparedScene::glossy_materials(&scene)
+        {
             bail!("--view {}: the scene has no glossy buffers", v.name());
         }
     }
@@ -133,7 +183,16 @@ pub fn run(a: RenderArgs) -> Result<()> {
         bail!("--primary-samples {primary_samples}: use 1 to {max_primary}");
     }
     let prefilter = chains.prefilter && !a.no_prefilter;
-    let settings = FrameSettings { max_depth, seed: a.seed, accumulate: a.accumulate || chains.accumulate, samples_per_pixel, sample_fraction, primary_samples, prefilter, ..chains };
+    let settings = FrameSettings {
+        max_depth,
+        seed: a.seed,
+        accumulate: a.accumulate || chains.accumulate,
+        samples_per_pixel,
+        sample_fraction,
+        primary_samples,
+        prefilter,
+        ..chains
+    };
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
@@ -141,13 +200,29 @@ pub fn run(a: RenderArgs) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     if let Some(target) = a.target_ms {
-        let inputs = (0..frames).map(|k| frame_input(path.as_ref(), camera, k, k as f64 / fps, shutter, fps));
+        let inputs = (0..frames)
+            .map(|k| frame_input(path.as_ref(), camera, k, k as f64 / fps, shutter, fps));
         let pinned = a.spp.is_some().then_some(settings.sample_fraction);
-        let rows = governed(&gpu, &mut r, &settings, inputs, target, a.min_scale.unwrap_or(0.25), pinned, size, a.out_dir.as_deref())?;
+        let rows = governed(
+            &gpu,
+            &mut r,
+            &settings,
+            inputs,
+            target,
+            a.min_scale.unwrap_or(0.25),
+            pinned,
+            size,
+            a.out_dir.as_deref(),
+        )?;
         let mut wall: Vec<f64> = rows.iter().map(|r| r.wall_ms).collect();
         wall.sort_by(f64::total_cmp);
         let pct = |q: f64| wall[((wall.len() - 1) as f64 * q).round() as usize];
-        eprintln!("{name}: {frames} frames governed to {target} ms: wall median {:.1} ms, 95th percentile {:.1} ms on {}", pct(0.5), pct(0.95), gpu.info.name);
+        eprintln!(
+            "{name}: {frames} frames governed to {target} ms: wall median {:.1} ms, 95th percentile {:.1} ms on {}",
+            pct(0.5),
+            pct(0.95),
+            gpu.info.name
+        );
         if let Some(out) = &a.out {
             r.read_hdr(&gpu)?.save(out)?;
         }
@@ -155,7 +230,14 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     for k in 0..frames {
         // Accumulation needs a frozen clock; otherwise time advances at --fps.
-        let input = frame_input(path.as_ref(), camera, k, if a.accumulate { 0.0 } else { k as f64 / fps }, shutter, fps);
+        let input = frame_input(
+            path.as_ref(),
+            camera,
+            k,
+            if a.accumulate { 0.0 } else { k as f64 / fps },
+            shutter,
+            fps,
+        );
         r.render(&gpu, &input, &settings, None)?;
         if let Some(dir) = &a.out_dir {
             r.read_hdr(&gpu)?.save(&dir.join(format!("frame_{k:05}.exr")))?;
@@ -192,27 +274,54 @@ pub struct GovernedFrame {
 /// tell the governor what it cost: the frame's wall time (resize, render and its timings read
 /// back, which waits for the device) and its trace time. `last_camera` tells it whether the
 /// camera moved.
-pub fn governed_frame(gpu: &hush_engine::gpu::Gpu, r: &mut Renderer, g: &mut hush_engine::governor::Governor, settings: &FrameSettings, input: &FrameInput, full: (u32, u32), last_camera: &mut Option<hush_engine::scene::Camera>) -> Result<GovernedFrame> {
+pub fn governed_frame(
+    gpu: &hush_engine::gpu::Gpu,
+    r: &mut Renderer,
+    g: &mut hush_engine::governor::Governor,
+    settings: &FrameSettings,
+    input: &FrameInput,
+    full: (u32, u32),
+    last_camera: &mut Option<hush_engine::scene::Camera>,
+) -> Result<GovernedFrame> {
     let c = g.choice();
-    let size = ((full.0 as f32 * c.scale).round().max(1.0) as u32, (full.1 as f32 * c.scale).round().max(1.0) as u32);
+    let size = (
+        (full.0 as f32 * c.scale).round().max(1.0) as u32,
+        (full.1 as f32 * c.scale).round().max(1.0) as u32,
+    );
     let s = FrameSettings { sample_fraction: c.fraction, ..settings.clone() };
     let start = std::time::Instant::now();
     r.resize(gpu, size)?;
     r.render(gpu, input, &s, None)?;
     let passes = r.pass_times(gpu)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let trace_ms = passes.iter().filter(|p| p.0 == hush_engine::passes::trace::LABEL).map(|p| p.1).sum();
+    let trace_ms =
+        passes.iter().filter(|p| p.0 == hush_engine::passes::trace::LABEL).map(|p| p.1).sum();
     let moving = last_camera.is_some_and(|l| l != input.camera);
     *last_camera = Some(input.camera);
     g.record(hush_engine::governor::FrameCost { wall_ms, trace_ms, choice: c, moving });
-    Ok(GovernedFrame { wall_ms, gpu_ms: passes.iter().map(|p| p.1).sum(), spp: s.samples_per_pixel as f64 / c.fraction.period() as f64, size })
+    Ok(GovernedFrame {
+        wall_ms,
+        gpu_ms: passes.iter().map(|p| p.1).sum(),
+        spp: s.samples_per_pixel as f64 / c.fraction.period() as f64,
+        size,
+    })
 }
 
 /// Render `inputs` with the governor holding `target_ms` (hush_engine::governor): before each
 /// frame the renderer takes the governor's scale of `full` and its sample fraction; after it,
 /// the frame's wall time (render and its timings read back) and trace time go back to it.
 #[allow(clippy::too_many_arguments)]
-fn governed(gpu: &hush_engine::gpu::Gpu, r: &mut Renderer, settings: &FrameSettings, inputs: impl Iterator<Item = FrameInput>, target_ms: f64, min_scale: f32, pinned: Option<SampleFraction>, full: (u32, u32), out_dir: Option<&std::path::Path>) -> Result<Vec<GovernedFrame>> {
+fn governed(
+    gpu: &hush_engine::gpu::Gpu,
+    r: &mut Renderer,
+    settings: &FrameSettings,
+    inputs: impl Iterator<Item = FrameInput>,
+    target_ms: f64,
+    min_scale: f32,
+    pinned: Option<SampleFraction>,
+    full: (u32, u32),
+    out_dir: Option<&std::path::Path>,
+) -> Result<Vec<GovernedFrame>> {
     if !(target_ms > 0.0 && target_ms.is_finite()) {
         bail!("--target-ms must be a positive number of milliseconds");
     }
@@ -234,7 +343,10 @@ fn governed(gpu: &hush_engine::gpu::Gpu, r: &mut Renderer, settings: &FrameSetti
     if let Some(dir) = out_dir {
         let mut csv = String::from("frame,wall_ms,gpu_ms,spp,width,height\n");
         for (k, f) in rows.iter().enumerate() {
-            csv += &format!("{k},{:.3},{:.3},{},{},{}\n", f.wall_ms, f.gpu_ms, f.spp, f.size.0, f.size.1);
+            csv += &format!(
+                "{k},{:.3},{:.3},{},{},{}\n",
+                f.wall_ms, f.gpu_ms, f.spp, f.size.0, f.size.1
+            );
         }
         let path = dir.join("frames.csv");
         std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;

@@ -75,7 +75,8 @@ fn mask(r: &Renderer, gpu: &Gpu, threshold: f32) -> Result<Mask> {
     let (spec, _) = r.read_texture(gpu, "gbuffer/specular")?;
     let (ids, _) = r.read_texture(gpu, "gbuffer/ids")?;
     let n = ids.len() / 8;
-    let mut m = Mask { glossy: vec![false; n], reflective: vec![false; n], roughness: vec![1.0; n] };
+    let mut m =
+        Mask { glossy: vec![false; n], reflective: vec![false; n], roughness: vec![1.0; n] };
     for i in 0..n {
         let hit = u32::from_le_bytes(ids[i * 8 + 4..i * 8 + 8].try_into().unwrap()) != u32::MAX;
         let f0 = spec[i * 4..i * 4 + 3].iter().copied().max().unwrap_or(0);
@@ -91,7 +92,12 @@ fn read_vec4(r: &Renderer, gpu: &Gpu, name: &str) -> Result<Vec<[f32; 4]>> {
     let (bytes, format) = r.read_texture(gpu, name)?;
     Ok(match format {
         wgpu::TextureFormat::Rgba32Float => bytemuck::cast_slice::<u8, [f32; 4]>(&bytes).to_vec(),
-        _ => bytes.chunks_exact(8).map(|c| std::array::from_fn(|k| half::f16::from_le_bytes([c[2 * k], c[2 * k + 1]]).to_f32())).collect(),
+        _ => bytes
+            .chunks_exact(8)
+            .map(|c| {
+                std::array::from_fn(|k| half::f16::from_le_bytes([c[2 * k], c[2 * k + 1]]).to_f32())
+            })
+            .collect(),
     })
 }
 
@@ -140,7 +146,8 @@ fn strafed(c: Camera, offset: f64) -> Camera {
 
 pub fn run(a: ReflectionsArgs) -> Result<()> {
     crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
-    std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
+    std::fs::create_dir_all(&a.out_dir)
+        .with_context(|| format!("creating {}", a.out_dir.display()))?;
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, Some(a.width), a.height);
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
@@ -150,7 +157,8 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     if !svgf && base.denoiser != hush_engine::settings::Denoiser::MARA {
         anyhow::bail!("--denoiser {}: reflections measures mara or svgf", a.denoiser);
     }
-    let threshold = if svgf { base.svgf.roughness_threshold } else { base.glossy.roughness_threshold };
+    let threshold =
+        if svgf { base.svgf.roughness_threshold } else { base.glossy.roughness_threshold };
     // What the glossy denoiser writes for the composite.
     let glossy_output = if svgf { "svgf/glossy out" } else { "glossy/denoised" };
     let camera = scene.camera_or_default();
@@ -161,7 +169,10 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     // 1. Temporal error, still camera and scene: the chain's output on a still raster (TAA off:
     // its sub-pixel jitter changes what every pixel samples, and that aliasing is TAA's to
     // remove), and the final image with TAA on glossy pixels.
-    println!("  still camera, {} frames: temporal error (mean |dY| on glossy pixels, second half)", a.frames);
+    println!(
+        "  still camera, {} frames: temporal error (mean |dY| on glossy pixels, second half)",
+        a.frames
+    );
     println!("    {:16} {:>14} {:>14} {:>14}", "", "chain output", "final image", "raw glossy");
     let mut still = vec![];
     for (name, s) in configs(&base) {
@@ -178,12 +189,24 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
                 let y: Vec<f32> = if taa {
                     r.read_hdr(&gpu)?.data.iter().map(|v| luminance(*v)).collect()
                 } else {
-                    read_vec4(&r, &gpu, glossy_output)?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect()
+                    read_vec4(&r, &gpu, glossy_output)?
+                        .iter()
+                        .map(|v| luminance(Vec3::new(v[0], v[1], v[2])))
+                        .collect()
                 };
-                let raw: Vec<f32> = read_vec4(&r, &gpu, "trace/glossy")?.iter().map(|v| luminance(Vec3::new(v[0], v[1], v[2]))).collect();
+                let raw: Vec<f32> = read_vec4(&r, &gpu, "trace/glossy")?
+                    .iter()
+                    .map(|v| luminance(Vec3::new(v[0], v[1], v[2])))
+                    .collect();
                 if let Some((p, pr)) = &prev {
-                    chain_err.push(masked_mean(y.iter().zip(p).map(|(a, b)| (a - b).abs() as f64), &m.glossy));
-                    raw_err.push(masked_mean(raw.iter().zip(pr).map(|(a, b)| (a - b).abs() as f64), &m.glossy));
+                    chain_err.push(masked_mean(
+                        y.iter().zip(p).map(|(a, b)| (a - b).abs() as f64),
+                        &m.glossy,
+                    ));
+                    raw_err.push(masked_mean(
+                        raw.iter().zip(pr).map(|(a, b)| (a - b).abs() as f64),
+                        &m.glossy,
+                    ));
                 }
                 prev = Some((y, raw));
             }
@@ -200,13 +223,23 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     if let Some(off) = still.iter().find(|s| s.0 == "no reprojection").cloned() {
         for (name, chain, fin) in &still {
             if *name != "no reprojection" {
-                println!("    no reprojection / {name}: {:.2}x (chain output), {:.2}x (final image)", off.1 / chain.max(1e-12), off.2 / fin.max(1e-12));
+                println!(
+                    "    no reprojection / {name}: {:.2}x (chain output), {:.2}x (final image)",
+                    off.1 / chain.max(1e-12),
+                    off.2 / fin.max(1e-12)
+                );
             }
         }
     }
 
     // 2. Camera strafe: references, then each configuration.
-    let inputs: Vec<FrameInput> = (0..a.path_frames).map(|k| FrameInput { camera: strafed(camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step), time: k as f64 / 30.0, shutter: None }).collect();
+    let inputs: Vec<FrameInput> = (0..a.path_frames)
+        .map(|k| FrameInput {
+            camera: strafed(camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step),
+            time: k as f64 / 30.0,
+            shutter: None,
+        })
+        .collect();
     let mut refr = new_renderer(&gpu, &scene, size)?;
     let acc = FrameSettings { accumulate: true, seed: 7919, ..Default::default() };
     let mut references: Vec<Image> = vec![];
@@ -217,7 +250,10 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
         references.push(refr.read_hdr(&gpu)?);
     }
     drop(refr);
-    println!("  camera strafe, {} frames ({} reference frames each): FLIP of reflective pixels, and of the ghost region", a.path_frames, a.reference_frames);
+    println!(
+        "  camera strafe, {} frames ({} reference frames each): FLIP of reflective pixels, and of the ghost region",
+        a.path_frames, a.reference_frames
+    );
     let mut flips = std::fs::File::create(a.out_dir.join("strafe.csv"))?;
     writeln!(flips, "frame,config,flip_reflective,flip_ghost_region")?;
     for (name, s) in configs(&base) {
@@ -233,7 +269,16 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
             let ghost: Vec<bool> = if k == 0 {
                 vec![false; f.len()]
             } else {
-                references[k].data.iter().zip(&references[k - 1].data).zip(&m.reflective).map(|((c, p), r)| *r && ((luminance(*c) - luminance(*p)).abs() > 0.2 * luminance(*c).max(luminance(*p)).max(0.02))).collect()
+                references[k]
+                    .data
+                    .iter()
+                    .zip(&references[k - 1].data)
+                    .zip(&m.reflective)
+                    .map(|((c, p), r)| {
+                        *r && ((luminance(*c) - luminance(*p)).abs()
+                            > 0.2 * luminance(*c).max(luminance(*p)).max(0.02))
+                    })
+                    .collect()
             };
             let g = masked_mean(f.iter().map(|v| *v as f64), &ghost);
             writeln!(flips, "{k},{name},{refl:.5},{g:.5}")?;
@@ -244,7 +289,11 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
             }
         }
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-        println!("    {name:16} reflective FLIP {:.4}   ghost-region FLIP {:.4}", mean(&fr), mean(&fg));
+        println!(
+            "    {name:16} reflective FLIP {:.4}   ghost-region FLIP {:.4}",
+            mean(&fr),
+            mean(&fg)
+        );
         writeln!(csv, "strafe,{name},flip_reflective,{:.5}", mean(&fr))?;
         writeln!(csv, "strafe,{name},flip_ghost_region,{:.5}", mean(&fg))?;
     }
@@ -252,7 +301,13 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     // 3. Motion vector accuracy against a brute-force search.
     let mv_scene = load_scene(&a.mv_scene, &a.load)?;
     let mv_camera = mv_scene.camera_or_default();
-    println!("  motion vectors on {} against a brute-force search of {}x{} pixels (strafe {} per frame)", a.mv_scene, 2 * a.search_radius + 1, 2 * a.search_radius + 1, a.step * 3.0);
+    println!(
+        "  motion vectors on {} against a brute-force search of {}x{} pixels (strafe {} per frame)",
+        a.mv_scene,
+        2 * a.search_radius + 1,
+        2 * a.search_radius + 1,
+        a.step * 3.0
+    );
     for (initial_step, traced) in [(4u32, true), (1, true), (4, false)] {
         let mut s = base.clone();
         s.glossy.initial_step = initial_step;
@@ -262,7 +317,11 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
         // (sum of errors, within one pixel, count) for mirror and glossy pixels.
         let mut stats = [(0.0f64, 0usize, 0usize); 2];
         for k in 0..a.path_frames {
-            let input = FrameInput { camera: strafed(mv_camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step * 3.0), time: 0.0, shutter: None };
+            let input = FrameInput {
+                camera: strafed(mv_camera, (k as f64 - a.path_frames as f64 / 2.0) * a.step * 3.0),
+                time: 0.0,
+                shutter: None,
+            };
             r.render(&gpu, &input, &s, None)?;
             if k == 0 {
                 continue;
@@ -277,7 +336,9 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
                 if !m.reflective[i] || !search[i][3].is_finite() || search[i][3] > 6.0e4 {
                     continue;
                 }
-                let e = ((motion[i][0] - motion[i][2]).powi(2) + (motion[i][1] - motion[i][3]).powi(2)).sqrt() as f64;
+                let e = ((motion[i][0] - motion[i][2]).powi(2)
+                    + (motion[i][1] - motion[i][3]).powi(2))
+                .sqrt() as f64;
                 let c = &mut stats[(m.roughness[i] > 0.01) as usize];
                 c.0 += e;
                 c.1 += (e <= 1.0) as usize;
@@ -292,7 +353,9 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
         for (kind, (sum, within, n)) in ["mirror sphere", "glossy sphere"].iter().zip(stats) {
             let mean = sum / n.max(1) as f64;
             let share = within as f64 / n.max(1) as f64 * 100.0;
-            println!("    {kind:14} {scaling:22} mean error {mean:.3} px, {share:.1}% within 1 px ({n} vectors)");
+            println!(
+                "    {kind:14} {scaling:22} mean error {mean:.3} px, {share:.1}% within 1 px ({n} vectors)"
+            );
             writeln!(csv, "motion,{kind} {scaling},mean_error_px,{mean:.4}")?;
             writeln!(csv, "motion,{kind} {scaling},within_1px_percent,{share:.2}")?;
         }

@@ -34,9 +34,14 @@ impl LoadArgs {
 
 /// Refuse an output file that could not be written, before any work: `what` names the flag.
 pub fn check_output(path: &Path, extensions: &[&str], what: &str) -> Result<()> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    let ext =
+        path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
     if !extensions.contains(&ext.as_str()) {
-        bail!("{what} {}: the file must end in {}", path.display(), extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or "));
+        bail!(
+            "{what} {}: the file must end in {}",
+            path.display(),
+            extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or ")
+        );
     }
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
@@ -50,7 +55,12 @@ pub fn check_output(path: &Path, extensions: &[&str], what: &str) -> Result<()> 
 
 /// Refuse a --width or --height over `max_side` before any work (the other side may come from
 /// the scene's aspect ratio, checked once the scene is loaded).
-pub fn check_sides(width: Option<u32>, height: Option<u32>, max_side: u32, mode: &str) -> Result<()> {
+pub fn check_sides(
+    width: Option<u32>,
+    height: Option<u32>,
+    max_side: u32,
+    mode: &str,
+) -> Result<()> {
     for (flag, v) in [("--width", width), ("--height", height)] {
         if let Some(v) = v.filter(|&v| v > max_side) {
             bail!("{flag} {v}: {mode} renders at most {max_side} pixels a side");
@@ -177,7 +187,9 @@ pub fn shutter(a: &RenderArgs) -> Result<f64> {
     match a.shutter {
         None => Ok(0.0),
         Some(s) if (0.0..=1.0).contains(&s) => Ok(s),
-        Some(s) => bail!("--shutter {s}: give the fraction of the frame interval the shutter is open, 0 to 1"),
+        Some(s) => bail!(
+            "--shutter {s}: give the fraction of the frame interval the shutter is open, 0 to 1"
+        ),
     }
 }
 
@@ -196,9 +208,14 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
     let mut fov = 45.0f32;
     let (mut aperture, mut focus) = (None, None);
     for part in s.split(';').map(str::trim).filter(|p| !p.is_empty()) {
-        let (k, v) = part.split_once('=').with_context(|| format!("camera part {part:?} is not key=value"))?;
+        let (k, v) = part
+            .split_once('=')
+            .with_context(|| format!("camera part {part:?} is not key=value"))?;
         let nums = || -> Result<glam::DVec3> {
-            let n: Vec<f64> = v.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>()
+            let n: Vec<f64> = v
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
                 .with_context(|| format!("camera {k}={v:?}: expected x,y,z"))?;
             if n.len() != 3 || n.iter().any(|x| !x.is_finite()) {
                 bail!("camera {k}={v:?}: expected three finite numbers");
@@ -214,8 +231,17 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
                     bail!("camera fov must be in (0, 180) degrees, got {fov}");
                 }
             }
-            "aperture" => aperture = Some(v.trim().parse::<f64>().with_context(|| format!("camera aperture={v:?}: the aperture radius in meters"))?),
-            "focus" => focus = Some(v.trim().parse::<f64>().with_context(|| format!("camera focus={v:?}: the focus distance in meters"))?),
+            "aperture" => {
+                aperture = Some(v.trim().parse::<f64>().with_context(|| {
+                    format!("camera aperture={v:?}: the aperture radius in meters")
+                })?)
+            }
+            "focus" => {
+                focus =
+                    Some(v.trim().parse::<f64>().with_context(|| {
+                        format!("camera focus={v:?}: the focus distance in meters")
+                    })?)
+            }
             other => bail!("unknown camera key {other:?} (use eye, target, fov, aperture, focus)"),
         }
     }
@@ -224,7 +250,8 @@ pub fn parse_camera(s: &str) -> Result<Camera> {
         (Some(a), Some(f)) => Some(hush_engine::scene::ThinLens::new(a, f).context("--camera")?),
         _ => bail!("a thin-lens camera needs both aperture=R and focus=D (meters)"),
     };
-    let (eye, target) = (eye.context("camera needs eye=x,y,z")?, target.context("camera needs target=x,y,z")?);
+    let (eye, target) =
+        (eye.context("camera needs eye=x,y,z")?, target.context("camera needs target=x,y,z")?);
     if (eye - target).length() == 0.0 {
         bail!("camera eye and target coincide");
     }
@@ -281,7 +308,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let given: Vec<&str> = realtime_only.iter().filter(|(_, on)| *on).map(|(f, _)| *f).collect();
     if !given.is_empty() {
         let verb = if given.len() == 1 { "applies" } else { "apply" };
-        bail!("{} only {verb} to --mode realtime; reference mode path-traces --spp samples with no settings to set", given.join(", "));
+        bail!(
+            "{} only {verb} to --mode realtime; reference mode path-traces --spp samples with no settings to set",
+            given.join(", ")
+        );
     }
     let out = a.out.clone().context("--out is required in reference mode")?;
     check_output(&out, &["exr", "png"], "--out")?;
@@ -289,14 +319,23 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let spp = match a.spp {
         None => 64,
         Some(Spp::Samples(n)) => n,
-        Some(Spp::Fraction(f)) => bail!("--spp {f}: reference mode traces whole samples per pixel; fractions are for --mode realtime"),
+        Some(Spp::Fraction(f)) => bail!(
+            "--spp {f}: reference mode traces whole samples per pixel; fractions are for --mode realtime"
+        ),
     };
     let kind = bvh_kind(&a.bvh)?;
     let camera = a.camera.as_deref().map(parse_camera).transpose()?;
     let scene = load_scene(&a.scene, &a.load)?;
     let (w, h) = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
-    let view = TraceView { camera, width: w, height: h, max_depth: a.max_depth.unwrap_or(scene.max_depth), seed: a.seed, shutter_camera: None };
+    let view = TraceView {
+        camera,
+        width: w,
+        height: h,
+        max_depth: a.max_depth.unwrap_or(scene.max_depth),
+        seed: a.seed,
+        shutter_camera: None,
+    };
     let mut prepared = PreparedScene::new(&scene, kind)?;
     let time = a.time.unwrap_or(0.0);
     let open = time - shutter(&a)? / fps(&a)?;
@@ -309,7 +348,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     let bar = if std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(spp as u64);
-        b.set_style(indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} spp {per_sec} eta {eta}")?.progress_chars("=> "));
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {pos}/{len} spp {per_sec} eta {eta}",
+            )?
+            .progress_chars("=> "),
+        );
         Some(b)
     } else {
         None
@@ -336,7 +380,14 @@ pub fn run(a: RenderArgs) -> Result<()> {
     acc.mean.save(&out)?;
     eprintln!(
         "{}: {}x{} {} spp in {:.2} s ({:.3} M samples/s) on {} -> {}",
-        scene.name, w, h, spp, secs, (w as f64 * h as f64 * spp as f64) / secs / 1e6, gpu.info.name, out.display()
+        scene.name,
+        w,
+        h,
+        spp,
+        secs,
+        (w as f64 * h as f64 * spp as f64) / secs / 1e6,
+        gpu.info.name,
+        out.display()
     );
     Ok(())
 }

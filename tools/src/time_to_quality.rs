@@ -88,7 +88,10 @@ struct RunSpec {
 fn parse_run(s: &str) -> Result<RunSpec> {
     let (rest, target_ms) = match s.split_once('@') {
         Some((r, t)) => {
-            let t: f64 = t.trim().parse().with_context(|| format!("--run {s:?}: {t:?} is not a frame time in ms"))?;
+            let t: f64 = t
+                .trim()
+                .parse()
+                .with_context(|| format!("--run {s:?}: {t:?} is not a frame time in ms"))?;
             if !(t > 0.0 && t.is_finite()) {
                 bail!("--run {s:?}: the target frame time must be a positive number of ms");
             }
@@ -137,7 +140,9 @@ impl Scenario {
                 Camera { world: DMat4::from_translation(right * offset) * view.world, ..*view }
             }
             // Turned about its own up axis: the view behind the camera.
-            Scenario::Cut => Camera { world: view.world * DMat4::from_rotation_y(std::f64::consts::PI), ..*view },
+            Scenario::Cut => {
+                Camera { world: view.world * DMat4::from_rotation_y(std::f64::consts::PI), ..*view }
+            }
         }
     }
 }
@@ -161,7 +166,15 @@ struct Runner {
 
 impl Runner {
     fn frame(&mut self, gpu: &Gpu, input: &FrameInput) -> Result<GovernedFrame> {
-        governed_frame(gpu, &mut self.renderer, &mut self.governor, &self.settings, input, self.full, &mut self.last_camera)
+        governed_frame(
+            gpu,
+            &mut self.renderer,
+            &mut self.governor,
+            &self.settings,
+            input,
+            self.full,
+            &mut self.last_camera,
+        )
     }
 
     /// The frame on screen, at full size.
@@ -173,15 +186,20 @@ impl Runner {
 pub fn run(a: TimeToQualityArgs) -> Result<()> {
     crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
     let runs: Vec<RunSpec> = a.runs.iter().map(|r| parse_run(r)).collect::<Result<_>>()?;
-    let scenarios: Vec<Scenario> = a.scenarios.iter().map(|s| Scenario::parse(s)).collect::<Result<_>>()?;
+    let scenarios: Vec<Scenario> =
+        a.scenarios.iter().map(|s| Scenario::parse(s)).collect::<Result<_>>()?;
     // Before any reference is rendered: a misspelt denoiser is a clear error at once.
     for r in &runs {
-        preset_settings(None, Some(&r.denoiser), &[], None).with_context(|| format!("--run {:?}", r.label))?;
+        preset_settings(None, Some(&r.denoiser), &[], None)
+            .with_context(|| format!("--run {:?}", r.label))?;
     }
     if !(a.seconds > 0.0 && a.seconds <= 600.0) || !(a.lead_in >= 0.0 && a.lead_in <= 600.0) {
         bail!("--seconds must be in (0, 600] and --lead-in in [0, 600]");
     }
-    if !a.speed.is_finite() || a.at.iter().any(|t| !(t.is_finite() && *t >= 0.0)) || a.reference_frames == 0 {
+    if !a.speed.is_finite()
+        || a.at.iter().any(|t| !(t.is_finite() && *t >= 0.0))
+        || a.reference_frames == 0
+    {
         bail!("--speed must be finite, --at times non-negative and --reference-frames at least 1");
     }
     let scene = load_scene(&a.scene, &a.load)?;
@@ -190,21 +208,43 @@ pub fn run(a: TimeToQualityArgs) -> Result<()> {
         Some(c) => parse_camera(c)?,
         None => scene.camera_or_default(),
     };
-    std::fs::create_dir_all(&a.out_dir).with_context(|| format!("creating {}", a.out_dir.display()))?;
+    std::fs::create_dir_all(&a.out_dir)
+        .with_context(|| format!("creating {}", a.out_dir.display()))?;
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(full))?;
     let input = FrameInput { camera: view, time: 0.0, shutter: None };
-    let acc = FrameSettings { accumulate: true, seed: a.seed.wrapping_add(7919), max_depth: scene.max_depth, ..Default::default() };
+    let acc = FrameSettings {
+        accumulate: true,
+        seed: a.seed.wrapping_add(7919),
+        max_depth: scene.max_depth,
+        ..Default::default()
+    };
     let converged = {
         let mut r = new_renderer(&gpu, &scene, full)?;
-        reference(&gpu, &mut r, &a.scene, &input, a.reference_frames, &acc, a.reference_cache.as_deref())?
+        reference(
+            &gpu,
+            &mut r,
+            &a.scene,
+            &input,
+            a.reference_frames,
+            &acc,
+            a.reference_cache.as_deref(),
+        )?
     };
 
     let mut curves = vec![];
     for run in &runs {
         for &scenario in &scenarios {
             let c = follow(&a, &gpu, &scene, full, run, scenario, &view, &converged)?;
-            eprintln!("{} {}: {} frames in {:.2} s, FLIP {:.4} -> {:.4}", run.label, scenario.name(), c.frames.len(), c.timeline.span(), c.timeline.before, c.timeline.shown_at(a.seconds));
+            eprintln!(
+                "{} {}: {} frames in {:.2} s, FLIP {:.4} -> {:.4}",
+                run.label,
+                scenario.name(),
+                c.frames.len(),
+                c.timeline.span(),
+                c.timeline.before,
+                c.timeline.shown_at(a.seconds)
+            );
             curves.push(c);
         }
     }
@@ -212,15 +252,31 @@ pub fn run(a: TimeToQualityArgs) -> Result<()> {
     report(&a, &curves, &scenarios, full, &gpu);
     // What a lower resolution costs by itself: the converged image at each scale the runs
     // ended at, stretched to full size, is the best FLIP a run at that scale can reach.
-    let mut sizes: Vec<(u32, u32)> = curves.iter().filter_map(|c| c.frames.last()).map(|f| f.size).filter(|s| *s != full).collect();
+    let mut sizes: Vec<(u32, u32)> = curves
+        .iter()
+        .filter_map(|c| c.frames.last())
+        .map(|f| f.size)
+        .filter(|s| *s != full)
+        .collect();
     sizes.sort();
     sizes.dedup();
     let mut floors = String::from("width,height,flip\n");
     for size in sizes {
         let mut r = new_renderer(&gpu, &scene, size)?;
-        let img = reference(&gpu, &mut r, &a.scene, &input, a.reference_frames, &acc, a.reference_cache.as_deref())?;
+        let img = reference(
+            &gpu,
+            &mut r,
+            &a.scene,
+            &input,
+            a.reference_frames,
+            &acc,
+            a.reference_cache.as_deref(),
+        )?;
         let flip = compare(&img.resized(full.0, full.1)?, &converged)?.flip;
-        println!("  converged at {}x{} and stretched to {}x{}: FLIP {flip:.4}", size.0, size.1, full.0, full.1);
+        println!(
+            "  converged at {}x{} and stretched to {}x{}: FLIP {flip:.4}",
+            size.0, size.1, full.0, full.1
+        );
         writeln!(floors, "{},{},{flip:.5}", size.0, size.1)?;
     }
     let path = a.out_dir.join("scale_floors.csv");
@@ -230,17 +286,37 @@ pub fn run(a: TimeToQualityArgs) -> Result<()> {
 
 /// Lead in, stop, and follow the view for `--seconds`.
 #[allow(clippy::too_many_arguments)]
-fn follow(a: &TimeToQualityArgs, gpu: &Gpu, scene: &Scene, full: (u32, u32), run: &RunSpec, scenario: Scenario, view: &Camera, reference: &Image) -> Result<Curve> {
-    let base = preset_settings(None, Some(&run.denoiser), &[], None).with_context(|| format!("--run {:?}", run.label))?;
+fn follow(
+    a: &TimeToQualityArgs,
+    gpu: &Gpu,
+    scene: &Scene,
+    full: (u32, u32),
+    run: &RunSpec,
+    scenario: Scenario,
+    view: &Camera,
+    reference: &Image,
+) -> Result<Curve> {
+    let base = preset_settings(None, Some(&run.denoiser), &[], None)
+        .with_context(|| format!("--run {:?}", run.label))?;
     let (samples_per_pixel, sample_fraction) = match run.spp {
         None => (1, SampleFraction::ONE),
         Some(Spp::Samples(n)) => (n, SampleFraction::ONE),
         Some(Spp::Fraction(f)) => (1, f),
     };
-    let settings = FrameSettings { seed: a.seed, max_depth: scene.max_depth, samples_per_pixel, sample_fraction, ..base };
+    let settings = FrameSettings {
+        seed: a.seed,
+        max_depth: scene.max_depth,
+        samples_per_pixel,
+        sample_fraction,
+        ..base
+    };
     let mut renderer = new_renderer(gpu, scene, full)?;
     if sample_fraction != SampleFraction::ONE && !renderer.fills_untraced_pixels(gpu, &settings)? {
-        bail!("--run {:?}: the {} denoiser does not take sample fractions below 1", run.label, run.denoiser);
+        bail!(
+            "--run {:?}: the {} denoiser does not take sample fractions below 1",
+            run.label,
+            run.denoiser
+        );
     }
     let governor = match run.target_ms {
         Some(t) => {
@@ -256,14 +332,22 @@ fn follow(a: &TimeToQualityArgs, gpu: &Gpu, scene: &Scene, full: (u32, u32), run
         }
     };
     // One frame before the clock starts: it compiles the pipelines, which a viewer does once.
-    let first = FrameInput { camera: scenario.lead_camera(view, 0.0, a.lead_in, a.speed), time: 0.0, shutter: None };
+    let first = FrameInput {
+        camera: scenario.lead_camera(view, 0.0, a.lead_in, a.speed),
+        time: 0.0,
+        shutter: None,
+    };
     renderer.render(gpu, &first, &settings, None)?;
     renderer.pass_times(gpu)?;
     let mut runner = Runner { renderer, settings, governor, last_camera: Some(first.camera), full };
 
     let (mut elapsed, mut lead_frames) = (0.0, 0);
     while elapsed < a.lead_in || lead_frames < 2 {
-        let lead = FrameInput { camera: scenario.lead_camera(view, elapsed, a.lead_in, a.speed), time: 0.0, shutter: None };
+        let lead = FrameInput {
+            camera: scenario.lead_camera(view, elapsed, a.lead_in, a.speed),
+            time: 0.0,
+            shutter: None,
+        };
         elapsed += runner.frame(gpu, &lead)?.wall_ms / 1e3;
         lead_frames += 1;
     }
@@ -276,7 +360,12 @@ fn follow(a: &TimeToQualityArgs, gpu: &Gpu, scene: &Scene, full: (u32, u32), run
         t += f.wall_ms / 1e3;
         let shown = runner.shown(gpu)?;
         if shown.nonfinite_pixels() > 0 {
-            bail!("--run {:?} {}: {} non-finite pixels on screen", run.label, scenario.name(), shown.nonfinite_pixels());
+            bail!(
+                "--run {:?} {}: {} non-finite pixels on screen",
+                run.label,
+                scenario.name(),
+                shown.nonfinite_pixels()
+            );
         }
         timeline.push(t, compare(&shown, reference)?.flip);
         frames.push(f);
@@ -291,7 +380,11 @@ fn write_outputs(a: &TimeToQualityArgs, curves: &[Curve], full: (u32, u32)) -> R
         let (run, sc) = (&c.run.label, c.scenario.name());
         writeln!(csv, "{run},{sc},-1,0,0,0,0,{},{},{:.5}", full.0, full.1, c.timeline.before)?;
         for (k, (f, (end, flip))) in c.frames.iter().zip(&c.timeline.frames).enumerate() {
-            writeln!(csv, "{run},{sc},{k},{end:.4},{:.3},{:.3},{},{},{},{flip:.5}", f.wall_ms, f.gpu_ms, f.spp, f.size.0, f.size.1)?;
+            writeln!(
+                csv,
+                "{run},{sc},{k},{end:.4},{:.3},{:.3},{},{},{},{flip:.5}",
+                f.wall_ms, f.gpu_ms, f.spp, f.size.0, f.size.1
+            )?;
         }
         for &t in &a.at {
             writeln!(at, "{run},{sc},{t},{:.5}", c.timeline.shown_at(t))?;
@@ -306,22 +399,45 @@ fn write_outputs(a: &TimeToQualityArgs, curves: &[Curve], full: (u32, u32)) -> R
 
 /// The table of FLIP at each `--at` time, and whether each governed run lies at or below every
 /// fixed run there.
-fn report(a: &TimeToQualityArgs, curves: &[Curve], scenarios: &[Scenario], full: (u32, u32), gpu: &Gpu) {
-    println!("{} at {}x{} on {}: FLIP on screen after the camera stops", a.scene, full.0, full.1, gpu.info.name);
+fn report(
+    a: &TimeToQualityArgs,
+    curves: &[Curve],
+    scenarios: &[Scenario],
+    full: (u32, u32),
+    gpu: &Gpu,
+) {
+    println!(
+        "{} at {}x{} on {}: FLIP on screen after the camera stops",
+        a.scene, full.0, full.1, gpu.info.name
+    );
     for &sc in scenarios {
         let times: Vec<String> = a.at.iter().map(|t| format!("{t:>7} s")).collect();
         println!("  {:<10} {:<24} {}   frames", sc.name(), "run", times.join(" "));
         let of = |c: &&Curve| c.scenario == sc;
         for c in curves.iter().filter(of) {
-            let flips: Vec<String> = a.at.iter().map(|&t| format!("{:9.4}", c.timeline.shown_at(t))).collect();
+            let flips: Vec<String> =
+                a.at.iter().map(|&t| format!("{:9.4}", c.timeline.shown_at(t))).collect();
             println!("  {:<10} {:<24} {}   {}", "", c.run.label, flips.join(" "), c.frames.len());
         }
         for g in curves.iter().filter(of).filter(|c| c.run.target_ms.is_some()) {
             for f in curves.iter().filter(of).filter(|c| c.run.target_ms.is_none()) {
-                let worse: Vec<String> = a.at.iter().filter(|&&t| g.timeline.shown_at(t) > f.timeline.shown_at(t)).map(|t| format!("{t} s")).collect();
+                let worse: Vec<String> =
+                    a.at.iter()
+                        .filter(|&&t| g.timeline.shown_at(t) > f.timeline.shown_at(t))
+                        .map(|t| format!("{t} s"))
+                        .collect();
                 match worse.is_empty() {
-                    true => println!("  {:<10} {} at or below {} at every time", "", g.run.label, f.run.label),
-                    false => println!("  {:<10} {} above {} at {}", "", g.run.label, f.run.label, worse.join(", ")),
+                    true => println!(
+                        "  {:<10} {} at or below {} at every time",
+                        "", g.run.label, f.run.label
+                    ),
+                    false => println!(
+                        "  {:<10} {} above {} at {}",
+                        "",
+                        g.run.label,
+                        f.run.label,
+                        worse.join(", ")
+                    ),
                 }
             }
         }
@@ -332,19 +448,31 @@ fn report(a: &TimeToQualityArgs, curves: &[Curve], scenarios: &[Scenario], full:
 fn plot(path: &std::path::Path, curves: &[Curve], seconds: f64, title: &str) -> Result<()> {
     use plotters::prelude::*;
     let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("plot {}: {e}", path.display());
-    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
+    let _ = plotters::style::register_font(
+        "sans-serif",
+        FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    );
     let mut scenarios: Vec<Scenario> = vec![];
     for c in curves {
         if !scenarios.contains(&c.scenario) {
             scenarios.push(c.scenario);
         }
     }
-    let root = BitMapBackend::new(path, (960, 420 * scenarios.len().max(1) as u32)).into_drawing_area();
+    let root =
+        BitMapBackend::new(path, (960, 420 * scenarios.len().max(1) as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let panels = root.split_evenly((scenarios.len().max(1), 1));
     for (area, sc) in panels.iter().zip(&scenarios) {
         let mine: Vec<&Curve> = curves.iter().filter(|c| c.scenario == *sc).collect();
-        let hi = mine.iter().flat_map(|c| std::iter::once(c.timeline.before).chain(c.timeline.frames.iter().map(|f| f.1))).fold(0.0f64, f64::max).max(1e-3) * 1.05;
+        let hi = mine
+            .iter()
+            .flat_map(|c| {
+                std::iter::once(c.timeline.before).chain(c.timeline.frames.iter().map(|f| f.1))
+            })
+            .fold(0.0f64, f64::max)
+            .max(1e-3)
+            * 1.05;
         let mut chart = ChartBuilder::on(area)
             .caption(format!("{title}: FLIP after a {}", sc.name()), ("sans-serif", 20))
             .margin(10)
@@ -352,7 +480,12 @@ fn plot(path: &std::path::Path, curves: &[Curve], seconds: f64, title: &str) -> 
             .y_label_area_size(60)
             .build_cartesian_2d(0.0..seconds, 0.0..hi)
             .map_err(|e| err(&e))?;
-        chart.configure_mesh().x_desc("seconds since the camera stopped").y_desc("FLIP").draw().map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("seconds since the camera stopped")
+            .y_desc("FLIP")
+            .draw()
+            .map_err(|e| err(&e))?;
         for (i, c) in mine.iter().enumerate() {
             let color = Palette99::pick(i).to_rgba();
             // A staircase: each value holds until the next frame finishes.
@@ -369,9 +502,16 @@ fn plot(path: &std::path::Path, curves: &[Curve], seconds: f64, title: &str) -> 
                 .draw_series(LineSeries::new(pts, color.stroke_width(2)))
                 .map_err(|e| err(&e))?
                 .label(c.run.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
         }
-        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())

@@ -19,7 +19,19 @@ fn render_then_compare_round_trips_through_files() {
     let png = dir.join("a.png");
     for out in [&exr, &png] {
         let o = bin("hush-cli")
-            .args(["render", "default", "--spp", "2", "--width", "33", "--height", "17", "--camera", "eye=0,1.4,4.8;target=0,1.1,0;fov=55", "--out"])
+            .args([
+                "render",
+                "default",
+                "--spp",
+                "2",
+                "--width",
+                "33",
+                "--height",
+                "17",
+                "--camera",
+                "eye=0,1.4,4.8;target=0,1.1,0;fov=55",
+                "--out",
+            ])
             .arg(out)
             .output()
             .unwrap();
@@ -41,39 +53,230 @@ fn bad_arguments_are_clear_errors() {
     let bad_preset = bad_preset.to_str().unwrap().to_string();
     let ttq = temp_dir("bad-ttq").to_str().unwrap().to_string();
     for (args, needle) in [
-        (vec!["render", "level", "--mode", "realtime", "--preset", &bad_preset, "--out", "x.exr"], "matte.hysteresis"),
-        (vec!["bench", "level", "--mode", "realtime", "--preset", "/nonexistent.toml"], "/nonexistent.toml"),
-        (vec!["render", "default", "--camera", "eye=0,0,0;target=0,0,0", "--out", "x.exr"], "coincide"),
-        (vec!["render", "default", "--camera", "eye=0,1,4;target=0,1,0;aperture=0.1", "--out", "x.exr"], "focus"),
-        (vec!["render", "default", "--camera", "eye=0,1,4;target=0,1,0;aperture=0;focus=3", "--out", "x.exr"], "aperture radius"),
+        (
+            vec![
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--preset",
+                &bad_preset,
+                "--out",
+                "x.exr",
+            ],
+            "matte.hysteresis",
+        ),
+        (
+            vec!["bench", "level", "--mode", "realtime", "--preset", "/nonexistent.toml"],
+            "/nonexistent.toml",
+        ),
+        (
+            vec!["render", "default", "--camera", "eye=0,0,0;target=0,0,0", "--out", "x.exr"],
+            "coincide",
+        ),
+        (
+            vec![
+                "render",
+                "default",
+                "--camera",
+                "eye=0,1,4;target=0,1,0;aperture=0.1",
+                "--out",
+                "x.exr",
+            ],
+            "focus",
+        ),
+        (
+            vec![
+                "render",
+                "default",
+                "--camera",
+                "eye=0,1,4;target=0,1,0;aperture=0;focus=3",
+                "--out",
+                "x.exr",
+            ],
+            "aperture radius",
+        ),
         (vec!["render", "default", "--spp", "0", "--out", "x.exr"], "--spp"),
         (vec!["render", "default", "--spp", "1", "--out", "x.bmp"], ".exr or .png"),
         (vec!["render", "/nonexistent.gltf", "--out", "x.exr"], "/nonexistent.gltf"),
         (vec!["render", "default", "--mode", "magic", "--out", "x.exr"], "--mode"),
-        (vec!["render", "level", "--mode", "realtime", "--view", "nope", "--width", "8", "--height", "8", "--out", "x.png"], "--view"),
-        (vec!["render", "level", "--mode", "realtime", "--frames", "0", "--out", "x.exr"], "--frames"),
-        (vec!["render", "level", "--mode", "realtime", "--denoiser", "mara", "--reflection-mv", "sideways", "--out", "x.exr"], "--reflection-mv"),
-        (vec!["render", "level", "--mode", "realtime", "--denoiser", "mara", "--disable", "glossy.nothing", "--out", "x.exr"], "glossy.bilateral"),
-        (vec!["render", "level", "--mode", "realtime", "--denoiser", "svgf", "--disable", "svgf.nothing", "--out", "x.exr"], "svgf.bandwidth_boost"),
-        (vec!["render", "level", "--mode", "realtime", "--spp", "17", "--out", "x.exr"], "at most 16"),
-        (vec!["render", "level", "--mode", "realtime", "--spp", "1/3", "--out", "x.exr"], "power of two"),
+        (
+            vec![
+                "render", "level", "--mode", "realtime", "--view", "nope", "--width", "8",
+                "--height", "8", "--out", "x.png",
+            ],
+            "--view",
+        ),
+        (
+            vec!["render", "level", "--mode", "realtime", "--frames", "0", "--out", "x.exr"],
+            "--frames",
+        ),
+        (
+            vec![
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--denoiser",
+                "mara",
+                "--reflection-mv",
+                "sideways",
+                "--out",
+                "x.exr",
+            ],
+            "--reflection-mv",
+        ),
+        (
+            vec![
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--denoiser",
+                "mara",
+                "--disable",
+                "glossy.nothing",
+                "--out",
+                "x.exr",
+            ],
+            "glossy.bilateral",
+        ),
+        (
+            vec![
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--denoiser",
+                "svgf",
+                "--disable",
+                "svgf.nothing",
+                "--out",
+                "x.exr",
+            ],
+            "svgf.bandwidth_boost",
+        ),
+        (
+            vec!["render", "level", "--mode", "realtime", "--spp", "17", "--out", "x.exr"],
+            "at most 16",
+        ),
+        (
+            vec!["render", "level", "--mode", "realtime", "--spp", "1/3", "--out", "x.exr"],
+            "power of two",
+        ),
         (vec!["render", "default", "--spp", "1/4", "--out", "x.exr"], "--mode realtime"),
-        (vec!["render", "level", "--mode", "realtime", "--spp", "1/4", "--denoiser", "mara", "--width", "8", "--height", "8", "--out", "x.exr"], "fills untraced pixels"),
-        (vec!["render", "level", "--mode", "realtime", "--denoiser", "oidn", "--out", "x.exr"], "svgf"),
+        (
+            vec![
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--spp",
+                "1/4",
+                "--denoiser",
+                "mara",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--out",
+                "x.exr",
+            ],
+            "fills untraced pixels",
+        ),
+        (
+            vec!["render", "level", "--mode", "realtime", "--denoiser", "oidn", "--out", "x.exr"],
+            "svgf",
+        ),
         (vec!["time-to-quality", "level", "--run", "oidn", "--out-dir", &ttq], "--run \"oidn\""),
         (vec!["time-to-quality", "level", "--run", "mara@0", "--out-dir", &ttq], "positive"),
-        (vec!["time-to-quality", "level", "--run", "mara:1/4", "--width", "8", "--height", "8", "--reference-frames", "1", "--out-dir", &ttq], "sample fractions below 1"),
-        (vec!["time-to-quality", "level", "--run", "mara", "--scenarios", "pan", "--out-dir", &ttq], "stop or cut"),
+        (
+            vec![
+                "time-to-quality",
+                "level",
+                "--run",
+                "mara:1/4",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--reference-frames",
+                "1",
+                "--out-dir",
+                &ttq,
+            ],
+            "sample fractions below 1",
+        ),
+        (
+            vec![
+                "time-to-quality",
+                "level",
+                "--run",
+                "mara",
+                "--scenarios",
+                "pan",
+                "--out-dir",
+                &ttq,
+            ],
+            "stop or cut",
+        ),
         (vec!["level", "--scene", "terrain:1", "--out", "x.gltf"], "terrain:N"),
         (vec!["render", "level", "--shutter", "1.5", "--out", "x.exr"], "--shutter 1.5"),
         (vec!["render", "level", "--shutter", "0.5", "--fps", "0", "--out", "x.exr"], "--fps"),
         (vec!["render", "level", "--mode", "realtime", "--time", "1", "--out", "x.exr"], "--time"),
-        (vec!["render", "level", "--mode", "realtime", "--primary-samples", "0", "--out", "x.exr"], "--primary-samples 0"),
+        (
+            vec![
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--primary-samples",
+                "0",
+                "--out",
+                "x.exr",
+            ],
+            "--primary-samples 0",
+        ),
         // Guide rays need the raster's G-buffer; an open shutter on the moving cube replaces it.
-        (vec!["render", "level", "--mode", "realtime", "--shutter", "1", "--spp", "2", "--width", "8", "--height", "8", "--out", "x.exr"], "samples per pixel to 1"),
+        (
+            vec![
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--shutter",
+                "1",
+                "--spp",
+                "2",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--out",
+                "x.exr",
+            ],
+            "samples per pixel to 1",
+        ),
         (vec!["level", "--scene", "nope", "--out", "x.gltf"], "no such built-in scene"),
         // A built-in scene has no file for Mitsuba to read (and CI has no Mitsuba either way).
-        (vec!["bench", "default", "--mitsuba", "--width", "8", "--height", "8", "--spp", "1", "--rays", "64", "--bvh", "cwbvh"], "--mitsuba"),
+        (
+            vec![
+                "bench",
+                "default",
+                "--mitsuba",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--spp",
+                "1",
+                "--rays",
+                "64",
+                "--bvh",
+                "cwbvh",
+            ],
+            "--mitsuba",
+        ),
     ] {
         let o = bin("hush-cli").args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
@@ -83,7 +286,13 @@ fn bad_arguments_are_clear_errors() {
 
 #[test]
 fn bench_reports_json() {
-    let o = bin("hush-cli").args(["bench", "default", "--json", "--width", "16", "--height", "16", "--spp", "2", "--rays", "4096"]).output().unwrap();
+    let o = bin("hush-cli")
+        .args([
+            "bench", "default", "--json", "--width", "16", "--height", "16", "--spp", "2",
+            "--rays", "4096",
+        ])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["layouts"].as_array().unwrap().len(), 2);
@@ -99,15 +308,34 @@ fn bench_reports_json() {
 fn terrain_is_generated_and_written() {
     let dir = temp_dir("terrain");
     let out = dir.join("t.gltf");
-    let o = bin("hush-cli").args(["level", "--scene", "terrain:5000", "--out", out.to_str().unwrap()]).output().unwrap();
+    let o = bin("hush-cli")
+        .args(["level", "--scene", "terrain:5000", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = bin("hush-cli").args(["bench", out.to_str().unwrap(), "--json", "--width", "8", "--height", "8", "--spp", "1", "--rays", "1024", "--bvh", "cwbvh"]).output().unwrap();
+    let o = bin("hush-cli")
+        .args([
+            "bench",
+            out.to_str().unwrap(),
+            "--json",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "1",
+            "--rays",
+            "1024",
+            "--bvh",
+            "cwbvh",
+        ])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let t = v["triangles"].as_u64().unwrap();
     assert!((4900..=5100).contains(&t), "{t} triangles");
 }
-
 
 #[test]
 fn realtime_sequences_are_deterministic_and_ordered() {
@@ -122,17 +350,39 @@ fn realtime_sequences_are_deterministic_and_ordered() {
     for run in ["a", "b"] {
         let out = dir.join(run);
         let o = bin("hush-cli")
-            .args(["render", "level", "--mode", "realtime", "--frames", "3", "--width", "40", "--height", "24", "--denoiser", "none", "--camera-path"])
+            .args([
+                "render",
+                "level",
+                "--mode",
+                "realtime",
+                "--frames",
+                "3",
+                "--width",
+                "40",
+                "--height",
+                "24",
+                "--denoiser",
+                "none",
+                "--camera-path",
+            ])
             .arg(&path)
             .arg("--out-dir")
             .arg(&out)
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let mut names: Vec<String> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        let mut names: Vec<String> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
         names.sort();
         assert_eq!(names, ["frame_00000.exr", "frame_00001.exr", "frame_00002.exr"]);
-        runs.push(names.iter().map(|n| hush_engine::quality::Image::load(&out.join(n)).unwrap()).collect::<Vec<_>>());
+        runs.push(
+            names
+                .iter()
+                .map(|n| hush_engine::quality::Image::load(&out.join(n)).unwrap())
+                .collect::<Vec<_>>(),
+        );
     }
     for (a, b) in runs[0].iter().zip(&runs[1]) {
         assert_eq!(a.data, b.data, "same scene, seed and path must give the same frames");
@@ -144,15 +394,49 @@ fn realtime_sequences_are_deterministic_and_ordered() {
 #[test]
 fn realtime_bench_reports_every_pass() {
     let profile = temp_dir("bench-profile").join("bench.puffin");
-    let o = bin("hush-cli").args(["bench", "level", "--mode", "realtime", "--json", "--width", "32", "--height", "18", "--frames", "3", "--profile"]).arg(&profile).output().unwrap();
+    let o = bin("hush-cli")
+        .args([
+            "bench",
+            "level",
+            "--mode",
+            "realtime",
+            "--json",
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--frames",
+            "3",
+            "--profile",
+        ])
+        .arg(&profile)
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let passes: Vec<&str> = v["passes"].as_array().unwrap().iter().map(|p| p["pass"].as_str().unwrap()).collect();
+    let passes: Vec<&str> =
+        v["passes"].as_array().unwrap().iter().map(|p| p["pass"].as_str().unwrap()).collect();
     // The glossy prefilter feeds only the neighbourhood clipping, off by default: it does not run.
-    assert_eq!(passes, [
-        "gbuffer", "trace", "matte/temporal", "matte/history_bilateral", "matte/disocclusion_h", "matte/disocclusion_v", "matte/firefly", "matte/bilateral",
-        "glossy/motion", "glossy/temporal", "glossy/bilateral_h", "glossy/bilateral_v", "composite", "taa", "display",
-    ]);
+    assert_eq!(
+        passes,
+        [
+            "gbuffer",
+            "trace",
+            "matte/temporal",
+            "matte/history_bilateral",
+            "matte/disocclusion_h",
+            "matte/disocclusion_v",
+            "matte/firefly",
+            "matte/bilateral",
+            "glossy/motion",
+            "glossy/temporal",
+            "glossy/bilateral_h",
+            "glossy/bilateral_v",
+            "composite",
+            "taa",
+            "display",
+        ]
+    );
     for p in v["passes"].as_array().unwrap() {
         assert!(p["median_ms"].as_f64().unwrap() > 0.0, "{p}");
     }
@@ -161,9 +445,14 @@ fn realtime_bench_reports_every_pass() {
     // The headless capture: every pass that ran has a CPU scope and a GPU scope with non-zero
     // time in each of the 3 frames, inside a frame scope.
     let scopes = hush_engine::profile::read_capture(&profile).unwrap();
-    let find = |gpu: bool, name: &str| scopes.iter().find(|(t, n, _, _)| (t == hush_engine::profile::GPU_THREAD) == gpu && n == name);
+    let find = |gpu: bool, name: &str| {
+        scopes
+            .iter()
+            .find(|(t, n, _, _)| (t == hush_engine::profile::GPU_THREAD) == gpu && n == name)
+    };
     for p in &passes {
-        let (_, _, ns, count) = find(true, p).unwrap_or_else(|| panic!("no GPU scope for {p} in {scopes:?}"));
+        let (_, _, ns, count) =
+            find(true, p).unwrap_or_else(|| panic!("no GPU scope for {p} in {scopes:?}"));
         assert!(*ns > 0 && *count == 3, "GPU {p}: {ns} ns over {count} frames");
         assert!(find(false, p).is_some_and(|s| s.3 == 3), "no CPU scope for {p} in {scopes:?}");
     }
@@ -177,7 +466,20 @@ fn realtime_bench_reports_every_pass() {
 fn quality_writes_scores_and_a_plot() {
     let dir = temp_dir("quality");
     let o = bin("hush-cli")
-        .args(["quality", "level", "--frames", "4", "--reference-frames", "4", "--width", "32", "--fps", "30", "--ablations", "--out-dir"])
+        .args([
+            "quality",
+            "level",
+            "--frames",
+            "4",
+            "--reference-frames",
+            "4",
+            "--width",
+            "32",
+            "--fps",
+            "30",
+            "--ablations",
+            "--out-dir",
+        ])
         .arg(&dir)
         .output()
         .unwrap();
@@ -195,7 +497,10 @@ fn quality_writes_scores_and_a_plot() {
         // FLIP over the pixels the matte temporal flagged lately: blank when there are none.
         let pixels: usize = fields[13].parse().unwrap();
         assert_eq!(fields[12].is_empty(), pixels == 0, "{r}");
-        assert!(fields[12].is_empty() || (0.0..=1.0).contains(&fields[12].parse::<f64>().unwrap()), "{r}");
+        assert!(
+            fields[12].is_empty() || (0.0..=1.0).contains(&fields[12].parse::<f64>().unwrap()),
+            "{r}"
+        );
     }
     let ablations = std::fs::read_to_string(dir.join("ablations.csv")).unwrap();
     // Header, the full chain, and each of the 6 matte and 3 glossy stages off.
@@ -210,14 +515,27 @@ fn quality_reuses_a_cached_reference() {
     let cache = dir.join("references");
     let run = |out: &str| {
         let o = bin("hush-cli")
-            .args(["quality", "level", "--frames", "3", "--reference-frames", "4", "--width", "32", "--reference-cache"])
+            .args([
+                "quality",
+                "level",
+                "--frames",
+                "3",
+                "--reference-frames",
+                "4",
+                "--width",
+                "32",
+                "--reference-cache",
+            ])
             .arg(&cache)
             .arg("--out-dir")
             .arg(dir.join(out))
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        (String::from_utf8_lossy(&o.stderr).into_owned(), std::fs::read_to_string(dir.join(out).join("quality.csv")).unwrap())
+        (
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+            std::fs::read_to_string(dir.join(out).join("quality.csv")).unwrap(),
+        )
     };
     let (first_log, first) = run("first");
     // A still camera has one reference, rendered once and kept.
@@ -227,7 +545,9 @@ fn quality_reuses_a_cached_reference() {
     let (second_log, second) = run("second");
     assert!(!second_log.contains("rendering the reference"), "{second_log}");
     // The EXR holds the reference exactly (32-bit floats), so the scores repeat.
-    let flips = |csv: &str| csv.lines().skip(1).map(|r| r.split(',').nth(2).unwrap().to_string()).collect::<Vec<_>>();
+    let flips = |csv: &str| {
+        csv.lines().skip(1).map(|r| r.split(',').nth(2).unwrap().to_string()).collect::<Vec<_>>()
+    };
     assert_eq!(flips(&first), flips(&second));
 }
 
@@ -239,7 +559,21 @@ fn image_size(p: &std::path::Path) -> (u32, u32) {
 #[test]
 fn sweep_marks_a_pareto_front() {
     let dir = temp_dir("sweep");
-    let o = bin("hush-cli").args(["sweep", "level", "--width", "32", "--frames", "2", "--reference-frames", "2", "--out-dir"]).arg(&dir).output().unwrap();
+    let o = bin("hush-cli")
+        .args([
+            "sweep",
+            "level",
+            "--width",
+            "32",
+            "--frames",
+            "2",
+            "--reference-frames",
+            "2",
+            "--out-dir",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
@@ -258,7 +592,21 @@ fn sweep_marks_a_pareto_front() {
 fn reflections_measures_every_reprojection() {
     let dir = temp_dir("reflections");
     let o = bin("hush-cli")
-        .args(["reflections", "reflections", "--width", "32", "--frames", "3", "--path-frames", "3", "--reference-frames", "2", "--search-radius", "4", "--out-dir"])
+        .args([
+            "reflections",
+            "reflections",
+            "--width",
+            "32",
+            "--frames",
+            "3",
+            "--path-frames",
+            "3",
+            "--reference-frames",
+            "2",
+            "--search-radius",
+            "4",
+            "--out-dir",
+        ])
         .arg(&dir)
         .output()
         .unwrap();
@@ -283,10 +631,17 @@ fn a_preset_sets_the_frame() {
     std::fs::write(&preset, "max_depth = 2\n").unwrap();
     let mean = |extra: &[&str], name: &str| {
         let out = dir.join(name);
-        let o = bin("hush-cli").args(["render", "level", "--mode", "realtime", "--width", "32", "--height", "18"]).args(extra).arg("--out").arg(&out).output().unwrap();
+        let o = bin("hush-cli")
+            .args(["render", "level", "--mode", "realtime", "--width", "32", "--height", "18"])
+            .args(extra)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let img = image::open(&out).unwrap().to_rgb8();
-        img.pixels().map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>()).sum::<f64>() / img.pixels().len() as f64
+        img.pixels().map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>()).sum::<f64>()
+            / img.pixels().len() as f64
     };
     let plain = mean(&[], "plain.png");
     let direct = mean(&["--preset", preset.to_str().unwrap()], "direct.png");
@@ -299,7 +654,23 @@ fn a_preset_sets_the_frame() {
 fn governed_render_writes_frames_csv() {
     let dir = temp_dir("governed");
     let o = bin("hush-cli")
-        .args(["render", "level", "--mode", "realtime", "--target-ms", "1", "--frames", "8", "--width", "64", "--height", "36", "--min-scale", "0.5", "--out-dir"])
+        .args([
+            "render",
+            "level",
+            "--mode",
+            "realtime",
+            "--target-ms",
+            "1",
+            "--frames",
+            "8",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--min-scale",
+            "0.5",
+            "--out-dir",
+        ])
         .arg(&dir)
         .output()
         .unwrap();
@@ -325,7 +696,20 @@ fn governed_render_writes_frames_csv() {
 fn time_to_quality_follows_each_run_past_the_last_time() {
     let dir = temp_dir("time-to-quality");
     let o = bin("hush-cli")
-        .args(["time-to-quality", "level", "--width", "32", "--reference-frames", "4", "--seconds", "0.4", "--lead-in", "0.1", "--at", "0,0.2,0.4"])
+        .args([
+            "time-to-quality",
+            "level",
+            "--width",
+            "32",
+            "--reference-frames",
+            "4",
+            "--seconds",
+            "0.4",
+            "--lead-in",
+            "0.1",
+            "--at",
+            "0,0.2,0.4",
+        ])
         .args(["--run", "none", "--run", "progressive@30"])
         .arg("--out-dir")
         .arg(&dir)
@@ -339,14 +723,25 @@ fn time_to_quality_follows_each_run_past_the_last_time() {
     let frames = std::fs::read_to_string(dir.join("time_to_quality.csv")).unwrap();
     for run in ["none", "progressive@30"] {
         for sc in ["stop", "cut"] {
-            let rows: Vec<Vec<&str>> = frames.lines().map(|l| l.split(',').collect::<Vec<_>>()).filter(|r| r[0] == run && r[1] == sc).collect();
+            let rows: Vec<Vec<&str>> = frames
+                .lines()
+                .map(|l| l.split(',').collect::<Vec<_>>())
+                .filter(|r| r[0] == run && r[1] == sc)
+                .collect();
             // The image before the stop, then frames until the clock passes --seconds.
             assert!(rows.len() >= 2, "{run} {sc}: {frames}");
             let ends: Vec<f64> = rows[1..].iter().map(|r| r[3].parse().unwrap()).collect();
-            assert!(ends.windows(2).all(|w| w[1] >= w[0]) && *ends.last().unwrap() >= 0.4, "{run} {sc}: {ends:?}");
+            assert!(
+                ends.windows(2).all(|w| w[1] >= w[0]) && *ends.last().unwrap() >= 0.4,
+                "{run} {sc}: {ends:?}"
+            );
             assert!(rows.iter().all(|r| r[9].parse::<f64>().unwrap().is_finite()), "{frames}");
         }
     }
-    assert!(stdout.contains("progressive@30 at or below none") || stdout.contains("progressive@30 above none"), "{stdout}");
+    assert!(
+        stdout.contains("progressive@30 at or below none")
+            || stdout.contains("progressive@30 above none"),
+        "{stdout}"
+    );
     assert_eq!(image_size(&dir.join("time_to_quality.png")), (960, 840));
 }

@@ -9,7 +9,9 @@ mod support;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
-use support::{Outcome, exr_header, fifo, png_bomb, quad_doc, run, symlink, tail, textured, write_case};
+use support::{
+    Outcome, exr_header, fifo, png_bomb, quad_doc, run, symlink, tail, textured, write_case,
+};
 
 /// Long enough for any case on a loaded 2-core CI machine; the hangs these cases caught ran
 /// until killed.
@@ -21,7 +23,14 @@ const REFUSED_MIB: f64 = 64.0;
 fn render(scene: &Path, extra: &[&str]) -> (Outcome, PathBuf) {
     let out = scene.with_file_name("out.png");
     let _ = std::fs::remove_file(&out);
-    let mut args: Vec<String> = vec!["render".into(), scene.display().to_string(), "--width".into(), "8".into(), "--height".into(), "8".into()];
+    let mut args: Vec<String> = vec![
+        "render".into(),
+        scene.display().to_string(),
+        "--width".into(),
+        "8".into(),
+        "--height".into(),
+        "8".into(),
+    ];
     if !extra.contains(&"realtime") {
         args.extend(["--spp".into(), "1".into()]);
     }
@@ -34,7 +43,12 @@ fn render(scene: &Path, extra: &[&str]) -> (Outcome, PathBuf) {
 #[track_caller]
 fn assert_refused(name: &str, scene: &Path, extra: &[&str], needle: &str) -> Outcome {
     let (o, out) = render(scene, extra);
-    assert!(o.refused(needle), "{name}: expected exit 1 with {needle:?}, got {:?}: {}", o.code, tail(&o.stderr));
+    assert!(
+        o.refused(needle),
+        "{name}: expected exit 1 with {needle:?}, got {:?}: {}",
+        o.code,
+        tail(&o.stderr)
+    );
     assert!(!out.exists(), "{name}: an output was written");
     assert!(o.peak_mib < REFUSED_MIB, "{name}: {:.1} MiB to refuse a file", o.peak_mib);
     o
@@ -44,7 +58,12 @@ fn assert_refused(name: &str, scene: &Path, extra: &[&str], needle: &str) -> Out
 #[track_caller]
 fn assert_renders(name: &str, scene: &Path, extra: &[&str], needle: &str) -> Outcome {
     let (o, out) = render(scene, extra);
-    assert!(o.code == Some(0) && out.exists() && !o.panicked(), "{name}: expected a render, got {:?}: {}", o.code, tail(&o.stderr));
+    assert!(
+        o.code == Some(0) && out.exists() && !o.panicked(),
+        "{name}: expected a render, got {:?}: {}",
+        o.code,
+        tail(&o.stderr)
+    );
     assert!(o.stderr.contains(needle), "{name}: expected {needle:?} in: {}", tail(&o.stderr));
     o
 }
@@ -59,33 +78,88 @@ fn case(name: &str, mutate: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
 fn files_that_panicked_are_clear_errors() {
     let png = png_bomb(4, 4);
     for (name, scene, needle) in [
-        ("float indices", case("float_indices", |d| d["accessors"][3]["componentType"] = json!(5126)), "indices (accessors[3]) is SCALAR of FLOAT"),
-        ("camera type without its data", case("camera_type", |d| d["cameras"][0] = json!({"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}})), "cameras[0] is of type perspective but has no `perspective`"),
-        ("image with uri and bufferView", write_case("image_both", &textured(quad_doc(), json!({"uri": "t.png", "bufferView": 0, "mimeType": "image/png"})), &[("t.png", &png)]), "images[0] has both `uri` and `bufferView`"),
-        ("image with neither", write_case("image_neither", &textured(quad_doc(), json!({"name": "x"})), &[]), "images[0] has neither `uri` nor `bufferView`"),
-        ("image in a view without mimeType", write_case("image_mime", &textured(quad_doc(), json!({"bufferView": 0})), &[]), "images[0] is stored in a bufferView but has no `mimeType`"),
-        ("normal map with short TEXCOORD_0", case("short_uv", |d| {
-            d["materials"][0]["normalTexture"] = json!({"index": 0});
-            d["textures"] = json!([{"source": 0}]);
-            d["images"] = json!([{"uri": "t.png"}]);
-            d["accessors"][2]["count"] = json!(2);
-        }), "TEXCOORD_0 has 2 elements and POSITION 4"),
-        ("POSITION naming a missing accessor", case("position_index", |d| d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(9)), "POSITION names accessors[9], which does not exist"),
-        ("animation of an unknown property", case("anim_path", |d| {
-            d["accessors"].as_array_mut().unwrap().push(json!({"bufferView": 3, "componentType": 5126, "count": 6, "type": "SCALAR"}));
-            d["animations"] = json!([{"channels": [{"sampler": 0, "target": {"node": 0, "path": "colour"}}], "samplers": [{"input": 4, "output": 0}]}]);
-        }), "target.path must be translation, rotation, scale or weights"),
-        ("spot light without spot", case("spot", |d| {
-            d["extensionsUsed"] = json!(["KHR_lights_punctual"]);
-            d["extensions"] = json!({"KHR_lights_punctual": {"lights": [{"type": "spot", "intensity": 5}]}});
-            d["nodes"][0]["extensions"] = json!({"KHR_lights_punctual": {"light": 0}});
-        }), "extensions.KHR_lights_punctual.lights[0] is a spot light without `spot`"),
+        (
+            "float indices",
+            case("float_indices", |d| d["accessors"][3]["componentType"] = json!(5126)),
+            "indices (accessors[3]) is SCALAR of FLOAT",
+        ),
+        (
+            "camera type without its data",
+            case(
+                "camera_type",
+                |d| d["cameras"][0] = json!({"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}}),
+            ),
+            "cameras[0] is of type perspective but has no `perspective`",
+        ),
+        (
+            "image with uri and bufferView",
+            write_case(
+                "image_both",
+                &textured(
+                    quad_doc(),
+                    json!({"uri": "t.png", "bufferView": 0, "mimeType": "image/png"}),
+                ),
+                &[("t.png", &png)],
+            ),
+            "images[0] has both `uri` and `bufferView`",
+        ),
+        (
+            "image with neither",
+            write_case("image_neither", &textured(quad_doc(), json!({"name": "x"})), &[]),
+            "images[0] has neither `uri` nor `bufferView`",
+        ),
+        (
+            "image in a view without mimeType",
+            write_case("image_mime", &textured(quad_doc(), json!({"bufferView": 0})), &[]),
+            "images[0] is stored in a bufferView but has no `mimeType`",
+        ),
+        (
+            "normal map with short TEXCOORD_0",
+            case("short_uv", |d| {
+                d["materials"][0]["normalTexture"] = json!({"index": 0});
+                d["textures"] = json!([{"source": 0}]);
+                d["images"] = json!([{"uri": "t.png"}]);
+                d["accessors"][2]["count"] = json!(2);
+            }),
+            "TEXCOORD_0 has 2 elements and POSITION 4",
+        ),
+        (
+            "POSITION naming a missing accessor",
+            case("position_index", |d| {
+                d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(9)
+            }),
+            "POSITION names accessors[9], which does not exist",
+        ),
+        (
+            "animation of an unknown property",
+            case("anim_path", |d| {
+                d["accessors"].as_array_mut().unwrap().push(
+                    json!({"bufferView": 3, "componentType": 5126, "count": 6, "type": "SCALAR"}),
+                );
+                d["animations"] = json!([{"channels": [{"sampler": 0, "target": {"node": 0, "path": "colour"}}], "samplers": [{"input": 4, "output": 0}]}]);
+            }),
+            "target.path must be translation, rotation, scale or weights",
+        ),
+        (
+            "spot light without spot",
+            case("spot", |d| {
+                d["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+                d["extensions"] =
+                    json!({"KHR_lights_punctual": {"lights": [{"type": "spot", "intensity": 5}]}});
+                d["nodes"][0]["extensions"] = json!({"KHR_lights_punctual": {"light": 0}});
+            }),
+            "extensions.KHR_lights_punctual.lights[0] is a spot light without `spot`",
+        ),
     ] {
         assert_refused(name, &scene, &[], needle);
     }
     // A GLB whose header's length is shorter than the header (the gltf crate subtracted unchecked).
     let glb = support::dir("glb_length").join("scene.glb");
-    std::fs::write(&glb, [&b"glTF"[..], &2u32.to_le_bytes(), &4u32.to_le_bytes(), &[0u8; 8]].concat()).unwrap();
+    std::fs::write(
+        &glb,
+        [&b"glTF"[..], &2u32.to_le_bytes(), &4u32.to_le_bytes(), &[0u8; 8]].concat(),
+    )
+    .unwrap();
     assert_refused("GLB length under its header", &glb, &[], "shorter than its 12-byte header");
 
     // Files that are fine but panicked in a dependency: a normal-mapped mesh whose triangles are
@@ -121,37 +195,79 @@ fn files_that_panicked_are_clear_errors() {
 
 #[test]
 fn inputs_that_hung_end_quickly() {
-    assert_refused("node that is its own child", &case("own_child", |d| d["nodes"][0]["children"] = json!([0])), &[], "nodes[0] is its own child");
-    assert_refused("camera node that is its own child", &case("camera_child", |d| d["nodes"][1]["children"] = json!([1])), &[], "nodes[1] is its own child");
+    assert_refused(
+        "node that is its own child",
+        &case("own_child", |d| d["nodes"][0]["children"] = json!([0])),
+        &[],
+        "nodes[0] is its own child",
+    );
+    assert_refused(
+        "camera node that is its own child",
+        &case("camera_child", |d| d["nodes"][1]["children"] = json!([1])),
+        &[],
+        "nodes[1] is its own child",
+    );
     assert_refused(
         "cycle out of the scene's reach",
         &case("cycle", |d| {
-            d["nodes"].as_array_mut().unwrap().extend([json!({"children": [3]}), json!({"children": [2], "mesh": 0})]);
+            d["nodes"]
+                .as_array_mut()
+                .unwrap()
+                .extend([json!({"children": [3]}), json!({"children": [2], "mesh": 0})]);
         }),
         &[],
         "cycle of children",
     );
     let buffer = case("buffer_fifo", |_| {});
     fifo(&buffer.with_file_name("scene.bin"));
-    assert_refused("buffer that is a FIFO", &buffer, &[], "scene.bin is a named pipe, not a regular file; refused");
+    assert_refused(
+        "buffer that is a FIFO",
+        &buffer,
+        &[],
+        "scene.bin is a named pipe, not a regular file; refused",
+    );
     let texture = write_case("texture_fifo", &textured(quad_doc(), json!({"uri": "t.png"})), &[]);
     fifo(&texture.with_file_name("t.png"));
-    assert_renders("texture that is a FIFO", &texture, &[], "t.png is a named pipe, not a regular file; refused; rendering without it");
-    let env = case("env_fifo", |d| d["scenes"][0]["extras"] = json!({"environment": {"map": "sky.exr"}}));
+    assert_renders(
+        "texture that is a FIFO",
+        &texture,
+        &[],
+        "t.png is a named pipe, not a regular file; refused; rendering without it",
+    );
+    let env =
+        case("env_fifo", |d| d["scenes"][0]["extras"] = json!({"environment": {"map": "sky.exr"}}));
     fifo(&env.with_file_name("sky.exr"));
     assert_refused("environment map that is a FIFO", &env, &[], "sky.exr is a named pipe");
     let ok = case("ok", |_| {});
     let path = ok.with_file_name("path.json");
     fifo(&path);
-    assert_refused("camera path that is a FIFO", &ok, &["--mode", "realtime", "--camera-path", path.to_str().unwrap()], "path.json is a named pipe");
+    assert_refused(
+        "camera path that is a FIFO",
+        &ok,
+        &["--mode", "realtime", "--camera-path", path.to_str().unwrap()],
+        "path.json is a named pipe",
+    );
     fifo(&ok.with_file_name("p.toml"));
-    assert_refused("preset that is a FIFO", &ok, &["--mode", "realtime", "--preset", ok.with_file_name("p.toml").to_str().unwrap()], "p.toml is a named pipe");
+    assert_refused(
+        "preset that is a FIFO",
+        &ok,
+        &["--mode", "realtime", "--preset", ok.with_file_name("p.toml").to_str().unwrap()],
+        "p.toml is a named pipe",
+    );
 
     // Copies of a quad that obvhs's PLOC merged one pair per pass: 20,000 stacked ones ran past
     // 60 s, nested ones too, and a row of evenly spaced ones took 15 s.
     for (name, place) in [
-        ("stacked", Box::new(|_: usize| json!({"mesh": 0})) as Box<dyn Fn(usize) -> serde_json::Value>),
-        ("nested", Box::new(|i| json!({"mesh": 0, "scale": [1.0 + i as f64 * 1e-3, 1, 1.0 + i as f64 * 1e-3]}))),
+        (
+            "stacked",
+            Box::new(|_: usize| json!({"mesh": 0})) as Box<dyn Fn(usize) -> serde_json::Value>,
+        ),
+        (
+            "nested",
+            Box::new(
+                |i| json!({"mesh": 0, "scale": [1.0 + i as f64 * 1e-3, 1, 1.0 + i as f64 * 1e-3]}),
+            ),
+        ),
         ("row", Box::new(|i| json!({"mesh": 0, "translation": [i as f64 * 2.0, 0, 0]}))),
     ] {
         let scene = case(&format!("instances_{name}"), |d| {
@@ -171,12 +287,18 @@ fn tiny_files_cannot_claim_runaway_memory() {
     // Each node lists the next one twice: 2^40 paths from 41 nodes.
     let dag = case("dag", |d| {
         let cam = d["nodes"][1].clone();
-        let mut nodes: Vec<_> = (0..40).map(|i| json!({"children": [i + 1, i + 1], "mesh": 0})).collect();
+        let mut nodes: Vec<_> =
+            (0..40).map(|i| json!({"children": [i + 1, i + 1], "mesh": 0})).collect();
         nodes.extend([json!({"mesh": 0}), cam]);
         d["nodes"] = json!(nodes);
         d["scenes"][0]["nodes"] = json!([0, 41]);
     });
-    assert_refused("nodes fanning out", &dag, &[], "nodes[1] is a child of both nodes[0] and nodes[0]");
+    assert_refused(
+        "nodes fanning out",
+        &dag,
+        &[],
+        "nodes[1] is a child of both nodes[0] and nodes[0]",
+    );
     let chain = case("chain", |d| {
         let cam = d["nodes"][1].clone();
         let mut nodes: Vec<_> = (0..2000).map(|i| json!({"children": [i + 1]})).collect();
@@ -184,30 +306,70 @@ fn tiny_files_cannot_claim_runaway_memory() {
         d["nodes"] = json!(nodes);
         d["scenes"][0]["nodes"] = json!([0, 2001]);
     });
-    assert_refused("a 2,001-deep hierarchy", &chain, &[], "against the hierarchy-depth budget of 1024; if the file is trusted, raise it with --limit hierarchy-depth=1025");
-    let exr = case("exr_header", |d| d["scenes"][0]["extras"] = json!({"environment": {"map": "sky.exr"}}));
+    assert_refused(
+        "a 2,001-deep hierarchy",
+        &chain,
+        &[],
+        "against the hierarchy-depth budget of 1024; if the file is trusted, raise it with --limit hierarchy-depth=1025",
+    );
+    let exr = case("exr_header", |d| {
+        d["scenes"][0]["extras"] = json!({"environment": {"map": "sky.exr"}})
+    });
     std::fs::write(exr.with_file_name("sky.exr"), exr_header(100_000, 50_000)).unwrap();
-    assert_refused("EXR declaring 100000x50000", &exr, &[], "(100000x50000) needs 5000000000 against the image-pixels budget of 67108864");
-    let bomb = write_case("png_bomb", &textured(quad_doc(), json!({"uri": "t.png"})), &[("t.png", &png_bomb(16384, 16384))]);
+    assert_refused(
+        "EXR declaring 100000x50000",
+        &exr,
+        &[],
+        "(100000x50000) needs 5000000000 against the image-pixels budget of 67108864",
+    );
+    let bomb = write_case(
+        "png_bomb",
+        &textured(quad_doc(), json!({"uri": "t.png"})),
+        &[("t.png", &png_bomb(16384, 16384))],
+    );
     assert!(std::fs::metadata(bomb.with_file_name("t.png")).unwrap().len() < 2 << 20);
-    assert_refused("grayscale PNG bomb", &bomb, &[], "(16384x16384) needs 268435456 against the image-pixels budget");
+    assert_refused(
+        "grayscale PNG bomb",
+        &bomb,
+        &[],
+        "(16384x16384) needs 268435456 against the image-pixels budget",
+    );
     let zero = case("dev_zero", |_| {});
     symlink(Path::new("/dev/zero"), &zero.with_file_name("scene.bin"));
-    assert_refused("buffer linked to /dev/zero", &zero, &[], "leads outside the scene's folder (to /dev/zero)");
+    assert_refused(
+        "buffer linked to /dev/zero",
+        &zero,
+        &[],
+        "leads outside the scene's folder (to /dev/zero)",
+    );
     let (o, out) = render(Path::new("/dev/zero"), &[]);
-    assert!(o.refused("/dev/zero is a device, not a regular file") && !out.exists(), "{}", tail(&o.stderr));
+    assert!(
+        o.refused("/dev/zero is a device, not a regular file") && !out.exists(),
+        "{}",
+        tail(&o.stderr)
+    );
     let sparse = case("sparse_count", |d| {
         d["accessors"][0] = json!({"componentType": 5126, "count": 1u64 << 31, "type": "VEC3", "min": [-1, 0, -1], "max": [1, 0, 1],
             "sparse": {"count": 1, "indices": {"bufferView": 3, "componentType": 5125}, "values": {"bufferView": 0}}});
     });
-    assert_refused("sparse accessor of 2^31 zeros", &sparse, &[], "against the decoded-bytes budget");
+    assert_refused(
+        "sparse accessor of 2^31 zeros",
+        &sparse,
+        &[],
+        "against the decoded-bytes budget",
+    );
     // One mesh of a million triangles (12 MB of indices) placed by 20 nodes.
     let mut bin = support::quad_bin();
     bin.extend((0..1_000_000).flat_map(|_| [0u32, 1, 2]).flat_map(u32::to_le_bytes));
     let mut doc = quad_doc();
     doc["buffers"][0]["byteLength"] = json!(bin.len());
-    doc["bufferViews"].as_array_mut().unwrap().push(json!({"buffer": 0, "byteOffset": 152, "byteLength": 12_000_000}));
-    doc["accessors"].as_array_mut().unwrap().push(json!({"bufferView": 4, "componentType": 5125, "count": 3_000_000, "type": "SCALAR"}));
+    doc["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"buffer": 0, "byteOffset": 152, "byteLength": 12_000_000}));
+    doc["accessors"].as_array_mut().unwrap().push(
+        json!({"bufferView": 4, "componentType": 5125, "count": 3_000_000, "type": "SCALAR"}),
+    );
     doc["meshes"][0]["primitives"][0]["indices"] = json!(4);
     let cam = doc["nodes"][1].clone();
     let mut nodes: Vec<_> = (0..20).map(|i| json!({"mesh": 0, "translation": [i, 0, 0]})).collect();
@@ -216,9 +378,19 @@ fn tiny_files_cannot_claim_runaway_memory() {
     doc["scenes"][0]["nodes"] = json!((0..21).collect::<Vec<_>>());
     let instanced = write_case("instanced", &doc, &[]);
     std::fs::write(instanced.with_file_name("scene.bin"), bin).unwrap();
-    assert_refused("20 million instanced triangles", &instanced, &[], "against the triangles budget of 16777215");
+    assert_refused(
+        "20 million instanced triangles",
+        &instanced,
+        &[],
+        "against the triangles budget of 16777215",
+    );
     // Budgets can be raised or lowered by name.
-    assert_refused("a lowered node budget", &case("nodes", |_| {}), &["--limit", "nodes=1"], "needs 2 against the nodes budget of 1");
+    assert_refused(
+        "a lowered node budget",
+        &case("nodes", |_| {}),
+        &["--limit", "nodes=1"],
+        "needs 2 against the nodes budget of 1",
+    );
     assert_renders("a raised depth budget", &chain, &["--limit", "hierarchy-depth=3000"], "");
 }
 
@@ -227,19 +399,28 @@ fn tiny_files_cannot_claim_runaway_memory() {
 /// resize's float buffer) and 200,000 instanced quads (536 MiB).
 #[test]
 fn the_largest_accepted_inputs_stay_within_their_memory() {
-    let texture = write_case("png_at_budget", &textured(quad_doc(), json!({"uri": "t.png"})), &[("t.png", &png_bomb(8192, 8192))]);
+    let texture = write_case(
+        "png_at_budget",
+        &textured(quad_doc(), json!({"uri": "t.png"})),
+        &[("t.png", &png_bomb(8192, 8192))],
+    );
     let big = assert_renders("an 8192x8192 texture", &texture, &[], "");
     assert!(big.peak_mib < 1200.0, "an 8192x8192 texture took {:.0} MiB", big.peak_mib);
     let many = case("instances_200k", |d| {
         let cam = d["nodes"][1].clone();
-        let mut nodes: Vec<_> = (0..200_000).map(|i| json!({"mesh": 0, "translation": [i % 500, 0, i / 500]})).collect();
+        let mut nodes: Vec<_> = (0..200_000)
+            .map(|i| json!({"mesh": 0, "translation": [i % 500, 0, i / 500]}))
+            .collect();
         nodes.push(cam);
         d["nodes"] = json!(nodes);
         d["scenes"][0]["nodes"] = json!((0..200_001).collect::<Vec<_>>());
     });
     let o = assert_renders("200,000 instances", &many, &[], "");
     assert!(o.peak_mib < 1024.0, "200,000 instances took {:.0} MiB", o.peak_mib);
-    println!("peak memory: 8192x8192 texture {:.0} MiB, 200,000 instances {:.0} MiB", big.peak_mib, o.peak_mib);
+    println!(
+        "peak memory: 8192x8192 texture {:.0} MiB, 200,000 instances {:.0} MiB",
+        big.peak_mib, o.peak_mib
+    );
 }
 
 #[test]
@@ -248,33 +429,66 @@ fn nothing_outside_the_scene_folder_is_read() {
     std::fs::write(&secret, b"SECRET-CONTENT").unwrap();
     let buffer = case("buffer_link", |_| {});
     symlink(&secret, &buffer.with_file_name("scene.bin"));
-    let o = assert_refused("buffer linked outside", &buffer, &[], "leads outside the scene's folder");
+    let o =
+        assert_refused("buffer linked outside", &buffer, &[], "leads outside the scene's folder");
     assert!(!o.stderr.contains("SECRET"));
     let texture = write_case("texture_link", &textured(quad_doc(), json!({"uri": "t.png"})), &[]);
     symlink(&secret, &texture.with_file_name("t.png"));
-    assert_renders("texture linked outside", &texture, &[], "t.png leads outside the scene's folder");
-    let env = case("env_link", |d| d["scenes"][0]["extras"] = json!({"environment": {"map": "sky.exr"}}));
+    assert_renders(
+        "texture linked outside",
+        &texture,
+        &[],
+        "t.png leads outside the scene's folder",
+    );
+    let env =
+        case("env_link", |d| d["scenes"][0]["extras"] = json!({"environment": {"map": "sky.exr"}}));
     symlink(&secret, &env.with_file_name("sky.exr"));
     assert_refused("environment map linked outside", &env, &[], "leads outside the scene's folder");
     let folder = case("folder_link", |d| d["buffers"][0]["uri"] = json!("sub/scene.bin"));
     let other = support::dir("other");
     std::fs::write(other.join("scene.bin"), support::quad_bin()).unwrap();
     symlink(&other, &folder.with_file_name("sub"));
-    assert_refused("folder linked outside", &folder, &[], "sub/scene.bin leads outside the scene's folder");
+    assert_refused(
+        "folder linked outside",
+        &folder,
+        &[],
+        "sub/scene.bin leads outside the scene's folder",
+    );
     for (name, uri, needle) in [
         ("parent", "../secret/secret.bin", "it leaves the scene's folder"),
         ("percent-encoded parent", "%2e%2e/secret/secret.bin", "it leaves the scene's folder"),
         ("absolute", "/etc/passwd", "only paths relative to the scene's folder are allowed"),
         ("file URL", "file:///etc/passwd", "only paths relative to the scene's folder are allowed"),
     ] {
-        assert_refused(name, &case(&format!("uri_{}", name.replace(' ', "_")), |d| d["buffers"][0]["uri"] = json!(uri)), &[], needle);
+        assert_refused(
+            name,
+            &case(&format!("uri_{}", name.replace(' ', "_")), |d| {
+                d["buffers"][0]["uri"] = json!(uri)
+            }),
+            &[],
+            needle,
+        );
     }
 }
 
 /// The mean of an EXR render at 8x8, 4 spp.
 fn mean(scene: &Path, name: &str) -> glam::Vec3 {
     let out = scene.with_file_name(format!("{name}.exr"));
-    let o = run(&["render", scene.to_str().unwrap(), "--width", "8", "--height", "8", "--spp", "4", "--out", out.to_str().unwrap()], LIMIT);
+    let o = run(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "4",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        LIMIT,
+    );
     assert_eq!(o.code, Some(0), "{name}: {}", tail(&o.stderr));
     hush_engine::quality::Image::load(&out).unwrap().mean()
 }
@@ -287,9 +501,15 @@ fn output_that_was_silently_wrong_is_right_or_refused() {
     // dropped, and the quad renders as without it (the infinite bounds had dropped everything).
     let stray = case("inf_vertex", |d| {
         d["buffers"][0]["byteLength"] = json!(152 + 36);
-        d["bufferViews"].as_array_mut().unwrap().push(json!({"buffer": 0, "byteOffset": 152, "byteLength": 36}));
+        d["bufferViews"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"buffer": 0, "byteOffset": 152, "byteLength": 36}));
         d["accessors"].as_array_mut().unwrap().push(json!({"bufferView": 4, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [0.5, 0, 0.5]}));
-        d["meshes"][0]["primitives"].as_array_mut().unwrap().push(json!({"attributes": {"POSITION": 4}, "material": 0}));
+        d["meshes"][0]["primitives"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"attributes": {"POSITION": 4}, "material": 0}));
     });
     let mut bin = support::quad_bin();
     for v in [[f32::INFINITY, 0.0, 0.0], [0.0, 0.0, 0.0], [0.5, 0.0, 0.5]] {
@@ -297,32 +517,95 @@ fn output_that_was_silently_wrong_is_right_or_refused() {
     }
     std::fs::write(stray.with_file_name("scene.bin"), bin).unwrap();
     let with_inf = mean(&stray, "inf");
-    assert!((with_inf - clean).abs().max_element() < 1e-4 * clean.max_element(), "+Inf vertex: {with_inf} against {clean}");
+    assert!(
+        (with_inf - clean).abs().max_element() < 1e-4 * clean.max_element(),
+        "+Inf vertex: {with_inf} against {clean}"
+    );
     // A camera node scaled to zero keeps its pose.
-    let zero_scale = mean(&case("camera_zero_scale", |d| d["nodes"][1]["scale"] = json!([0, 0, 0])), "zero_scale");
-    assert!((zero_scale - clean).abs().max_element() < 1e-3 * clean.max_element(), "zero-scale camera: {zero_scale} against {clean}");
+    let zero_scale = mean(
+        &case("camera_zero_scale", |d| d["nodes"][1]["scale"] = json!([0, 0, 0])),
+        "zero_scale",
+    );
+    assert!(
+        (zero_scale - clean).abs().max_element() < 1e-3 * clean.max_element(),
+        "zero-scale camera: {zero_scale} against {clean}"
+    );
 
     for (name, mutate, needle) in [
-        ("indices past their buffer", Box::new(|d: &mut serde_json::Value| d["bufferViews"][3]["byteOffset"] = json!(140)) as Box<dyn Fn(&mut serde_json::Value)>, "indices (accessors[3]): bufferViews[3] (bytes 140..164) runs past its buffer of 152 bytes"),
-        ("yfov 0", Box::new(|d| d["cameras"][0]["perspective"]["yfov"] = json!(0)), "cameras[0].perspective.yfov must be in (0, pi) radians, got 0"),
-        ("negative yfov", Box::new(|d| d["cameras"][0]["perspective"]["yfov"] = json!(-0.5)), "yfov must be in (0, pi) radians, got -0.5"),
-        ("yfov of pi", Box::new(|d| d["cameras"][0]["perspective"]["yfov"] = json!(std::f32::consts::PI)), "yfov must be in (0, pi) radians"),
-        ("POSITION of unsigned bytes", Box::new(|d| d["accessors"][0]["componentType"] = json!(5121)), "POSITION (accessors[0]) is VEC3 of UNSIGNED_BYTE; Hush reads it as VEC3 of FLOAT"),
-        ("POSITION of VEC2", Box::new(|d| d["accessors"][0]["type"] = json!("VEC2")), "POSITION (accessors[0]) is VEC2 of FLOAT; Hush reads it as VEC3 of FLOAT"),
-        ("environment intensity \"bright\"", Box::new(|d| d["scenes"][0]["extras"] = json!({"environment": {"map": "sky.exr", "intensity": "bright"}})), "scenes[0].extras.environment.intensity must be a number >= 0, got \"bright\""),
+        (
+            "indices past their buffer",
+            Box::new(|d: &mut serde_json::Value| d["bufferViews"][3]["byteOffset"] = json!(140))
+                as Box<dyn Fn(&mut serde_json::Value)>,
+            "indices (accessors[3]): bufferViews[3] (bytes 140..164) runs past its buffer of 152 bytes",
+        ),
+        (
+            "yfov 0",
+            Box::new(|d| d["cameras"][0]["perspective"]["yfov"] = json!(0)),
+            "cameras[0].perspective.yfov must be in (0, pi) radians, got 0",
+        ),
+        (
+            "negative yfov",
+            Box::new(|d| d["cameras"][0]["perspective"]["yfov"] = json!(-0.5)),
+            "yfov must be in (0, pi) radians, got -0.5",
+        ),
+        (
+            "yfov of pi",
+            Box::new(|d| d["cameras"][0]["perspective"]["yfov"] = json!(std::f32::consts::PI)),
+            "yfov must be in (0, pi) radians",
+        ),
+        (
+            "POSITION of unsigned bytes",
+            Box::new(|d| d["accessors"][0]["componentType"] = json!(5121)),
+            "POSITION (accessors[0]) is VEC3 of UNSIGNED_BYTE; Hush reads it as VEC3 of FLOAT",
+        ),
+        (
+            "POSITION of VEC2",
+            Box::new(|d| d["accessors"][0]["type"] = json!("VEC2")),
+            "POSITION (accessors[0]) is VEC2 of FLOAT; Hush reads it as VEC3 of FLOAT",
+        ),
+        (
+            "environment intensity \"bright\"",
+            Box::new(|d| {
+                d["scenes"][0]["extras"] =
+                    json!({"environment": {"map": "sky.exr", "intensity": "bright"}})
+            }),
+            "scenes[0].extras.environment.intensity must be a number >= 0, got \"bright\"",
+        ),
     ] {
         assert_refused(name, &case(&name.replace([' ', '"'], "_"), |d| mutate(d)), &[], needle);
     }
     let ok = case("flags", |_| {});
     let (o, out) = render(&ok, &["--max-depth", "-2"]);
-    assert!(o.code == Some(2) && o.stderr.contains("-2 is not in -1..=65536") && !out.exists(), "{}", tail(&o.stderr));
+    assert!(
+        o.code == Some(2) && o.stderr.contains("-2 is not in -1..=65536") && !out.exists(),
+        "{}",
+        tail(&o.stderr)
+    );
     let preset = ok.with_file_name("p.toml");
     std::fs::write(&preset, "denoiser = \"Mara\"\n").unwrap();
-    assert_refused("--preset in reference mode", &ok, &["--preset", preset.to_str().unwrap()], "--preset only applies to --mode realtime");
+    assert_refused(
+        "--preset in reference mode",
+        &ok,
+        &["--preset", preset.to_str().unwrap()],
+        "--preset only applies to --mode realtime",
+    );
     // An orthographic camera renders through a perspective one, and says so.
-    let ortho = case("ortho", |d| d["cameras"][0] = json!({"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.01, "zfar": 10}}));
-    assert_renders("orthographic camera", &ortho, &[], "cameras[0] is orthographic; Hush renders it as a perspective camera");
-    assert_renders("orthographic camera in real time", &ortho, &["--mode", "realtime"], "cameras[0] is orthographic");
+    let ortho = case(
+        "ortho",
+        |d| d["cameras"][0] = json!({"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.01, "zfar": 10}}),
+    );
+    assert_renders(
+        "orthographic camera",
+        &ortho,
+        &[],
+        "cameras[0] is orthographic; Hush renders it as a perspective camera",
+    );
+    assert_renders(
+        "orthographic camera in real time",
+        &ortho,
+        &["--mode", "realtime"],
+        "cameras[0] is orthographic",
+    );
 }
 
 #[test]
@@ -330,34 +613,95 @@ fn errors_come_before_the_work_and_say_what_is_wrong() {
     // Output checks come before the scene is even read: the scene here does not exist.
     let missing = Path::new("/nonexistent/scene.gltf");
     let o = run(&["render", "/nonexistent/scene.gltf", "--out", "x.jpg"], LIMIT);
-    assert!(o.refused("--out x.jpg: the file must end in .exr or .png") && !o.stderr.contains("nonexistent"), "{}", tail(&o.stderr));
-    let o = run(&["render", missing.to_str().unwrap(), "--out", "/nonexistent/folder/x.png"], LIMIT);
+    assert!(
+        o.refused("--out x.jpg: the file must end in .exr or .png")
+            && !o.stderr.contains("nonexistent"),
+        "{}",
+        tail(&o.stderr)
+    );
+    let o =
+        run(&["render", missing.to_str().unwrap(), "--out", "/nonexistent/folder/x.png"], LIMIT);
     assert!(o.refused("the folder /nonexistent/folder does not exist"), "{}", tail(&o.stderr));
-    let o = run(&["render", missing.to_str().unwrap(), "--width", "65536", "--height", "65537", "--out", "x.png"], LIMIT);
-    assert!(o.refused("--width 65536: reference mode renders at most 16384 pixels a side"), "{}", tail(&o.stderr));
-    let o = run(&["render", missing.to_str().unwrap(), "--mode", "realtime", "--width", "9000", "--out", "x.png"], LIMIT);
-    assert!(o.refused("--width 9000: real-time mode renders at most 8192 pixels a side"), "{}", tail(&o.stderr));
+    let o = run(
+        &[
+            "render",
+            missing.to_str().unwrap(),
+            "--width",
+            "65536",
+            "--height",
+            "65537",
+            "--out",
+            "x.png",
+        ],
+        LIMIT,
+    );
+    assert!(
+        o.refused("--width 65536: reference mode renders at most 16384 pixels a side"),
+        "{}",
+        tail(&o.stderr)
+    );
+    let o = run(
+        &[
+            "render",
+            missing.to_str().unwrap(),
+            "--mode",
+            "realtime",
+            "--width",
+            "9000",
+            "--out",
+            "x.png",
+        ],
+        LIMIT,
+    );
+    assert!(
+        o.refused("--width 9000: real-time mode renders at most 8192 pixels a side"),
+        "{}",
+        tail(&o.stderr)
+    );
     // The other commands' outputs too, before any rendering.
     let file = support::dir("outputs").join("a-file");
     std::fs::write(&file, b"").unwrap();
     let under_file = file.join("out");
     for (args, needle) in [
-        (vec!["quality", "level", "--out-dir", under_file.to_str().unwrap()], "a-file is not a folder"),
-        (vec!["sweep", "level", "--out-dir", under_file.to_str().unwrap()], "a-file is not a folder"),
-        (vec!["bench", "level", "--mode", "realtime", "--profile", "/nonexistent/x.puffin"], "the folder /nonexistent does not exist"),
+        (
+            vec!["quality", "level", "--out-dir", under_file.to_str().unwrap()],
+            "a-file is not a folder",
+        ),
+        (
+            vec!["sweep", "level", "--out-dir", under_file.to_str().unwrap()],
+            "a-file is not a folder",
+        ),
+        (
+            vec!["bench", "level", "--mode", "realtime", "--profile", "/nonexistent/x.puffin"],
+            "the folder /nonexistent does not exist",
+        ),
     ] {
         let o = run(&args, LIMIT);
         assert!(o.refused(needle) && o.peak_mib < REFUSED_MIB, "{args:?}: {}", tail(&o.stderr));
     }
     // An accessor past its view names it (it had said 'a primitive has no POSITION').
-    assert_refused("accessor past its view", &case("past_view", |d| d["accessors"][0]["byteOffset"] = json!(40)), &[], "POSITION (accessors[0]): 4 elements of 12 bytes (stride 12) from byte 40 run past bufferViews[0] of 48 bytes");
+    assert_refused(
+        "accessor past its view",
+        &case("past_view", |d| d["accessors"][0]["byteOffset"] = json!(40)),
+        &[],
+        "POSITION (accessors[0]): 4 elements of 12 bytes (stride 12) from byte 40 run past bufferViews[0] of 48 bytes",
+    );
     // A 21 MB data URI that is not base64: the error quotes its first 64 characters.
     let big = format!("data:application/octet-stream;base64,{}", "!".repeat(21 << 20));
-    let o = assert_refused("21 MB of bad base64", &case("base64", |d| d["buffers"][0]["uri"] = json!(big)), &[], "invalid base64");
+    let o = assert_refused(
+        "21 MB of bad base64",
+        &case("base64", |d| d["buffers"][0]["uri"] = json!(big)),
+        &[],
+        "invalid base64",
+    );
     assert!(o.stderr.len() < 2000, "the error is {} bytes long", o.stderr.len());
     // compare reads images within the same budgets.
     let exr = support::dir("compare").join("big.exr");
     std::fs::write(&exr, exr_header(100_000, 50_000)).unwrap();
     let o = run(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap()], LIMIT);
-    assert!(o.refused("against the image-pixels budget") && o.peak_mib < REFUSED_MIB, "{}", tail(&o.stderr));
+    assert!(
+        o.refused("against the image-pixels budget") && o.peak_mib < REFUSED_MIB,
+        "{}",
+        tail(&o.stderr)
+    );
 }

@@ -73,7 +73,15 @@ pub struct Accel {
 impl Accel {
     /// Placeholder before the first build (no nodes).
     pub fn empty(kind: BvhKind) -> Accel {
-        Accel { kind, nodes: vec![], node_count: 0, order: vec![], build_time: Duration::ZERO, median_fallback: false, depth: 0 }
+        Accel {
+            kind,
+            nodes: vec![],
+            node_count: 0,
+            order: vec![],
+            build_time: Duration::ZERO,
+            median_fallback: false,
+            depth: 0,
+        }
     }
 }
 
@@ -144,7 +152,15 @@ pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel
         // An empty scene binds one node no ray can enter, in either layout's size.
         let mut nodes = bytemuck::bytes_of(&node).to_vec();
         nodes.resize(80, 0);
-        return Accel { kind: BvhKind::Bvh2, nodes, node_count: 1, order: vec![], build_time: start.elapsed(), median_fallback: false, depth: 1 };
+        return Accel {
+            kind: BvhKind::Bvh2,
+            nodes,
+            node_count: 1,
+            order: vec![],
+            build_time: start.elapsed(),
+            median_fallback: false,
+            depth: 1,
+        };
     }
     // obvhs's PLOC merges mutual nearest neighbours. Triangles that share one centroid (stacked
     // or nested copies) are all equally near each other: they merge one pair per pass (quadratic
@@ -156,8 +172,20 @@ pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel
     let sah = match (survey.coincident > COINCIDENT_LIMIT, survey.tied > TIE_LIMIT) {
         (true, _) => None,
         (false, true) => {
-            log::info!("{} neighbour pairs of {} triangles share one merge cost: PLOC's boxes are jittered", survey.tied, tris.len());
-            sah_build(&tris.iter().enumerate().map(|(i, t)| TieBroken::new(t.aabb(), i)).collect::<Vec<_>>(), kind, max_depth)
+            log::info!(
+                "{} neighbour pairs of {} triangles share one merge cost: PLOC's boxes are jittered",
+                survey.tied,
+                tris.len()
+            );
+            sah_build(
+                &tris
+                    .iter()
+                    .enumerate()
+                    .map(|(i, t)| TieBroken::new(t.aabb(), i))
+                    .collect::<Vec<_>>(),
+                kind,
+                max_depth,
+            )
         }
         (false, false) => sah_build(tris, kind, max_depth),
     };
@@ -183,19 +211,36 @@ type Built = (Vec<u8>, usize, Vec<u32>, usize);
 /// deep trees, and after it.
 fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind, max_depth: usize) -> Option<Built> {
     let p = params();
-    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(prims.len()).build(p.ploc_search_distance, prims, (0..prims.len() as u32).collect(), p.sort_precision, p.search_depth_threshold);
-    let reinsert = |bvh: &mut obvhs::bvh2::Bvh2, ratio: f32| obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(bvh, ratio, None);
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(prims.len()).build(
+        p.ploc_search_distance,
+        prims,
+        (0..prims.len() as u32).collect(),
+        p.sort_precision,
+        p.search_depth_threshold,
+    );
+    let reinsert = |bvh: &mut obvhs::bvh2::Bvh2, ratio: f32| {
+        obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(bvh, ratio, None)
+    };
     match kind {
         BvhKind::Bvh2 => {
             if bvh2_depth(&bvh.nodes) > 2 * max_depth {
                 return None;
             }
             reinsert(&mut bvh, p.reinsertion_batch_ratio);
-            obvhs::bvh2::leaf_collapser::collapse(&mut bvh, p.max_prims_per_leaf, p.collapse_traversal_cost);
-            reinsert(&mut bvh, p.reinsertion_batch_ratio * p.post_collapse_reinsertion_batch_ratio_multiplier);
+            obvhs::bvh2::leaf_collapser::collapse(
+                &mut bvh,
+                p.max_prims_per_leaf,
+                p.collapse_traversal_cost,
+            );
+            reinsert(
+                &mut bvh,
+                p.reinsertion_batch_ratio * p.post_collapse_reinsertion_batch_ratio_multiplier,
+            );
             let nodes = pack_bvh2(&bvh.nodes);
             let depth = packed_bvh2_depth(&nodes);
-            (depth <= max_depth).then(|| (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices, depth))
+            (depth <= max_depth).then(|| {
+                (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices, depth)
+            })
         }
         BvhKind::Cwbvh => {
             // A CWBVH node spans up to three binary levels.
@@ -203,9 +248,21 @@ fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind, max_depth: usize) 
                 return None;
             }
             reinsert(&mut bvh, p.reinsertion_batch_ratio);
-            let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&bvh, p.max_prims_per_leaf.clamp(1, 3), true, false);
+            let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
+                &bvh,
+                p.max_prims_per_leaf.clamp(1, 3),
+                true,
+                false,
+            );
             let depth = cwbvh_depth(&cw.nodes);
-            (depth <= max_depth).then(|| (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices, depth))
+            (depth <= max_depth).then(|| {
+                (
+                    bytemuck::cast_slice(&cw.nodes).to_vec(),
+                    cw.nodes.len(),
+                    cw.primitive_indices,
+                    depth,
+                )
+            })
         }
     }
 }
@@ -216,12 +273,27 @@ fn median_build(tris: &[Triangle], kind: BvhKind) -> Built {
         BvhKind::Bvh2 => {
             let bvh = median_bvh2(tris, p.max_prims_per_leaf as usize);
             let nodes = pack_bvh2(&bvh.nodes);
-            (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices, packed_bvh2_depth(&nodes))
+            (
+                bytemuck::cast_slice(&nodes).to_vec(),
+                nodes.len(),
+                bvh.primitive_indices,
+                packed_bvh2_depth(&nodes),
+            )
         }
         BvhKind::Cwbvh => {
             // obvhs's CWBVH leaves hold at most 3 triangles.
-            let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&median_bvh2(tris, 1), p.max_prims_per_leaf.clamp(1, 3), true, false);
-            (bytemuck::cast_slice(&cw.nodes).to_vec(), cw.nodes.len(), cw.primitive_indices, cwbvh_depth(&cw.nodes))
+            let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
+                &median_bvh2(tris, 1),
+                p.max_prims_per_leaf.clamp(1, 3),
+                true,
+                false,
+            );
+            (
+                bytemuck::cast_slice(&cw.nodes).to_vec(),
+                cw.nodes.len(),
+                cw.primitive_indices,
+                cwbvh_depth(&cw.nodes),
+            )
         }
     }
 }
@@ -275,13 +347,21 @@ impl Survey {
             .enumerate()
             .map(|(i, b)| {
                 let c = b.center();
-                let unit = ((c.as_dvec3() - total.min.as_dvec3()) / span).clamp(glam::DVec3::ZERO, glam::DVec3::ONE);
-                (obvhs::ploc::morton::morton_encode_u64_unorm(unit), c.to_array().map(f32::to_bits), i as u32)
+                let unit = ((c.as_dvec3() - total.min.as_dvec3()) / span)
+                    .clamp(glam::DVec3::ZERO, glam::DVec3::ONE);
+                (
+                    obvhs::ploc::morton::morton_encode_u64_unorm(unit),
+                    c.to_array().map(f32::to_bits),
+                    i as u32,
+                )
             })
             .collect();
         keys.sort_unstable();
         let coincident = keys.chunk_by(|a, b| a.1 == b.1).map(|run| run.len()).max().unwrap_or(0);
-        let mut costs: Vec<u32> = keys.windows(2).map(|w| boxes[w[0].2 as usize].union(&boxes[w[1].2 as usize]).half_area().to_bits()).collect();
+        let mut costs: Vec<u32> = keys
+            .windows(2)
+            .map(|w| boxes[w[0].2 as usize].union(&boxes[w[1].2 as usize]).half_area().to_bits())
+            .collect();
         costs.sort_unstable();
         let tied = costs.chunk_by(|a, b| a == b).map(|run| run.len()).max().unwrap_or(0);
         Survey { coincident, tied }
@@ -363,7 +443,9 @@ fn median_bvh2(tris: &[Triangle], leaf: usize) -> obvhs::bvh2::Bvh2 {
         }
         let axis = cb.largest_axis();
         let mid = (s + e) / 2;
-        prims[s..e].select_nth_unstable_by(mid - s, |&a, &b| centre[a as usize][axis].total_cmp(&centre[b as usize][axis]).then(a.cmp(&b)));
+        prims[s..e].select_nth_unstable_by(mid - s, |&a, &b| {
+            centre[a as usize][axis].total_cmp(&centre[b as usize][axis]).then(a.cmp(&b))
+        });
         let first = nodes.len();
         nodes.push(Bvh2Node::default());
         nodes.push(Bvh2Node::default());
@@ -377,13 +459,27 @@ fn median_bvh2(tris: &[Triangle], leaf: usize) -> obvhs::bvh2::Bvh2 {
 /// obvhs's BVH2 (each node its own box, children adjacent) -> nodes holding both child boxes.
 fn pack_bvh2(nodes: &[obvhs::bvh2::node::Bvh2Node]) -> Vec<Bvh2GpuNode> {
     let root = &nodes[0];
-    let child = |n: &obvhs::bvh2::node::Bvh2Node, gpu_index: u32| -> ([f32; 3], [f32; 3], u32, u32) {
-        let (lo, hi) = (n.aabb.min.to_array(), n.aabb.max.to_array());
-        if n.prim_count > 0 { (lo, hi, n.first_index, n.prim_count) } else { (lo, hi, gpu_index, 0) }
-    };
+    let child =
+        |n: &obvhs::bvh2::node::Bvh2Node, gpu_index: u32| -> ([f32; 3], [f32; 3], u32, u32) {
+            let (lo, hi) = (n.aabb.min.to_array(), n.aabb.max.to_array());
+            if n.prim_count > 0 {
+                (lo, hi, n.first_index, n.prim_count)
+            } else {
+                (lo, hi, gpu_index, 0)
+            }
+        };
     if root.prim_count > 0 {
         let (lmin, lmax, l_index, l_count) = child(root, 0);
-        return vec![Bvh2GpuNode { lmin, l_index, lmax, l_count, rmin: EMPTY_MIN, r_index: 0, rmax: EMPTY_MAX, r_count: 1 }];
+        return vec![Bvh2GpuNode {
+            lmin,
+            l_index,
+            lmax,
+            l_count,
+            rmin: EMPTY_MIN,
+            r_index: 0,
+            rmax: EMPTY_MAX,
+            r_count: 1,
+        }];
     }
     // Breadth-first numbering of inner nodes: gpu[i] holds obvhs inner node inner[i].
     let mut inner = vec![0usize];
@@ -412,7 +508,6 @@ fn pack_bvh2(nodes: &[obvhs::bvh2::node::Bvh2Node]) -> Vec<Bvh2GpuNode> {
         .collect()
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -421,7 +516,11 @@ mod tests {
     /// traverse; an ordinary scene keeps its PLOC tree.
     #[test]
     fn degenerate_layouts_build_fast_shallow_trees() {
-        let t = Triangle { v0: glam::Vec3A::new(-1.0, 0.0, -1.0), v1: glam::Vec3A::new(1.0, 0.0, 1.0), v2: glam::Vec3A::new(1.0, 0.0, -1.0) };
+        let t = Triangle {
+            v0: glam::Vec3A::new(-1.0, 0.0, -1.0),
+            v1: glam::Vec3A::new(1.0, 0.0, 1.0),
+            v2: glam::Vec3A::new(1.0, 0.0, -1.0),
+        };
         let stacked = vec![t; 5000];
         let grid: Vec<Triangle> = (0..5000)
             .map(|i| {
@@ -439,18 +538,27 @@ mod tests {
         }
         // Evenly spaced copies in a row (PLOC's ties) and nested copies (one centroid) build in
         // well under a second, where obvhs's PLOC alone took 4.9 s and 54 s.
-        let row: Vec<Triangle> = (0..20000).map(|i| {
-            let o = glam::Vec3A::new(i as f32 * 2.0, 0.0, 0.0);
-            Triangle { v0: t.v0 + o, v1: t.v1 + o, v2: t.v2 + o }
-        }).collect();
-        let nested: Vec<Triangle> = (0..20000).map(|i| {
-            let k = 1.0 + i as f32 * 1e-3;
-            Triangle { v0: t.v0 * k, v1: t.v1 * k, v2: t.v2 * k }
-        }).collect();
+        let row: Vec<Triangle> = (0..20000)
+            .map(|i| {
+                let o = glam::Vec3A::new(i as f32 * 2.0, 0.0, 0.0);
+                Triangle { v0: t.v0 + o, v1: t.v1 + o, v2: t.v2 + o }
+            })
+            .collect();
+        let nested: Vec<Triangle> = (0..20000)
+            .map(|i| {
+                let k = 1.0 + i as f32 * 1e-3;
+                Triangle { v0: t.v0 * k, v1: t.v1 * k, v2: t.v2 * k }
+            })
+            .collect();
         assert!(Survey::of(&row).tied > TIE_LIMIT && Survey::of(&grid).tied <= TIE_LIMIT);
         for (name, tris, fallback) in [("row", &row, false), ("nested", &nested, true)] {
             let a = build(tris, BvhKind::Cwbvh);
-            assert!(a.build_time.as_secs_f64() < 1.0 && a.median_fallback == fallback, "{name}: {:?}, fallback {}", a.build_time, a.median_fallback);
+            assert!(
+                a.build_time.as_secs_f64() < 1.0 && a.median_fallback == fallback,
+                "{name}: {:?}, fallback {}",
+                a.build_time,
+                a.median_fallback
+            );
         }
         let median = median_bvh2(&stacked, 1);
         assert_eq!(bvh2_depth(&median.nodes), 14, "ceil(log2(5000)) + 1");
@@ -460,24 +568,46 @@ mod tests {
     /// tree a rebuild within it can return (the median tree where the SAH tree is too deep).
     #[test]
     fn traversal_stacks_hold_the_trees_built_within_them() {
-        let t = Triangle { v0: glam::Vec3A::new(-1.0, 0.0, -1.0), v1: glam::Vec3A::new(1.0, 0.0, 1.0), v2: glam::Vec3A::new(1.0, 0.0, -1.0) };
+        let t = Triangle {
+            v0: glam::Vec3A::new(-1.0, 0.0, -1.0),
+            v1: glam::Vec3A::new(1.0, 0.0, 1.0),
+            v2: glam::Vec3A::new(1.0, 0.0, -1.0),
+        };
         // A row of triangles shrinking geometrically: PLOC chains them into a deep tree.
-        let chain: Vec<Triangle> = (0..3000).map(|i| {
-            let k = 0.99f32.powi(i);
-            let o = glam::Vec3A::new(k * 100.0, 0.0, 0.0);
-            Triangle { v0: t.v0 * k + o, v1: t.v1 * k + o, v2: t.v2 * k + o }
-        }).collect();
+        let chain: Vec<Triangle> = (0..3000)
+            .map(|i| {
+                let k = 0.99f32.powi(i);
+                let o = glam::Vec3A::new(k * 100.0, 0.0, 0.0);
+                Triangle { v0: t.v0 * k + o, v1: t.v1 * k + o, v2: t.v2 * k + o }
+            })
+            .collect();
         for kind in [BvhKind::Bvh2, BvhKind::Cwbvh] {
             let a = build(&chain, kind);
             let stack = traversal_stack(kind, a.depth, chain.len(), false) as usize;
-            assert!(stack >= a.depth && stack % 4 == 0 && stack < a.depth + 4, "{kind:?}: depth {} stack {stack}", a.depth);
+            assert!(
+                stack >= a.depth && stack % 4 == 0 && stack < a.depth + 4,
+                "{kind:?}: depth {} stack {stack}",
+                a.depth
+            );
             let animated = traversal_stack(kind, a.depth, chain.len(), true) as usize;
-            assert!(animated >= median_depth_bound(chain.len()) && animated >= a.depth + 4, "{kind:?}");
+            assert!(
+                animated >= median_depth_bound(chain.len()) && animated >= a.depth + 4,
+                "{kind:?}"
+            );
             // A limit below the SAH tree's depth gets the median tree, which fits the animated
             // scene's stack.
             let limited = build_within(&chain, kind, a.depth - 1);
-            assert!(limited.median_fallback && limited.depth <= animated, "{kind:?}: depth {} limit {}", limited.depth, a.depth - 1);
-            assert!(limited.depth <= median_depth_bound(chain.len()), "{kind:?}: median depth {}", limited.depth);
+            assert!(
+                limited.median_fallback && limited.depth <= animated,
+                "{kind:?}: depth {} limit {}",
+                limited.depth,
+                a.depth - 1
+            );
+            assert!(
+                limited.depth <= median_depth_bound(chain.len()),
+                "{kind:?}: median depth {}",
+                limited.depth
+            );
         }
         assert_eq!(median_depth_bound(5000), 14);
         assert_eq!(median_depth_bound(1), 1);

@@ -17,7 +17,14 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let d = &gpu.device;
     let params = memory.buffer(d, "matte/params", size_of::<DenoiseParams>() as u64, u);
     let glossy_params = memory.buffer(d, "glossy/params", size_of::<GlossyParams>() as u64, u);
-    Ok(Box::new(Mara { scene: *scene, params, glossy_params, targets: None, matte: None, glossy: None }))
+    Ok(Box::new(Mara {
+        scene: *scene,
+        params,
+        glossy_params,
+        targets: None,
+        matte: None,
+        glossy: None,
+    }))
 }
 
 struct Mara {
@@ -40,8 +47,16 @@ impl Denoiser for Mara {
         self.targets = Some((MatteTargets::new(d, memory, size), glossy));
     }
 
-    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
-        let (m, g) = self.targets.as_ref().context("the Mara denoiser records before its textures exist")?;
+    fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let (m, g) =
+            self.targets.as_ref().context("the Mara denoiser records before its textures exist")?;
         let s = cx.settings;
         let dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dp));
@@ -49,22 +64,47 @@ impl Denoiser for Mara {
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
         if self.matte.is_none() {
-            self.matte = Some(MatteChain::new(gpu, &inputs, self.scene.animated).context("creating the matte chain")?);
+            self.matte = Some(
+                MatteChain::new(gpu, &inputs, self.scene.animated)
+                    .context("creating the matte chain")?,
+            );
         }
-        self.matte.as_mut().unwrap().record(gpu, enc, cx.key, &inputs, cx.parity, timer.as_deref_mut())?;
+        self.matte.as_mut().unwrap().record(
+            gpu,
+            enc,
+            cx.key,
+            &inputs,
+            cx.parity,
+            timer.as_deref_mut(),
+        )?;
         if let Some(g) = g {
-            let inputs = GlossyInputs { io: *io, denoise: &self.params, params: &self.glossy_params, glossy: g };
+            let inputs = GlossyInputs {
+                io: *io,
+                denoise: &self.params,
+                params: &self.glossy_params,
+                glossy: g,
+            };
             if self.glossy.is_none() {
-                self.glossy = Some(GlossyChain::new(gpu, &inputs, self.scene.animated).context("creating the glossy chain")?);
+                self.glossy = Some(
+                    GlossyChain::new(gpu, &inputs, self.scene.animated)
+                        .context("creating the glossy chain")?,
+                );
             }
-            self.glossy.as_mut().unwrap().record(gpu, enc, cx.key, &inputs, cx.parity, &s.glossy, timer)?;
+            self.glossy
+                .as_mut()
+                .unwrap()
+                .record(gpu, enc, cx.key, &inputs, cx.parity, &s.glossy, timer)?;
         }
         Ok(())
     }
 
     fn output(&self, _parity: usize) -> Denoised<'_> {
         let Some((m, g)) = &self.targets else { return Denoised::default() };
-        Denoised { matte: Some(&m.denoised.1), glossy: g.as_ref().map(|g| &g.denoised.1), direct: None }
+        Denoised {
+            matte: Some(&m.denoised.1),
+            glossy: g.as_ref().map(|g| &g.denoised.1),
+            direct: None,
+        }
     }
 
     fn taa_follow(&self, parity: usize) -> TaaFollow<'_> {
@@ -72,7 +112,13 @@ impl Denoiser for Mara {
         TaaFollow {
             matte: Some((&m.temporal.1, &m.reason.1)),
             // The glossy temporal wrote history[1 - parity] this frame.
-            glossy: g.as_ref().map(|g| GlossyFollow { denoised: &g.denoised.1, temporal: &g.history[1 - parity].1, previous: &g.history[parity].1, info: &g.info.1, params: &self.glossy_params }),
+            glossy: g.as_ref().map(|g| GlossyFollow {
+                denoised: &g.denoised.1,
+                temporal: &g.history[1 - parity].1,
+                previous: &g.history[parity].1,
+                info: &g.info.1,
+                params: &self.glossy_params,
+            }),
         }
     }
 

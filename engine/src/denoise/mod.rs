@@ -66,7 +66,14 @@ pub trait Denoiser {
     fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32));
 
     /// Record its passes for this frame.
-    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, timer: Option<&mut GpuTimer>) -> Result<()>;
+    fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()>;
 
     /// The light it produced this frame (after [`Denoiser::record`]).
     fn output(&self, parity: usize) -> Denoised<'_>;
@@ -108,10 +115,34 @@ pub struct Entry {
 
 /// The denoisers built into Hush.
 pub const BUILT_IN: &[Entry] = &[
-    Entry { name: "none", summary: "the raw 1-sample frame (composite only)", make: None, views: &[], fractions: true },
-    Entry { name: "mara", summary: "Mara et al. 2017: the matte and glossy chains, then TAA", make: Some(mara::make), views: crate::settings::MARA_VIEWS, fractions: false },
-    Entry { name: "svgf", summary: "SVGF (Schied et al. 2017) with Voorhuis's reflections and robustness, then TAA", make: Some(svgf::make), views: crate::settings::SVGF_VIEWS, fractions: false },
-    Entry { name: "progressive", summary: "Dundr et al.'s progressive SVGF, for sample fractions below 1 (--spp 1/N), then TAA", make: Some(progressive::make), views: crate::settings::PROGRESSIVE_VIEWS, fractions: true },
+    Entry {
+        name: "none",
+        summary: "the raw 1-sample frame (composite only)",
+        make: None,
+        views: &[],
+        fractions: true,
+    },
+    Entry {
+        name: "mara",
+        summary: "Mara et al. 2017: the matte and glossy chains, then TAA",
+        make: Some(mara::make),
+        views: crate::settings::MARA_VIEWS,
+        fractions: false,
+    },
+    Entry {
+        name: "svgf",
+        summary: "SVGF (Schied et al. 2017) with Voorhuis's reflections and robustness, then TAA",
+        make: Some(svgf::make),
+        views: crate::settings::SVGF_VIEWS,
+        fractions: false,
+    },
+    Entry {
+        name: "progressive",
+        summary: "Dundr et al.'s progressive SVGF, for sample fractions below 1 (--spp 1/N), then TAA",
+        make: Some(progressive::make),
+        views: crate::settings::PROGRESSIVE_VIEWS,
+        fractions: true,
+    },
 ];
 
 static REGISTERED: RwLock<Vec<Entry>> = RwLock::new(Vec::new());
@@ -152,6 +183,9 @@ pub fn find(name: &str) -> Result<Entry> {
     let all = entries();
     match all.iter().find(|e| e.name == name) {
         Some(e) => Ok(*e),
-        None => bail!("no denoiser {name:?} (there are {})", all.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")),
+        None => bail!(
+            "no denoiser {name:?} (there are {})",
+            all.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")
+        ),
     }
 }

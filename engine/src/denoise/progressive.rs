@@ -94,9 +94,21 @@ impl Signal {
     /// Labels are 'static: the profiler and the pass timings key on them.
     fn labels(self) -> [&'static str; 3] {
         match self {
-            Signal::Matte => ["progressive/matte temporal", "progressive/matte variance", "progressive/matte atrous"],
-            Signal::Glossy => ["progressive/glossy temporal", "progressive/glossy variance", "progressive/glossy atrous"],
-            Signal::Direct => ["progressive/direct temporal", "progressive/direct variance", "progressive/direct atrous"],
+            Signal::Matte => [
+                "progressive/matte temporal",
+                "progressive/matte variance",
+                "progressive/matte atrous",
+            ],
+            Signal::Glossy => [
+                "progressive/glossy temporal",
+                "progressive/glossy variance",
+                "progressive/glossy atrous",
+            ],
+            Signal::Direct => [
+                "progressive/direct temporal",
+                "progressive/direct variance",
+                "progressive/direct atrous",
+            ],
         }
     }
 }
@@ -109,8 +121,17 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let dn = memory.buffer(d, "progressive/denoise params", size_of::<DenoiseParams>() as u64, u);
     let levels = [false, true].map(|fill_only| {
         std::array::from_fn(|i| {
-            let b = memory.buffer(d, &format!("progressive/level {i}"), size_of::<Level>() as u64, u);
-            gpu.queue.write_buffer(&b, 0, bytemuck::bytes_of(&Level { step: 1 << i, fill_only: fill_only as u32, _pad: [0; 2] }));
+            let b =
+                memory.buffer(d, &format!("progressive/level {i}"), size_of::<Level>() as u64, u);
+            gpu.queue.write_buffer(
+                &b,
+                0,
+                bytemuck::bytes_of(&Level {
+                    step: 1 << i,
+                    fill_only: fill_only as u32,
+                    _pad: [0; 2],
+                }),
+            );
             b
         })
     });
@@ -118,7 +139,16 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     if scene.glossy {
         signals.insert(1, Signal::Glossy);
     }
-    Ok(Box::new(Progressive { scene: *scene, pp, dn, levels, targets: None, features: None, stages: vec![], signals }))
+    Ok(Box::new(Progressive {
+        scene: *scene,
+        pp,
+        dn,
+        levels,
+        targets: None,
+        features: None,
+        stages: vec![],
+        signals,
+    }))
 }
 
 type Tex = (wgpu::Texture, wgpu::TextureView);
@@ -137,8 +167,11 @@ pub struct SignalTargets {
 
 impl SignalTargets {
     fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), name: &str) -> SignalTargets {
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
-        let mut t = |label: &str, f| mem.texture(d, &format!("progressive/{name} {label}"), size, f, rw);
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let mut t =
+            |label: &str, f| mem.texture(d, &format!("progressive/{name} {label}"), size, f, rw);
         SignalTargets {
             history: [t("history 0", RGBA16F), t("history 1", RGBA16F)],
             moments: [t("moments 0", RGBA32F), t("moments 1", RGBA32F)],
@@ -195,7 +228,12 @@ struct Progressive {
 }
 
 /// The modules of a program of `signal`'s `stage`.
-pub fn modules(stage: &'static str, signal: Signal, glossy: bool, animated: bool) -> Vec<&'static str> {
+pub fn modules(
+    stage: &'static str,
+    signal: Signal,
+    glossy: bool,
+    animated: bool,
+) -> Vec<&'static str> {
     let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl"];
     if glossy {
         m.push("realtime/glossy_in.wgsl");
@@ -207,10 +245,21 @@ pub fn modules(stage: &'static str, signal: Signal, glossy: bool, animated: bool
 }
 
 impl Progressive {
-    fn bindings<'a>(&'a self, io: &FrameIo<'a>, signal: Signal, pass: Pass, parity: usize, levels: usize) -> Bindings<'a> {
+    fn bindings<'a>(
+        &'a self,
+        io: &FrameIo<'a>,
+        signal: Signal,
+        pass: Pass,
+        parity: usize,
+        levels: usize,
+    ) -> Bindings<'a> {
         let t = self.targets.as_ref().unwrap();
         let s = &t.signals.iter().find(|(g, _)| *g == signal).unwrap().1;
-        let b = io.bindings().buffer("pp", &self.pp).buffer("dn", &self.dn).texture("features", &t.features.1);
+        let b = io
+            .bindings()
+            .buffer("pp", &self.pp)
+            .buffer("dn", &self.dn)
+            .texture("features", &t.features.1);
         match pass {
             Pass::Features => b.texture("out_features", &t.features.1),
             Pass::Temporal => b
@@ -218,35 +267,55 @@ impl Progressive {
                 .texture("moments", &s.moments[parity].1)
                 .texture("out_integrated", &s.history[1 - parity].1)
                 .texture("out_moments", &s.moments[1 - parity].1),
-            Pass::Variance => b.texture("integrated", &s.history[1 - parity].1).texture("moments", &s.moments[1 - parity].1).texture("dst", &s.variance.1),
+            Pass::Variance => b
+                .texture("integrated", &s.history[1 - parity].1)
+                .texture("moments", &s.moments[1 - parity].1)
+                .texture("dst", &s.variance.1),
             Pass::Atrous(i) => {
                 let src = if i == 0 { &s.variance } else { s.output(i) };
                 let dst = s.output(i + 1);
                 // Large scale first: level i of n steps 2^(n - 1 - i) pixels.
                 let step = levels.saturating_sub(1 + i).min(LEVELS - 1);
-                b.texture("src", &src.1).texture("dst", &dst.1).buffer("level", &self.levels[(signal == Signal::Direct) as usize][step])
+                b.texture("src", &src.1)
+                    .texture("dst", &dst.1)
+                    .buffer("level", &self.levels[(signal == Signal::Direct) as usize][step])
             }
         }
     }
 
     fn write_params(&self, gpu: &Gpu, io: &FrameIo, cx: &FrameContext) {
         let s: &FrameSettings = cx.settings;
-        gpu.queue.write_buffer(&self.pp, 0, bytemuck::bytes_of(&ProgressiveParams::new(&s.progressive)));
+        gpu.queue.write_buffer(
+            &self.pp,
+            0,
+            bytemuck::bytes_of(&ProgressiveParams::new(&s.progressive)),
+        );
         let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
         dp.reprojection_min_cos = crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES);
         gpu.queue.write_buffer(&self.dn, 0, bytemuck::bytes_of(&dp));
     }
 
     fn offered<'a>(&'a self, io: &FrameIo<'a>, signal: Signal) -> Bindings<'a> {
-        [Pass::Temporal, Pass::Variance, Pass::Atrous(0)].into_iter().fold(self.bindings(io, signal, Pass::Features, 0, 1), |b, pass| b.with(&self.bindings(io, signal, pass, 0, 1)))
+        [Pass::Temporal, Pass::Variance, Pass::Atrous(0)]
+            .into_iter()
+            .fold(self.bindings(io, signal, Pass::Features, 0, 1), |b, pass| {
+                b.with(&self.bindings(io, signal, pass, 0, 1))
+            })
     }
 
     fn make_stages(&self, gpu: &Gpu, io: &FrameIo, signal: Signal) -> Result<SignalStages> {
         let (g, a) = (self.scene.glossy, self.scene.animated);
         let offered = self.offered(io, signal);
         let [lt, lv, la] = signal.labels();
-        let stage = |label, file| ChainStage::new(gpu, label, &modules(file, signal, g, a), "main", &offered);
-        Ok(SignalStages { signal, temporal: stage(lt, "progressive/temporal.wgsl")?, variance: stage(lv, "progressive/variance.wgsl")?, atrous: stage(la, "progressive/atrous.wgsl")? })
+        let stage = |label, file| {
+            ChainStage::new(gpu, label, &modules(file, signal, g, a), "main", &offered)
+        };
+        Ok(SignalStages {
+            signal,
+            temporal: stage(lt, "progressive/temporal.wgsl")?,
+            variance: stage(lv, "progressive/variance.wgsl")?,
+            atrous: stage(la, "progressive/atrous.wgsl")?,
+        })
     }
 }
 
@@ -260,39 +329,92 @@ impl Denoiser for Progressive {
     }
 
     fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         let features = memory.texture(&gpu.device, "progressive/features", size, RGBA32F, rw);
-        let signals = self.signals.iter().map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name()))).collect();
+        let signals = self
+            .signals
+            .iter()
+            .map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name())))
+            .collect();
         self.targets = Some(Targets { features, signals, levels: 0 });
     }
 
-    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
-        self.targets.as_mut().context("the progressive filter records before its textures exist")?.levels = cx.settings.progressive.levels.min(PROGRESSIVE_MAX_LEVELS) as usize;
+    fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        self.targets
+            .as_mut()
+            .context("the progressive filter records before its textures exist")?
+            .levels = cx.settings.progressive.levels.min(PROGRESSIVE_MAX_LEVELS) as usize;
         self.write_params(gpu, io, cx);
         let (key, parity, size) = (cx.key, cx.parity, io.size);
         let levels = self.targets.as_ref().unwrap().levels;
         if self.features.is_none() {
-            let m = modules("progressive/features.wgsl", Signal::Matte, self.scene.glossy, self.scene.animated);
-            self.features = Some(ChainStage::new(gpu, "progressive/features", &m, "main", &self.bindings(io, Signal::Matte, Pass::Features, 0, levels)).context("creating the progressive filter's stages")?);
+            let m = modules(
+                "progressive/features.wgsl",
+                Signal::Matte,
+                self.scene.glossy,
+                self.scene.animated,
+            );
+            self.features = Some(
+                ChainStage::new(
+                    gpu,
+                    "progressive/features",
+                    &m,
+                    "main",
+                    &self.bindings(io, Signal::Matte, Pass::Features, 0, levels),
+                )
+                .context("creating the progressive filter's stages")?,
+            );
         }
         if self.stages.is_empty() {
-            self.stages = self.signals.iter().map(|&s| self.make_stages(gpu, io, s)).collect::<Result<_>>().context("creating the progressive filter's stages")?;
+            self.stages = self
+                .signals
+                .iter()
+                .map(|&s| self.make_stages(gpu, io, s))
+                .collect::<Result<_>>()
+                .context("creating the progressive filter's stages")?;
         }
         let mut features = self.features.take().unwrap();
-        let r = features.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, Signal::Matte, Pass::Features, p, levels));
+        let r = features.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+            self.bindings(io, Signal::Matte, Pass::Features, p, levels)
+        });
         self.features = Some(features);
         r?;
         let mut stages = std::mem::take(&mut self.stages);
         let mut result = Ok(());
         for st in stages.iter_mut() {
             let s = st.signal;
-            result = st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, s, Pass::Temporal, p, levels));
-            result = result.and_then(|_| st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, s, Pass::Variance, p, levels)));
+            result = st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+                self.bindings(io, s, Pass::Temporal, p, levels)
+            });
+            result = result.and_then(|_| {
+                st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+                    self.bindings(io, s, Pass::Variance, p, levels)
+                })
+            });
             for i in 0..levels {
                 // Bind groups are keyed by (parity, level); the level count is in the key, since
                 // it picks each level's step.
                 let k = key.wrapping_mul(8).wrapping_add(levels as u64);
-                result = result.and_then(|_| st.atrous.record_variant(gpu, enc, k, (2 * LEVELS, parity * LEVELS + i), size, timer.as_deref_mut(), |v| self.bindings(io, s, Pass::Atrous(v % LEVELS), v / LEVELS, levels)));
+                result = result.and_then(|_| {
+                    st.atrous.record_variant(
+                        gpu,
+                        enc,
+                        k,
+                        (2 * LEVELS, parity * LEVELS + i),
+                        size,
+                        timer.as_deref_mut(),
+                        |v| self.bindings(io, s, Pass::Atrous(v % LEVELS), v / LEVELS, levels),
+                    )
+                });
             }
             if result.is_err() {
                 break;
@@ -304,8 +426,14 @@ impl Denoiser for Progressive {
 
     fn output(&self, _parity: usize) -> Denoised<'_> {
         let Some(t) = &self.targets else { return Denoised::default() };
-        let out = |s: Signal| t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(t.levels).1);
-        Denoised { matte: out(Signal::Matte), glossy: out(Signal::Glossy), direct: out(Signal::Direct) }
+        let out = |s: Signal| {
+            t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(t.levels).1)
+        };
+        Denoised {
+            matte: out(Signal::Matte),
+            glossy: out(Signal::Glossy),
+            direct: out(Signal::Direct),
+        }
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
@@ -314,7 +442,11 @@ impl Denoiser for Progressive {
             v.push(&mut f.pipeline);
         }
         for s in self.stages.iter_mut() {
-            v.extend([&mut s.temporal, &mut s.variance, &mut s.atrous].into_iter().map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload));
+            v.extend(
+                [&mut s.temporal, &mut s.variance, &mut s.atrous]
+                    .into_iter()
+                    .map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload),
+            );
         }
         v
     }

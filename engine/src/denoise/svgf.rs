@@ -82,10 +82,29 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let gp = memory.buffer(d, "svgf/glossy params", size_of::<GlossyParams>() as u64, u);
     let levels = std::array::from_fn(|i| {
         let b = memory.buffer(d, &format!("svgf/level {i}"), size_of::<Level>() as u64, u);
-        gpu.queue.write_buffer(&b, 0, bytemuck::bytes_of(&Level { step: 1 << i, write_history: (i == 0) as u32, index: i as u32, _pad: 0 }));
+        gpu.queue.write_buffer(
+            &b,
+            0,
+            bytemuck::bytes_of(&Level {
+                step: 1 << i,
+                write_history: (i == 0) as u32,
+                index: i as u32,
+                _pad: 0,
+            }),
+        );
         b
     });
-    Ok(Box::new(Svgf { scene: *scene, sv, dn, gp, levels, targets: None, matte: None, glossy: None, motion: None }))
+    Ok(Box::new(Svgf {
+        scene: *scene,
+        sv,
+        dn,
+        gp,
+        levels,
+        targets: None,
+        matte: None,
+        glossy: None,
+        motion: None,
+    }))
 }
 
 type Tex = (wgpu::Texture, wgpu::TextureView);
@@ -112,8 +131,16 @@ pub struct SignalTargets {
 
 impl SignalTargets {
     fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), name: &str) -> SignalTargets {
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST;
-        let taps = mem.buffer(d, &format!("svgf/{name} taps"), size.0 as u64 * size.1 as u64 * 16, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST;
+        let taps = mem.buffer(
+            d,
+            &format!("svgf/{name} taps"),
+            size.0 as u64 * size.1 as u64 * 16,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        );
         let mut t = |label: &str, f| mem.texture(d, &format!("svgf/{name} {label}"), size, f, rw);
         SignalTargets {
             taps,
@@ -146,13 +173,21 @@ pub struct SvgfTargets {
 }
 
 impl SvgfTargets {
-    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), glossy: bool) -> SvgfTargets {
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    pub fn new(
+        d: &wgpu::Device,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        glossy: bool,
+    ) -> SvgfTargets {
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         let features = mem.texture(d, "svgf/features", size, RG32F, rw);
         let matte = SignalTargets::new(d, mem, size, "matte");
         let glossy = glossy.then(|| {
             let signal = SignalTargets::new(d, mem, size, "glossy");
-            let mut t = |label: &str, f| mem.texture(d, &format!("svgf/glossy {label}"), size, f, rw);
+            let mut t =
+                |label: &str, f| mem.texture(d, &format!("svgf/glossy {label}"), size, f, rw);
             let motion = MotionTargets {
                 hit: [t("hit 0", RGBA32F), t("hit 1", RGBA32F)],
                 motion: t("motion", RGBA32F),
@@ -200,11 +235,18 @@ impl SignalStages {
         let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
         // Labels are 'static: the profiler and the pass timings key on them.
         let labels: [&'static str; 4] = if glossy {
-            ["svgf/glossy temporal", "svgf/glossy variance", "svgf/glossy atrous", "svgf/glossy final"]
+            [
+                "svgf/glossy temporal",
+                "svgf/glossy variance",
+                "svgf/glossy atrous",
+                "svgf/glossy final",
+            ]
         } else {
             ["svgf/matte temporal", "svgf/matte variance", "svgf/matte atrous", "svgf/matte final"]
         };
-        let stage = |label, file, b: &Bindings| ChainStage::new(gpu, label, &modules(file, glossy, animated), "main", b);
+        let stage = |label, file, b: &Bindings| {
+            ChainStage::new(gpu, label, &modules(file, glossy, animated), "main", b)
+        };
         Ok(SignalStages {
             temporal: stage(labels[0], temporal, offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
@@ -214,7 +256,9 @@ impl SignalStages {
     }
 
     fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
-        [&mut self.temporal, &mut self.variance, &mut self.atrous, &mut self.last].into_iter().map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload)
+        [&mut self.temporal, &mut self.variance, &mut self.atrous, &mut self.last]
+            .into_iter()
+            .map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 }
 
@@ -250,12 +294,26 @@ enum Pass {
 impl Svgf {
     /// Everything every SVGF program may bind, plus what `pass` of one signal reads and
     /// writes for history parity `parity`.
-    fn bindings<'a>(&'a self, io: &FrameIo<'a>, glossy: bool, pass: Pass, parity: usize) -> Bindings<'a> {
+    fn bindings<'a>(
+        &'a self,
+        io: &FrameIo<'a>,
+        glossy: bool,
+        pass: Pass,
+        parity: usize,
+    ) -> Bindings<'a> {
         let t = self.targets.as_ref().unwrap();
-        let mut b = io.bindings().buffer("sv", &self.sv).buffer("dn", &self.dn).texture("features", &t.features.1);
+        let mut b = io
+            .bindings()
+            .buffer("sv", &self.sv)
+            .buffer("dn", &self.dn)
+            .texture("features", &t.features.1);
         let s = if glossy {
             let (s, m) = t.glossy.as_ref().unwrap();
-            b = b.buffer("gp", &self.gp).texture("prev_hit", &m.hit[parity].1).texture("motion", &m.motion.1).texture("neighbourhood", &m.neighbourhood.1);
+            b = b
+                .buffer("gp", &self.gp)
+                .texture("prev_hit", &m.hit[parity].1)
+                .texture("motion", &m.motion.1)
+                .texture("neighbourhood", &m.neighbourhood.1);
             s
         } else {
             &t.matte
@@ -267,7 +325,11 @@ impl Svgf {
                 .texture("out_integrated", &s.integrated.1)
                 .texture("out_moments", &s.moments[1 - parity].1)
                 .texture("out_features", &t.features.1),
-            Pass::Variance => b.texture("integrated", &s.integrated.1).texture("moments", &s.moments[1 - parity].1).texture("dst", &s.variance.1).buffer("out_taps", &s.taps),
+            Pass::Variance => b
+                .texture("integrated", &s.integrated.1)
+                .texture("moments", &s.moments[1 - parity].1)
+                .texture("dst", &s.variance.1)
+                .buffer("out_taps", &s.taps),
             Pass::Atrous(level) => {
                 let src = match level {
                     0 => &s.variance,
@@ -275,18 +337,35 @@ impl Svgf {
                     _ => &s.ping,
                 };
                 let dst = if level % 2 == 0 { &s.pong } else { &s.ping };
-                b.texture("src", &src.1).texture("dst", &dst.1).buffer("taps", &s.taps).texture("moments", &s.moments[1 - parity].1).texture("out_history", &s.history[1 - parity].1).buffer("level", &self.levels[level])
+                b.texture("src", &src.1)
+                    .texture("dst", &dst.1)
+                    .buffer("taps", &s.taps)
+                    .texture("moments", &s.moments[1 - parity].1)
+                    .texture("out_history", &s.history[1 - parity].1)
+                    .buffer("level", &self.levels[level])
             }
-            Pass::Final(last) => b.texture("src", &[&s.variance, &s.ping, &s.pong][last].1).texture("moments", &s.moments[1 - parity].1).texture("dst", &s.out.1),
+            Pass::Final(last) => b
+                .texture("src", &[&s.variance, &s.ping, &s.pong][last].1)
+                .texture("moments", &s.moments[1 - parity].1)
+                .texture("dst", &s.out.1),
         }
     }
 
     /// The glossy chain's motion and prefilter stages on SVGF's textures.
-    fn motion_bindings<'a>(&'a self, io: &FrameIo<'a>, prefilter: Option<bool>, parity: usize) -> Bindings<'a> {
+    fn motion_bindings<'a>(
+        &'a self,
+        io: &FrameIo<'a>,
+        prefilter: Option<bool>,
+        parity: usize,
+    ) -> Bindings<'a> {
         let (_, m) = self.targets.as_ref().unwrap().glossy.as_ref().unwrap();
         let b = io.bindings().buffer("dn", &self.dn).buffer("gp", &self.gp);
         match prefilter {
-            None => b.texture("prev_hit", &m.hit[parity].1).texture("out_motion", &m.motion.1).texture("out_search", &m.search.1).texture("out_hit", &m.hit[1 - parity].1),
+            None => b
+                .texture("prev_hit", &m.hit[parity].1)
+                .texture("out_motion", &m.motion.1)
+                .texture("out_search", &m.search.1)
+                .texture("out_hit", &m.hit[1 - parity].1),
             Some(false) => b.texture("src", &m.neighbourhood.1).texture("dst", &m.scratch.1),
             Some(true) => b.texture("src", &m.scratch.1).texture("dst", &m.neighbourhood.1),
         }
@@ -310,11 +389,20 @@ impl Svgf {
         gpu.queue.write_buffer(&self.gp, 0, bytemuck::bytes_of(&gp));
     }
 
-    fn record_signal(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, glossy: bool, timer: Option<&mut GpuTimer>) -> Result<()> {
+    fn record_signal(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        glossy: bool,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let made = if glossy { self.glossy.take() } else { self.matte.take() };
         let mut stages = match made {
             Some(s) => s,
-            None => SignalStages::new(gpu, glossy, self.scene.animated, &self.offered(io, glossy)).context("creating SVGF's stages")?,
+            None => SignalStages::new(gpu, glossy, self.scene.animated, &self.offered(io, glossy))
+                .context("creating SVGF's stages")?,
         };
         let result = self.record_stages(gpu, enc, io, cx, glossy, &mut stages, timer);
         *(if glossy { &mut self.glossy } else { &mut self.matte }) = Some(stages);
@@ -324,49 +412,110 @@ impl Svgf {
     /// Every resource any stage of a signal binds (only the names matter: each program's
     /// layout is checked against them).
     fn offered<'a>(&'a self, io: &FrameIo<'a>, glossy: bool) -> Bindings<'a> {
-        [Pass::Variance, Pass::Atrous(0), Pass::Final(0)].into_iter().fold(self.bindings(io, glossy, Pass::Temporal, 0), |b, pass| b.with(&self.bindings(io, glossy, pass, 0)))
+        [Pass::Variance, Pass::Atrous(0), Pass::Final(0)]
+            .into_iter()
+            .fold(self.bindings(io, glossy, Pass::Temporal, 0), |b, pass| {
+                b.with(&self.bindings(io, glossy, pass, 0))
+            })
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn record_stages(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, glossy: bool, st: &mut SignalStages, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    fn record_stages(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        glossy: bool,
+        st: &mut SignalStages,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let (key, parity, size) = (cx.key, cx.parity, io.size);
-        st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, glossy, Pass::Temporal, p))?;
-        st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.bindings(io, glossy, Pass::Variance, p))?;
+        st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+            self.bindings(io, glossy, Pass::Temporal, p)
+        })?;
+        st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+            self.bindings(io, glossy, Pass::Variance, p)
+        })?;
         let levels = cx.settings.svgf.atrous_levels() as usize;
         for level in 0..levels {
-            st.atrous.record_variant(gpu, enc, key, (2 * LEVELS, parity * LEVELS + level), size, timer.as_deref_mut(), |v| self.bindings(io, glossy, Pass::Atrous(v % LEVELS), v / LEVELS))?;
+            st.atrous.record_variant(
+                gpu,
+                enc,
+                key,
+                (2 * LEVELS, parity * LEVELS + level),
+                size,
+                timer.as_deref_mut(),
+                |v| self.bindings(io, glossy, Pass::Atrous(v % LEVELS), v / LEVELS),
+            )?;
         }
         let t = self.targets.as_ref().unwrap();
         let s = if glossy { &t.glossy.as_ref().unwrap().0 } else { &t.matte };
         if levels == 0 || !cx.settings.svgf.filtered_history {
             // No level wrote the history: it is the integrated light.
             let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
-            enc.copy_texture_to_texture(s.integrated.0.as_image_copy(), s.history[1 - parity].0.as_image_copy(), extent);
+            enc.copy_texture_to_texture(
+                s.integrated.0.as_image_copy(),
+                s.history[1 - parity].0.as_image_copy(),
+                extent,
+            );
         }
         // The last level wrote pong when its index was even.
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
-        st.last.record_variant(gpu, enc, key, (6, 2 * last + parity), size, timer, |v| self.bindings(io, glossy, Pass::Final(v / 2), v % 2))
+        st.last.record_variant(gpu, enc, key, (6, 2 * last + parity), size, timer, |v| {
+            self.bindings(io, glossy, Pass::Final(v / 2), v % 2)
+        })
     }
 
-    fn record_motion(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    fn record_motion(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         use crate::passes::glossy::modules;
         if self.motion.is_none() {
             let a = self.scene.animated;
-            let stage = |label, file, entry, b: &Bindings| ChainStage::new(gpu, label, &modules(file, a), entry, b);
+            let stage = |label, file, entry, b: &Bindings| {
+                ChainStage::new(gpu, label, &modules(file, a), entry, b)
+            };
             self.motion = Some(MotionStages {
-                motion: stage("svgf/glossy motion", "glossy/motion.wgsl", "main", &self.motion_bindings(io, None, 0))?,
-                prefilter_h: stage("svgf/glossy prefilter_h", "glossy/prefilter.wgsl", "pre_h", &self.motion_bindings(io, Some(false), 0))?,
-                prefilter_v: stage("svgf/glossy prefilter_v", "glossy/prefilter.wgsl", "pre_v", &self.motion_bindings(io, Some(true), 0))?,
+                motion: stage(
+                    "svgf/glossy motion",
+                    "glossy/motion.wgsl",
+                    "main",
+                    &self.motion_bindings(io, None, 0),
+                )?,
+                prefilter_h: stage(
+                    "svgf/glossy prefilter_h",
+                    "glossy/prefilter.wgsl",
+                    "pre_h",
+                    &self.motion_bindings(io, Some(false), 0),
+                )?,
+                prefilter_v: stage(
+                    "svgf/glossy prefilter_v",
+                    "glossy/prefilter.wgsl",
+                    "pre_v",
+                    &self.motion_bindings(io, Some(true), 0),
+                )?,
             });
         }
         let mut m = self.motion.take().unwrap();
         let (key, parity, size) = (cx.key, cx.parity, io.size);
         let sv = &cx.settings.svgf;
-        let mut result = m.motion.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.motion_bindings(io, None, p));
+        let mut result = m.motion.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+            self.motion_bindings(io, None, p)
+        });
         if result.is_ok() && sv.clipping && sv.temporal {
-            result = m.prefilter_h.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| self.motion_bindings(io, Some(false), p));
+            result = m.prefilter_h.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+                self.motion_bindings(io, Some(false), p)
+            });
             if result.is_ok() {
-                result = m.prefilter_v.record(gpu, enc, key, parity, size, timer, |p| self.motion_bindings(io, Some(true), p));
+                result = m.prefilter_v.record(gpu, enc, key, parity, size, timer, |p| {
+                    self.motion_bindings(io, Some(true), p)
+                });
             }
         }
         self.motion = Some(m);
@@ -383,7 +532,14 @@ impl Denoiser for Svgf {
         self.targets = Some(SvgfTargets::new(&gpu.device, memory, size, self.scene.glossy));
     }
 
-    fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, io: &FrameIo, cx: &FrameContext, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        io: &FrameIo,
+        cx: &FrameContext,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         self.targets.as_ref().context("SVGF records before its textures exist")?;
         self.write_params(gpu, io, cx);
         self.record_signal(gpu, enc, io, cx, false, timer.as_deref_mut())?;
@@ -396,7 +552,11 @@ impl Denoiser for Svgf {
 
     fn output(&self, _parity: usize) -> Denoised<'_> {
         let Some(t) = &self.targets else { return Denoised::default() };
-        Denoised { matte: Some(&t.matte.out.1), glossy: t.glossy.as_ref().map(|(s, _)| &s.out.1), direct: None }
+        Denoised {
+            matte: Some(&t.matte.out.1),
+            glossy: t.glossy.as_ref().map(|(s, _)| &s.out.1),
+            direct: None,
+        }
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
@@ -408,7 +568,11 @@ impl Denoiser for Svgf {
             v.extend(s.pipelines());
         }
         if let Some(m) = self.motion.as_mut() {
-            v.extend([&mut m.motion, &mut m.prefilter_h, &mut m.prefilter_v].into_iter().map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload));
+            v.extend(
+                [&mut m.motion, &mut m.prefilter_h, &mut m.prefilter_v]
+                    .into_iter()
+                    .map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload),
+            );
         }
         v
     }

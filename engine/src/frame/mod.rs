@@ -5,12 +5,12 @@
 //! BVH rebuilds) and the denoiser chosen (its textures are made on its first frame).
 
 mod params;
-pub mod schedule;
 mod readback;
 mod reload;
+pub mod schedule;
 
-pub use params::{CameraSetup, FrameParams, random_jitter};
 pub use crate::settings::View;
+pub use params::{CameraSetup, FrameParams, random_jitter};
 
 use crate::accel::BvhKind;
 use crate::denoise::{Denoiser, DenoiserScene, FrameContext};
@@ -19,11 +19,11 @@ use crate::passes::composite::{CompositePass, DisplayPass, FrameBuffers};
 use crate::passes::gbuffer::{self, GBufferPass, GBufferTargets};
 use crate::passes::io::{FrameIo, PreviousGBuffer};
 use crate::passes::matte::{ChainView, DenoiseParams};
-use crate::passes::reference::{TraceParams, TraceView, make_params};
-use crate::passes::taa::TaaStage;
 use crate::passes::prefilter::{Prefilter, PrefilterTargets};
 use crate::passes::primaries::{Primaries, PrimaryTargets};
+use crate::passes::reference::{TraceParams, TraceView, make_params};
 use crate::passes::supersample::{Supersample, SupersampleTargets};
+use crate::passes::taa::TaaStage;
 use crate::passes::trace::{TracePass, TraceTargets};
 use crate::scene::{Camera, Scene};
 use crate::settings::FrameSettings;
@@ -61,7 +61,12 @@ impl FrameInput {
     /// The exposure over `shutter` of the frame interval `frame_dt` (seconds) ending at `time`,
     /// the camera at the open given by `camera_at` (a camera path's interpolation; the same
     /// camera for a still one). `shutter` = 0: an instant exposure.
-    pub fn exposed(camera_at: impl Fn(f64) -> Camera, time: f64, shutter: f64, frame_dt: f64) -> FrameInput {
+    pub fn exposed(
+        camera_at: impl Fn(f64) -> Camera,
+        time: f64,
+        shutter: f64,
+        frame_dt: f64,
+    ) -> FrameInput {
         let open = time - shutter.clamp(0.0, 1.0) * frame_dt.max(0.0);
         let shutter = (open < time).then(|| ShutterOpen { camera: camera_at(open), time: open });
         FrameInput { camera: camera_at(time), time, shutter }
@@ -106,13 +111,39 @@ impl Targets {
         let gbuffer = GBufferTargets::new(gpu, &mut memory, size);
         let trace = TraceTargets::new(gpu, &mut memory, size, glossy);
         // COPY_DST: the supersampling's resolve writes it back.
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let hdr = memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
-        Targets { size, gbuffer, trace, hdr, accumulation: None, previous: None, supersample: None, primaries: None, prefilter: None, memory, epoch, generation }
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let hdr =
+            memory.buffer(&gpu.device, "composite/hdr", size.0 as u64 * size.1 as u64 * 16, usage);
+        Targets {
+            size,
+            gbuffer,
+            trace,
+            hdr,
+            accumulation: None,
+            previous: None,
+            supersample: None,
+            primaries: None,
+            prefilter: None,
+            memory,
+            epoch,
+            generation,
+        }
     }
 
     fn io<'a>(&'a self, frame: &'a wgpu::Buffer, objects: Option<&'a wgpu::Buffer>) -> FrameIo<'a> {
-        FrameIo { size: self.size, frame, objects, gbuffer: &self.gbuffer, previous: self.previous.as_ref(), trace: &self.trace, mixed: None, hdr: &self.hdr, memory: &self.memory }
+        FrameIo {
+            size: self.size,
+            frame,
+            objects,
+            gbuffer: &self.gbuffer,
+            previous: self.previous.as_ref(),
+            trace: &self.trace,
+            mixed: None,
+            hdr: &self.hdr,
+            memory: &self.memory,
+        }
     }
 }
 
@@ -188,18 +219,29 @@ impl Renderer {
     /// Prepare `scene`, open a headless device that fits it, and build the frame.
     pub fn headless(scene: Scene, kind: BvhKind, size: (u32, u32)) -> Result<(Gpu, Renderer)> {
         check_size(size)?;
-        let prepared = PreparedScene::new(&scene, kind).with_context(|| format!("preparing scene {:?}", scene.name))?;
+        let prepared = PreparedScene::new(&scene, kind)
+            .with_context(|| format!("preparing scene {:?}", scene.name))?;
         let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
         let r = Renderer::new(&gpu, scene, prepared, size)?;
         Ok((gpu, r))
     }
 
-    pub fn new(gpu: &Gpu, scene: Scene, prepared: PreparedScene, size: (u32, u32)) -> Result<Renderer> {
+    pub fn new(
+        gpu: &Gpu,
+        scene: Scene,
+        prepared: PreparedScene,
+        size: (u32, u32),
+    ) -> Result<Renderer> {
         check_size(size)?;
         gpu.validated("creating the real-time frame", || Self::create(gpu, scene, prepared, size))
     }
 
-    fn create(gpu: &Gpu, scene: Scene, prepared: PreparedScene, size: (u32, u32)) -> Result<Renderer> {
+    fn create(
+        gpu: &Gpu,
+        scene: Scene,
+        prepared: PreparedScene,
+        size: (u32, u32),
+    ) -> Result<Renderer> {
         let gpu_scene = prepared.upload(gpu);
         let targets = Targets::new(gpu, size, prepared.features.glossy, 0, 0);
         let mut memory = GpuMemory::default();
@@ -208,11 +250,29 @@ impl Renderer {
         let params_buf = memory.buffer(d, "frame/scene params", size_of::<TraceParams>() as u64, u);
         let frame_buf = memory.buffer(d, "frame/params", size_of::<FrameParams>() as u64, u);
         let display_buf = memory.buffer(d, "display/options", 32, u);
-        let no_accumulation = memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
-        let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
-        let trace = TracePass::new(gpu, &gpu_scene, &params_buf, &frame_buf, &targets.gbuffer, &targets.trace).context("creating the trace pass")?;
+        let no_accumulation =
+            memory.buffer(d, "composite/no accumulation", 16, wgpu::BufferUsages::STORAGE);
+        let gbuffer =
+            GBufferPass::new(gpu, &gpu_scene, &frame_buf).context("creating the G-buffer pass")?;
+        let trace = TracePass::new(
+            gpu,
+            &gpu_scene,
+            &params_buf,
+            &frame_buf,
+            &targets.gbuffer,
+            &targets.trace,
+        )
+        .context("creating the trace pass")?;
         let io = targets.io(&frame_buf, gpu_scene.objects.as_ref());
-        let fb = FrameBuffers { io, shown: &targets.hdr, accumulation: &no_accumulation, display: &display_buf, matte: None, glossy: None, direct: None };
+        let fb = FrameBuffers {
+            io,
+            shown: &targets.hdr,
+            accumulation: &no_accumulation,
+            display: &display_buf,
+            matte: None,
+            glossy: None,
+            direct: None,
+        };
         let composite = CompositePass::new(gpu, &fb).context("creating the composite pass")?;
         let taa = TaaStage::new(gpu, &mut memory, prepared.features.animated);
         let timer = GpuTimer::new(gpu, TIMED_PASSES);
@@ -253,7 +313,14 @@ impl Renderer {
         let f = &self.prepared.features;
         let (w, h) = self.targets.size;
         let per_pixel = self.bytes_per_pixel();
-        let buffers = self.targets.memory.allocations.iter().map(|(l, b)| format!("{l}={b}")).collect::<Vec<_>>().join(" ");
+        let buffers = self
+            .targets
+            .memory
+            .allocations
+            .iter()
+            .map(|(l, b)| format!("{l}={b}"))
+            .collect::<Vec<_>>()
+            .join(" ");
         format!(
             "real-time frame {w}x{h}: passes gbuffer, trace ({}), composite, display; animated: {}; scene {} bytes, per-pixel targets {} bytes ({per_pixel:.0} B/pixel): {buffers}",
             if f.glossy { "matte + glossy" } else { "matte only" },
@@ -298,7 +365,8 @@ impl Renderer {
             return Ok(());
         }
         let t = &self.targets;
-        self.targets = Targets::new(gpu, size, self.prepared.features.glossy, t.epoch + 1, t.generation + 1);
+        self.targets =
+            Targets::new(gpu, size, self.prepared.features.glossy, t.epoch + 1, t.generation + 1);
         self.prev_view_proj = None;
         self.prev_jittered = None;
         self.denoised_last = None;
@@ -318,7 +386,13 @@ impl Renderer {
     }
 
     /// Render one frame; with `target`, also tone-map (or show `settings.view`) into it.
-    pub fn render(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        target: Option<&DisplayTarget>,
+    ) -> Result<()> {
         gpu.validated("rendering a frame", || self.record_frame(gpu, input, settings, target))
     }
 
@@ -333,8 +407,13 @@ impl Renderer {
             Some(i) => i,
             None => {
                 let Some(make) = crate::denoise::find(name)?.make else { return Ok(None) };
-                let scene = DenoiserScene { glossy: self.prepared.features.glossy, animated: self.prepared.features.animated, extent: self.prepared.extent as f32 };
-                let denoiser = make(gpu, &scene).with_context(|| format!("creating the {name} denoiser"))?;
+                let scene = DenoiserScene {
+                    glossy: self.prepared.features.glossy,
+                    animated: self.prepared.features.animated,
+                    extent: self.prepared.extent as f32,
+                };
+                let denoiser =
+                    make(gpu, &scene).with_context(|| format!("creating the {name} denoiser"))?;
                 self.denoisers.push(MadeDenoiser { name: name.to_string(), epoch: None, denoiser });
                 self.denoisers.len() - 1
             }
@@ -370,13 +449,20 @@ impl Renderer {
             self.accumulated_state = None;
             return;
         }
-        let same = self.accumulated_state.as_ref().is_some_and(|(i, s)| i == input && s.max_depth == settings.max_depth && s.seed == settings.seed);
+        let same = self.accumulated_state.as_ref().is_some_and(|(i, s)| {
+            i == input && s.max_depth == settings.max_depth && s.seed == settings.seed
+        });
         self.accumulated = if same { self.accumulated + 1 } else { 1 };
         self.accumulated_state = Some((*input, settings.clone()));
         let t = &mut self.targets;
         if t.accumulation.is_none() {
             let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-            t.accumulation = Some(t.memory.buffer(&gpu.device, "composite/accumulation", t.size.0 as u64 * t.size.1 as u64 * 16, usage));
+            t.accumulation = Some(t.memory.buffer(
+                &gpu.device,
+                "composite/accumulation",
+                t.size.0 as u64 * t.size.1 as u64 * 16,
+                usage,
+            ));
             t.generation += 1;
         }
     }
@@ -385,7 +471,16 @@ impl Renderer {
     /// uniforms written; returns what the denoiser and TAA know of the cameras, and the
     /// jittered view-projection and jitter (the next frame's "previous").
     #[allow(clippy::too_many_arguments)]
-    fn upload_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, cam: &CameraSetup, moved: bool, denoised: bool, primary_samples: u32) -> (ChainView, Mat4, Vec2) {
+    fn upload_frame(
+        &mut self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        cam: &CameraSetup,
+        moved: bool,
+        denoised: bool,
+        primary_samples: u32,
+    ) -> (ChainView, Mat4, Vec2) {
         let size = self.targets.size;
         let jitter = if settings.accumulate {
             random_jitter(self.frame_index, settings.seed)
@@ -406,18 +501,49 @@ impl Renderer {
         };
         let g = &settings.glossy;
         // The glossy chain's reflection motion wants the representative ray of glossy surfaces.
-        let representative = if denoised && g.trace_representative_ray && g.reflection_mv != crate::settings::ReflectionMv::Primary { g.roughness_threshold } else { 0.0 };
+        let representative = if denoised
+            && g.trace_representative_ray
+            && g.reflection_mv != crate::settings::ReflectionMv::Primary
+        {
+            g.roughness_threshold
+        } else {
+            0.0
+        };
         let prev = self.prev_view_proj.unwrap_or(cam.view_proj);
-        let mut fp = FrameParams::new(cam, jittered, prev, jitter, size, self.frame_index, settings, self.accumulated, self.prepared.ray_epsilon(), representative);
+        let mut fp = FrameParams::new(
+            cam,
+            jittered,
+            prev,
+            jitter,
+            size,
+            self.frame_index,
+            settings,
+            self.accumulated,
+            self.prepared.ray_epsilon(),
+            representative,
+        );
         fp.primary_samples = primary_samples;
-        let trace_view = TraceView { camera: input.camera, width: size.0, height: size.1, max_depth: settings.max_depth, seed: settings.seed, shutter_camera: input.shutter.map(|s| s.camera) };
+        let trace_view = TraceView {
+            camera: input.camera,
+            width: size.0,
+            height: size.1,
+            max_depth: settings.max_depth,
+            seed: settings.seed,
+            shutter_camera: input.shutter.map(|s| s.camera),
+        };
         let tp = make_params(&self.prepared, &trace_view);
         gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&tp));
         gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&fp));
         (view, jittered, jitter)
     }
 
-    fn record_frame(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings, target: Option<&DisplayTarget>) -> Result<()> {
+    fn record_frame(
+        &mut self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        target: Option<&DisplayTarget>,
+    ) -> Result<()> {
         puffin::profile_function!();
         let mut moved = false;
         if self.prepared.features.animated {
@@ -438,53 +564,101 @@ impl Renderer {
             }
         }
         // Samples per pixel (Voorhuis §5); the accumulate mode box-filters by itself.
-        let samples = if settings.accumulate { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) };
+        let samples = if settings.accumulate {
+            1
+        } else {
+            settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL)
+        };
         // Below one sample per pixel (Dundr §5): only denoisers that fill the untraced pixels.
         let period = if settings.accumulate { 1 } else { settings.sample_fraction.period() };
         if period > 1 {
             if samples > 1 {
-                bail!("sample fraction {} traces some pixels each frame and {samples} samples per pixel traces every pixel {samples} times: choose one", settings.sample_fraction);
+                bail!(
+                    "sample fraction {} traces some pixels each frame and {samples} samples per pixel traces every pixel {samples} times: choose one",
+                    settings.sample_fraction
+                );
             }
-            if let Some(i) = denoiser.filter(|&i| !self.denoisers[i].denoiser.fills_untraced_pixels()) {
-                let fills: Vec<&str> = crate::denoise::entries().into_iter().filter(|e| e.fractions).map(|e| e.name).collect();
-                bail!("the {} denoiser needs every pixel traced each frame; sample fraction {} needs one that fills untraced pixels ({})", self.denoisers[i].name, settings.sample_fraction, fills.join(", "));
+            if let Some(i) =
+                denoiser.filter(|&i| !self.denoisers[i].denoiser.fills_untraced_pixels())
+            {
+                let fills: Vec<&str> = crate::denoise::entries()
+                    .into_iter()
+                    .filter(|e| e.fractions)
+                    .map(|e| e.name)
+                    .collect();
+                bail!(
+                    "the {} denoiser needs every pixel traced each frame; sample fraction {} needs one that fills untraced pixels ({})",
+                    self.denoisers[i].name,
+                    settings.sample_fraction,
+                    fills.join(", ")
+                );
             }
         }
-        if samples > 1 && self.targets.supersample.as_ref().is_none_or(|s| s.k != samples || s.epoch != self.targets.epoch) {
+        if samples > 1
+            && self
+                .targets
+                .supersample
+                .as_ref()
+                .is_none_or(|s| s.k != samples || s.epoch != self.targets.epoch)
+        {
             let t = &mut self.targets;
             t.memory.forget(SupersampleTargets::PREFIX);
-            t.supersample = Some(SupersampleTargets::new(&gpu.device, &mut t.memory, t.size, samples, self.prepared.features.glossy, t.epoch));
+            t.supersample = Some(SupersampleTargets::new(
+                &gpu.device,
+                &mut t.memory,
+                t.size,
+                samples,
+                self.prepared.features.glossy,
+                t.epoch,
+            ));
             t.generation += 1;
         }
         // A thin lens or motion blur (a stochastic primary hit): the G-buffer is traced (k rays
         // per pixel, each through its own lens point at its own time), not rasterised; the
         // accumulate mode traces one, so that its mean over frames is exact.
-        let blurred = input.shutter.is_some_and(|s| s.camera != input.camera) || self.prepared.shutter_moves();
+        let blurred = input.shutter.is_some_and(|s| s.camera != input.camera)
+            || self.prepared.shutter_moves();
         let traced = input.camera.lens.is_some_and(|l| l.aperture_radius > 0.0) || blurred;
         let primary_samples = match (traced, settings.accumulate) {
             (false, _) => 0,
             (true, true) => 1,
-            (true, false) => settings.primary_samples.clamp(1, crate::settings::MAX_PRIMARY_SAMPLES),
+            (true, false) => {
+                settings.primary_samples.clamp(1, crate::settings::MAX_PRIMARY_SAMPLES)
+            }
         };
         let prefilter = traced && settings.prefilter && !settings.accumulate;
         if traced {
             if samples > 1 {
-                bail!("{samples} samples per pixel (guide rays) need the raster's G-buffer, which depth of field and motion blur replace by traced primaries: set samples per pixel to 1 (they trace {} primary samples per pixel)", settings.primary_samples);
+                bail!(
+                    "{samples} samples per pixel (guide rays) need the raster's G-buffer, which depth of field and motion blur replace by traced primaries: set samples per pixel to 1 (they trace {} primary samples per pixel)",
+                    settings.primary_samples
+                );
             }
             let t = &mut self.targets;
             if t.primaries.as_ref().is_none_or(|p| p.epoch != t.epoch) {
                 t.memory.forget(PrimaryTargets::PREFIX);
-                t.primaries = Some(PrimaryTargets::new(&gpu.device, &mut t.memory, t.size, t.epoch));
+                t.primaries =
+                    Some(PrimaryTargets::new(&gpu.device, &mut t.memory, t.size, t.epoch));
                 t.generation += 1;
             }
             if prefilter && t.prefilter.as_ref().is_none_or(|p| p.epoch != t.epoch) {
                 t.memory.forget(PrefilterTargets::PREFIX);
-                t.prefilter = Some(PrefilterTargets::new(&gpu.device, &mut t.memory, t.size, t.epoch));
+                t.prefilter =
+                    Some(PrefilterTargets::new(&gpu.device, &mut t.memory, t.size, t.epoch));
                 t.generation += 1;
             }
         }
-        let (mut view, jittered, jitter) = self.upload_frame(gpu, input, settings, &cam, moved, denoiser.is_some(), primary_samples);
-        view.history_valid = denoiser.is_some() && self.denoised_last == denoiser && self.prev_jittered.is_some();
+        let (mut view, jittered, jitter) = self.upload_frame(
+            gpu,
+            input,
+            settings,
+            &cam,
+            moved,
+            denoiser.is_some(),
+            primary_samples,
+        );
+        view.history_valid =
+            denoiser.is_some() && self.denoised_last == denoiser && self.prev_jittered.is_some();
         self.denoised_last = denoiser;
         if let Some(target) = target {
             self.prepare_display(gpu, target, settings)?;
@@ -492,7 +666,9 @@ impl Renderer {
         drop(setup);
 
         let encode = crate::profile::scope("encode");
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut enc = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         if let Some(t) = self.timer.as_mut() {
             t.begin_frame();
         }
@@ -506,29 +682,91 @@ impl Renderer {
         match t.primaries.as_ref().filter(|_| traced) {
             None => {
                 let _pass = crate::profile::scope(gbuffer::LABEL);
-                self.gbuffer.record(gpu, &mut enc, &self.gpu_scene, &self.frame_buf, &t.gbuffer, self.timer.as_mut())?;
+                self.gbuffer.record(
+                    gpu,
+                    &mut enc,
+                    &self.gpu_scene,
+                    &self.frame_buf,
+                    &t.gbuffer,
+                    self.timer.as_mut(),
+                )?;
             }
             Some(p) => {
                 // The pre-filter stage (Moon et al. 2017) between the traced features and the
                 // G-buffer every later stage reads.
-                self.primaries.record_trace(gpu, &mut enc, key, &self.gpu_scene, &self.params_buf, &self.frame_buf, p, size, self.prepared.shutter_moves(), self.timer.as_mut())?;
+                self.primaries.record_trace(
+                    gpu,
+                    &mut enc,
+                    key,
+                    &self.gpu_scene,
+                    &self.params_buf,
+                    &self.frame_buf,
+                    p,
+                    size,
+                    self.prepared.shutter_moves(),
+                    self.timer.as_mut(),
+                )?;
                 let mut edges = None;
                 if let Some(pf) = t.prefilter.as_ref().filter(|_| prefilter) {
                     let offered = crate::passes::prefilter::bindings(&self.frame_buf, p, pf);
-                    self.prefilter.record(gpu, &mut enc, key, size, &offered, self.timer.as_mut())?;
+                    self.prefilter.record(
+                        gpu,
+                        &mut enc,
+                        key,
+                        size,
+                        &offered,
+                        self.timer.as_mut(),
+                    )?;
                     edges = Some(&pf.features);
                 }
-                self.primaries.record_resolve(gpu, &mut enc, key, &self.frame_buf, p, edges, &t.gbuffer, self.timer.as_mut())?;
+                self.primaries.record_resolve(
+                    gpu,
+                    &mut enc,
+                    key,
+                    &self.frame_buf,
+                    p,
+                    edges,
+                    &t.gbuffer,
+                    self.timer.as_mut(),
+                )?;
             }
         }
         let pass = crate::profile::scope(crate::passes::trace::LABEL);
-        self.trace.record(gpu, &mut enc, (self.gpu_scene.generation, t.generation), &self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace, size, period, self.prepared.shutter_moves(), self.timer.as_mut())?;
+        self.trace.record(
+            gpu,
+            &mut enc,
+            (self.gpu_scene.generation, t.generation),
+            &self.gpu_scene,
+            &self.params_buf,
+            &self.frame_buf,
+            &t.gbuffer,
+            &t.trace,
+            size,
+            period,
+            self.prepared.shutter_moves(),
+            self.timer.as_mut(),
+        )?;
         drop(pass);
         let mut io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
         let ss = t.supersample.as_ref().filter(|s| s.k == samples);
         if let Some(ss) = ss {
-            let trace = crate::passes::trace::bindings(&self.gpu_scene, &self.params_buf, &self.frame_buf, &t.gbuffer, &t.trace);
-            self.supersample.record_mix(gpu, &mut enc, key, &self.gpu_scene, trace, &io, ss, self.timer.as_mut())?;
+            let trace = crate::passes::trace::bindings(
+                &self.gpu_scene,
+                &self.params_buf,
+                &self.frame_buf,
+                &t.gbuffer,
+                &t.trace,
+            );
+            self.supersample.record_mix(
+                gpu,
+                &mut enc,
+                key,
+                &self.gpu_scene,
+                trace,
+                &io,
+                ss,
+                self.timer.as_mut(),
+            )?;
             io.mixed = Some(&ss.mixed);
         }
         let cx = FrameContext { index: self.frame_index, parity, view, settings, key };
@@ -540,7 +778,15 @@ impl Renderer {
         let accumulation = t.accumulation.as_ref().unwrap_or(&self.no_accumulation);
         let fb = |p: usize| {
             let out = denoiser.map(|d| d.output(p)).unwrap_or_default();
-            FrameBuffers { io, shown: &t.hdr, accumulation, display: &self.display_buf, matte: out.matte, glossy: out.glossy, direct: out.direct }
+            FrameBuffers {
+                io,
+                shown: &t.hdr,
+                accumulation,
+                display: &self.display_buf,
+                matte: out.matte,
+                glossy: out.glossy,
+                direct: out.direct,
+            }
         };
         let pass = crate::profile::scope(crate::passes::composite::COMPOSITE);
         self.composite.record(gpu, &mut enc, output_key, fb, parity, self.timer.as_mut())?;
@@ -550,14 +796,44 @@ impl Renderer {
         }
         if let Some(d) = denoiser {
             // TAA runs after any denoiser; with its stage off it passes the composite on.
-            let dp = DenoiseParams::new(&settings.matte, &settings.taa, size.0, self.frame_index, &cx.view);
-            self.taa.record(gpu, &mut enc, output_key, &io, |p| d.taa_follow(p), &dp, parity, self.timer.as_mut())?;
+            let dp = DenoiseParams::new(
+                &settings.matte,
+                &settings.taa,
+                size.0,
+                self.frame_index,
+                &cx.view,
+            );
+            self.taa.record(
+                gpu,
+                &mut enc,
+                output_key,
+                &io,
+                |p| d.taa_follow(p),
+                &dp,
+                parity,
+                self.timer.as_mut(),
+            )?;
         }
-        let shown = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, denoiser.is_some(), self.taa.output());
+        let shown = shown_buffers(
+            t,
+            &io,
+            &self.display_buf,
+            &self.no_accumulation,
+            denoiser.is_some(),
+            self.taa.output(),
+        );
         if let (Some(target), Some(d)) = (target, self.display.as_mut()) {
             let _pass = crate::profile::scope(crate::passes::composite::DISPLAY);
             let (view, view_key) = view_texture(t, settings);
-            d.record(gpu, &mut enc, output_key * 1024 + view_key, &shown, view, target.view, self.timer.as_mut())?;
+            d.record(
+                gpu,
+                &mut enc,
+                output_key * 1024 + view_key,
+                &shown,
+                view,
+                target.view,
+                self.timer.as_mut(),
+            )?;
         }
         if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
             p.record_copy(&mut enc, &t.gbuffer, size);
@@ -580,18 +856,34 @@ impl Renderer {
         Ok(())
     }
 
-
     /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
-    pub fn redisplay(&mut self, gpu: &Gpu, settings: &FrameSettings, target: &DisplayTarget) -> Result<()> {
+    pub fn redisplay(
+        &mut self,
+        gpu: &Gpu,
+        settings: &FrameSettings,
+        target: &DisplayTarget,
+    ) -> Result<()> {
         gpu.validated("displaying the frame", || {
             self.prepare_display(gpu, target, settings)?;
             // Only the exposure changes; the rest of the uniform is the last frame's.
-            gpu.queue.write_buffer(&self.frame_buf, std::mem::offset_of!(FrameParams, exposure) as u64, bytemuck::bytes_of(&settings.exposure_scale()));
+            gpu.queue.write_buffer(
+                &self.frame_buf,
+                std::mem::offset_of!(FrameParams, exposure) as u64,
+                bytemuck::bytes_of(&settings.exposure_scale()),
+            );
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             let t = &self.targets;
             let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
-            let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, self.denoised_last.is_some(), self.taa.output());
-            let key = (self.gpu_scene.generation * 1_000_003 + t.generation) * 64 + self.denoised_last.map_or(0, |i| i as u64 + 1);
+            let fb = shown_buffers(
+                t,
+                &io,
+                &self.display_buf,
+                &self.no_accumulation,
+                self.denoised_last.is_some(),
+                self.taa.output(),
+            );
+            let key = (self.gpu_scene.generation * 1_000_003 + t.generation) * 64
+                + self.denoised_last.map_or(0, |i| i as u64 + 1);
             let (view, view_key) = view_texture(t, settings);
             if let Some(d) = self.display.as_mut() {
                 d.record(gpu, &mut enc, key * 1024 + view_key, &fb, view, target.view, None)?;
@@ -602,20 +894,33 @@ impl Renderer {
     }
 
     /// Make the display pass for `target`'s format and write its options (the view's map).
-    fn prepare_display(&mut self, gpu: &Gpu, target: &DisplayTarget, settings: &FrameSettings) -> Result<()> {
+    fn prepare_display(
+        &mut self,
+        gpu: &Gpu,
+        target: &DisplayTarget,
+        settings: &FrameSettings,
+    ) -> Result<()> {
         if self.display.as_ref().is_none_or(|d| d.format != target.format) {
             let t = &self.targets;
             let io = t.io(&self.frame_buf, self.gpu_scene.objects.as_ref());
             let fb = shown_buffers(t, &io, &self.display_buf, &self.no_accumulation, false, None);
-            self.display = Some(DisplayPass::new(gpu, &fb, target.format).context("creating the display pass")?);
+            self.display = Some(
+                DisplayPass::new(gpu, &fb, target.format).context("creating the display pass")?,
+            );
         }
         let spec = match settings.view.is_final() {
             true => None,
-            false => Some(settings.view.spec().with_context(|| format!("no view {:?}", settings.view.name()))?),
+            false => Some(
+                settings
+                    .view
+                    .spec()
+                    .with_context(|| format!("no view {:?}", settings.view.name()))?,
+            ),
         };
         let (map, channel, param) = spec.map_or((0, 0, 0.0), |s| s.map.encode(self.targets.size.0));
         let srgb = !target.format.is_srgb() as u32;
-        let options: [u32; 8] = [srgb, map, target.size.0, target.size.1, channel, param.to_bits(), 0, 0];
+        let options: [u32; 8] =
+            [srgb, map, target.size.0, target.size.1, channel, param.to_bits(), 0, 0];
         gpu.queue.write_buffer(&self.display_buf, 0, bytemuck::cast_slice(&options));
         Ok(())
     }
@@ -625,7 +930,9 @@ impl Renderer {
 /// the denoiser has run), and a key that changes with it.
 fn view_texture<'a>(t: &'a Targets, settings: &FrameSettings) -> (Option<&'a wgpu::Texture>, u64) {
     let views = crate::settings::all_views();
-    let Some(i) = views.iter().position(|v| v.name == settings.view.name()) else { return (None, 0) };
+    let Some(i) = views.iter().position(|v| v.name == settings.view.name()) else {
+        return (None, 0);
+    };
     match t.memory.find_texture(views[i].texture) {
         Some(tex) => (Some(tex), i as u64 + 1),
         None => (None, 0),
@@ -633,7 +940,14 @@ fn view_texture<'a>(t: &'a Targets, settings: &FrameSettings) -> (Option<&'a wgp
 }
 
 /// What the display reads: the image after TAA when a denoiser ran, else the composite's.
-fn shown_buffers<'a>(t: &'a Targets, io: &FrameIo<'a>, display: &'a wgpu::Buffer, no_accumulation: &'a wgpu::Buffer, denoised: bool, taa: Option<&'a wgpu::Buffer>) -> FrameBuffers<'a> {
+fn shown_buffers<'a>(
+    t: &'a Targets,
+    io: &FrameIo<'a>,
+    display: &'a wgpu::Buffer,
+    no_accumulation: &'a wgpu::Buffer,
+    denoised: bool,
+    taa: Option<&'a wgpu::Buffer>,
+) -> FrameBuffers<'a> {
     FrameBuffers {
         io: *io,
         shown: taa.filter(|_| denoised).unwrap_or(&t.hdr),

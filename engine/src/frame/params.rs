@@ -37,7 +37,18 @@ impl FrameParams {
     /// `jittered`: this frame's view-projection with `jitter` (the raster's); `prev`: the last
     /// frame's without jitter (motion vectors compare it with `cam.view_proj`).
     #[allow(clippy::too_many_arguments)]
-    pub fn new(cam: &CameraSetup, jittered: Mat4, prev: Mat4, jitter: Vec2, size: (u32, u32), index: u32, settings: &crate::settings::FrameSettings, accumulated: u32, ray_epsilon: f32, representative_roughness: f32) -> FrameParams {
+    pub fn new(
+        cam: &CameraSetup,
+        jittered: Mat4,
+        prev: Mat4,
+        jitter: Vec2,
+        size: (u32, u32),
+        index: u32,
+        settings: &crate::settings::FrameSettings,
+        accumulated: u32,
+        ray_epsilon: f32,
+        representative_roughness: f32,
+    ) -> FrameParams {
         FrameParams {
             view_proj: jittered.to_cols_array_2d(),
             unjittered_view_proj: cam.view_proj.to_cols_array_2d(),
@@ -53,7 +64,11 @@ impl FrameParams {
             accumulated,
             paths: settings.paths_per_pixel.clamp(1, 64),
             representative_roughness,
-            samples: if accumulated > 0 { 1 } else { settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL) },
+            samples: if accumulated > 0 {
+                1
+            } else {
+                settings.samples_per_pixel.clamp(1, crate::settings::MAX_SAMPLES_PER_PIXEL)
+            },
             period: if accumulated > 0 { 1 } else { settings.sample_fraction.period() },
             primary_samples: 0,
         }
@@ -83,7 +98,8 @@ impl CameraSetup {
         let fov = if camera.yfov.is_finite() { camera.yfov.clamp(1e-4, 3.1) } else { 0.8 };
         let th = (fov * 0.5).tan();
         let aspect = size.0 as f32 / size.1 as f32;
-        let view = Mat4::from_cols(x.extend(0.0), y.extend(0.0), z.extend(0.0), pos.extend(1.0)).inverse();
+        let view =
+            Mat4::from_cols(x.extend(0.0), y.extend(0.0), z.extend(0.0), pos.extend(1.0)).inverse();
         // Right-handed, depth in [0, 1] reversed (1 at `near`, 0 at infinity): float depth then
         // keeps its precision with distance.
         let f = 1.0 / th;
@@ -98,7 +114,10 @@ impl CameraSetup {
 
     /// The projection shifted so that pixel centres sample `jitter` (in [0, 1)^2) of each pixel.
     pub fn jittered(&self, jitter: Vec2, size: (u32, u32)) -> Mat4 {
-        let o = Vec2::new((0.5 - jitter.x) * 2.0 / size.0 as f32, -(0.5 - jitter.y) * 2.0 / size.1 as f32);
+        let o = Vec2::new(
+            (0.5 - jitter.x) * 2.0 / size.0 as f32,
+            -(0.5 - jitter.y) * 2.0 / size.1 as f32,
+        );
         Mat4::from_translation(o.extend(0.0)) * self.view_proj
     }
 }

@@ -9,7 +9,11 @@ use glam::Vec3;
 
 impl Renderer {
     /// The display's image of the last frame (tone-mapped or the chosen debug view) as 8-bit sRGB.
-    pub fn display_image(&mut self, gpu: &Gpu, settings: &FrameSettings) -> Result<image::RgbaImage> {
+    pub fn display_image(
+        &mut self,
+        gpu: &Gpu,
+        settings: &FrameSettings,
+    ) -> Result<image::RgbaImage> {
         let (w, h) = self.targets.size;
         let format = wgpu::TextureFormat::Rgba8Unorm;
         let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
@@ -72,7 +76,8 @@ impl Renderer {
     pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
         let (w, h) = self.targets.size;
         let n = w as u64 * h as u64 * 16;
-        let shown = self.taa.output().filter(|_| self.denoised_last.is_some()).unwrap_or(&self.targets.hdr);
+        let shown =
+            self.taa.output().filter(|_| self.denoised_last.is_some()).unwrap_or(&self.targets.hdr);
         let (buf, scale) = match (&self.targets.accumulation, self.accumulated) {
             (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
             _ => (shown, 1.0),
@@ -115,7 +120,8 @@ impl Renderer {
     /// The bytes of the frame's buffer labelled `name` (`supersample/samples`, ...).
     pub fn read_buffer(&self, gpu: &Gpu, name: &str) -> Result<Vec<u8>> {
         let b = self.targets.memory.find_buffer(name).with_context(|| {
-            let labels: Vec<&str> = self.targets.memory.buffers.iter().map(|(l, _)| l.as_str()).collect();
+            let labels: Vec<&str> =
+                self.targets.memory.buffers.iter().map(|(l, _)| l.as_str()).collect();
             format!("no buffer {name:?} in this frame (its buffers: {})", labels.join(", "))
         })?;
         crate::gpu::readback_buffer(&gpu.device, &gpu.queue, b, b.size())

@@ -9,7 +9,11 @@ impl Renderer {
     /// Every pipeline of the frame that exists now (denoisers, TAA and the display are made on
     /// first use).
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
-        let mut v: Vec<&mut dyn Reload> = vec![&mut self.gbuffer.pipeline, &mut self.trace.pipeline, &mut self.composite.pipeline];
+        let mut v: Vec<&mut dyn Reload> = vec![
+            &mut self.gbuffer.pipeline,
+            &mut self.trace.pipeline,
+            &mut self.composite.pipeline,
+        ];
         if let Some(d) = self.display.as_mut() {
             v.push(&mut d.pipeline);
         }
@@ -40,6 +44,9 @@ impl Renderer {
 
     /// (pipeline, error) for every pipeline whose last reload failed.
     pub fn shader_errors(&mut self) -> Vec<(String, String)> {
-        self.pipelines().into_iter().filter_map(|p| p.error().map(|e| (p.label().to_string(), e.to_string()))).collect()
+        self.pipelines()
+            .into_iter()
+            .filter_map(|p| p.error().map(|e| (p.label().to_string(), e.to_string())))
+            .collect()
     }
 }

@@ -94,7 +94,10 @@ mod tests {
             let (w, _) = tile(period);
             let q = period / 4;
             for start in (0..period).step_by(q as usize) {
-                let mut blocks: Vec<_> = (start..start + q).map(|r| cell(r, period)).map(|(x, y)| y / 2 * (w / 2) + x / 2).collect();
+                let mut blocks: Vec<_> = (start..start + q)
+                    .map(|r| cell(r, period))
+                    .map(|(x, y)| y / 2 * (w / 2) + x / 2)
+                    .collect();
                 blocks.sort();
                 blocks.dedup();
                 assert_eq!(blocks.len() as u32, q, "period {period}, ranks {start}..");

@@ -78,7 +78,13 @@ impl<'a> Bindings<'a> {
     }
 
     /// The bind groups of `program` (one per layout), each resource found by name.
-    pub fn create_groups(&self, device: &wgpu::Device, label: &str, program: &ProgramBindings, layouts: &[wgpu::BindGroupLayout]) -> Result<Vec<wgpu::BindGroup>> {
+    pub fn create_groups(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        program: &ProgramBindings,
+        layouts: &[wgpu::BindGroupLayout],
+    ) -> Result<Vec<wgpu::BindGroup>> {
         self.check(label, program)?;
         Ok(layouts
             .iter()
@@ -96,7 +102,11 @@ impl<'a> Bindings<'a> {
                         wgpu::BindGroupEntry { binding: s.binding, resource }
                     })
                     .collect();
-                device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(label),
+                    layout,
+                    entries: &entries,
+                })
             })
             .collect())
     }
@@ -124,7 +134,14 @@ pub struct BindCache {
 
 impl BindCache {
     /// The groups of variant `v`, making all variants with `make(v)` if `key` or `builds` changed.
-    pub fn get(&mut self, key: u64, builds: u32, variants: usize, v: usize, make: impl Fn(usize) -> Result<Vec<wgpu::BindGroup>>) -> Result<&[wgpu::BindGroup]> {
+    pub fn get(
+        &mut self,
+        key: u64,
+        builds: u32,
+        variants: usize,
+        v: usize,
+        make: impl Fn(usize) -> Result<Vec<wgpu::BindGroup>>,
+    ) -> Result<&[wgpu::BindGroup]> {
         if self.cached.as_ref().is_none_or(|(k, b, _)| *k != key || *b != builds) {
             let groups = (0..variants).map(&make).collect::<Result<Vec<_>>>()?;
             self.cached = Some((key, builds, groups));

@@ -88,17 +88,28 @@ impl Gpu {
     ) -> Result<Gpu> {
         let info = adapter.get_info();
         let have = adapter.limits();
-        let mut limits = if req.adapter_limits { have.clone() } else { wgpu::Limits::default().using_resolution(have.clone()) };
+        let mut limits = if req.adapter_limits {
+            have.clone()
+        } else {
+            wgpu::Limits::default().using_resolution(have.clone())
+        };
         limits.max_storage_buffer_binding_size =
             limits.max_storage_buffer_binding_size.max(req.max_storage_buffer_binding_size);
         limits.max_buffer_size = limits.max_buffer_size.max(req.max_storage_buffer_binding_size);
         limits.max_storage_buffers_per_shader_stage = limits
             .max_storage_buffers_per_shader_stage
             .max(req.max_storage_buffers_per_shader_stage);
-        limits.max_storage_textures_per_shader_stage = limits.max_storage_textures_per_shader_stage.max(req.max_storage_textures_per_shader_stage);
-        limits.max_color_attachment_bytes_per_sample = limits.max_color_attachment_bytes_per_sample.max(req.max_color_attachment_bytes_per_sample);
-        limits.max_sampled_textures_per_shader_stage = limits.max_sampled_textures_per_shader_stage.max(req.max_sampled_textures_per_shader_stage);
-        limits.max_texture_dimension_2d = limits.max_texture_dimension_2d.max(req.max_texture_dimension_2d);
+        limits.max_storage_textures_per_shader_stage = limits
+            .max_storage_textures_per_shader_stage
+            .max(req.max_storage_textures_per_shader_stage);
+        limits.max_color_attachment_bytes_per_sample = limits
+            .max_color_attachment_bytes_per_sample
+            .max(req.max_color_attachment_bytes_per_sample);
+        limits.max_sampled_textures_per_shader_stage = limits
+            .max_sampled_textures_per_shader_stage
+            .max(req.max_sampled_textures_per_shader_stage);
+        limits.max_texture_dimension_2d =
+            limits.max_texture_dimension_2d.max(req.max_texture_dimension_2d);
         if limits.max_texture_dimension_2d > have.max_texture_dimension_2d {
             return Err(anyhow!(
                 "adapter {:?} allows textures of {} rows; the scene's geometry and materials need {} rows of {} texels",
@@ -108,7 +119,8 @@ impl Gpu {
                 super::scene::TEXEL_ROW
             ));
         }
-        if limits.max_sampled_textures_per_shader_stage > have.max_sampled_textures_per_shader_stage {
+        if limits.max_sampled_textures_per_shader_stage > have.max_sampled_textures_per_shader_stage
+        {
             return Err(anyhow!(
                 "adapter {:?} allows {} sampled textures per stage; the real-time frame's debug views need {}",
                 info.name,
@@ -117,7 +129,8 @@ impl Gpu {
             ));
         }
         if limits.max_storage_textures_per_shader_stage > have.max_storage_textures_per_shader_stage
-            || limits.max_color_attachment_bytes_per_sample > have.max_color_attachment_bytes_per_sample
+            || limits.max_color_attachment_bytes_per_sample
+                > have.max_color_attachment_bytes_per_sample
         {
             return Err(anyhow!(
                 "adapter {:?} is too small for the real-time frame: it needs {} storage textures per \
@@ -143,7 +156,8 @@ impl Gpu {
             ));
         }
         if limits.max_storage_buffer_binding_size > have.max_storage_buffer_binding_size
-            || limits.max_storage_buffers_per_shader_stage > have.max_storage_buffers_per_shader_stage
+            || limits.max_storage_buffers_per_shader_stage
+                > have.max_storage_buffers_per_shader_stage
         {
             return Err(anyhow!(
                 "adapter {:?} cannot hold this scene: it needs storage buffers of {} bytes \

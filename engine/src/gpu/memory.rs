@@ -116,9 +116,8 @@ pub fn readback_buffer(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("readback"),
-    });
+    let mut enc =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
     enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
     queue.submit([enc.finish()]);
     let slice = staging.slice(..);
@@ -132,10 +131,7 @@ pub fn readback_buffer(
     rx.recv()
         .map_err(|_| anyhow!("readback callback never ran"))?
         .map_err(|e| anyhow!("mapping readback buffer: {e}"))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| anyhow!("reading mapped range: {e}"))?
-        .to_vec();
+    let data = slice.get_mapped_range().map_err(|e| anyhow!("reading mapped range: {e}"))?.to_vec();
     staging.unmap();
     Ok(data)
 }
@@ -143,7 +139,10 @@ pub fn readback_buffer(
 /// Copy a 2D texture (COPY_SRC) into memory, rows tightly packed.
 pub fn readback_texture(gpu: &super::Gpu, tex: &wgpu::Texture) -> Result<Vec<u8>> {
     let (w, h) = (tex.width(), tex.height());
-    let bpp = tex.format().block_copy_size(Some(wgpu::TextureAspect::All)).ok_or_else(|| anyhow!("texture format {:?} cannot be copied", tex.format()))?;
+    let bpp = tex
+        .format()
+        .block_copy_size(Some(wgpu::TextureAspect::All))
+        .ok_or_else(|| anyhow!("texture format {:?} cannot be copied", tex.format()))?;
     let row = w * bpp;
     let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -155,7 +154,14 @@ pub fn readback_texture(gpu: &super::Gpu, tex: &wgpu::Texture) -> Result<Vec<u8>
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     enc.copy_texture_to_buffer(
         tex.as_image_copy(),
-        wgpu::TexelCopyBufferInfo { buffer: &staging, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) } },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
         wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([enc.finish()]);

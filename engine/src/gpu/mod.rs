@@ -8,9 +8,9 @@ pub mod prepare;
 pub mod scene;
 mod timestamps;
 
+pub use binding::{BindCache, Bindings, Resource, set_compute_groups, set_render_groups};
 pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP};
 pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use prepare::{EnvKind, PreparedScene, SceneFeatures};
 pub use scene::GpuScene;
 pub use timestamps::GpuTimer;
-pub use binding::{BindCache, Bindings, Resource, set_compute_groups, set_render_groups};

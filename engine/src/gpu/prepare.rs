@@ -75,7 +75,12 @@ impl From<&crate::scene::Material> for GpuMaterial {
             alpha_cutoff: cutoff,
             normal_scale: m.normal_scale,
             flags: mask | if m.double_sided { MAT_DOUBLE_SIDED } else { 0 },
-            tex: [t(m.base_color_texture), t(m.metallic_roughness_texture), t(m.normal_texture), t(m.emissive_texture)],
+            tex: [
+                t(m.base_color_texture),
+                t(m.metallic_roughness_texture),
+                t(m.normal_texture),
+                t(m.emissive_texture),
+            ],
         }
     }
 }
@@ -143,7 +148,13 @@ struct Flat {
     dropped: usize,
 }
 
-fn flatten(scene: &Scene, object: usize, transform: DMat4, origin: DVec3, normal_maps: bool) -> Flat {
+fn flatten(
+    scene: &Scene,
+    object: usize,
+    transform: DMat4,
+    origin: DVec3,
+    normal_maps: bool,
+) -> Flat {
     let o = &scene.objects[object];
     let mesh = &scene.meshes[o.mesh];
     let m3 = DMat3::from_mat4(transform);
@@ -154,14 +165,22 @@ fn flatten(scene: &Scene, object: usize, transform: DMat4, origin: DVec3, normal
     for t in mesh.indices.chunks_exact(3) {
         // A mirroring transform reverses the winding; swap to keep the front face CCW.
         let idx = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
-        let p64 = idx.map(|i| transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin);
+        let p64 =
+            idx.map(|i| transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin);
         let p = p64.map(|v| v.as_vec3());
         // Degenerate: zero area, or so thin (area below 1e-12 of the longest edge squared)
         // that f32 arithmetic cannot resolve it; such a triangle cannot be hit reliably.
         let area2 = (p64[1] - p64[0]).cross(p64[2] - p64[0]).length();
-        let edge2 = (p64[1] - p64[0]).length_squared().max((p64[2] - p64[1]).length_squared()).max((p64[0] - p64[2]).length_squared());
+        let edge2 = (p64[1] - p64[0])
+            .length_squared()
+            .max((p64[2] - p64[1]).length_squared())
+            .max((p64[0] - p64[2]).length_squared());
         let area2_f32 = (p[1] - p[0]).cross(p[2] - p[0]).length();
-        if !p.iter().all(|v| v.is_finite()) || !(area2 > 1e-12 * edge2) || !(area2_f32 > 0.0) || !area2_f32.is_finite() {
+        if !p.iter().all(|v| v.is_finite())
+            || !(area2 > 1e-12 * edge2)
+            || !(area2_f32 > 0.0)
+            || !area2_f32.is_finite()
+        {
             f.dropped += 1;
             continue;
         }
@@ -184,7 +203,8 @@ fn flatten(scene: &Scene, object: usize, transform: DMat4, origin: DVec3, normal
         ]);
         if normal_maps {
             f.tans.push(idx.map(|i| {
-                let t = mesh.tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
+                let t =
+                    mesh.tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
                 let xyz = (m3 * t.truncate().as_dvec3()).normalize_or_zero().as_vec3();
                 let w = if flip { -t.w } else { t.w };
                 if xyz.is_finite() { xyz.extend(w) } else { Vec4::new(1.0, 0.0, 0.0, 1.0) }
@@ -204,18 +224,23 @@ impl PreparedScene {
     /// Whether a material some object uses has a specular (GGX) lobe: the glossy path, its
     /// buffers and chain exist. Importers append an unused default material, which does not count.
     pub fn glossy_materials(scene: &Scene) -> bool {
-        let used: std::collections::HashSet<usize> = scene.objects.iter().map(|o| scene.meshes[o.mesh].material as usize).collect();
+        let used: std::collections::HashSet<usize> =
+            scene.objects.iter().map(|o| scene.meshes[o.mesh].material as usize).collect();
         scene.materials.iter().enumerate().filter(|(i, _)| used.contains(i)).any(|(_, m)| {
             let g = GpuMaterial::from(m);
-            g.metallic > 0.0 || (g.specular_factor > 0.0 && g.specular_color.iter().any(|c| *c > 0.0))
+            g.metallic > 0.0
+                || (g.specular_factor > 0.0 && g.specular_color.iter().any(|c| *c > 0.0))
         })
     }
 
     pub fn new(scene: &Scene, kind: BvhKind) -> Result<PreparedScene> {
         let origin = scene.origin();
-        let extent = scene.bounds().map(|(lo, hi)| (hi - lo).length()).filter(|e| *e > 0.0).unwrap_or(1.0);
+        let extent =
+            scene.bounds().map(|(lo, hi)| (hi - lo).length()).filter(|e| *e > 0.0).unwrap_or(1.0);
         let normal_maps = scene.materials.iter().any(|m| m.normal_texture.is_some());
-        let flat: Vec<Flat> = (0..scene.objects.len()).map(|i| flatten(scene, i, scene.objects[i].transform, origin, normal_maps)).collect();
+        let flat: Vec<Flat> = (0..scene.objects.len())
+            .map(|i| flatten(scene, i, scene.objects[i].transform, origin, normal_maps))
+            .collect();
         let dropped: usize = flat.iter().map(|f| f.dropped).sum();
         if dropped > 0 {
             log::warn!("dropped {dropped} triangles with non-finite vertices or zero area");
@@ -237,7 +262,11 @@ impl PreparedScene {
             }
             Environment::Constant(_) => EnvKind::None,
             Environment::Map(map) => {
-                if env.pack_map(map) { EnvKind::Map } else { EnvKind::None }
+                if env.pack_map(map) {
+                    EnvKind::Map
+                } else {
+                    EnvKind::None
+                }
             }
         };
         let tex_data = pack_textures(scene);
@@ -333,9 +362,23 @@ impl PreparedScene {
     fn open_shutter(&mut self, scene: &Scene, open: Option<f64>) -> bool {
         let mut open_from_close = vec![];
         if let Some(t) = open.filter(|_| self.features.animated) {
-            let moving = scene.objects.iter().enumerate().take(self.world.len()).any(|(i, o)| o.animation.is_some() && o.transform_at(t) != self.world[i]);
+            let moving = scene
+                .objects
+                .iter()
+                .enumerate()
+                .take(self.world.len())
+                .any(|(i, o)| o.animation.is_some() && o.transform_at(t) != self.world[i]);
             if moving {
-                open_from_close = scene.objects.iter().enumerate().take(self.world.len()).map(|(i, o)| rebased(o.transform_at(t), self.origin) * rebased(self.world[i], self.origin).inverse()).collect();
+                open_from_close = scene
+                    .objects
+                    .iter()
+                    .enumerate()
+                    .take(self.world.len())
+                    .map(|(i, o)| {
+                        rebased(o.transform_at(t), self.origin)
+                            * rebased(self.world[i], self.origin).inverse()
+                    })
+                    .collect();
             }
         }
         let changed = open_from_close != self.open_from_close;
@@ -358,7 +401,11 @@ impl PreparedScene {
             mats.extend_from_slice(&f.mats);
             if let Some(m) = self.open_from_close.get(i) {
                 let to = |v: Vec3A| Vec3A::from(m.transform_point3(v.into()));
-                open_in.extend(f.tris.iter().map(|t| Triangle { v0: to(t.v0), v1: to(t.v1), v2: to(t.v2) }));
+                open_in.extend(f.tris.iter().map(|t| Triangle {
+                    v0: to(t.v0),
+                    v1: to(t.v1),
+                    v2: to(t.v2),
+                }));
             }
         }
         // With motion, the tree is built over each triangle's box at both ends of the shutter:
@@ -366,16 +413,24 @@ impl PreparedScene {
         let accel = if open_in.is_empty() {
             accel::build_within(&tris_in, kind, self.traversal_stack as usize)
         } else {
-            let swept: Vec<Triangle> = tris_in.iter().zip(&open_in).map(|(c, o)| {
-                let b = c.aabb().union(&o.aabb());
-                Triangle { v0: b.min, v1: b.max, v2: b.min }
-            }).collect();
+            let swept: Vec<Triangle> = tris_in
+                .iter()
+                .zip(&open_in)
+                .map(|(c, o)| {
+                    let b = c.aabb().union(&o.aabb());
+                    Triangle { v0: b.min, v1: b.max, v2: b.min }
+                })
+                .collect();
             accel::build_within(&swept, kind, self.traversal_stack as usize)
         };
         if accel.depth > self.traversal_stack as usize {
             // Not reachable: the stack of an animated scene holds any median tree over its
             // triangles ([`accel::traversal_stack`]).
-            log::error!("the rebuilt BVH is {} levels deep; the traversal holds {}: geometry will be missing", accel.depth, self.traversal_stack);
+            log::error!(
+                "the rebuilt BVH is {} levels deep; the traversal holds {}: geometry will be missing",
+                accel.depth,
+                self.traversal_stack
+            );
         }
         self.tris.clear();
         self.tris_open.clear();
@@ -389,7 +444,11 @@ impl PreparedScene {
             self.tris.push(v(t.v2).extend(0.0));
             if self.features.animated {
                 let o = open_in.get(i).unwrap_or(t);
-                self.tris_open.extend([v(o.v0).extend(0.0), v(o.v1).extend(0.0), v(o.v2).extend(0.0)]);
+                self.tris_open.extend([
+                    v(o.v0).extend(0.0),
+                    v(o.v1).extend(0.0),
+                    v(o.v2).extend(0.0),
+                ]);
             }
             self.shading.extend_from_slice(attrs[i]);
             if self.features.normal_maps {
@@ -401,7 +460,10 @@ impl PreparedScene {
         let mut weights = vec![];
         for (slot, &orig) in accel.order.iter().enumerate() {
             let m = mats[orig as usize] as usize;
-            let lum = self.materials.get(m).map_or(0.0, |m| crate::quality::luminance(Vec3::from_slice(&m.emission)));
+            let lum = self
+                .materials
+                .get(m)
+                .map_or(0.0, |m| crate::quality::luminance(Vec3::from_slice(&m.emission)));
             if lum > 0.0 {
                 let t = &tris_in[orig as usize];
                 let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
@@ -504,11 +566,13 @@ impl EnvPack {
         for r in 0..h {
             let s = (std::f64::consts::PI * (r as f64 + 0.5) / h as f64).sin();
             let mut acc = 0f64;
-            let f: Vec<f64> = (0..w).map(|c| crate::quality::luminance(map.rgb[r * w + c]) as f64 * s).collect();
+            let f: Vec<f64> =
+                (0..w).map(|c| crate::quality::luminance(map.rgb[r * w + c]) as f64 * s).collect();
             let sum: f64 = f.iter().sum();
             for c in 0..w {
                 acc += f[c];
-                cond[r * (w + 1) + c + 1] = if sum > 0.0 { (acc / sum) as f32 } else { (c + 1) as f32 / w as f32 };
+                cond[r * (w + 1) + c + 1] =
+                    if sum > 0.0 { (acc / sum) as f32 } else { (c + 1) as f32 / w as f32 };
             }
             cond[r * (w + 1) + w] = 1.0;
             rows[r] = sum;
@@ -539,8 +603,11 @@ pub const TEXTURE_BUDGET_BYTES: usize = 128 << 20;
 
 fn pack_textures(scene: &Scene) -> Vec<u32> {
     let n = scene.textures.len();
-    let mut textures: Vec<std::borrow::Cow<crate::scene::Texture>> = scene.textures.iter().map(std::borrow::Cow::Borrowed).collect();
-    let bytes = |t: &[std::borrow::Cow<crate::scene::Texture>]| n * 16 + t.iter().map(|t| t.rgba8.len()).sum::<usize>();
+    let mut textures: Vec<std::borrow::Cow<crate::scene::Texture>> =
+        scene.textures.iter().map(std::borrow::Cow::Borrowed).collect();
+    let bytes = |t: &[std::borrow::Cow<crate::scene::Texture>]| {
+        n * 16 + t.iter().map(|t| t.rgba8.len()).sum::<usize>()
+    };
     let before = bytes(&textures);
     while bytes(&textures) > TEXTURE_BUDGET_BYTES {
         let largest = (0..n).max_by_key(|&i| textures[i].rgba8.len()).unwrap_or(0);
@@ -550,7 +617,11 @@ fn pack_textures(scene: &Scene) -> Vec<u32> {
         textures[largest] = std::borrow::Cow::Owned(textures[largest].halved());
     }
     if bytes(&textures) != before {
-        log::warn!("textures need {} MiB; halved the largest to fit {} MiB", before >> 20, TEXTURE_BUDGET_BYTES >> 20);
+        log::warn!(
+            "textures need {} MiB; halved the largest to fit {} MiB",
+            before >> 20,
+            TEXTURE_BUDGET_BYTES >> 20
+        );
     }
     let mut data = vec![0u32; n * 4];
     for (i, t) in textures.iter().enumerate() {
@@ -576,8 +647,22 @@ mod tests {
     #[test]
     fn textures_over_the_binding_budget_are_halved_to_fit() {
         let side = 5800u32; // 5800² x 4 bytes = 134.6 MB > 128 MiB
-        let big = Texture { name: "big".into(), width: side, height: side, rgba8: vec![128; (side * side * 4) as usize], srgb: true, wrap_s: Wrap::Repeat, wrap_t: Wrap::Repeat };
-        let small = Texture { name: "small".into(), width: 4, height: 2, rgba8: vec![7; 32], ..big.clone() };
+        let big = Texture {
+            name: "big".into(),
+            width: side,
+            height: side,
+            rgba8: vec![128; (side * side * 4) as usize],
+            srgb: true,
+            wrap_s: Wrap::Repeat,
+            wrap_t: Wrap::Repeat,
+        };
+        let small = Texture {
+            name: "small".into(),
+            width: 4,
+            height: 2,
+            rgba8: vec![7; 32],
+            ..big.clone()
+        };
         let scene = Scene { textures: vec![big, small], ..Default::default() };
         let data = pack_textures(&scene);
         assert!(data.len() * 4 <= TEXTURE_BUDGET_BYTES, "{} bytes", data.len() * 4);

@@ -55,11 +55,26 @@ impl PreparedScene {
             + f.normal_maps as u32;
         let d = GpuRequirements::default();
         GpuRequirements {
-            max_storage_buffer_binding_size: sizes.into_iter().max().unwrap_or(0).max(d.max_storage_buffer_binding_size),
+            max_storage_buffer_binding_size: sizes
+                .into_iter()
+                .max()
+                .unwrap_or(0)
+                .max(d.max_storage_buffer_binding_size),
             max_storage_buffers_per_shader_stage: count.max(d.max_storage_buffers_per_shader_stage),
             output_bytes,
             output_pixels,
-            max_texture_dimension_2d: [self.accel.nodes.len(), self.tris.len() * 16, self.tex_data.len() * 4, self.shading.len() * 16, self.materials.len() * 80].into_iter().map(texel_row_count).max().unwrap_or(1).max(d.max_texture_dimension_2d),
+            max_texture_dimension_2d: [
+                self.accel.nodes.len(),
+                self.tris.len() * 16,
+                self.tex_data.len() * 4,
+                self.shading.len() * 16,
+                self.materials.len() * 80,
+            ]
+            .into_iter()
+            .map(texel_row_count)
+            .max()
+            .unwrap_or(1)
+            .max(d.max_texture_dimension_2d),
             ..d
         }
     }
@@ -67,26 +82,76 @@ impl PreparedScene {
     pub fn upload(&self, gpu: &Gpu) -> GpuScene {
         let mut mem = GpuMemory::default();
         // Animated scenes rewrite their geometry every frame.
-        let s = if self.features.animated { wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST } else { wgpu::BufferUsages::STORAGE };
+        let s = if self.features.animated {
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST
+        } else {
+            wgpu::BufferUsages::STORAGE
+        };
         let d = &gpu.device;
         fn b<T: bytemuck::Pod>(v: &[T]) -> &[u8] {
             bytemuck::cast_slice(v)
         }
         let f = self.features;
-        let nodes = Texels::new(gpu, &mut mem, "scene/bvh nodes", &self.accel.nodes, wgpu::TextureFormat::Rgba32Uint);
+        let nodes = Texels::new(
+            gpu,
+            &mut mem,
+            "scene/bvh nodes",
+            &self.accel.nodes,
+            wgpu::TextureFormat::Rgba32Uint,
+        );
         let tris = mem.buffer_init(d, "scene/triangles", b(&self.tris), s);
-        let tri_texels = Texels::new(gpu, &mut mem, "scene/triangle texels", b(&self.tris), wgpu::TextureFormat::Rgba32Float);
-        let tri_open_texels = self.features.animated.then(|| Texels::new(gpu, &mut mem, "scene/triangle texels at shutter open", b(&self.tris_open), wgpu::TextureFormat::Rgba32Float));
-        let shading = Texels::new(gpu, &mut mem, "scene/shading", b(&self.shading), wgpu::TextureFormat::Rgba32Float);
-        let materials = Texels::new(gpu, &mut mem, "scene/materials", b(&self.materials), wgpu::TextureFormat::Rgba32Uint);
+        let tri_texels = Texels::new(
+            gpu,
+            &mut mem,
+            "scene/triangle texels",
+            b(&self.tris),
+            wgpu::TextureFormat::Rgba32Float,
+        );
+        let tri_open_texels = self.features.animated.then(|| {
+            Texels::new(
+                gpu,
+                &mut mem,
+                "scene/triangle texels at shutter open",
+                b(&self.tris_open),
+                wgpu::TextureFormat::Rgba32Float,
+            )
+        });
+        let shading = Texels::new(
+            gpu,
+            &mut mem,
+            "scene/shading",
+            b(&self.shading),
+            wgpu::TextureFormat::Rgba32Float,
+        );
+        let materials = Texels::new(
+            gpu,
+            &mut mem,
+            "scene/materials",
+            b(&self.materials),
+            wgpu::TextureFormat::Rgba32Uint,
+        );
         let copy = s | wgpu::BufferUsages::COPY_DST;
         // Lights and environment are rewritten when the user moves the sun.
-        let lights = f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), copy));
-        let emitters = f.emitters.then(|| mem.buffer_init(d, "scene/emitters", b(&self.emitters), s));
-        let env = (f.env == EnvKind::Map).then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), copy));
-        let textures = f.textures.then(|| Texels::new(gpu, &mut mem, "scene/textures", b(&self.tex_data), wgpu::TextureFormat::Rgba32Uint));
-        let tangents = f.normal_maps.then(|| mem.buffer_init(d, "scene/tangents", b(&self.tangents), s));
-        let objects = f.animated.then(|| mem.buffer_init(d, "scene/object motion", b(&self.prev_from_current), copy));
+        let lights =
+            f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), copy));
+        let emitters =
+            f.emitters.then(|| mem.buffer_init(d, "scene/emitters", b(&self.emitters), s));
+        let env = (f.env == EnvKind::Map)
+            .then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), copy));
+        let textures = f.textures.then(|| {
+            Texels::new(
+                gpu,
+                &mut mem,
+                "scene/textures",
+                b(&self.tex_data),
+                wgpu::TextureFormat::Rgba32Uint,
+            )
+        });
+        let tangents =
+            f.normal_maps.then(|| mem.buffer_init(d, "scene/tangents", b(&self.tangents), s));
+        let objects = f
+            .animated
+            .then(|| mem.buffer_init(d, "scene/object motion", b(&self.prev_from_current), copy));
         log::info!(
             "scene on the GPU: {} triangles, {} BVH nodes ({}), features {:?}, {} bytes: {}",
             self.triangle_count(),
@@ -150,7 +215,9 @@ impl GpuScene {
             if data.is_empty() {
                 return;
             }
-            if (data.len() as u64) <= buf.size() && buf.usage().contains(wgpu::BufferUsages::COPY_DST) {
+            if (data.len() as u64) <= buf.size()
+                && buf.usage().contains(wgpu::BufferUsages::COPY_DST)
+            {
                 gpu.queue.write_buffer(buf, 0, data);
             } else {
                 mem.allocations.retain(|(l, _)| l != label);
@@ -208,7 +275,22 @@ impl GpuScene {
     /// 962-985 ms at 640x360), so programs use it only while something moves.
     pub fn shading_modules_for(&self, moving: bool) -> Vec<&'static str> {
         let f = &self.features;
-        let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if moving && f.animated { "common/motion_blur.wgsl" } else { "common/motion_none.wgsl" }, self.traversal_module(), "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/camera.wgsl", "common/path.wgsl"];
+        let mut m = vec![
+            "common/math.wgsl",
+            "common/rng.wgsl",
+            "common/geometry.wgsl",
+            if moving && f.animated {
+                "common/motion_blur.wgsl"
+            } else {
+                "common/motion_none.wgsl"
+            },
+            self.traversal_module(),
+            "common/scene.wgsl",
+            "common/bsdf.wgsl",
+            "common/params.wgsl",
+            "common/camera.wgsl",
+            "common/path.wgsl",
+        ];
         m.push(if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" });
         m.push(if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" });
         m.push(if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" });
@@ -269,15 +351,33 @@ pub struct Texels {
 }
 
 impl Texels {
-    pub fn new(gpu: &Gpu, mem: &mut GpuMemory, label: &str, bytes: &[u8], format: wgpu::TextureFormat) -> Texels {
+    pub fn new(
+        gpu: &Gpu,
+        mem: &mut GpuMemory,
+        label: &str,
+        bytes: &[u8],
+        format: wgpu::TextureFormat,
+    ) -> Texels {
         let (texture, view) = Self::make(gpu, mem, label, texel_row_count(bytes.len()), format);
         let t = Texels { texture, view, label: label.to_string(), format };
         t.upload(gpu, bytes);
         t
     }
 
-    fn make(gpu: &Gpu, mem: &mut GpuMemory, label: &str, rows: u32, format: wgpu::TextureFormat) -> (wgpu::Texture, wgpu::TextureView) {
-        mem.texture(&gpu.device, label, (TEXEL_ROW, rows), format, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST)
+    fn make(
+        gpu: &Gpu,
+        mem: &mut GpuMemory,
+        label: &str,
+        rows: u32,
+        format: wgpu::TextureFormat,
+    ) -> (wgpu::Texture, wgpu::TextureView) {
+        mem.texture(
+            &gpu.device,
+            label,
+            (TEXEL_ROW, rows),
+            format,
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        )
     }
 
     fn upload(&self, gpu: &Gpu, bytes: &[u8]) {
@@ -286,10 +386,20 @@ impl Texels {
         }
         let full_rows = (bytes.len() / 16) as u32 / TEXEL_ROW;
         let row_bytes = (TEXEL_ROW * 16) as usize;
-        let layout = wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(TEXEL_ROW * 16), rows_per_image: None };
+        let layout = wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(TEXEL_ROW * 16),
+            rows_per_image: None,
+        };
         if full_rows > 0 {
-            let extent = wgpu::Extent3d { width: TEXEL_ROW, height: full_rows, depth_or_array_layers: 1 };
-            gpu.queue.write_texture(self.texture.as_image_copy(), &bytes[..full_rows as usize * row_bytes], layout, extent);
+            let extent =
+                wgpu::Extent3d { width: TEXEL_ROW, height: full_rows, depth_or_array_layers: 1 };
+            gpu.queue.write_texture(
+                self.texture.as_image_copy(),
+                &bytes[..full_rows as usize * row_bytes],
+                layout,
+                extent,
+            );
         }
         let rest = &bytes[full_rows as usize * row_bytes..];
         if !rest.is_empty() {
@@ -297,7 +407,11 @@ impl Texels {
             last.resize(rest.len().next_multiple_of(16), 0);
             let mut at = self.texture.as_image_copy();
             at.origin.y = full_rows;
-            let extent = wgpu::Extent3d { width: (last.len() / 16) as u32, height: 1, depth_or_array_layers: 1 };
+            let extent = wgpu::Extent3d {
+                width: (last.len() / 16) as u32,
+                height: 1,
+                depth_or_array_layers: 1,
+            };
             gpu.queue.write_texture(at, &last, layout, extent);
         }
     }
@@ -312,7 +426,8 @@ impl Texels {
             // Headroom, so that a BVH a few nodes larger next frame does not reallocate again,
             // within what the device allows.
             let most = gpu.device.limits().max_texture_dimension_2d.max(rows);
-            (self.texture, self.view) = Self::make(gpu, mem, &self.label, (rows + rows / 4 + 1).min(most), self.format);
+            (self.texture, self.view) =
+                Self::make(gpu, mem, &self.label, (rows + rows / 4 + 1).min(most), self.format);
         }
         self.upload(gpu, bytes);
         replaced
@@ -320,7 +435,13 @@ impl Texels {
 }
 
 /// A compute pipeline with entry point `entry`.
-pub fn compute_pipeline(device: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, entry: &str) -> wgpu::ComputePipeline {
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    entry: &str,
+) -> wgpu::ComputePipeline {
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
         layout: Some(layout),

@@ -5,9 +5,9 @@
 
 use super::Gpu;
 use crate::profile::PassSpan;
+use anyhow::{Result, anyhow};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use anyhow::{Result, anyhow};
 
 pub struct GpuTimer {
     set: wgpu::QuerySet,
@@ -42,14 +42,28 @@ impl GpuTimer {
             return None;
         }
         let capacity = passes * 2;
-        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("pass timestamps"), ty: wgpu::QueryType::Timestamp, count: capacity });
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("pass timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count: capacity,
+        });
         let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pass timestamps"),
             size: capacity as u64 * 8,
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        Some(GpuTimer { set, resolve, capacity, labels: vec![], dropped: 0, period_ns: gpu.queue.get_timestamp_period() as f64, submitted_ns: 0, ring: vec![], copying: None })
+        Some(GpuTimer {
+            set,
+            resolve,
+            capacity,
+            labels: vec![],
+            dropped: 0,
+            period_ns: gpu.queue.get_timestamp_period() as f64,
+            submitted_ns: 0,
+            ring: vec![],
+            copying: None,
+        })
     }
 
     pub fn begin_frame(&mut self) {
@@ -73,12 +87,20 @@ impl GpuTimer {
 
     pub fn compute(&mut self, label: &'static str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         let i = self.next(label)?;
-        Some(wgpu::ComputePassTimestampWrites { query_set: &self.set, beginning_of_pass_write_index: Some(i), end_of_pass_write_index: Some(i + 1) })
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set: &self.set,
+            beginning_of_pass_write_index: Some(i),
+            end_of_pass_write_index: Some(i + 1),
+        })
     }
 
     pub fn render(&mut self, label: &'static str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
         let i = self.next(label)?;
-        Some(wgpu::RenderPassTimestampWrites { query_set: &self.set, beginning_of_pass_write_index: Some(i), end_of_pass_write_index: Some(i + 1) })
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set: &self.set,
+            beginning_of_pass_write_index: Some(i),
+            end_of_pass_write_index: Some(i + 1),
+        })
     }
 
     /// Resolve the frame's timestamps; with `ring`, also copy them into a free ring slot for
@@ -122,7 +144,9 @@ impl GpuTimer {
         slot.submitted_ns = self.submitted_ns;
         let done = Arc::new(AtomicBool::new(false));
         let flag = done.clone();
-        slot.buffer.slice(..slot.labels.len() as u64 * 16).map_async(wgpu::MapMode::Read, move |r| flag.store(r.is_ok(), Ordering::Release));
+        slot.buffer
+            .slice(..slot.labels.len() as u64 * 16)
+            .map_async(wgpu::MapMode::Read, move |r| flag.store(r.is_ok(), Ordering::Release));
         slot.mapped = Some(done);
     }
 
@@ -140,7 +164,12 @@ impl GpuTimer {
         let slot = &mut self.ring[i];
         let n = slot.labels.len() as u64 * 16;
         let period_ns = self.period_ns;
-        let spans = slot.buffer.slice(..n).get_mapped_range().ok().map(|data| spans(period_ns, &slot.labels, bytemuck::cast_slice(&data)));
+        let spans = slot
+            .buffer
+            .slice(..n)
+            .get_mapped_range()
+            .ok()
+            .map(|data| spans(period_ns, &slot.labels, bytemuck::cast_slice(&data)));
         slot.buffer.unmap();
         slot.mapped = None;
         Some((slot.submitted_ns, spans?.ok()?))

@@ -14,26 +14,63 @@ pub struct ChainStage {
 
 impl ChainStage {
     /// `offered`: what the stage binds for either parity (only the names matter here).
-    pub fn new(gpu: &Gpu, label: &'static str, modules: &[&'static str], entry: &str, offered: &Bindings) -> Result<ChainStage> {
+    pub fn new(
+        gpu: &Gpu,
+        label: &'static str,
+        modules: &[&'static str],
+        entry: &str,
+        offered: &Bindings,
+    ) -> Result<ChainStage> {
         let entry = entry.to_string();
-        let pipeline = Reloadable::new(gpu, label, "", modules, wgpu::ShaderStages::COMPUTE, offered, move |d, m, l| compute_pipeline(d, label, m, l, &entry))?;
+        let pipeline = Reloadable::new(
+            gpu,
+            label,
+            "",
+            modules,
+            wgpu::ShaderStages::COMPUTE,
+            offered,
+            move |d, m, l| compute_pipeline(d, label, m, l, &entry),
+        )?;
         Ok(ChainStage { label, pipeline, groups: BindCache::default() })
     }
 
     /// Dispatch one thread per pixel in 8x8 groups; `bindings(p)` gives what parity p binds.
     #[allow(clippy::too_many_arguments)]
-    pub fn record<'a>(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, parity: usize, size: (u32, u32), timer: Option<&mut GpuTimer>, bindings: impl Fn(usize) -> Bindings<'a>) -> Result<()> {
+    pub fn record<'a>(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        parity: usize,
+        size: (u32, u32),
+        timer: Option<&mut GpuTimer>,
+        bindings: impl Fn(usize) -> Bindings<'a>,
+    ) -> Result<()> {
         self.record_variant(gpu, enc, key, (2, parity), size, timer, bindings)
     }
 
     /// As [`ChainStage::record`] for a stage with `variant.0` sets of bindings (parity, level,
     /// ...), recording set `variant.1`; `bindings(v)` gives set v.
     #[allow(clippy::too_many_arguments)]
-    pub fn record_variant<'a>(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, variant: (usize, usize), size: (u32, u32), timer: Option<&mut GpuTimer>, bindings: impl Fn(usize) -> Bindings<'a>) -> Result<()> {
+    pub fn record_variant<'a>(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        variant: (usize, usize),
+        size: (u32, u32),
+        timer: Option<&mut GpuTimer>,
+        bindings: impl Fn(usize) -> Bindings<'a>,
+    ) -> Result<()> {
         let p = &self.pipeline;
-        let groups = self.groups.get(key, p.builds(), variant.0, variant.1, |v| p.bind_groups(&gpu.device, &bindings(v)))?;
+        let groups = self.groups.get(key, p.builds(), variant.0, variant.1, |v| {
+            p.bind_groups(&gpu.device, &bindings(v))
+        })?;
         let _scope = crate::profile::scope(self.label);
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.label), timestamp_writes: timer.and_then(|t| t.compute(self.label)) });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(self.label),
+            timestamp_writes: timer.and_then(|t| t.compute(self.label)),
+        });
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);

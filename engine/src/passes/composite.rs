@@ -40,7 +40,14 @@ fn inputs<'a>(b: &FrameBuffers<'a>, hdr: &'a wgpu::Buffer) -> Bindings<'a> {
 }
 
 fn modules(glossy: bool, last: &'static str) -> Vec<&'static str> {
-    vec!["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" }, last]
+    vec![
+        "common/math.wgsl",
+        "common/rng.wgsl",
+        "realtime/frame.wgsl",
+        "realtime/gbuffer_in.wgsl",
+        if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" },
+        last,
+    ]
 }
 
 pub struct CompositePass {
@@ -51,20 +58,39 @@ pub struct CompositePass {
 impl CompositePass {
     pub fn new(gpu: &Gpu, b: &FrameBuffers) -> Result<CompositePass> {
         let modules = modules(b.io.trace.glossy.is_some(), "realtime/composite.wgsl");
-        let pipeline = Reloadable::new(gpu, COMPOSITE, "", &modules, wgpu::ShaderStages::COMPUTE, &inputs(b, b.io.hdr), |d, m, l| compute_pipeline(d, COMPOSITE, m, l, "main"))?;
+        let pipeline = Reloadable::new(
+            gpu,
+            COMPOSITE,
+            "",
+            &modules,
+            wgpu::ShaderStages::COMPUTE,
+            &inputs(b, b.io.hdr),
+            |d, m, l| compute_pipeline(d, COMPOSITE, m, l, "main"),
+        )?;
         Ok(CompositePass { pipeline, groups: BindCache::default() })
     }
 
     #[allow(clippy::too_many_arguments)]
     /// `b(p)`: what it binds at history parity p (a denoiser's output may ping-pong).
-    pub fn record<'a>(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, b: impl Fn(usize) -> FrameBuffers<'a>, parity: usize, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record<'a>(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        b: impl Fn(usize) -> FrameBuffers<'a>,
+        parity: usize,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let p = &self.pipeline;
         let size = b(parity).io.size;
         let groups = self.groups.get(key, p.builds(), 2, parity, |v| {
             let b = b(v);
             p.bind_groups(&gpu.device, &inputs(&b, b.io.hdr))
         })?;
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(COMPOSITE), timestamp_writes: timer.and_then(|t| t.compute(COMPOSITE)) });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(COMPOSITE),
+            timestamp_writes: timer.and_then(|t| t.compute(COMPOSITE)),
+        });
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
@@ -96,29 +122,70 @@ impl DisplayPass {
     pub fn new(gpu: &Gpu, b: &FrameBuffers, format: wgpu::TextureFormat) -> Result<DisplayPass> {
         let mut mem = crate::gpu::GpuMemory::default();
         let usage = wgpu::TextureUsages::TEXTURE_BINDING;
-        let zero_float = mem.texture(&gpu.device, "display/no float view", (1, 1), wgpu::TextureFormat::Rgba16Float, usage);
-        let zero_uint = mem.texture(&gpu.device, "display/no uint view", (1, 1), wgpu::TextureFormat::R32Uint, usage);
-        let offered = inputs(b, b.shown).texture("view_float", &zero_float.1).texture("view_uint", &zero_uint.1);
+        let zero_float = mem.texture(
+            &gpu.device,
+            "display/no float view",
+            (1, 1),
+            wgpu::TextureFormat::Rgba16Float,
+            usage,
+        );
+        let zero_uint = mem.texture(
+            &gpu.device,
+            "display/no uint view",
+            (1, 1),
+            wgpu::TextureFormat::R32Uint,
+            usage,
+        );
+        let offered = inputs(b, b.shown)
+            .texture("view_float", &zero_float.1)
+            .texture("view_uint", &zero_uint.1);
         let modules = modules(b.io.trace.glossy.is_some(), "realtime/display.wgsl");
-        let pipeline = Reloadable::new(gpu, DISPLAY, "", &modules, wgpu::ShaderStages::FRAGMENT, &offered, move |d, module, pl| {
-            d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(DISPLAY),
-                layout: Some(pl),
-                vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &[Some(format.into())] }),
-                multiview_mask: None,
-                cache: None,
-            })
-        })?;
+        let pipeline = Reloadable::new(
+            gpu,
+            DISPLAY,
+            "",
+            &modules,
+            wgpu::ShaderStages::FRAGMENT,
+            &offered,
+            move |d, module, pl| {
+                d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(DISPLAY),
+                    layout: Some(pl),
+                    vertex: wgpu::VertexState {
+                        module,
+                        entry_point: Some("vs_main"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: Default::default(),
+                    depth_stencil: None,
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module,
+                        entry_point: Some("fs_main"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(format.into())],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            },
+        )?;
         Ok(DisplayPass { pipeline, groups: BindCache::default(), format, zero_float, zero_uint })
     }
 
     /// `view`: the texture the debug view shows (None for the image); `key` must change with it.
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, b: &FrameBuffers, view: Option<&wgpu::Texture>, target: &wgpu::TextureView, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        b: &FrameBuffers,
+        view: Option<&wgpu::Texture>,
+        target: &wgpu::TextureView,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let p = &self.pipeline;
         let (zf, zu) = (&self.zero_float.1, &self.zero_uint.1);
         let groups = self.groups.get(key, p.builds(), 1, 0, |_| {
@@ -131,7 +198,15 @@ impl DisplayPass {
         })?;
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(DISPLAY),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: target, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store } })],
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
             depth_stencil_attachment: None,
             timestamp_writes: timer.and_then(|t| t.render(DISPLAY)),
             occlusion_query_set: None,

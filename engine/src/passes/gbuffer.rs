@@ -41,9 +41,14 @@ pub struct GBufferTargets {
 
 impl GBufferTargets {
     pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32)) -> GBufferTargets {
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         let depth = mem.texture(&gpu.device, "gbuffer/depth", size, DEPTH_FORMAT, usage);
-        let color = COLOR_FORMATS.iter().map(|(l, f)| mem.texture(&gpu.device, l, size, *f, usage)).collect();
+        let color = COLOR_FORMATS
+            .iter()
+            .map(|(l, f)| mem.texture(&gpu.device, l, size, *f, usage))
+            .collect();
         GBufferTargets { depth, color }
     }
 
@@ -53,21 +58,38 @@ impl GBufferTargets {
 
     /// A colour channel by name (`normal`, `ids`, ...).
     pub fn channel(&self, name: &str) -> &(wgpu::Texture, wgpu::TextureView) {
-        let i = COLOR_FORMATS.iter().position(|(l, _)| l.strip_prefix("gbuffer/") == Some(name)).expect("G-buffer channel");
+        let i = COLOR_FORMATS
+            .iter()
+            .position(|(l, _)| l.strip_prefix("gbuffer/") == Some(name))
+            .expect("G-buffer channel");
         &self.color[i]
     }
 
     /// A render pass writing every channel and the depth, cleared (ids to "no surface", depth to
     /// 0, reversed Z's far): the raster's, and the traced primaries' resolve.
-    pub fn begin_pass<'e>(&self, enc: &'e mut wgpu::CommandEncoder, label: &'static str, timer: Option<&mut GpuTimer>) -> wgpu::RenderPass<'e> {
+    pub fn begin_pass<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        label: &'static str,
+        timer: Option<&mut GpuTimer>,
+    ) -> wgpu::RenderPass<'e> {
         let clear_ids = wgpu::Color { r: u32::MAX as f64, g: u32::MAX as f64, b: 0.0, a: 0.0 };
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = self
             .color
             .iter()
             .enumerate()
             .map(|(i, (_, v))| {
-                let clear = if i == COLOR_FORMATS.len() - 1 { clear_ids } else { wgpu::Color::TRANSPARENT };
-                Some(wgpu::RenderPassColorAttachment { view: v, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store } })
+                let clear =
+                    if i == COLOR_FORMATS.len() - 1 { clear_ids } else { wgpu::Color::TRANSPARENT };
+                Some(wgpu::RenderPassColorAttachment {
+                    view: v,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(clear),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
             })
             .collect();
         enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -75,7 +97,10 @@ impl GBufferTargets {
             color_attachments: &attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth.1,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
                 stencil_ops: None,
             }),
             timestamp_writes: timer.and_then(|t| t.render(label)),
@@ -86,22 +111,53 @@ impl GBufferTargets {
 
     /// A colour channel's format by name.
     pub fn format(name: &str) -> wgpu::TextureFormat {
-        COLOR_FORMATS.iter().find(|(l, _)| l.strip_prefix("gbuffer/") == Some(name)).expect("G-buffer channel").1
+        COLOR_FORMATS
+            .iter()
+            .find(|(l, _)| l.strip_prefix("gbuffer/") == Some(name))
+            .expect("G-buffer channel")
+            .1
     }
 }
 
 /// A pipeline that writes every G-buffer channel and the depth (entry points `vs_main` and
 /// `fs_main`, both faces drawn), depth compared by `depth_compare`.
-pub fn render_pipeline(d: &wgpu::Device, label: &str, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, depth_compare: wgpu::CompareFunction) -> wgpu::RenderPipeline {
-    let targets: Vec<Option<wgpu::ColorTargetState>> = COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
+pub fn render_pipeline(
+    d: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    depth_compare: wgpu::CompareFunction,
+) -> wgpu::RenderPipeline {
+    let targets: Vec<Option<wgpu::ColorTargetState>> =
+        COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
     d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
-        vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
-        primitive: wgpu::PrimitiveState { cull_mode: None, front_face: wgpu::FrontFace::Ccw, ..Default::default() },
-        depth_stencil: Some(wgpu::DepthStencilState { format: DEPTH_FORMAT, depth_write_enabled: Some(true), depth_compare: Some(depth_compare), stencil: Default::default(), bias: Default::default() }),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            front_face: wgpu::FrontFace::Ccw,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(depth_compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
         multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState { module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
         multiview_mask: None,
         cache: None,
     })
@@ -134,13 +190,31 @@ impl GBufferPass {
         ];
         let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         // Reversed Z: larger is nearer.
-        let pipeline = Reloadable::new(gpu, LABEL, "", &modules, visibility, &bindings(scene, frame), |d, module, pl| render_pipeline(d, LABEL, module, pl, wgpu::CompareFunction::Greater))?;
+        let pipeline = Reloadable::new(
+            gpu,
+            LABEL,
+            "",
+            &modules,
+            visibility,
+            &bindings(scene, frame),
+            |d, module, pl| render_pipeline(d, LABEL, module, pl, wgpu::CompareFunction::Greater),
+        )?;
         Ok(GBufferPass { pipeline, groups: BindCache::default() })
     }
 
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &wgpu::Buffer, t: &GBufferTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &wgpu::Buffer,
+        t: &GBufferTargets,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let p = &self.pipeline;
-        let groups = self.groups.get(scene.generation, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, frame)))?;
+        let groups = self.groups.get(scene.generation, p.builds(), 1, 0, |_| {
+            p.bind_groups(&gpu.device, &bindings(scene, frame))
+        })?;
         let mut pass = t.begin_pass(enc, LABEL, timer);
         pass.set_pipeline(p.get());
         set_render_groups(&mut pass, groups);

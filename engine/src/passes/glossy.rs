@@ -102,7 +102,9 @@ pub struct GlossyChainTargets {
 
 impl GlossyChainTargets {
     pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> GlossyChainTargets {
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
         GlossyChainTargets {
             hit: [t("glossy/hit 0", RGBA32F), t("glossy/hit 1", RGBA32F)],
@@ -150,7 +152,11 @@ fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a>
     let g = i.glossy;
     let b = i.io.bindings().buffer("dn", i.denoise).buffer("gp", i.params);
     match kind {
-        Kind::Motion => b.texture("prev_hit", &g.hit[parity].1).texture("out_motion", &g.motion.1).texture("out_search", &g.search.1).texture("out_hit", &g.hit[1 - parity].1),
+        Kind::Motion => b
+            .texture("prev_hit", &g.hit[parity].1)
+            .texture("out_motion", &g.motion.1)
+            .texture("out_search", &g.search.1)
+            .texture("out_hit", &g.hit[1 - parity].1),
         Kind::PrefilterH => b.texture("src", &g.neighbourhood.1).texture("dst", &g.scratch.1),
         Kind::PrefilterV => b.texture("src", &g.scratch.1).texture("dst", &g.neighbourhood.1),
         Kind::Temporal => b
@@ -167,7 +173,14 @@ fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a>
 
 /// The modules of a glossy stage's program.
 pub fn modules(stage: &'static str, animated: bool) -> Vec<&'static str> {
-    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "realtime/glossy_in.wgsl", "matte/common.wgsl", "glossy/common.wgsl"];
+    let mut m = vec![
+        "common/math.wgsl",
+        "realtime/frame.wgsl",
+        "realtime/gbuffer_in.wgsl",
+        "realtime/glossy_in.wgsl",
+        "matte/common.wgsl",
+        "glossy/common.wgsl",
+    ];
     m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
     if stage == "glossy/motion.wgsl" {
         m.push("glossy/diamond.wgsl");
@@ -189,17 +202,39 @@ impl GlossyChain {
     pub fn new(gpu: &Gpu, i: &GlossyInputs, animated: bool) -> Result<GlossyChain> {
         let mut stages = vec![];
         for (kind, label, file, entry) in STAGES {
-            stages.push((kind, ChainStage::new(gpu, label, &modules(file, animated), entry, &bindings(kind, i, 0))?));
+            stages.push((
+                kind,
+                ChainStage::new(
+                    gpu,
+                    label,
+                    &modules(file, animated),
+                    entry,
+                    &bindings(kind, i, 0),
+                )?,
+            ));
         }
         Ok(GlossyChain { stages })
     }
 
     /// Record the chain. The prefilter runs only when the clip uses it.
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &GlossyInputs, parity: usize, settings: &GlossySettings, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        i: &GlossyInputs,
+        parity: usize,
+        settings: &GlossySettings,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let size = i.io.size;
         let clip = settings.temporal && settings.clipping;
-        for (kind, s) in self.stages.iter_mut().filter(|(k, _)| clip || !matches!(k, Kind::PrefilterH | Kind::PrefilterV)) {
+        for (kind, s) in self
+            .stages
+            .iter_mut()
+            .filter(|(k, _)| clip || !matches!(k, Kind::PrefilterH | Kind::PrefilterV))
+        {
             s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;
         }
         Ok(())

@@ -47,7 +47,11 @@ impl<'a> FrameIo<'a> {
             .texture("tr_matte", &t.matte.1)
             .texture("tr_direct", &t.direct.1);
         if let Some(gl) = &t.glossy {
-            b = b.texture("tr_glossy", &gl.light.1).texture("tr_reflection", &gl.reflection.1).texture("tr_mirror", &gl.mirror.1).texture("tr_mirror_hit", &gl.mirror_hit.1);
+            b = b
+                .texture("tr_glossy", &gl.light.1)
+                .texture("tr_reflection", &gl.reflection.1)
+                .texture("tr_mirror", &gl.mirror.1)
+                .texture("tr_mirror_hit", &gl.mirror_hit.1);
         }
         if let Some(m) = self.mixed {
             b = b.texture("tr_matte", &m.matte.1).texture("tr_direct", &m.direct.1);
@@ -56,7 +60,10 @@ impl<'a> FrameIo<'a> {
             }
         }
         if let Some(p) = self.previous {
-            b = b.texture("prev_depth", &p.depth.1).texture("prev_normal", &p.normal.1).texture("prev_object", &p.ids.1);
+            b = b
+                .texture("prev_depth", &p.depth.1)
+                .texture("prev_normal", &p.normal.1)
+                .texture("prev_object", &p.ids.1);
         }
         b
     }
@@ -74,20 +81,53 @@ pub struct PreviousGBuffer {
 
 impl PreviousGBuffer {
     pub fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> PreviousGBuffer {
-        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::COPY_SRC;
         PreviousGBuffer {
-            depth: mem.texture(device, "gbuffer/previous depth", size, super::gbuffer::DEPTH_FORMAT, usage),
-            normal: mem.texture(device, "gbuffer/previous normal", size, GBufferTargets::format("normal"), usage),
-            ids: mem.texture(device, "gbuffer/previous ids", size, GBufferTargets::format("ids"), usage),
+            depth: mem.texture(
+                device,
+                "gbuffer/previous depth",
+                size,
+                super::gbuffer::DEPTH_FORMAT,
+                usage,
+            ),
+            normal: mem.texture(
+                device,
+                "gbuffer/previous normal",
+                size,
+                GBufferTargets::format("normal"),
+                usage,
+            ),
+            ids: mem.texture(
+                device,
+                "gbuffer/previous ids",
+                size,
+                GBufferTargets::format("ids"),
+                usage,
+            ),
         }
     }
 
     /// Record the copy of this frame's depth, normal and ids, after every stage read the previous.
-    pub fn record_copy(&self, enc: &mut wgpu::CommandEncoder, g: &GBufferTargets, size: (u32, u32)) {
+    pub fn record_copy(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        g: &GBufferTargets,
+        size: (u32, u32),
+    ) {
         let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
-        enc.copy_texture_to_texture(g.depth.0.as_image_copy(), self.depth.0.as_image_copy(), extent);
+        enc.copy_texture_to_texture(
+            g.depth.0.as_image_copy(),
+            self.depth.0.as_image_copy(),
+            extent,
+        );
         for (from, to) in [("normal", &self.normal), ("ids", &self.ids)] {
-            enc.copy_texture_to_texture(g.channel(from).0.as_image_copy(), to.0.as_image_copy(), extent);
+            enc.copy_texture_to_texture(
+                g.channel(from).0.as_image_copy(),
+                to.0.as_image_copy(),
+                extent,
+            );
         }
     }
 }

@@ -87,7 +87,13 @@ pub struct ChainView {
 
 impl DenoiseParams {
     /// The matte chain's parameters and TAA's (`taa`), which TAA reads from the same struct.
-    pub fn new(s: &MatteSettings, taa: &TaaSettings, width: u32, frame: u32, view: &ChainView) -> DenoiseParams {
+    pub fn new(
+        s: &MatteSettings,
+        taa: &TaaSettings,
+        width: u32,
+        frame: u32,
+        view: &ChainView,
+    ) -> DenoiseParams {
         let w = width as f32;
         DenoiseParams {
             inv_view_proj: view.inv_view_proj.to_cols_array_2d(),
@@ -113,7 +119,8 @@ impl DenoiseParams {
             history_full_frames: s.history_full_frames.max(0.0),
             jitter_shift: view.jitter_shift.to_array(),
             taa_still_frames: taa.still_frames.clamp(0.0, 1024.0),
-            min_radius_px: (s.min_radius_fraction * w).clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
+            min_radius_px: (s.min_radius_fraction * w)
+                .clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
             edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
             static_view: view.static_view as u32,
             reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
@@ -153,7 +160,9 @@ pub struct MatteTargets {
 
 impl MatteTargets {
     pub fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> MatteTargets {
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         let mut t = |label: &str, f| mem.texture(device, label, size, f, rw);
         let history = [t("matte/history 0", RGBA32F), t("matte/history 1", RGBA32F)];
         let temporal = t("matte/temporal", RGBA32F);
@@ -196,21 +205,44 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> 
     let m = i.matte;
     let b = i.io.bindings().buffer("dn", i.params);
     match kind {
-        Kind::Temporal => b.texture("history", &m.history[parity].1).texture("out_temporal", &m.temporal.1).texture("out_reason", &m.reason.1),
-        Kind::HistoryBilateral => b.texture("filter_in", &m.temporal.1).texture("reason_in", &m.reason.1).texture("out_history", &m.history[1 - parity].1),
-        Kind::MinH => b.texture("filter_in", &m.temporal.1).texture("min_in", &m.radius.1).texture("out_min", &m.min.1),
-        Kind::MinV => b.texture("filter_in", &m.temporal.1).texture("min_in", &m.min.1).texture("out_min", &m.radius.1),
+        Kind::Temporal => b
+            .texture("history", &m.history[parity].1)
+            .texture("out_temporal", &m.temporal.1)
+            .texture("out_reason", &m.reason.1),
+        Kind::HistoryBilateral => b
+            .texture("filter_in", &m.temporal.1)
+            .texture("reason_in", &m.reason.1)
+            .texture("out_history", &m.history[1 - parity].1),
+        Kind::MinH => b
+            .texture("filter_in", &m.temporal.1)
+            .texture("min_in", &m.radius.1)
+            .texture("out_min", &m.min.1),
+        Kind::MinV => b
+            .texture("filter_in", &m.temporal.1)
+            .texture("min_in", &m.min.1)
+            .texture("out_min", &m.radius.1),
         Kind::Firefly => b.texture("filter_in", &m.temporal.1).texture("out_median", &m.median.1),
-        Kind::Bilateral => b.texture("filter_in", &m.median.1).texture("radius_in", &m.radius.1).texture("reason_in", &m.reason.1).texture("out_matte", &m.denoised.1),
+        Kind::Bilateral => b
+            .texture("filter_in", &m.median.1)
+            .texture("radius_in", &m.radius.1)
+            .texture("reason_in", &m.reason.1)
+            .texture("out_matte", &m.denoised.1),
     }
 }
 
 fn modules(kind: Kind, animated: bool) -> Vec<&'static str> {
-    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl"];
+    let mut m = vec![
+        "common/math.wgsl",
+        "realtime/frame.wgsl",
+        "realtime/gbuffer_in.wgsl",
+        "matte/common.wgsl",
+    ];
     m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
     m.extend(match kind {
         Kind::Temporal => vec!["matte/temporal.wgsl"],
-        Kind::HistoryBilateral => vec!["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
+        Kind::HistoryBilateral => {
+            vec!["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"]
+        }
         Kind::MinH | Kind::MinV => vec!["matte/disocclusion.wgsl"],
         Kind::Firefly => vec!["matte/firefly.wgsl"],
         Kind::Bilateral => vec!["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"],
@@ -236,15 +268,34 @@ impl MatteChain {
                 Kind::MinV => "min_v",
                 _ => "main",
             };
-            stages.push((kind, ChainStage::new(gpu, label, &modules(kind, animated), entry, &bindings(kind, i, 0))?));
+            stages.push((
+                kind,
+                ChainStage::new(
+                    gpu,
+                    label,
+                    &modules(kind, animated),
+                    entry,
+                    &bindings(kind, i, 0),
+                )?,
+            ));
         }
         Ok(MatteChain { stages })
     }
 
     /// Record stages 3-7.
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, i: &ChainInputs, parity: usize, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        i: &ChainInputs,
+        parity: usize,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         for (kind, s) in self.stages.iter_mut() {
-            s.record(gpu, enc, key, parity, i.io.size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;
+            s.record(gpu, enc, key, parity, i.io.size, timer.as_deref_mut(), |p| {
+                bindings(*kind, i, p)
+            })?;
         }
         Ok(())
     }

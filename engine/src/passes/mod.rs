@@ -7,13 +7,13 @@ pub use raycast::{RayHit, Raycaster};
 pub use reference::{Accumulation, ReferenceTracer, TraceView};
 
 pub mod chain;
-pub mod io;
-pub mod taa;
 pub mod composite;
 pub mod gbuffer;
 pub mod glossy;
+pub mod io;
 pub mod matte;
 pub mod prefilter;
 pub mod primaries;
 pub mod supersample;
+pub mod taa;
 pub mod trace;

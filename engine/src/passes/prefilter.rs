@@ -38,23 +38,46 @@ pub struct PrefilterTargets {
 impl PrefilterTargets {
     pub const PREFIX: &str = "prefilter/";
 
-    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), epoch: u64) -> PrefilterTargets {
+    pub fn new(
+        d: &wgpu::Device,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        epoch: u64,
+    ) -> PrefilterTargets {
         let pixels = size.0 as u64 * size.1 as u64;
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-        let tex = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let tex = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         PrefilterTargets {
             epoch,
-            stats: ["prefilter/inverse covariance a", "prefilter/inverse covariance b", "prefilter/position", "prefilter/even position"].map(|l| mem.texture(d, l, size, wgpu::TextureFormat::Rgba32Float, tex)),
+            stats: [
+                "prefilter/inverse covariance a",
+                "prefilter/inverse covariance b",
+                "prefilter/position",
+                "prefilter/even position",
+            ]
+            .map(|l| mem.texture(d, l, size, wgpu::TextureFormat::Rgba32Float, tex)),
             bandwidth: mem.buffer(d, "prefilter/bandwidth", pixels * 4, usage),
             features: mem.buffer(d, "prefilter/features", pixels * FEATURE_WORDS * 16, usage),
             view: mem.texture(d, "prefilter/view", size, wgpu::TextureFormat::Rgba16Float, tex),
-            normals: mem.texture(d, "prefilter/normals", size, wgpu::TextureFormat::Rgba16Float, tex),
+            normals: mem.texture(
+                d,
+                "prefilter/normals",
+                size,
+                wgpu::TextureFormat::Rgba16Float,
+                tex,
+            ),
         }
     }
 }
 
 /// What the pre-filter binds: the frame uniform, the primaries' buffers and its own.
-pub fn bindings<'a>(frame: &'a wgpu::Buffer, p: &'a PrimaryTargets, t: &'a PrefilterTargets) -> Bindings<'a> {
+pub fn bindings<'a>(
+    frame: &'a wgpu::Buffer,
+    p: &'a PrimaryTargets,
+    t: &'a PrefilterTargets,
+) -> Bindings<'a> {
     Bindings::new()
         .buffer("frame", frame)
         .buffer("pr_features", &p.features)
@@ -86,18 +109,35 @@ pub struct Prefilter {
 
 impl Prefilter {
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
-        self.stages.iter_mut().flat_map(|s| s.iter_mut().map(|s| &mut s.pipeline as &mut dyn Reload)).collect()
+        self.stages
+            .iter_mut()
+            .flat_map(|s| s.iter_mut().map(|s| &mut s.pipeline as &mut dyn Reload))
+            .collect()
     }
 
     /// Record the three passes over `size` pixels; `key` changes whenever a bound buffer may
     /// have been replaced.
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, size: (u32, u32), offered: &Bindings, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        size: (u32, u32),
+        offered: &Bindings,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         if self.stages.is_none() {
             let stage = |label, file| ChainStage::new(gpu, label, &modules(file), "main", offered);
-            self.stages = Some([stage(COVARIANCE, "prefilter/covariance.wgsl")?, stage(SURE, "prefilter/sure.wgsl")?, stage(FEATURES, "prefilter/features.wgsl")?]);
+            self.stages = Some([
+                stage(COVARIANCE, "prefilter/covariance.wgsl")?,
+                stage(SURE, "prefilter/sure.wgsl")?,
+                stage(FEATURES, "prefilter/features.wgsl")?,
+            ]);
         }
         for s in self.stages.as_mut().unwrap() {
-            s.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| offered.clone())?;
+            s.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| {
+                offered.clone()
+            })?;
         }
         Ok(())
     }

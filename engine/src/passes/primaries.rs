@@ -8,7 +8,9 @@
 //! Per pixel: 80 bytes of features and 64 of position moments (144 bytes).
 
 use crate::gpu::scene::compute_pipeline;
-use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups, set_render_groups};
+use crate::gpu::{
+    BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups, set_render_groups,
+};
 use crate::passes::gbuffer::{GBufferTargets, render_pipeline};
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
@@ -30,10 +32,21 @@ pub struct PrimaryTargets {
 impl PrimaryTargets {
     pub const PREFIX: &str = "primaries/";
 
-    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), epoch: u64) -> PrimaryTargets {
+    pub fn new(
+        d: &wgpu::Device,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        epoch: u64,
+    ) -> PrimaryTargets {
         let pixels = size.0 as u64 * size.1 as u64;
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        PrimaryTargets { epoch, features: mem.buffer(d, "primaries/features", pixels * FEATURE_WORDS * 16, usage), moments: mem.buffer(d, "primaries/moments", pixels * MOMENT_WORDS * 16, usage) }
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        PrimaryTargets {
+            epoch,
+            features: mem.buffer(d, "primaries/features", pixels * FEATURE_WORDS * 16, usage),
+            moments: mem.buffer(d, "primaries/moments", pixels * MOMENT_WORDS * 16, usage),
+        }
     }
 }
 
@@ -45,8 +58,18 @@ pub struct Primaries {
     resolve: Option<(Reloadable<wgpu::RenderPipeline>, [BindCache; 2])>,
 }
 
-fn trace_bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::Buffer, t: &'a PrimaryTargets) -> Bindings<'a> {
-    scene.bindings().buffer("params", params).buffer("frame", frame).buffer("pr_features", &t.features).buffer("pr_moments", &t.moments)
+fn trace_bindings<'a>(
+    scene: &'a GpuScene,
+    params: &'a wgpu::Buffer,
+    frame: &'a wgpu::Buffer,
+    t: &'a PrimaryTargets,
+) -> Bindings<'a> {
+    scene
+        .bindings()
+        .buffer("params", params)
+        .buffer("frame", frame)
+        .buffer("pr_features", &t.features)
+        .buffer("pr_moments", &t.moments)
 }
 
 impl Primaries {
@@ -64,21 +87,48 @@ impl Primaries {
     /// Trace frame.primary_samples lens rays per pixel into `t`; `moving`: objects move during
     /// the shutter.
     #[allow(clippy::too_many_arguments)]
-    pub fn record_trace(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, t: &PrimaryTargets, size: (u32, u32), moving: bool, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record_trace(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        scene: &GpuScene,
+        params: &wgpu::Buffer,
+        frame: &wgpu::Buffer,
+        t: &PrimaryTargets,
+        size: (u32, u32),
+        moving: bool,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let offered = trace_bindings(scene, params, frame, t);
         let slot = &mut self.trace[moving as usize];
         if slot.is_none() {
             let mut modules = scene.shading_modules_for(moving);
             modules.push("realtime/frame.wgsl");
-            modules.push(if scene.features.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+            modules.push(if scene.features.animated {
+                "realtime/motion_objects.wgsl"
+            } else {
+                "realtime/motion_static.wgsl"
+            });
             modules.extend(["realtime/lens.wgsl", "realtime/primaries.wgsl"]);
-            let p = Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, wgpu::ShaderStages::COMPUTE, &offered, |d, m, l| compute_pipeline(d, LABEL, m, l, "main"))?;
+            let p = Reloadable::new(
+                gpu,
+                LABEL,
+                &scene.prelude(),
+                &modules,
+                wgpu::ShaderStages::COMPUTE,
+                &offered,
+                |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),
+            )?;
             *slot = Some((p, BindCache::default()));
         }
         let (p, cache) = slot.as_mut().unwrap();
         let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(LABEL);
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(LABEL),
+            timestamp_writes: timer.and_then(|t| t.compute(LABEL)),
+        });
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
@@ -88,17 +138,42 @@ impl Primaries {
     /// Write the raw features of `t` into the G-buffer targets, the normal and depth from
     /// `edges` where given (the pre-filter's, in the same layout).
     #[allow(clippy::too_many_arguments)]
-    pub fn record_resolve(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, frame: &wgpu::Buffer, t: &PrimaryTargets, edges: Option<&wgpu::Buffer>, g: &GBufferTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record_resolve(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        frame: &wgpu::Buffer,
+        t: &PrimaryTargets,
+        edges: Option<&wgpu::Buffer>,
+        g: &GBufferTargets,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let filtered = edges.is_some();
-        let offered = Bindings::new().buffer("frame", frame).buffer("features", &t.features).buffer("edges", edges.unwrap_or(&t.features));
+        let offered = Bindings::new()
+            .buffer("frame", frame)
+            .buffer("features", &t.features)
+            .buffer("edges", edges.unwrap_or(&t.features));
         if self.resolve.is_none() {
-            let modules = ["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"];
+            let modules =
+                ["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"];
             // Every pixel is written: the depth is the resolved one, not a nearest surface.
-            let p = Reloadable::new(gpu, RESOLVE, "", &modules, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT, &offered, |d, module, pl| render_pipeline(d, RESOLVE, module, pl, wgpu::CompareFunction::Always))?;
+            let p = Reloadable::new(
+                gpu,
+                RESOLVE,
+                "",
+                &modules,
+                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+                &offered,
+                |d, module, pl| {
+                    render_pipeline(d, RESOLVE, module, pl, wgpu::CompareFunction::Always)
+                },
+            )?;
             self.resolve = Some((p, Default::default()));
         }
         let (p, caches) = self.resolve.as_mut().unwrap();
-        let groups = caches[filtered as usize].get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
+        let groups = caches[filtered as usize]
+            .get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(RESOLVE);
         let mut pass = g.begin_pass(enc, RESOLVE, timer);
         pass.set_pipeline(p.get());

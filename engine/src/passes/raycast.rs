@@ -35,7 +35,9 @@ impl Raycaster {
         // The per-cast buffers are made by each cast: offer the scene's and their names.
         let mut offered: Vec<&str> = scene.bindings().names().collect();
         offered.extend(CAST_BUFFERS);
-        Ok(Raycaster { compute: FixedCompute::new(gpu, LABEL, &scene.traversal_prelude(), &modules, &offered)? })
+        Ok(Raycaster {
+            compute: FixedCompute::new(gpu, LABEL, &scene.traversal_prelude(), &modules, &offered)?,
+        })
     }
 
     /// Trace `rays` (origin, direction, tmax) in scene-relative coordinates. Returns the hits
@@ -68,20 +70,44 @@ impl Raycaster {
     ) -> Result<(Vec<Option<RayHit>>, std::time::Duration)> {
         let mut mem = GpuMemory::default();
         let n = rays.len() as u32;
-        let ray_data: Vec<[f32; 4]> = rays.iter().flat_map(|(o, d, t)| [o.extend(*t).to_array(), d.extend(0.0).to_array()]).collect();
+        let ray_data: Vec<[f32; 4]> = rays
+            .iter()
+            .flat_map(|(o, d, t)| [o.extend(*t).to_array(), d.extend(0.0).to_array()])
+            .collect();
         let params = [n, any_hit as u32, 0, 0];
         let d = &gpu.device;
-        let pbuf = mem.buffer_init(d, "raycast/params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
-        let rbuf = mem.buffer_init(d, "raycast/rays", bytemuck::cast_slice(&ray_data), wgpu::BufferUsages::STORAGE);
-        let hbuf = mem.buffer(d, "raycast/hits", n as u64 * 16, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let pbuf = mem.buffer_init(
+            d,
+            "raycast/params",
+            bytemuck::cast_slice(&params),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let rbuf = mem.buffer_init(
+            d,
+            "raycast/rays",
+            bytemuck::cast_slice(&ray_data),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let hbuf = mem.buffer(
+            d,
+            "raycast/hits",
+            n as u64 * 16,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        );
         // A refused binding or dispatch is an error here, not a silently empty result.
-        let groups = gpu.validated(&format!("binding {n} rays"), || self.compute.bind_groups(d, &cast_bindings(scene, &pbuf, &rbuf, &hbuf)))?;
+        let groups = gpu.validated(&format!("binding {n} rays"), || {
+            self.compute.bind_groups(d, &cast_bindings(scene, &pbuf, &rbuf, &hbuf))
+        })?;
         gpu.wait()?;
         let start = std::time::Instant::now();
         gpu.validated(&format!("casting {n} rays"), || {
-            let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
+            let mut enc =
+                d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
             {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: None });
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(LABEL),
+                    timestamp_writes: None,
+                });
                 pass.set_pipeline(&self.compute.pipeline);
                 crate::gpu::set_compute_groups(&mut pass, &groups);
                 let groups = n.div_ceil(64);
@@ -97,7 +123,12 @@ impl Raycaster {
         let hits = v
             .iter()
             .map(|h| {
-                (h[0] >= 0.0).then(|| RayHit { t: h[0], triangle: h[1].to_bits(), b1: h[2], b2: h[3] })
+                (h[0] >= 0.0).then(|| RayHit {
+                    t: h[0],
+                    triangle: h[1].to_bits(),
+                    b1: h[2],
+                    b2: h[3],
+                })
             })
             .collect();
         Ok((hits, elapsed))
@@ -107,7 +138,12 @@ impl Raycaster {
 /// What each cast binds beside the scene (accel/raycast.wgsl).
 const CAST_BUFFERS: [&str; 3] = ["params", "rays", "hits"];
 
-fn cast_bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, rays: &'a wgpu::Buffer, hits: &'a wgpu::Buffer) -> Bindings<'a> {
+fn cast_bindings<'a>(
+    scene: &'a GpuScene,
+    params: &'a wgpu::Buffer,
+    rays: &'a wgpu::Buffer,
+    hits: &'a wgpu::Buffer,
+) -> Bindings<'a> {
     let [p, r, h] = CAST_BUFFERS;
     scene.bindings().buffer(p, params).buffer(r, rays).buffer(h, hits)
 }

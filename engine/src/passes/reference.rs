@@ -96,7 +96,12 @@ pub const BATCH_PATHS: u64 = 1 << 21;
 pub const MAX_SIDE: u32 = 16384;
 
 impl ReferenceTracer {
-    pub fn new(gpu: &Gpu, prepared: &PreparedScene, scene: &GpuScene, view: &TraceView) -> Result<ReferenceTracer> {
+    pub fn new(
+        gpu: &Gpu,
+        prepared: &PreparedScene,
+        scene: &GpuScene,
+        view: &TraceView,
+    ) -> Result<ReferenceTracer> {
         let (w, h) = (view.width, view.height);
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
             bail!("image size {w}x{h} is out of range (1..={MAX_SIDE} per side)");
@@ -108,7 +113,9 @@ impl ReferenceTracer {
             &gpu.device,
             "reference/accumulation",
             w as u64 * h as u64 * 32,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
         );
         let params_buf = memory.buffer(
             &gpu.device,
@@ -117,7 +124,13 @@ impl ReferenceTracer {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let resources = scene.bindings().buffer("params", &params_buf).buffer("accum", &accum);
-        let fixed = crate::shader::FixedCompute::new(gpu, LABEL, &scene.prelude(), &modules, &resources.names().collect::<Vec<_>>())?;
+        let fixed = crate::shader::FixedCompute::new(
+            gpu,
+            LABEL,
+            &scene.prelude(),
+            &modules,
+            &resources.names().collect::<Vec<_>>(),
+        )?;
         let bind_groups = fixed.bind_groups(&gpu.device, &resources)?;
         let pipeline = fixed.pipeline;
         let params = make_params(prepared, view);
@@ -156,12 +169,21 @@ impl ReferenceTracer {
             self.params.sample_index = self.samples;
             self.params.batch[0] = batch;
             gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
-            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
+            let mut enc = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(LABEL) });
             {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: None });
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(LABEL),
+                    timestamp_writes: None,
+                });
                 pass.set_pipeline(&self.pipeline);
                 crate::gpu::set_compute_groups(&mut pass, &self.bind_groups);
-                pass.dispatch_workgroups(self.params.width.div_ceil(8), self.params.height.div_ceil(8), 1);
+                pass.dispatch_workgroups(
+                    self.params.width.div_ceil(8),
+                    self.params.height.div_ceil(8),
+                    1,
+                );
             }
             gpu.queue.submit([enc.finish()]);
             self.samples += batch;
@@ -180,7 +202,8 @@ impl ReferenceTracer {
 
     pub fn readback(&self, gpu: &Gpu) -> Result<Accumulation> {
         let (w, h) = self.size();
-        let bytes = readback_buffer(&gpu.device, &gpu.queue, &self.accum, w as u64 * h as u64 * 32)?;
+        let bytes =
+            readback_buffer(&gpu.device, &gpu.queue, &self.accum, w as u64 * h as u64 * 32)?;
         let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
         let n = self.samples.max(1) as f32;
         let mut mean = Image::new(w, h);
@@ -195,7 +218,12 @@ impl ReferenceTracer {
             var.data[i] = sample_var / n;
             bad += v[i * 2 + 1][3] as u64;
         }
-        Ok(Accumulation { samples: self.samples, mean, variance_of_mean: var, nonfinite_samples: bad })
+        Ok(Accumulation {
+            samples: self.samples,
+            mean,
+            variance_of_mean: var,
+            nonfinite_samples: bad,
+        })
     }
 }
 

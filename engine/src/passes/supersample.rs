@@ -42,17 +42,35 @@ impl SupersampleTargets {
     /// Labels of everything it allocates start with this.
     pub const PREFIX: &str = "supersample/";
 
-    pub fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), k: u32, glossy: bool, epoch: u64) -> SupersampleTargets {
+    pub fn new(
+        d: &wgpu::Device,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        k: u32,
+        glossy: bool,
+        epoch: u64,
+    ) -> SupersampleTargets {
         let pixels = size.0 as u64 * size.1 as u64;
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         let f = super::trace::MATTE_FORMAT;
         let mut t = |label: &str| mem.texture(d, label, size, f, rw);
-        let mixed = MixedLight { matte: t("supersample/matte"), direct: t("supersample/direct"), glossy: glossy.then(|| t("supersample/glossy")) };
+        let mixed = MixedLight {
+            matte: t("supersample/matte"),
+            direct: t("supersample/direct"),
+            glossy: glossy.then(|| t("supersample/glossy")),
+        };
         SupersampleTargets {
             k,
             epoch,
-            samples: mem.buffer(d, "supersample/samples", pixels * (k.max(2) - 1) as u64 * RECORD_BYTES, storage),
+            samples: mem.buffer(
+                d,
+                "supersample/samples",
+                pixels * (k.max(2) - 1) as u64 * RECORD_BYTES,
+                storage,
+            ),
             guides: mem.buffer(d, "supersample/guides", pixels * 16, storage),
             mixed,
             resolved: mem.buffer(d, "supersample/resolved", pixels * 16, storage),
@@ -66,7 +84,11 @@ pub fn modules(stage: &'static str, glossy: bool) -> Vec<&'static str> {
     m.push(if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" });
     m.push("supersample/common.wgsl");
     if stage == "supersample/mix.wgsl" {
-        m.push(if glossy { "supersample/mix_glossy.wgsl" } else { "supersample/mix_glossy_none.wgsl" });
+        m.push(if glossy {
+            "supersample/mix_glossy.wgsl"
+        } else {
+            "supersample/mix_glossy_none.wgsl"
+        });
     }
     m.push(stage);
     m
@@ -77,7 +99,11 @@ pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
     let mut m = scene.shading_modules();
     m.push("realtime/frame.wgsl");
     m.push("realtime/lens.wgsl");
-    m.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
+    m.push(if scene.features.glossy {
+        "realtime/trace_glossy.wgsl"
+    } else {
+        "realtime/trace_glossy_none.wgsl"
+    });
     m.extend(["realtime/trace.wgsl", "supersample/common.wgsl", "supersample/samples.wgsl"]);
     m
 }
@@ -105,7 +131,12 @@ impl Supersample {
     }
 
     fn own<'a>(t: &'a SupersampleTargets, b: Bindings<'a>) -> Bindings<'a> {
-        let b = b.buffer("ss_samples", &t.samples).buffer("ss_guides", &t.guides).texture("out_matte", &t.mixed.matte.1).texture("out_direct", &t.mixed.direct.1).buffer("resolved", &t.resolved);
+        let b = b
+            .buffer("ss_samples", &t.samples)
+            .buffer("ss_guides", &t.guides)
+            .texture("out_matte", &t.mixed.matte.1)
+            .texture("out_direct", &t.mixed.direct.1)
+            .buffer("resolved", &t.resolved);
         match &t.mixed.glossy {
             Some(g) => b.texture("out_glossy", &g.1),
             None => b,
@@ -115,18 +146,40 @@ impl Supersample {
     /// Trace the extra samples, assign and mix them (before the denoiser). `io`: the frame's
     /// I/O with the trace's own light.
     #[allow(clippy::too_many_arguments)]
-    pub fn record_mix(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, scene: &GpuScene, trace_bindings: Bindings, io: &FrameIo, t: &SupersampleTargets, mut timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record_mix(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        scene: &GpuScene,
+        trace_bindings: Bindings,
+        io: &FrameIo,
+        t: &SupersampleTargets,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let size = io.size;
         let sample_bindings = Self::own(t, trace_bindings);
         if self.samples.is_none() {
-            let p = Reloadable::new(gpu, SAMPLES, &scene.prelude(), &sample_modules(scene), wgpu::ShaderStages::COMPUTE, &sample_bindings, |d, m, l| compute_pipeline(d, SAMPLES, m, l, "samples"))?;
+            let p = Reloadable::new(
+                gpu,
+                SAMPLES,
+                &scene.prelude(),
+                &sample_modules(scene),
+                wgpu::ShaderStages::COMPUTE,
+                &sample_bindings,
+                |d, m, l| compute_pipeline(d, SAMPLES, m, l, "samples"),
+            )?;
             self.samples = Some((p, BindCache::default()));
         }
         let (p, cache) = self.samples.as_mut().unwrap();
-        let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &sample_bindings))?;
+        let groups =
+            cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &sample_bindings))?;
         {
             let _scope = crate::profile::scope(SAMPLES);
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(SAMPLES), timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(SAMPLES)) });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(SAMPLES),
+                timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(SAMPLES)),
+            });
             pass.set_pipeline(p.get());
             set_compute_groups(&mut pass, groups);
             pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
@@ -134,21 +187,44 @@ impl Supersample {
         let offered = Self::own(t, io.bindings().buffer("hdr", io.hdr));
         if self.stages.is_none() {
             let glossy = t.mixed.glossy.is_some();
-            let stage = |label, file| ChainStage::new(gpu, label, &modules(file, glossy), "main", &offered);
-            self.stages = Some([stage("supersample/assign", "supersample/assign.wgsl")?, stage("supersample/mix", "supersample/mix.wgsl")?, stage("supersample/resolve", "supersample/resolve.wgsl")?]);
+            let stage =
+                |label, file| ChainStage::new(gpu, label, &modules(file, glossy), "main", &offered);
+            self.stages = Some([
+                stage("supersample/assign", "supersample/assign.wgsl")?,
+                stage("supersample/mix", "supersample/mix.wgsl")?,
+                stage("supersample/resolve", "supersample/resolve.wgsl")?,
+            ]);
         }
         let [assign, mix, _] = self.stages.as_mut().unwrap();
-        assign.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| offered.clone())?;
+        assign.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| {
+            offered.clone()
+        })?;
         mix.record_variant(gpu, enc, key, (1, 0), size, timer, |_| offered.clone())
     }
 
     /// After the composite: each pixel the mean of its samples' guides, copied back into the
     /// composite's image for TAA and the display.
-    pub fn record_resolve(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, io: &FrameIo, t: &SupersampleTargets, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record_resolve(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        io: &FrameIo,
+        t: &SupersampleTargets,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         let offered = Self::own(t, io.bindings().buffer("hdr", io.hdr));
-        let Some([_, _, resolve]) = self.stages.as_mut() else { anyhow::bail!("the supersampling resolves before it mixed") };
+        let Some([_, _, resolve]) = self.stages.as_mut() else {
+            anyhow::bail!("the supersampling resolves before it mixed")
+        };
         resolve.record_variant(gpu, enc, key, (1, 0), io.size, timer, |_| offered.clone())?;
-        enc.copy_buffer_to_buffer(&t.resolved, 0, io.hdr, 0, io.size.0 as u64 * io.size.1 as u64 * 16);
+        enc.copy_buffer_to_buffer(
+            &t.resolved,
+            0,
+            io.hdr,
+            0,
+            io.size.0 as u64 * io.size.1 as u64 * 16,
+        );
         Ok(())
     }
 }

@@ -48,11 +48,22 @@ struct TaaTargets {
 
 impl TaaTargets {
     fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> TaaTargets {
-        let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
-        let mut pair = |l: &str| [mem.texture(device, &format!("taa/{l} 0"), size, RGBA32F, rw), mem.texture(device, &format!("taa/{l} 1"), size, RGBA32F, rw)];
-        let (history, material, residual, glossy) = (pair("history"), pair("material"), pair("residual"), pair("glossy"));
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let final_image = mem.buffer(device, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let mut pair = |l: &str| {
+            [
+                mem.texture(device, &format!("taa/{l} 0"), size, RGBA32F, rw),
+                mem.texture(device, &format!("taa/{l} 1"), size, RGBA32F, rw),
+            ]
+        };
+        let (history, material, residual, glossy) =
+            (pair("history"), pair("material"), pair("residual"), pair("glossy"));
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let final_image =
+            mem.buffer(device, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
         TaaTargets { history, material, residual, glossy, final_image }
     }
 }
@@ -77,7 +88,13 @@ impl TaaStage {
     }
 
     /// Make the textures for the frame targets of `epoch` (once per size); true if it did.
-    pub fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32), epoch: u64) -> bool {
+    pub fn allocate(
+        &mut self,
+        gpu: &Gpu,
+        memory: &mut GpuMemory,
+        size: (u32, u32),
+        epoch: u64,
+    ) -> bool {
         if self.targets.as_ref().is_some_and(|(e, _)| *e == epoch) {
             return false;
         }
@@ -94,14 +111,30 @@ impl TaaStage {
     /// `key` changes whenever a bound resource may have (scene, targets, denoiser).
     #[allow(clippy::too_many_arguments)]
     /// `follow(p)`: what TAA follows at history parity p.
-    pub fn record<'a>(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: u64, io: &FrameIo<'a>, follow: impl Fn(usize) -> TaaFollow<'a>, params: &DenoiseParams, parity: usize, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record<'a>(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: u64,
+        io: &FrameIo<'a>,
+        follow: impl Fn(usize) -> TaaFollow<'a>,
+        params: &DenoiseParams,
+        parity: usize,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let (_, t) = self.targets.as_ref().expect("TaaStage::allocate runs before record");
         let f = follow(parity);
         let variant = (f.matte.is_some(), f.glossy.is_some());
         let bindings = |p: usize| taa_bindings(io, t, &self.params, &follow(p), p);
         if !self.programs.iter().any(|(v, _)| *v == variant) {
-            let stage = ChainStage::new(gpu, LABEL, &modules(variant, self.animated), "main", &bindings(0))?;
+            let stage = ChainStage::new(
+                gpu,
+                LABEL,
+                &modules(variant, self.animated),
+                "main",
+                &bindings(0),
+            )?;
             self.programs.push((variant, stage));
         }
         let (_, stage) = self.programs.iter_mut().find(|(v, _)| *v == variant).expect("made above");
@@ -109,7 +142,13 @@ impl TaaStage {
     }
 }
 
-fn taa_bindings<'a>(io: &FrameIo<'a>, t: &'a TaaTargets, params: &'a wgpu::Buffer, follow: &TaaFollow<'a>, parity: usize) -> Bindings<'a> {
+fn taa_bindings<'a>(
+    io: &FrameIo<'a>,
+    t: &'a TaaTargets,
+    params: &'a wgpu::Buffer,
+    follow: &TaaFollow<'a>,
+    parity: usize,
+) -> Bindings<'a> {
     let mut b = io
         .bindings()
         .buffer("dn", params)
@@ -127,15 +166,29 @@ fn taa_bindings<'a>(io: &FrameIo<'a>, t: &'a TaaTargets, params: &'a wgpu::Buffe
         b = b.texture("matte_temporal", light).texture("matte_reason", state);
     }
     if let Some(g) = follow.glossy {
-        b = b.texture("tr_glossy", g.denoised).texture("glossy_temporal", g.temporal).texture("glossy_previous", g.previous).texture("glossy_info", g.info).buffer("gp", g.params);
+        b = b
+            .texture("tr_glossy", g.denoised)
+            .texture("glossy_temporal", g.temporal)
+            .texture("glossy_previous", g.previous)
+            .texture("glossy_info", g.info)
+            .buffer("gp", g.params);
     }
     b
 }
 
 fn modules((matte, glossy): (bool, bool), animated: bool) -> Vec<&'static str> {
-    let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl"];
+    let mut m = vec![
+        "common/math.wgsl",
+        "realtime/frame.wgsl",
+        "realtime/gbuffer_in.wgsl",
+        "matte/common.wgsl",
+    ];
     m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
-    m.extend(if glossy { ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice() } else { ["taa/glossy_none.wgsl"].as_slice() });
+    m.extend(if glossy {
+        ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice()
+    } else {
+        ["taa/glossy_none.wgsl"].as_slice()
+    });
     m.push(if matte { "taa/matte.wgsl" } else { "taa/matte_none.wgsl" });
     m.push("taa/taa.wgsl");
     m

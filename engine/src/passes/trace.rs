@@ -35,7 +35,9 @@ pub struct GlossyTargets {
 
 impl TraceTargets {
     pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32), glossy: bool) -> TraceTargets {
-        let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let usage = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
         let d = &gpu.device;
         TraceTargets {
             matte: mem.texture(d, "trace/matte", size, MATTE_FORMAT, usage),
@@ -58,26 +60,66 @@ pub struct TracePass {
     pub moving: Option<(crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>,
 }
 
-fn program(gpu: &Gpu, scene: &GpuScene, offered: &Bindings, moving: bool) -> Result<crate::shader::Reloadable<wgpu::ComputePipeline>> {
+fn program(
+    gpu: &Gpu,
+    scene: &GpuScene,
+    offered: &Bindings,
+    moving: bool,
+) -> Result<crate::shader::Reloadable<wgpu::ComputePipeline>> {
     let mut modules = scene.shading_modules_for(moving);
     modules.push("realtime/frame.wgsl");
     modules.push("realtime/lens.wgsl");
-    modules.push(if scene.features.glossy { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" });
+    modules.push(if scene.features.glossy {
+        "realtime/trace_glossy.wgsl"
+    } else {
+        "realtime/trace_glossy_none.wgsl"
+    });
     modules.push("realtime/trace.wgsl");
-    crate::shader::Reloadable::new(gpu, LABEL, &scene.prelude(), &modules, wgpu::ShaderStages::COMPUTE, offered, |d, m, l| compute_pipeline(d, LABEL, m, l, "main"))
+    crate::shader::Reloadable::new(
+        gpu,
+        LABEL,
+        &scene.prelude(),
+        &modules,
+        wgpu::ShaderStages::COMPUTE,
+        offered,
+        |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),
+    )
 }
 
 /// What the trace (and the supersampling's samples pass, which shades as it does) binds.
-pub fn bindings<'a>(scene: &'a GpuScene, params: &'a wgpu::Buffer, frame: &'a wgpu::Buffer, g: &'a GBufferTargets, t: &'a TraceTargets) -> Bindings<'a> {
-    let mut b = scene.bindings().buffer("params", params).buffer("frame", frame).texture("gb_ids", g.view("ids")).texture("out_matte", &t.matte.1).texture("out_direct", &t.direct.1);
+pub fn bindings<'a>(
+    scene: &'a GpuScene,
+    params: &'a wgpu::Buffer,
+    frame: &'a wgpu::Buffer,
+    g: &'a GBufferTargets,
+    t: &'a TraceTargets,
+) -> Bindings<'a> {
+    let mut b = scene
+        .bindings()
+        .buffer("params", params)
+        .buffer("frame", frame)
+        .texture("gb_ids", g.view("ids"))
+        .texture("out_matte", &t.matte.1)
+        .texture("out_direct", &t.direct.1);
     if let Some(gl) = &t.glossy {
-        b = b.texture("out_glossy", &gl.light.1).texture("out_reflection", &gl.reflection.1).texture("out_mirror", &gl.mirror.1).texture("out_mirror_hit", &gl.mirror_hit.1);
+        b = b
+            .texture("out_glossy", &gl.light.1)
+            .texture("out_reflection", &gl.reflection.1)
+            .texture("out_mirror", &gl.mirror.1)
+            .texture("out_mirror_hit", &gl.mirror_hit.1);
     }
     b
 }
 
 impl TracePass {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets) -> Result<TracePass> {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        params: &wgpu::Buffer,
+        frame: &wgpu::Buffer,
+        g: &GBufferTargets,
+        t: &TraceTargets,
+    ) -> Result<TracePass> {
         let pipeline = program(gpu, scene, &bindings(scene, params, frame, g, t), false)?;
         Ok(TracePass { pipeline, groups: BindCache::default(), moving: None })
     }
@@ -86,22 +128,48 @@ impl TracePass {
     /// `period`: 1 / f, the frames between two samples of a pixel. `moving`: objects move during
     /// the shutter (the motion-blur program).
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, key: (u64, u64), scene: &GpuScene, params: &wgpu::Buffer, frame: &wgpu::Buffer, g: &GBufferTargets, t: &TraceTargets, size: (u32, u32), period: u32, moving: bool, timer: Option<&mut GpuTimer>) -> Result<()> {
+    pub fn record(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        key: (u64, u64),
+        scene: &GpuScene,
+        params: &wgpu::Buffer,
+        frame: &wgpu::Buffer,
+        g: &GBufferTargets,
+        t: &TraceTargets,
+        size: (u32, u32),
+        period: u32,
+        moving: bool,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
         use crate::shader::Reload;
         if moving && self.moving.is_none() {
-            self.moving = Some((program(gpu, scene, &bindings(scene, params, frame, g, t), true)?, BindCache::default()));
+            self.moving = Some((
+                program(gpu, scene, &bindings(scene, params, frame, g, t), true)?,
+                BindCache::default(),
+            ));
         }
         let (p, cache) = match self.moving.as_mut().filter(|_| moving) {
             Some((p, c)) => (&*p, c),
             None => (&self.pipeline, &mut self.groups),
         };
-        let groups = cache.get(key.0 * 1_000_003 + key.1, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t)))?;
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(LABEL), timestamp_writes: timer.and_then(|t| t.compute(LABEL)) });
+        let groups = cache.get(key.0 * 1_000_003 + key.1, p.builds(), 1, 0, |_| {
+            p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t))
+        })?;
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(LABEL),
+            timestamp_writes: timer.and_then(|t| t.compute(LABEL)),
+        });
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         // Below one sample per pixel one thread per tile (frame/schedule.rs), so the cost falls as f.
         let (tw, th) = crate::frame::schedule::tile(period);
-        pass.dispatch_workgroups(size.0.div_ceil(tw).div_ceil(8), size.1.div_ceil(th).div_ceil(8), 1);
+        pass.dispatch_workgroups(
+            size.0.div_ceil(tw).div_ceil(8),
+            size.1.div_ceil(th).div_ceil(8),
+            1,
+        );
         Ok(())
     }
 }

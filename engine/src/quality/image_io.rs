@@ -87,7 +87,8 @@ impl Image {
         let taps = |dst: u32, src: u32| -> Vec<(u32, u32, f32)> {
             (0..dst)
                 .map(|i| {
-                    let x = ((i as f32 + 0.5) * src as f32 / dst as f32 - 0.5).clamp(0.0, (src - 1) as f32);
+                    let x = ((i as f32 + 0.5) * src as f32 / dst as f32 - 0.5)
+                        .clamp(0.0, (src - 1) as f32);
                     let x0 = x.floor() as u32;
                     (x0, (x0 + 1).min(src - 1), x - x0 as f32)
                 })
@@ -118,11 +119,19 @@ impl Image {
 /// The first RGBA layer of an EXR held in memory, as linear RGB. Every layer's size is read
 /// from the headers and charged to `budget` (12 bytes a pixel) before any pixel is allocated:
 /// a header can declare 100000 x 50000 pixels in a few bytes.
-pub fn decode_exr(name: &str, bytes: &[u8], budget: &mut crate::limits::Budget) -> Result<(u32, u32, Vec<Vec3>)> {
+pub fn decode_exr(
+    name: &str,
+    bytes: &[u8],
+    budget: &mut crate::limits::Budget,
+) -> Result<(u32, u32, Vec<Vec3>)> {
     use exr::prelude::*;
     let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
         .map_err(|e| anyhow!("reading EXR {name}: {e}"))?;
-    let largest = meta.headers.iter().map(|h| h.layer_size).max_by_key(|s| s.width().saturating_mul(s.height()));
+    let largest = meta
+        .headers
+        .iter()
+        .map(|h| h.layer_size)
+        .max_by_key(|s| s.width().saturating_mul(s.height()));
     let size = largest.ok_or_else(|| anyhow!("reading EXR {name}: no layers"))?;
     budget.image(size.width() as u64, size.height() as u64, 12, format_args!("EXR {name}"))?;
     if size.width() > u32::MAX as usize || size.height() > u32::MAX as usize {
@@ -203,7 +212,13 @@ mod tests {
         assert!(row.windows(2).all(|w| w[1] >= w[0]), "{row:?}");
         assert!(row[0] >= 0.0 && row[7] <= 3.0 && row[7] > row[0], "{row:?}");
         let flat = Image { width: 3, height: 3, data: vec![Vec3::new(0.5, 1.0, 2.0); 9] };
-        assert!(flat.resized(7, 5).unwrap().data.iter().all(|p| (*p - Vec3::new(0.5, 1.0, 2.0)).abs().max_element() < 1e-6));
+        assert!(
+            flat.resized(7, 5)
+                .unwrap()
+                .data
+                .iter()
+                .all(|p| (*p - Vec3::new(0.5, 1.0, 2.0)).abs().max_element() < 1e-6)
+        );
         assert!(img.resized(0, 4).is_err());
     }
 }

@@ -37,7 +37,8 @@ fn check_sizes(x: &Image, y: &Image) -> Result<()> {
 }
 
 pub fn rmse(x: &Image, y: &Image) -> f64 {
-    let s: f64 = x.data.iter().zip(&y.data).map(|(a, b)| (*a - *b).as_dvec3().length_squared()).sum();
+    let s: f64 =
+        x.data.iter().zip(&y.data).map(|(a, b)| (*a - *b).as_dvec3().length_squared()).sum();
     (s / (3 * x.data.len()) as f64).sqrt()
 }
 
@@ -81,7 +82,11 @@ pub fn flip_over(x: &Image, y: &Image, region: &[bool]) -> Option<(f64, usize)> 
 /// Mean of a per-pixel map (as `flip_map` returns) over the pixels where `region` is true, and
 /// how many there are; None where the region is empty.
 pub fn region_mean(map: &[f32], region: &[bool]) -> Option<(f64, usize)> {
-    let (sum, n) = map.iter().zip(region).filter(|(_, r)| **r).fold((0.0f64, 0usize), |(s, n), (e, _)| (s + *e as f64, n + 1));
+    let (sum, n) = map
+        .iter()
+        .zip(region)
+        .filter(|(_, r)| **r)
+        .fold((0.0f64, 0usize), |(s, n), (e, _)| (s + *e as f64, n + 1));
     (n > 0).then(|| (sum / n as f64, n))
 }
 
@@ -126,7 +131,12 @@ fn metrics(test: &Image, reference: &Image) -> Result<(Metrics, nv_flip::FlipIma
     let x = sanitized(test);
     let y = sanitized(reference);
     let n = x.data.len() as f64;
-    let mae = x.data.iter().zip(&y.data).map(|(a, b)| (*a - *b).abs().as_dvec3().element_sum()).sum::<f64>()
+    let mae = x
+        .data
+        .iter()
+        .zip(&y.data)
+        .map(|(a, b)| (*a - *b).abs().as_dvec3().element_sum())
+        .sum::<f64>()
         / (3.0 * n);
     let (mx, my) = (x.mean().as_dvec3(), y.mean().as_dvec3());
     let bias = [0, 1, 2].map(|k| if my[k] != 0.0 { (mx[k] - my[k]) / my[k] } else { 0.0 });

@@ -6,6 +6,9 @@ mod ssim;
 mod timeline;
 
 pub use image_io::{Image, decode_exr, tonemap_srgb8, write_exr, write_png};
-pub use metrics::{Metrics, compare, compare_with_flip_map, flip_ldr, flip_map, flip_over, luminance, region_mean, relmse, rmse, save_flip_heatmap};
+pub use metrics::{
+    Metrics, compare, compare_with_flip_map, flip_ldr, flip_map, flip_over, luminance, region_mean,
+    relmse, rmse, save_flip_heatmap,
+};
 pub use ssim::ssim_luma;
 pub use timeline::Timeline;

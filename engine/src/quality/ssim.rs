@@ -12,14 +12,20 @@ pub fn ssim_luma(x: &Image, y: &Image) -> f64 {
     let luma = |img: &Image| -> Vec<f64> {
         img.data
             .iter()
-            .map(|p| 0.2126 * display(p.x) as f64 + 0.7152 * display(p.y) as f64 + 0.0722 * display(p.z) as f64)
+            .map(|p| {
+                0.2126 * display(p.x) as f64
+                    + 0.7152 * display(p.y) as f64
+                    + 0.0722 * display(p.z) as f64
+            })
             .collect()
     };
     let (a, b) = (luma(x), luma(y));
     // skimage: truncate = 3.5, radius = int(3.5 * sigma + 0.5) = 5 (an 11x11 window).
     let sigma = 1.5f64;
     let r = 5usize;
-    let k: Vec<f64> = (0..=2 * r).map(|i| (-((i as f64 - r as f64).powi(2)) / (2.0 * sigma * sigma)).exp()).collect();
+    let k: Vec<f64> = (0..=2 * r)
+        .map(|i| (-((i as f64 - r as f64).powi(2)) / (2.0 * sigma * sigma)).exp())
+        .collect();
     let ks: f64 = k.iter().sum();
     let k: Vec<f64> = k.iter().map(|v| v / ks).collect();
     // scipy.ndimage.gaussian_filter with mode 'reflect' (d c b a | a b c d | d c b a).
@@ -74,7 +80,8 @@ pub fn ssim_luma(x: &Image, y: &Image) -> f64 {
             let vx = uxx[i] - mx * mx;
             let vy = uyy[i] - my * my;
             let cxy = uxy[i] - mx * my;
-            sum += ((2.0 * mx * my + c1) * (2.0 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+            sum += ((2.0 * mx * my + c1) * (2.0 * cxy + c2))
+                / ((mx * mx + my * my + c1) * (vx + vy + c2));
             n += 1;
         }
     }

@@ -32,13 +32,17 @@ const FLOAT: &[(ComponentType, bool)] = &[(F32, false)];
 pub const POSITION: Expect = Expect { ty: Type::Vec3, components: FLOAT };
 pub const NORMAL: Expect = Expect { ty: Type::Vec3, components: FLOAT };
 pub const TANGENT: Expect = Expect { ty: Type::Vec4, components: FLOAT };
-pub const TEXCOORD: Expect = Expect { ty: Type::Vec2, components: &[(F32, false), (U8, true), (U16, true)] };
-pub const INDICES: Expect = Expect { ty: Type::Scalar, components: &[(U8, false), (U16, false), (U32, false)] };
+pub const TEXCOORD: Expect =
+    Expect { ty: Type::Vec2, components: &[(F32, false), (U8, true), (U16, true)] };
+pub const INDICES: Expect =
+    Expect { ty: Type::Scalar, components: &[(U8, false), (U16, false), (U32, false)] };
 pub const KEY_TIMES: Expect = Expect { ty: Type::Scalar, components: FLOAT };
 pub const TRANSLATION: Expect = Expect { ty: Type::Vec3, components: FLOAT };
 pub const SCALE: Expect = Expect { ty: Type::Vec3, components: FLOAT };
-pub const ROTATION: Expect =
-    Expect { ty: Type::Vec4, components: &[(F32, false), (I8, true), (U8, true), (I16, true), (U16, true)] };
+pub const ROTATION: Expect = Expect {
+    ty: Type::Vec4,
+    components: &[(F32, false), (I8, true), (U8, true), (I16, true), (U16, true)],
+};
 
 fn type_name(t: Type) -> &'static str {
     match t {
@@ -71,7 +75,13 @@ fn allowed(e: &Expect) -> String {
 
 /// An accessor's elements as floats (normalized integers mapped as glTF says), `count` x the
 /// type's component count, flat.
-pub fn read_f32(data: &Data, index: usize, expect: Expect, budget: &mut Budget, what: &str) -> Result<Vec<f32>> {
+pub fn read_f32(
+    data: &Data,
+    index: usize,
+    expect: Expect,
+    budget: &mut Budget,
+    what: &str,
+) -> Result<Vec<f32>> {
     let (component, normalized, raw) = read_raw(data, index, expect, budget, what)?;
     let size = component.size();
     Ok(raw
@@ -89,7 +99,12 @@ pub fn read_f32(data: &Data, index: usize, expect: Expect, budget: &mut Budget, 
 }
 
 /// An index accessor's values.
-pub fn read_indices(data: &Data, index: usize, budget: &mut Budget, what: &str) -> Result<Vec<u32>> {
+pub fn read_indices(
+    data: &Data,
+    index: usize,
+    budget: &mut Budget,
+    what: &str,
+) -> Result<Vec<u32>> {
     let (component, _, raw) = read_raw(data, index, INDICES, budget, what)?;
     Ok(match component {
         U8 => raw.iter().map(|&b| b as u32).collect(),
@@ -100,7 +115,13 @@ pub fn read_indices(data: &Data, index: usize, budget: &mut Budget, what: &str) 
 
 /// Checks the accessor against `expect` and returns its elements packed (no stride), with sparse
 /// substitution applied.
-fn read_raw(data: &Data, index: usize, expect: Expect, budget: &mut Budget, what: &str) -> Result<(ComponentType, bool, Vec<u8>)> {
+fn read_raw(
+    data: &Data,
+    index: usize,
+    expect: Expect,
+    budget: &mut Budget,
+    what: &str,
+) -> Result<(ComponentType, bool, Vec<u8>)> {
     let here = format!("{what} (accessors[{index}])");
     let acc = data.root.accessors.get(index).ok_or_else(|| anyhow!("{here}: no such accessor"))?;
     let (ty, component) = match (&acc.type_, &acc.component_type) {
@@ -116,10 +137,14 @@ fn read_raw(data: &Data, index: usize, expect: Expect, budget: &mut Budget, what
         );
     }
     let elem = component.size() * ty.multiplicity();
-    let count = usize::try_from(acc.count.0).map_err(|_| anyhow!("{here}: count {} is too large", acc.count.0))?;
+    let count = usize::try_from(acc.count.0)
+        .map_err(|_| anyhow!("{here}: count {} is too large", acc.count.0))?;
     let bytes = (count as u64).saturating_mul(elem as u64);
     // The packed bytes and their decoded form (4 bytes a component) live together for a while.
-    budget.decode(bytes.saturating_add((count as u64).saturating_mul(ty.multiplicity() as u64 * 4)), &here)?;
+    budget.decode(
+        bytes.saturating_add((count as u64).saturating_mul(ty.multiplicity() as u64 * 4)),
+        &here,
+    )?;
     let mut out = vec![0u8; count * elem];
     if count == 0 {
         return Ok((component, acc.normalized, out));
@@ -139,11 +164,27 @@ fn read_raw(data: &Data, index: usize, expect: Expect, budget: &mut Budget, what
         }
         let ic = match &sparse.indices.component_type {
             Checked::Valid(c) => c.0,
-            Checked::Invalid => bail!("{here}: sparse.indices.componentType must be UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT"),
+            Checked::Invalid => bail!(
+                "{here}: sparse.indices.componentType must be UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT"
+            ),
         };
         let isize_ = ic.size();
-        let (ib, istride) = view_elements(data, sparse.indices.buffer_view.value(), sparse.indices.byte_offset.0, n, isize_, &format!("{here} sparse.indices"))?;
-        let (vb, vstride) = view_elements(data, sparse.values.buffer_view.value(), sparse.values.byte_offset.0, n, elem, &format!("{here} sparse.values"))?;
+        let (ib, istride) = view_elements(
+            data,
+            sparse.indices.buffer_view.value(),
+            sparse.indices.byte_offset.0,
+            n,
+            isize_,
+            &format!("{here} sparse.indices"),
+        )?;
+        let (vb, vstride) = view_elements(
+            data,
+            sparse.values.buffer_view.value(),
+            sparse.values.byte_offset.0,
+            n,
+            elem,
+            &format!("{here} sparse.values"),
+        )?;
         let mut previous: Option<usize> = None;
         for k in 0..n {
             let b = &ib[k * istride..k * istride + isize_];
@@ -153,7 +194,9 @@ fn read_raw(data: &Data, index: usize, expect: Expect, budget: &mut Budget, what
                 _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
             };
             if i >= count || previous.is_some_and(|p| i <= p) {
-                bail!("{here}: sparse index {i} at {k} is out of range or not increasing (count {count})");
+                bail!(
+                    "{here}: sparse index {i} at {k} is out of range or not increasing (count {count})"
+                );
             }
             previous = Some(i);
             out[i * elem..(i + 1) * elem].copy_from_slice(&vb[k * vstride..k * vstride + elem]);
@@ -164,18 +207,38 @@ fn read_raw(data: &Data, index: usize, expect: Expect, budget: &mut Budget, what
 
 /// The bytes of buffer view `view` from `offset` that hold `count` elements of `elem` bytes, and
 /// the stride between them: checked to lie inside the view, and the view inside its buffer.
-fn view_elements<'a>(data: &'a Data, view: usize, offset: u64, count: usize, elem: usize, here: &str) -> Result<(&'a [u8], usize)> {
-    let v = data.root.buffer_views.get(view).ok_or_else(|| anyhow!("{here}: no bufferViews[{view}]"))?;
-    let buffer = data.buffers.get(v.buffer.value()).ok_or_else(|| anyhow!("{here}: bufferViews[{view}] names a missing buffer"))?;
+fn view_elements<'a>(
+    data: &'a Data,
+    view: usize,
+    offset: u64,
+    count: usize,
+    elem: usize,
+    here: &str,
+) -> Result<(&'a [u8], usize)> {
+    let v = data
+        .root
+        .buffer_views
+        .get(view)
+        .ok_or_else(|| anyhow!("{here}: no bufferViews[{view}]"))?;
+    let buffer = data
+        .buffers
+        .get(v.buffer.value())
+        .ok_or_else(|| anyhow!("{here}: bufferViews[{view}] names a missing buffer"))?;
     let start = v.byte_offset.map_or(0, |o| o.0);
     let len = v.byte_length.0;
     let end = start.checked_add(len).filter(|&e| e <= buffer.len() as u64).ok_or_else(|| {
-        anyhow!("{here}: bufferViews[{view}] (bytes {start}..{}) runs past its buffer of {} bytes", start.saturating_add(len), buffer.len())
+        anyhow!(
+            "{here}: bufferViews[{view}] (bytes {start}..{}) runs past its buffer of {} bytes",
+            start.saturating_add(len),
+            buffer.len()
+        )
     })?;
     let view_bytes = &buffer[start as usize..end as usize];
     let stride = v.byte_stride.map_or(elem, |s| s.0);
     if stride < elem {
-        bail!("{here}: bufferViews[{view}].byteStride {stride} is less than the element's {elem} bytes");
+        bail!(
+            "{here}: bufferViews[{view}].byteStride {stride} is less than the element's {elem} bytes"
+        );
     }
     let need = (count as u64 - 1)
         .checked_mul(stride as u64)
@@ -221,7 +284,10 @@ mod tests {
         );
         let data = Data { root: &r, buffers: &buffers };
         let mut b = Budget::new(Limits::default());
-        assert_eq!(read_f32(&data, 0, POSITION, &mut b, "p").unwrap(), vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(
+            read_f32(&data, 0, POSITION, &mut b, "p").unwrap(),
+            vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+        );
         let e = read_f32(&data, 1, POSITION, &mut b, "POSITION").unwrap_err().to_string();
         assert!(e.contains("VEC2 of UNSIGNED_BYTE") && e.contains("VEC3 of FLOAT"), "{e}");
         let e = read_f32(&data, 2, POSITION, &mut b, "p").unwrap_err().to_string();

@@ -80,7 +80,8 @@ impl Animation {
     pub fn world_at(&self, time: f64) -> DMat4 {
         let d = self.duration();
         let t = if d > 0.0 && time.is_finite() { time.rem_euclid(d) } else { 0.0 };
-        let tr = self.translation_track.as_ref().and_then(|k| k.sample(t)).unwrap_or(self.translation);
+        let tr =
+            self.translation_track.as_ref().and_then(|k| k.sample(t)).unwrap_or(self.translation);
         let r = self.rotation_track.as_ref().and_then(|k| k.sample(t)).unwrap_or(self.rotation);
         let s = self.scale_track.as_ref().and_then(|k| k.sample(t)).unwrap_or(self.scale);
         let local = DMat4::from_scale_rotation_translation(s, r.normalize(), tr);
@@ -100,7 +101,11 @@ mod tests {
             translation: DVec3::ZERO,
             rotation: DQuat::IDENTITY,
             scale: DVec3::ONE,
-            translation_track: Some(Track { times: vec![0.0, 2.0], values: vec![DVec3::ZERO, DVec3::new(4.0, 0.0, 0.0)], step: false }),
+            translation_track: Some(Track {
+                times: vec![0.0, 2.0],
+                values: vec![DVec3::ZERO, DVec3::new(4.0, 0.0, 0.0)],
+                step: false,
+            }),
             rotation_track: None,
             scale_track: None,
         };

@@ -36,14 +36,32 @@ impl CameraKey {
     pub fn from_camera(camera: &Camera, time: f64) -> CameraKey {
         let eye = camera.eye();
         let fwd = -camera.world.z_axis.truncate().normalize_or(DVec3::NEG_Z);
-        let lens = camera.lens.map(|l| KeyLens { aperture_radius: l.aperture_radius, focus_distance: l.focus_distance });
-        CameraKey { time, eye: eye.to_array(), target: (eye + fwd).to_array(), yfov_degrees: camera.yfov.to_degrees(), lens }
+        let lens = camera.lens.map(|l| KeyLens {
+            aperture_radius: l.aperture_radius,
+            focus_distance: l.focus_distance,
+        });
+        CameraKey {
+            time,
+            eye: eye.to_array(),
+            target: (eye + fwd).to_array(),
+            yfov_degrees: camera.yfov.to_degrees(),
+            lens,
+        }
     }
 
     /// The key's camera (a lens that [`CameraPath::validate`] would refuse is left out).
     pub fn camera(&self) -> Camera {
-        let lens = self.lens.and_then(|l| super::ThinLens::new(l.aperture_radius as f64, l.focus_distance as f64).ok());
-        Camera { lens, ..Camera::look_at(DVec3::from_array(self.eye), DVec3::from_array(self.target), self.yfov_degrees) }
+        let lens = self.lens.and_then(|l| {
+            super::ThinLens::new(l.aperture_radius as f64, l.focus_distance as f64).ok()
+        });
+        Camera {
+            lens,
+            ..Camera::look_at(
+                DVec3::from_array(self.eye),
+                DVec3::from_array(self.target),
+                self.yfov_degrees,
+            )
+        }
     }
 }
 
@@ -58,7 +76,8 @@ impl CameraPath {
 
     pub fn save(&self, path: &Path) -> Result<()> {
         let text = serde_json::to_string_pretty(self)?;
-        std::fs::write(path, text).with_context(|| format!("writing camera path {}", path.display()))
+        std::fs::write(path, text)
+            .with_context(|| format!("writing camera path {}", path.display()))
     }
 
     pub fn validate(&self) -> Result<()> {
@@ -77,7 +96,8 @@ impl CameraPath {
                 bail!("key {i}: yfov_degrees must be in (0, 180), got {}", k.yfov_degrees);
             }
             if let Some(l) = k.lens {
-                super::ThinLens::new(l.aperture_radius as f64, l.focus_distance as f64).with_context(|| format!("key {i}: lens"))?;
+                super::ThinLens::new(l.aperture_radius as f64, l.focus_distance as f64)
+                    .with_context(|| format!("key {i}: lens"))?;
             }
         }
         Ok(())
@@ -94,7 +114,14 @@ impl CameraPath {
         let (a, b) = (&self.keys[i - 1], &self.keys[i]);
         let t = if b.time > a.time { (time - a.time) / (b.time - a.time) } else { 1.0 };
         let mix = |p: [f64; 3], q: [f64; 3]| DVec3::from_array(p).lerp(DVec3::from_array(q), t);
-        Camera { lens: a.camera().lens, ..Camera::look_at(mix(a.eye, b.eye), mix(a.target, b.target), a.yfov_degrees + (b.yfov_degrees - a.yfov_degrees) * t as f32) }
+        Camera {
+            lens: a.camera().lens,
+            ..Camera::look_at(
+                mix(a.eye, b.eye),
+                mix(a.target, b.target),
+                a.yfov_degrees + (b.yfov_degrees - a.yfov_degrees) * t as f32,
+            )
+        }
     }
 
     /// The key for frame `i` (the last key holds once the path has ended).
@@ -112,16 +139,28 @@ mod tests {
     #[test]
     fn keys_keep_the_lens_and_interpolate_in_time() {
         let lens = crate::scene::ThinLens::new(0.05, 2.5).unwrap();
-        let a = Camera { lens: Some(lens), ..Camera::look_at(DVec3::new(0.0, 1.0, 4.0), DVec3::new(0.0, 1.0, 0.0), 45.0) };
-        let b = Camera { lens: Some(lens), ..Camera::look_at(DVec3::new(2.0, 1.0, 4.0), DVec3::new(2.0, 1.0, 0.0), 45.0) };
-        let path = CameraPath { keys: vec![CameraKey::from_camera(&a, 1.0), CameraKey::from_camera(&b, 2.0)] };
-        let back: CameraPath = serde_json::from_str(&serde_json::to_string(&path).unwrap()).unwrap();
+        let a = Camera {
+            lens: Some(lens),
+            ..Camera::look_at(DVec3::new(0.0, 1.0, 4.0), DVec3::new(0.0, 1.0, 0.0), 45.0)
+        };
+        let b = Camera {
+            lens: Some(lens),
+            ..Camera::look_at(DVec3::new(2.0, 1.0, 4.0), DVec3::new(2.0, 1.0, 0.0), 45.0)
+        };
+        let path = CameraPath {
+            keys: vec![CameraKey::from_camera(&a, 1.0), CameraKey::from_camera(&b, 2.0)],
+        };
+        let back: CameraPath =
+            serde_json::from_str(&serde_json::to_string(&path).unwrap()).unwrap();
         assert_eq!(back, path);
         assert_eq!(back.keys[0].camera().lens, Some(lens));
         let mid = back.camera_at(1.25);
         assert!((mid.eye() - DVec3::new(0.5, 1.0, 4.0)).length() < 1e-9, "{}", mid.eye());
         assert_eq!(mid.lens, Some(lens));
-        assert!((back.camera_at(0.0).eye() - a.eye()).length() < 1e-9 && (back.camera_at(9.0).eye() - b.eye()).length() < 1e-9);
+        assert!(
+            (back.camera_at(0.0).eye() - a.eye()).length() < 1e-9
+                && (back.camera_at(9.0).eye() - b.eye()).length() < 1e-9
+        );
         let mut bad = path.clone();
         bad.keys[1].lens = Some(KeyLens { aperture_radius: 0.05, focus_distance: -1.0 });
         assert!(format!("{:#}", bad.validate().unwrap_err()).contains("key 1"));

@@ -17,7 +17,13 @@ pub(super) fn lambert(name: &str, c: Vec3) -> Material {
 }
 
 pub(super) fn metal(name: &str, c: Vec3, roughness: f32) -> Material {
-    Material { name: name.into(), base_color: c.extend(1.0), metallic: 1.0, roughness, ..Default::default() }
+    Material {
+        name: name.into(),
+        base_color: c.extend(1.0),
+        metallic: 1.0,
+        roughness,
+        ..Default::default()
+    }
 }
 
 /// The quad centre ± u ± v, facing u x v (CCW winding seen from that side). Also for tests'
@@ -28,7 +34,12 @@ pub fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
     Mesh {
         positions,
         normals: vec![n; 4],
-        uvs: vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)],
+        uvs: vec![
+            Vec2::new(0.0, 1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.0, 0.0),
+        ],
         tangents: vec![],
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
@@ -111,7 +122,12 @@ pub fn default_scene() -> Scene {
         quad(Vec3::new(-w, h, 0.0), Vec3::new(0.0, 0.0, -d), Vec3::new(0.0, h, 0.0), 1),
         quad(Vec3::new(w, h, 0.0), Vec3::new(0.0, 0.0, d), Vec3::new(0.0, h, 0.0), 2),
         // Ceiling panel facing down, just below the ceiling.
-        quad(Vec3::new(0.0, 2.0 * h - 0.01, 0.3), Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.3), 3),
+        quad(
+            Vec3::new(0.0, 2.0 * h - 0.01, 0.3),
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.3),
+            3,
+        ),
         cuboid(Vec3::new(-1.0, 0.6, -0.8), Vec3::new(0.4, 0.6, 0.4), 0),
         uv_sphere(Vec3::new(0.9, 0.55, -0.4), 0.55, 4, 48, 24),
         uv_sphere(Vec3::new(-0.1, 0.3, 0.6), 0.3, 5, 32, 16),
@@ -129,7 +145,12 @@ pub fn default_scene() -> Scene {
     // Sun from behind the room, through the window, onto the floor.
     let (sun, sky) = sky::sun_and_sky(Vec3::new(0.3, -0.55, 0.78).normalize());
     let objects = (0..meshes.len())
-        .map(|i| Object { name: format!("part{i}"), mesh: i, transform: DMat4::IDENTITY, animation: None })
+        .map(|i| Object {
+            name: format!("part{i}"),
+            mesh: i,
+            transform: DMat4::IDENTITY,
+            animation: None,
+        })
         .collect();
     Scene {
         name: "default".into(),

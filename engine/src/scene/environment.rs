@@ -27,8 +27,15 @@ pub struct EnvMap {
 impl EnvMap {
     /// An equirectangular map from EXR bytes, decoded within `budget` (see
     /// [`crate::quality::decode_exr`]).
-    pub fn from_exr(name: &str, bytes: &[u8], intensity: f32, rotation_y_degrees: f32, budget: &mut crate::limits::Budget) -> Result<EnvMap> {
-        let (width, height, rgb) = crate::quality::decode_exr(name, bytes, budget).with_context(|| format!("reading environment map {name}"))?;
+    pub fn from_exr(
+        name: &str,
+        bytes: &[u8],
+        intensity: f32,
+        rotation_y_degrees: f32,
+        budget: &mut crate::limits::Budget,
+    ) -> Result<EnvMap> {
+        let (width, height, rgb) = crate::quality::decode_exr(name, bytes, budget)
+            .with_context(|| format!("reading environment map {name}"))?;
         if width == 0 || height == 0 {
             bail!("environment map {name} is empty");
         }

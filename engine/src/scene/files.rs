@@ -24,7 +24,8 @@ pub struct SceneFolder {
 impl SceneFolder {
     pub fn new(dir: &Path) -> Result<SceneFolder> {
         let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
-        let root = std::fs::canonicalize(dir).with_context(|| format!("resolving the scene's folder {}", dir.display()))?;
+        let root = std::fs::canonicalize(dir)
+            .with_context(|| format!("resolving the scene's folder {}", dir.display()))?;
         Ok(SceneFolder { root })
     }
 }
@@ -32,9 +33,14 @@ impl SceneFolder {
 impl SceneFiles for SceneFolder {
     fn read(&self, rel: &Path, limit: u64) -> Result<Vec<u8>> {
         let path = self.root.join(rel);
-        let real = std::fs::canonicalize(&path).map_err(|e| anyhow!("reading {}: {e}", path.display()))?;
+        let real =
+            std::fs::canonicalize(&path).map_err(|e| anyhow!("reading {}: {e}", path.display()))?;
         if !real.starts_with(&self.root) {
-            bail!("{} leads outside the scene's folder (to {}); refused", path.display(), real.display());
+            bail!(
+                "{} leads outside the scene's folder (to {}); refused",
+                path.display(),
+                real.display()
+            );
         }
         read_regular_file(&real, limit)
     }
@@ -58,7 +64,10 @@ impl MemoryFiles {
 
 impl SceneFiles for MemoryFiles {
     fn read(&self, rel: &Path, limit: u64) -> Result<Vec<u8>> {
-        let bytes = self.files.get(rel).ok_or_else(|| anyhow!("reading {}: no such file", rel.display()))?;
+        let bytes = self
+            .files
+            .get(rel)
+            .ok_or_else(|| anyhow!("reading {}: no such file", rel.display()))?;
         if bytes.len() as u64 > limit {
             return Err(over_budget("file-bytes", rel.display(), bytes.len() as u64, limit));
         }
@@ -74,7 +83,12 @@ pub fn read_uri(files: &dyn SceneFiles, uri: &str, limit: u64) -> Result<Vec<u8>
             .ok_or_else(|| anyhow!("data URI {} has no base64 payload", short(uri)))?;
         let decoded_len = data.len() as u64 / 4 * 3;
         if decoded_len > limit {
-            return Err(over_budget("file-bytes", format_args!("data URI {}", short(uri)), decoded_len, limit));
+            return Err(over_budget(
+                "file-bytes",
+                format_args!("data URI {}", short(uri)),
+                decoded_len,
+                limit,
+            ));
         }
         return base64_decode(data).with_context(|| format!("data URI {}", short(uri)));
     }
@@ -85,7 +99,11 @@ pub fn read_uri(files: &dyn SceneFiles, uri: &str, limit: u64) -> Result<Vec<u8>
 /// are absolute, carry a scheme, or climb out of the folder.
 pub fn relative_path(uri: &str) -> Result<PathBuf> {
     let decoded = percent_encoding::percent_decode_str(uri).decode_utf8_lossy().into_owned();
-    if decoded.contains("://") || decoded.starts_with('/') || decoded.starts_with('\\') || decoded.contains('\0') {
+    if decoded.contains("://")
+        || decoded.starts_with('/')
+        || decoded.starts_with('\\')
+        || decoded.contains('\0')
+    {
         bail!("refusing URI {}: only paths relative to the scene's folder are allowed", short(uri));
     }
     let mut parts: Vec<&std::ffi::OsStr> = vec![];
@@ -121,7 +139,9 @@ pub fn short(s: &str) -> String {
 
 fn base64_decode(s: &str) -> Result<Vec<u8>> {
     use base64::Engine;
-    base64::engine::general_purpose::STANDARD.decode(s.trim()).map_err(|e| anyhow!("invalid base64: {e}"))
+    base64::engine::general_purpose::STANDARD
+        .decode(s.trim())
+        .map_err(|e| anyhow!("invalid base64: {e}"))
 }
 
 #[cfg(test)]
@@ -133,7 +153,15 @@ mod tests {
         assert_eq!(relative_path("tex/x.png").unwrap(), Path::new("tex/x.png"));
         assert_eq!(relative_path("tex/../x.png").unwrap(), Path::new("x.png"));
         assert_eq!(relative_path("./a%20b.png").unwrap(), Path::new("a b.png"));
-        for bad in ["../b/x.png", "tex/../../x.png", "/etc/passwd", "file:///etc/passwd", "%2E%2E/x.png", "tex/..", "a%00b"] {
+        for bad in [
+            "../b/x.png",
+            "tex/../../x.png",
+            "/etc/passwd",
+            "file:///etc/passwd",
+            "%2E%2E/x.png",
+            "tex/..",
+            "a%00b",
+        ] {
             assert!(relative_path(bad).is_err(), "{bad}");
         }
     }
@@ -142,7 +170,10 @@ mod tests {
     fn decodes_base64_and_keeps_long_uris_out_of_messages() {
         assert_eq!(base64_decode("aGVsbG8=").unwrap(), b"hello");
         let files = MemoryFiles::default();
-        assert_eq!(read_uri(&files, "data:application/octet-stream;base64,AAECAw==", 100).unwrap(), vec![0, 1, 2, 3]);
+        assert_eq!(
+            read_uri(&files, "data:application/octet-stream;base64,AAECAw==", 100).unwrap(),
+            vec![0, 1, 2, 3]
+        );
         let huge = format!("data:image/png;base64,{}", "!".repeat(1 << 20));
         let e = format!("{:#}", read_uri(&files, &huge, 1 << 30).unwrap_err());
         assert!(e.len() < 300 && e.contains("invalid base64"), "{e}");

@@ -11,7 +11,9 @@ pub(super) fn local_rotation(node: &gltf::Node) -> DQuat {
         }
         gltf::scene::Transform::Matrix { matrix } => {
             let m = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(|x| x as f64)));
-            orthonormal(DMat3::from_mat4(m)).map(|r| DQuat::from_mat3(&r)).unwrap_or(DQuat::IDENTITY)
+            orthonormal(DMat3::from_mat4(m))
+                .map(|r| DQuat::from_mat3(&r))
+                .unwrap_or(DQuat::IDENTITY)
         }
     }
 }
@@ -32,7 +34,13 @@ fn orthonormal(m: DMat3) -> Option<DMat3> {
 /// rotations stands in. None where neither gives a pose.
 pub(super) fn camera_pose(world: DMat4, rotation: DQuat) -> Option<DMat4> {
     let eye = world.w_axis.truncate();
-    let axes = orthonormal(DMat3::from_mat4(world)).or_else(|| rotation.is_finite().then(|| DMat3::from_quat(rotation.normalize())))?;
-    let m = DMat4::from_cols(axes.x_axis.extend(0.0), axes.y_axis.extend(0.0), axes.z_axis.extend(0.0), eye.extend(1.0));
+    let axes = orthonormal(DMat3::from_mat4(world))
+        .or_else(|| rotation.is_finite().then(|| DMat3::from_quat(rotation.normalize())))?;
+    let m = DMat4::from_cols(
+        axes.x_axis.extend(0.0),
+        axes.y_axis.extend(0.0),
+        axes.z_axis.extend(0.0),
+        eye.extend(1.0),
+    );
     m.is_finite().then_some(m)
 }

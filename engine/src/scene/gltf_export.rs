@@ -34,7 +34,14 @@ impl Writer {
 
     /// Float accessor of `n`-component elements; min/max as glTF requires for positions and
     /// animation inputs.
-    fn floats(&mut self, data: &[f32], n: usize, kind: &str, target: Option<u32>, bounds: bool) -> usize {
+    fn floats(
+        &mut self,
+        data: &[f32],
+        n: usize,
+        kind: &str,
+        target: Option<u32>,
+        bounds: bool,
+    ) -> usize {
         let bytes: Vec<u8> = data.iter().flat_map(|f| f.to_le_bytes()).collect();
         let view = self.view(&bytes, target);
         let mut a = json!({"bufferView": view, "componentType": 5126, "count": data.len() / n, "type": kind});
@@ -89,7 +96,10 @@ fn aim(dir: Vec3) -> [f64; 4] {
 pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     let ctx = || format!("writing glTF {}", path.display());
     let dir = path.parent().unwrap_or(Path::new("."));
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
     let mut w = Writer::default();
 
     let mut images = vec![];
@@ -97,7 +107,8 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     let mut textures = vec![];
     for (i, t) in scene.textures.iter().enumerate() {
         let file = format!("{stem}_tex{i}.png");
-        let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba8.clone()).context("texture size")?;
+        let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba8.clone())
+            .context("texture size")?;
         img.save(dir.join(&file)).with_context(|| format!("writing {file}"))?;
         images.push(json!({"uri": file, "name": t.name}));
         samplers.push(json!({"wrapS": wrap(t.wrap_s), "wrapT": wrap(t.wrap_t)}));
@@ -187,12 +198,17 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
                 }
                 if let Some(t) = &a.rotation_track {
                     let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
-                    let values: Vec<f32> = t.values.iter().flat_map(|q| q.as_quat().to_array()).collect();
-                    let (i, o) = (w.floats(&times, 1, "SCALAR", None, true), w.floats(&values, 4, "VEC4", None, false));
+                    let values: Vec<f32> =
+                        t.values.iter().flat_map(|q| q.as_quat().to_array()).collect();
+                    let (i, o) = (
+                        w.floats(&times, 1, "SCALAR", None, true),
+                        w.floats(&values, 4, "VEC4", None, false),
+                    );
                     channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "rotation"}}));
                     samplers.push(json!({"input": i, "output": o, "interpolation": step(t.step)}));
                 }
-                animations.push(json!({"name": o.name, "samplers": samplers, "channels": channels}));
+                animations
+                    .push(json!({"name": o.name, "samplers": samplers, "channels": channels}));
                 if a.parent != DMat4::IDENTITY {
                     nodes.push(node);
                     node = json!({"name": format!("{} parent", o.name), "matrix": mat(a.parent), "children": [target]});
@@ -209,9 +225,17 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     let mut lights = vec![];
     for l in &scene.lights {
         let (kind, c, node) = match *l {
-            Light::Directional { direction, irradiance } => ("directional", irradiance, json!({"rotation": aim(direction)})),
-            Light::Point { position, intensity } => ("point", intensity, json!({"translation": position.to_array()})),
-            Light::Spot { position, direction, intensity, .. } => ("spot", intensity, json!({"translation": position.to_array(), "rotation": aim(direction)})),
+            Light::Directional { direction, irradiance } => {
+                ("directional", irradiance, json!({"rotation": aim(direction)}))
+            }
+            Light::Point { position, intensity } => {
+                ("point", intensity, json!({"translation": position.to_array()}))
+            }
+            Light::Spot { position, direction, intensity, .. } => (
+                "spot",
+                intensity,
+                json!({"translation": position.to_array(), "rotation": aim(direction)}),
+            ),
         };
         let i = c.max_element().max(0.0);
         let color = if i > 0.0 { c / i } else { Vec3::ONE };
@@ -228,9 +252,11 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
 
     let mut cameras = vec![];
     if let Some(c) = &scene.camera {
-        let mut cam = json!({"type": "perspective", "perspective": {"yfov": c.yfov, "znear": 0.01}});
+        let mut cam =
+            json!({"type": "perspective", "perspective": {"yfov": c.yfov, "znear": 0.01}});
         if let Some(l) = c.lens {
-            cam["extras"] = json!({"aperture_radius": l.aperture_radius, "focus_distance": l.focus_distance});
+            cam["extras"] =
+                json!({"aperture_radius": l.aperture_radius, "focus_distance": l.focus_distance});
         }
         cameras.push(cam);
         roots.push(nodes.len());
@@ -246,8 +272,10 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
         Environment::Constant(c) => extras["environment"] = json!({"radiance": c.to_array()}),
         Environment::Map(m) => {
             let file = format!("{stem}_environment.exr");
-            Image { width: m.width, height: m.height, data: m.rgb.clone() }.save(&dir.join(&file))?;
-            extras["environment"] = json!({"map": file, "intensity": 1.0, "rotation_y_degrees": m.rotation_y_degrees});
+            Image { width: m.width, height: m.height, data: m.rgb.clone() }
+                .save(&dir.join(&file))?;
+            extras["environment"] =
+                json!({"map": file, "intensity": 1.0, "rotation_y_degrees": m.rotation_y_degrees});
         }
     }
 
@@ -271,7 +299,13 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
         "bufferViews": w.views,
         "buffers": [{"uri": bin_name, "byteLength": w.bin.len()}],
     });
-    for (k, v) in [("images", images), ("samplers", samplers), ("textures", textures), ("animations", animations), ("cameras", cameras)] {
+    for (k, v) in [
+        ("images", images),
+        ("samplers", samplers),
+        ("textures", textures),
+        ("animations", animations),
+        ("cameras", cameras),
+    ] {
         if !v.is_empty() {
             doc[k] = Value::Array(v);
         }

@@ -9,7 +9,10 @@
 use super::files::{SceneFiles, SceneFolder, read_uri, short};
 use super::gltf_camera::{camera_pose, local_rotation};
 use super::gltf_mesh::{animations, primitive};
-use super::{Camera, EnvMap, Environment, Light, Material, Mesh, Object, Scene, Texture, TextureRef, Wrap, DEFAULT_MAX_DEPTH};
+use super::{
+    Camera, DEFAULT_MAX_DEPTH, EnvMap, Environment, Light, Material, Mesh, Object, Scene, Texture,
+    TextureRef, Wrap,
+};
 use crate::limits::{Budget, Limits, is_over_budget, over_budget, read_regular_file};
 use anyhow::{Context, Result, anyhow, bail};
 use glam::{DMat4, DQuat, DVec3, Vec3, Vec4};
@@ -18,11 +21,8 @@ use std::path::Path;
 
 /// Extensions whose meaning Hush implements. Anything else is ignored with a warning when
 /// optional and refused when required.
-pub const SUPPORTED_EXTENSIONS: &[&str] = &[
-    "KHR_lights_punctual",
-    "KHR_materials_emissive_strength",
-    "KHR_materials_specular",
-];
+pub const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_specular"];
 
 /// Largest texture side kept on load (larger ones are halved until they fit).
 pub const DEFAULT_MAX_TEXTURE_SIZE: u32 = 2048;
@@ -63,14 +63,28 @@ pub fn load_gltf_opts(path: &Path, opts: &LoadOptions) -> Result<Scene> {
 /// Load a scene from the bytes of its `.gltf`/`.glb` file, reading the files it names from
 /// `files`. A panic inside a dependency comes back as an error: a last line of defence, as
 /// every input known to cause one is refused before it reaches the dependency.
-pub fn load_gltf_from(bytes: &[u8], name: &str, files: &dyn SceneFiles, opts: &LoadOptions) -> Result<Scene> {
+pub fn load_gltf_from(
+    bytes: &[u8],
+    name: &str,
+    files: &dyn SceneFiles,
+    opts: &LoadOptions,
+) -> Result<Scene> {
     let run = std::panic::AssertUnwindSafe(|| {
         let (document, blob) = parse(bytes, &opts.limits)?;
-        Importer { files, warnings: vec![], max_texture_size: opts.max_texture_size, budget: Budget::new(opts.limits), triangles: 0 }
-            .import(&document, blob, name.to_string())
+        Importer {
+            files,
+            warnings: vec![],
+            max_texture_size: opts.max_texture_size,
+            budget: Budget::new(opts.limits),
+            triangles: 0,
+        }
+        .import(&document, blob, name.to_string())
     });
     std::panic::catch_unwind(run).unwrap_or_else(|p| {
-        let msg = p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned());
+        let msg = p
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| p.downcast_ref::<String>().cloned());
         Err(anyhow::Error::new(ImportPanic(msg.unwrap_or_else(|| "panic".into()))))
     })
 }
@@ -82,7 +96,11 @@ pub struct ImportPanic(pub String);
 
 impl std::fmt::Display for ImportPanic {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        write!(f, "internal error while importing (a bug in Hush or a library it uses; please report it with the file): {}", self.0)
+        write!(
+            f,
+            "internal error while importing (a bug in Hush or a library it uses; please report it with the file): {}",
+            self.0
+        )
     }
 }
 
@@ -95,17 +113,27 @@ fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8
         // The gltf crate subtracts the header's 12 bytes from this length unchecked.
         let length = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
         if length.is_some_and(|l| l < 12) {
-            bail!("reading GLB container: its length {} is shorter than its 12-byte header", length.unwrap_or(0));
+            bail!(
+                "reading GLB container: its length {} is shorter than its 12-byte header",
+                length.unwrap_or(0)
+            );
         }
-        let glb = gltf::Glb::from_slice(bytes).map_err(|e| anyhow!("reading GLB container: {e}"))?;
+        let glb =
+            gltf::Glb::from_slice(bytes).map_err(|e| anyhow!("reading GLB container: {e}"))?;
         (glb.json, glb.bin.map(|b| b.to_vec()))
     } else {
         (std::borrow::Cow::Borrowed(bytes), None)
     };
     if json.len() as u64 > limits.json_bytes {
-        return Err(over_budget("json-bytes", "the file's JSON", json.len() as u64, limits.json_bytes));
+        return Err(over_budget(
+            "json-bytes",
+            "the file's JSON",
+            json.len() as u64,
+            limits.json_bytes,
+        ));
     }
-    let mut v: serde_json::Value = serde_json::from_slice(&json).map_err(|e| anyhow!("parsing glTF JSON: {e}"))?;
+    let mut v: serde_json::Value =
+        serde_json::from_slice(&json).map_err(|e| anyhow!("parsing glTF JSON: {e}"))?;
     drop(json);
     let mut unsupported = vec![];
     if let Some(req) = v.get("extensionsRequired").and_then(|r| r.as_array()) {
@@ -128,7 +156,8 @@ fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8
             s.entry("nodes").or_insert_with(|| serde_json::json!([]));
         }
     }
-    let root: gltf::json::Root = serde_json::from_value(v).map_err(|e| anyhow!("reading glTF JSON: {e}"))?;
+    let root: gltf::json::Root =
+        serde_json::from_value(v).map_err(|e| anyhow!("reading glTF JSON: {e}"))?;
     super::gltf_check::check(&root, limits)?;
     let document = gltf::Document::from_json(root).map_err(|e| anyhow!("invalid glTF: {e}"))?;
     Ok((document, blob))
@@ -156,20 +185,33 @@ impl Importer<'_> {
         self.warnings.push(msg);
     }
 
-    fn import(mut self, doc: &gltf::Document, blob: Option<Vec<u8>>, name: String) -> Result<Scene> {
+    fn import(
+        mut self,
+        doc: &gltf::Document,
+        blob: Option<Vec<u8>>,
+        name: String,
+    ) -> Result<Scene> {
         for ext in doc.extensions_used() {
             if !SUPPORTED_EXTENSIONS.contains(&ext) {
-                self.warn(format!("optional glTF extension {} is not supported; ignored", short(ext)));
+                self.warn(format!(
+                    "optional glTF extension {} is not supported; ignored",
+                    short(ext)
+                ));
             }
         }
         let buffers = self.load_buffers(doc, blob)?;
         let (textures, tex_map) = self.load_textures(doc, &buffers)?;
-        let materials: Vec<Material> = doc.materials().map(|m| self.material(&m, &tex_map)).collect();
-        let mut scene = Scene { name, textures, materials, max_depth: DEFAULT_MAX_DEPTH, ..Default::default() };
+        let materials: Vec<Material> =
+            doc.materials().map(|m| self.material(&m, &tex_map)).collect();
+        let mut scene =
+            Scene { name, textures, materials, max_depth: DEFAULT_MAX_DEPTH, ..Default::default() };
         let default_material = scene.materials.len() as u32;
         scene.materials.push(Material::default());
 
-        let gscene = doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| anyhow!("the file has no scene"))?;
+        let gscene = doc
+            .default_scene()
+            .or_else(|| doc.scenes().next())
+            .ok_or_else(|| anyhow!("the file has no scene"))?;
         self.scene_extras(&gscene, &mut scene)?;
         let data = super::accessor::Data { root: doc.as_json(), buffers: &buffers };
         let mut mesh_cache: HashMap<usize, Vec<usize>> = HashMap::new();
@@ -177,7 +219,8 @@ impl Importer<'_> {
         let mut ortho: Option<Orthographic> = None;
         // (node, parent world transform, parent world rotation, whether an ancestor is animated).
         // The node hierarchy is a forest (gltf_check), so this walk visits each node once.
-        let mut stack: Vec<(gltf::Node, DMat4, DQuat, bool)> = gscene.nodes().map(|n| (n, DMat4::IDENTITY, DQuat::IDENTITY, false)).collect();
+        let mut stack: Vec<(gltf::Node, DMat4, DQuat, bool)> =
+            gscene.nodes().map(|n| (n, DMat4::IDENTITY, DQuat::IDENTITY, false)).collect();
         while let Some((node, parent, parent_rotation, moving_parent)) = stack.pop() {
             let mut animation = animated.remove(&node.index());
             if let Some(a) = animation.as_mut() {
@@ -190,7 +233,10 @@ impl Importer<'_> {
             let world = parent * DMat4::from_cols_array_2d(&local);
             let rotation = parent_rotation * local_rotation(&node);
             if !world.is_finite() {
-                self.warn(format!("nodes[{}] has a non-finite transform; skipped with its children", node.index()));
+                self.warn(format!(
+                    "nodes[{}] has a non-finite transform; skipped with its children",
+                    node.index()
+                ));
                 continue;
             }
             if let Some(mesh) = node.mesh() {
@@ -202,8 +248,12 @@ impl Importer<'_> {
                         ids
                     }
                 };
-                let placed: u64 = ids.iter().map(|&id| scene.meshes[id].indices.len() as u64 / 3).sum();
-                self.place_triangles(placed, format_args!("nodes[{}] (meshes[{}])", node.index(), mesh.index()))?;
+                let placed: u64 =
+                    ids.iter().map(|&id| scene.meshes[id].indices.len() as u64 / 3).sum();
+                self.place_triangles(
+                    placed,
+                    format_args!("nodes[{}] (meshes[{}])", node.index(), mesh.index()),
+                )?;
                 for id in ids {
                     scene.objects.push(Object {
                         name: node.name().unwrap_or("").to_string(),
@@ -231,7 +281,10 @@ impl Importer<'_> {
             }
             let moving = moving_parent || animation.is_some();
             if animation.is_some() && node.children().next().is_some() {
-                self.warn(format!("children of animated node {:?} are placed at its rest pose", node.name()));
+                self.warn(format!(
+                    "children of animated node {:?} are placed at its rest pose",
+                    node.name()
+                ));
             }
             for child in node.children() {
                 stack.push((child, world, rotation, moving));
@@ -252,7 +305,12 @@ impl Importer<'_> {
         let total = self.triangles.saturating_add(n);
         let limit = self.budget.limits.triangles;
         if total > limit {
-            return Err(over_budget("triangles", format_args!("the scene, up to {what},"), total, limit));
+            return Err(over_budget(
+                "triangles",
+                format_args!("the scene, up to {what},"),
+                total,
+                limit,
+            ));
         }
         Ok(())
     }
@@ -285,20 +343,31 @@ impl Importer<'_> {
         Camera { world: o.pose, yfov, lens: None }
     }
 
-    fn load_buffers(&mut self, doc: &gltf::Document, mut blob: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>> {
+    fn load_buffers(
+        &mut self,
+        doc: &gltf::Document,
+        mut blob: Option<Vec<u8>>,
+    ) -> Result<Vec<Vec<u8>>> {
         let limit = self.budget.limits.file_bytes;
         let mut out = vec![];
         for b in doc.buffers() {
             let data = match b.source() {
-                gltf::buffer::Source::Bin => blob
-                    .take()
-                    .ok_or_else(|| anyhow!("buffers[{}] has no uri and there is no (unclaimed) GLB binary chunk", b.index()))?,
-                gltf::buffer::Source::Uri(uri) => {
-                    read_uri(self.files, uri, limit).with_context(|| format!("buffers[{}] ({})", b.index(), short(uri)))?
-                }
+                gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                    anyhow!(
+                        "buffers[{}] has no uri and there is no (unclaimed) GLB binary chunk",
+                        b.index()
+                    )
+                })?,
+                gltf::buffer::Source::Uri(uri) => read_uri(self.files, uri, limit)
+                    .with_context(|| format!("buffers[{}] ({})", b.index(), short(uri)))?,
             };
             if (data.len() as u64) < b.length() as u64 {
-                bail!("buffers[{}] holds {} bytes, the file says {}", b.index(), data.len(), b.length());
+                bail!(
+                    "buffers[{}] holds {} bytes, the file says {}",
+                    b.index(),
+                    data.len(),
+                    b.length()
+                );
             }
             self.budget.decode(data.len() as u64, format_args!("buffers[{}]", b.index()))?;
             out.push(data);
@@ -309,7 +378,11 @@ impl Importer<'_> {
     /// Decode every texture a material uses, each image once per colour space. A texture that
     /// cannot be read is a warning and a neutral fallback (the material renders with its factors
     /// alone); one over a budget is an error.
-    fn load_textures(&mut self, doc: &gltf::Document, buffers: &[Vec<u8>]) -> Result<(Vec<Texture>, HashMap<(usize, bool), u32>)> {
+    fn load_textures(
+        &mut self,
+        doc: &gltf::Document,
+        buffers: &[Vec<u8>],
+    ) -> Result<(Vec<Texture>, HashMap<(usize, bool), u32>)> {
         // Which textures are colour (sRGB) and which are data.
         let mut uses: Vec<(usize, bool)> = vec![];
         for m in doc.materials() {
@@ -377,14 +450,28 @@ impl Importer<'_> {
 
     /// One image decoded, or None with a warning where it cannot be read (a budget overrun is an
     /// error: the scene would render, but not as its author meant, and the user can raise it).
-    fn decode_image(&mut self, img: &gltf::Image, buffers: &[Vec<u8>], srgb: bool) -> Result<Option<Texture>> {
+    fn decode_image(
+        &mut self,
+        img: &gltf::Image,
+        buffers: &[Vec<u8>],
+        srgb: bool,
+    ) -> Result<Option<Texture>> {
         let limit = self.budget.limits.file_bytes;
         let (label, bytes) = match img.source() {
-            gltf::image::Source::Uri { uri, .. } => (short(uri), read_uri(self.files, uri, limit).map_err(|e| format!("{e:#}"))),
+            gltf::image::Source::Uri { uri, .. } => {
+                (short(uri), read_uri(self.files, uri, limit).map_err(|e| format!("{e:#}")))
+            }
             gltf::image::Source::View { view, .. } => {
-                let b = buffers.get(view.buffer().index()).map(|b| b.as_slice()).unwrap_or_default();
-                let r = view.offset().checked_add(view.length()).and_then(|end| b.get(view.offset()..end));
-                (format!("images[{}]", img.index()), r.map(|s| s.to_vec()).ok_or("its bufferView runs past its buffer".into()))
+                let b =
+                    buffers.get(view.buffer().index()).map(|b| b.as_slice()).unwrap_or_default();
+                let r = view
+                    .offset()
+                    .checked_add(view.length())
+                    .and_then(|end| b.get(view.offset()..end));
+                (
+                    format!("images[{}]", img.index()),
+                    r.map(|s| s.to_vec()).ok_or("its bufferView runs past its buffer".into()),
+                )
             }
         };
         let bytes = match bytes {
@@ -404,10 +491,18 @@ impl Importer<'_> {
         }
     }
 
-    fn tex(&mut self, map: &HashMap<(usize, bool), u32>, t: Option<(gltf::Texture, u32)>, srgb: bool) -> Option<TextureRef> {
+    fn tex(
+        &mut self,
+        map: &HashMap<(usize, bool), u32>,
+        t: Option<(gltf::Texture, u32)>,
+        srgb: bool,
+    ) -> Option<TextureRef> {
         let (t, set) = t?;
         if set != 0 {
-            self.warn(format!("textures[{}] is used with TEXCOORD_{set}; only TEXCOORD_0 is supported", t.index()));
+            self.warn(format!(
+                "textures[{}] is used with TEXCOORD_{set}; only TEXCOORD_0 is supported",
+                t.index()
+            ));
         }
         map.get(&(t.index(), srgb)).map(|&index| TextureRef { index })
     }
@@ -417,7 +512,10 @@ impl Importer<'_> {
         let (specular_factor, specular_color) = match m.specular() {
             Some(s) => {
                 if s.specular_texture().is_some() || s.specular_color_texture().is_some() {
-                    self.warn(format!("material {:?}: specular textures are not supported", m.name()));
+                    self.warn(format!(
+                        "material {:?}: specular textures are not supported",
+                        m.name()
+                    ));
                 }
                 (s.specular_factor(), Vec3::from(s.specular_color_factor()))
             }
@@ -425,7 +523,9 @@ impl Importer<'_> {
         };
         let alpha_mode = match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => super::AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => super::AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Mask => {
+                super::AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5))
+            }
             gltf::material::AlphaMode::Blend => {
                 // A path tracer has no draw order; blending is rendered as a 50% cut-out.
                 self.warn(format!("material {:?}: alpha BLEND is rendered as MASK 0.5", m.name()));
@@ -445,26 +545,58 @@ impl Importer<'_> {
             ("roughnessFactor", in01(pbr.roughness_factor())),
             ("emission", emission.is_finite() && emission.min_element() >= 0.0),
             ("specularFactor", in01(specular_factor)),
-            ("specularColorFactor", specular_color.is_finite() && specular_color.min_element() >= 0.0),
+            (
+                "specularColorFactor",
+                specular_color.is_finite() && specular_color.min_element() >= 0.0,
+            ),
         ]
         .into_iter()
         .filter(|(_, ok)| !ok)
         .map(|(name, _)| name)
         .collect();
         if !out_of_range.is_empty() {
-            self.warn(format!("materials[{}] ({:?}): {} out of range; clamped", m.index().unwrap_or(0), m.name().unwrap_or(""), out_of_range.join(", ")));
+            self.warn(format!(
+                "materials[{}] ({:?}): {} out of range; clamped",
+                m.index().unwrap_or(0),
+                m.name().unwrap_or(""),
+                out_of_range.join(", ")
+            ));
         }
         Material {
             name: m.name().unwrap_or("").to_string(),
-            base_color: if base.is_finite() { base.clamp(Vec4::ZERO, Vec4::ONE) } else { Vec4::ONE },
-            base_color_texture: self.tex(tex, pbr.base_color_texture().map(|i| (i.texture(), i.tex_coord())), true),
+            base_color: if base.is_finite() {
+                base.clamp(Vec4::ZERO, Vec4::ONE)
+            } else {
+                Vec4::ONE
+            },
+            base_color_texture: self.tex(
+                tex,
+                pbr.base_color_texture().map(|i| (i.texture(), i.tex_coord())),
+                true,
+            ),
             metallic: clamp01(pbr.metallic_factor()),
             roughness: clamp01(pbr.roughness_factor()),
-            metallic_roughness_texture: self.tex(tex, pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord())), false),
-            normal_texture: self.tex(tex, m.normal_texture().map(|i| (i.texture(), i.tex_coord())), false),
-            normal_scale: m.normal_texture().map(|n| n.scale()).filter(|s| s.is_finite()).unwrap_or(1.0),
+            metallic_roughness_texture: self.tex(
+                tex,
+                pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord())),
+                false,
+            ),
+            normal_texture: self.tex(
+                tex,
+                m.normal_texture().map(|i| (i.texture(), i.tex_coord())),
+                false,
+            ),
+            normal_scale: m
+                .normal_texture()
+                .map(|n| n.scale())
+                .filter(|s| s.is_finite())
+                .unwrap_or(1.0),
             emission: fin(emission),
-            emissive_texture: self.tex(tex, m.emissive_texture().map(|i| (i.texture(), i.tex_coord())), true),
+            emissive_texture: self.tex(
+                tex,
+                m.emissive_texture().map(|i| (i.texture(), i.tex_coord())),
+                true,
+            ),
             specular_factor: clamp01(specular_factor),
             specular_color: fin(specular_color),
             alpha_mode,
@@ -472,7 +604,13 @@ impl Importer<'_> {
         }
     }
 
-    fn mesh(&mut self, mesh: &gltf::Mesh, data: &super::accessor::Data, default_material: u32, out: &mut Vec<Mesh>) -> Result<Vec<usize>> {
+    fn mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        data: &super::accessor::Data,
+        default_material: u32,
+        out: &mut Vec<Mesh>,
+    ) -> Result<Vec<usize>> {
         let mut ids = vec![];
         for prim in mesh.primitives() {
             let here = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
@@ -500,15 +638,20 @@ impl Importer<'_> {
         match l.kind() {
             Kind::Directional => Light::Directional { direction, irradiance: c },
             Kind::Point => Light::Point { position, intensity: c },
-            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
-                Light::Spot { position, direction, intensity: c, inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
-            }
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => Light::Spot {
+                position,
+                direction,
+                intensity: c,
+                inner_cone: inner_cone_angle,
+                outer_cone: outer_cone_angle,
+            },
         }
     }
 
     fn scene_extras(&mut self, s: &gltf::Scene, scene: &mut Scene) -> Result<()> {
         let Some(raw) = s.extras() else { return Ok(()) };
-        let v: serde_json::Value = serde_json::from_str(raw.get()).context("parsing scene extras")?;
+        let v: serde_json::Value =
+            serde_json::from_str(raw.get()).context("parsing scene extras")?;
         let here = format!("scenes[{}].extras", s.index());
         if let Some(r) = v.get("resolution") {
             let wh = r
@@ -516,46 +659,84 @@ impl Importer<'_> {
                 .filter(|a| a.len() == 2)
                 .and_then(|a| Some((a[0].as_u64()?, a[1].as_u64()?)))
                 .filter(|&(w, h)| w > 0 && h > 0 && w <= 16384 && h <= 16384)
-                .ok_or_else(|| anyhow!("{here}.resolution must be [width, height] in 1..=16384, got {}", shown(r)))?;
+                .ok_or_else(|| {
+                    anyhow!(
+                        "{here}.resolution must be [width, height] in 1..=16384, got {}",
+                        shown(r)
+                    )
+                })?;
             scene.resolution = Some((wh.0 as u32, wh.1 as u32));
         }
         if let Some(d) = v.get("max_depth") {
-            scene.max_depth = d
-                .as_i64()
-                .filter(|&d| (-1..=1 << 16).contains(&d))
-                .ok_or_else(|| anyhow!("{here}.max_depth must be an integer in -1..=65536, got {}", shown(d)))? as i32;
+            scene.max_depth =
+                d.as_i64().filter(|&d| (-1..=1 << 16).contains(&d)).ok_or_else(|| {
+                    anyhow!("{here}.max_depth must be an integer in -1..=65536, got {}", shown(d))
+                })? as i32;
         }
         // Written by Hush's exporter: the environment is the sun's procedural sky.
         if let Some(p) = v.get("procedural_sky") {
-            scene.procedural_sky = p.as_bool().ok_or_else(|| anyhow!("{here}.procedural_sky must be true or false, got {}", shown(p)))?;
+            scene.procedural_sky = p.as_bool().ok_or_else(|| {
+                anyhow!("{here}.procedural_sky must be true or false, got {}", shown(p))
+            })?;
         }
         let Some(env) = v.get("environment") else { return Ok(()) };
         if let Some(obj) = env.as_object() {
-            let known: &[&str] = if obj.contains_key("radiance") { &["radiance"] } else { &["map", "intensity", "rotation_y_degrees"] };
+            let known: &[&str] = if obj.contains_key("radiance") {
+                &["radiance"]
+            } else {
+                &["map", "intensity", "rotation_y_degrees"]
+            };
             for k in obj.keys().filter(|k| !known.contains(&k.as_str())) {
-                self.warn(format!("{here}.environment.{}: not used with {}; ignored", short(k), known[0]));
+                self.warn(format!(
+                    "{here}.environment.{}: not used with {}; ignored",
+                    short(k),
+                    known[0]
+                ));
             }
         }
-        let number = |key: &str, default: f64, ok: &dyn Fn(f64) -> bool, what: &str| -> Result<f64> {
-            match env.get(key) {
-                None => Ok(default),
-                Some(x) => x.as_f64().filter(|x| x.is_finite() && ok(*x)).ok_or_else(|| anyhow!("{here}.environment.{key} must be {what}, got {}", shown(x))),
-            }
-        };
+        let number =
+            |key: &str, default: f64, ok: &dyn Fn(f64) -> bool, what: &str| -> Result<f64> {
+                match env.get(key) {
+                    None => Ok(default),
+                    Some(x) => x.as_f64().filter(|x| x.is_finite() && ok(*x)).ok_or_else(|| {
+                        anyhow!("{here}.environment.{key} must be {what}, got {}", shown(x))
+                    }),
+                }
+            };
         if let Some(rad) = env.get("radiance") {
             let c = rad
                 .as_array()
                 .filter(|a| a.len() == 3)
-                .and_then(|a| Some(Vec3::new(a[0].as_f64()? as f32, a[1].as_f64()? as f32, a[2].as_f64()? as f32)))
+                .and_then(|a| {
+                    Some(Vec3::new(
+                        a[0].as_f64()? as f32,
+                        a[1].as_f64()? as f32,
+                        a[2].as_f64()? as f32,
+                    ))
+                })
                 .filter(|c| c.is_finite() && c.min_element() >= 0.0)
-                .ok_or_else(|| anyhow!("{here}.environment.radiance must be [r, g, b] >= 0, got {}", shown(rad)))?;
+                .ok_or_else(|| {
+                    anyhow!(
+                        "{here}.environment.radiance must be [r, g, b] >= 0, got {}",
+                        shown(rad)
+                    )
+                })?;
             scene.environment = Environment::Constant(c);
         } else if let Some(map) = env.get("map") {
-            let map = map.as_str().ok_or_else(|| anyhow!("{here}.environment.map must be a file name, got {}", shown(map)))?;
+            let map = map.as_str().ok_or_else(|| {
+                anyhow!("{here}.environment.map must be a file name, got {}", shown(map))
+            })?;
             let intensity = number("intensity", 1.0, &|x| x >= 0.0, "a number >= 0")? as f32;
             let rot = number("rotation_y_degrees", 0.0, &|_| true, "a number (degrees)")? as f32;
-            let bytes = read_uri(self.files, map, self.budget.limits.file_bytes).with_context(|| format!("{here}.environment.map"))?;
-            scene.environment = Environment::Map(EnvMap::from_exr(&short(map), &bytes, intensity, rot, &mut self.budget)?);
+            let bytes = read_uri(self.files, map, self.budget.limits.file_bytes)
+                .with_context(|| format!("{here}.environment.map"))?;
+            scene.environment = Environment::Map(EnvMap::from_exr(
+                &short(map),
+                &bytes,
+                intensity,
+                rot,
+                &mut self.budget,
+            )?);
         } else {
             bail!("{here}.environment needs `radiance` or `map`, got {}", shown(env));
         }
@@ -574,11 +755,22 @@ fn shown(v: &serde_json::Value) -> String {
 fn camera_lens(cam: &gltf::Camera) -> Result<Option<crate::scene::ThinLens>> {
     let Some(raw) = cam.extras() else { return Ok(None) };
     let here = format!("cameras[{}].extras", cam.index());
-    let v: serde_json::Value = serde_json::from_str(raw.get()).with_context(|| format!("parsing {here}"))?;
-    let num = |k: &str| v.get(k).map(|x| x.as_f64().ok_or_else(|| anyhow!("{here}.{k} must be a number of meters, got {}", shown(x)))).transpose();
+    let v: serde_json::Value =
+        serde_json::from_str(raw.get()).with_context(|| format!("parsing {here}"))?;
+    let num = |k: &str| {
+        v.get(k)
+            .map(|x| {
+                x.as_f64().ok_or_else(|| {
+                    anyhow!("{here}.{k} must be a number of meters, got {}", shown(x))
+                })
+            })
+            .transpose()
+    };
     match (num("aperture_radius")?, num("focus_distance")?) {
         (None, None) => Ok(None),
-        (Some(a), Some(f)) => crate::scene::ThinLens::new(a, f).map(Some).with_context(|| here.clone()),
+        (Some(a), Some(f)) => {
+            crate::scene::ThinLens::new(a, f).map(Some).with_context(|| here.clone())
+        }
         _ => Err(anyhow!("{here} needs both aperture_radius and focus_distance for a thin lens")),
     }
 }

@@ -8,7 +8,13 @@ use glam::{DQuat, DVec3, Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 
 /// Read one primitive as a triangle mesh, or None (with a warning) for points and lines.
-pub(super) fn primitive(imp: &mut Importer, prim: &gltf::Primitive, data: &Data, default_material: u32, here: &str) -> Result<Option<Mesh>> {
+pub(super) fn primitive(
+    imp: &mut Importer,
+    prim: &gltf::Primitive,
+    data: &Data,
+    default_material: u32,
+    here: &str,
+) -> Result<Option<Mesh>> {
     use gltf::mesh::Mode;
     let mode = prim.mode();
     if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
@@ -20,10 +26,18 @@ pub(super) fn primitive(imp: &mut Importer, prim: &gltf::Primitive, data: &Data,
         imp.warn(format!("{here} has no POSITION; skipped"));
         return Ok(None);
     };
-    let positions: Vec<Vec3> = vec3s(accessor::read_f32(data, pos, accessor::POSITION, &mut imp.budget, &format!("{here}.attributes.POSITION"))?);
+    let positions: Vec<Vec3> = vec3s(accessor::read_f32(
+        data,
+        pos,
+        accessor::POSITION,
+        &mut imp.budget,
+        &format!("{here}.attributes.POSITION"),
+    )?);
     let n = positions.len();
     let raw: Vec<u32> = match prim.indices() {
-        Some(a) => accessor::read_indices(data, a.index(), &mut imp.budget, &format!("{here}.indices"))?,
+        Some(a) => {
+            accessor::read_indices(data, a.index(), &mut imp.budget, &format!("{here}.indices"))?
+        }
         None => (0..n as u32).collect(),
     };
     if let Some(bad) = raw.iter().find(|&&i| i as usize >= n) {
@@ -39,25 +53,40 @@ pub(super) fn primitive(imp: &mut Importer, prim: &gltf::Primitive, data: &Data,
     let indices = triangulate(mode, &raw);
     drop(raw);
     // glTF 2.0 §3.7.2.1: all attributes of a primitive have the same count.
-    let same_count = |name: &str, s: gltf::Semantic, expect: Expect, imp: &mut Importer| -> Result<Option<Vec<f32>>> {
+    let same_count = |name: &str,
+                      s: gltf::Semantic,
+                      expect: Expect,
+                      imp: &mut Importer|
+     -> Result<Option<Vec<f32>>> {
         let Some(i) = attribute(s) else { return Ok(None) };
         let what = format!("{here}.attributes.{name}");
         let v = accessor::read_f32(data, i, expect, &mut imp.budget, &what)?;
         let count = v.len() / expect.ty.multiplicity();
         if count != n {
-            bail!("{what} has {count} elements and POSITION {n}; a primitive's attributes have one count");
+            bail!(
+                "{what} has {count} elements and POSITION {n}; a primitive's attributes have one count"
+            );
         }
         Ok(Some(v))
     };
     let normals = same_count("NORMAL", gltf::Semantic::Normals, accessor::NORMAL, imp)?.map(vec3s);
-    let uvs: Vec<Vec2> = match same_count("TEXCOORD_0", gltf::Semantic::TexCoords(0), accessor::TEXCOORD, imp)? {
-        Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
-        None => vec![Vec2::ZERO; n],
-    };
-    let tangents: Option<Vec<Vec4>> = same_count("TANGENT", gltf::Semantic::Tangents, accessor::TANGENT, imp)?
-        .map(|t| t.chunks_exact(4).map(|c| Vec4::new(c[0], c[1], c[2], c[3])).collect());
+    let uvs: Vec<Vec2> =
+        match same_count("TEXCOORD_0", gltf::Semantic::TexCoords(0), accessor::TEXCOORD, imp)? {
+            Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
+            None => vec![Vec2::ZERO; n],
+        };
+    let tangents: Option<Vec<Vec4>> =
+        same_count("TANGENT", gltf::Semantic::Tangents, accessor::TANGENT, imp)?
+            .map(|t| t.chunks_exact(4).map(|c| Vec4::new(c[0], c[1], c[2], c[3])).collect());
     let material = prim.material().index().map(|i| i as u32).unwrap_or(default_material);
-    let mut m = Mesh { positions, normals: normals.unwrap_or_default(), uvs, tangents: vec![], indices, material };
+    let mut m = Mesh {
+        positions,
+        normals: normals.unwrap_or_default(),
+        uvs,
+        tangents: vec![],
+        indices,
+        material,
+    };
     if m.normals.len() != n {
         // glTF: without NORMAL, clients compute flat normals.
         flatten_with_face_normals(&mut m);
@@ -80,7 +109,13 @@ fn triangulate(mode: gltf::mesh::Mode, idx: &[u32]) -> Vec<u32> {
     match mode {
         Mode::Triangles => idx[..idx.len() / 3 * 3].to_vec(),
         Mode::TriangleStrip => (2..idx.len())
-            .flat_map(|i| if i % 2 == 0 { [idx[i - 2], idx[i - 1], idx[i]] } else { [idx[i - 1], idx[i - 2], idx[i]] })
+            .flat_map(|i| {
+                if i % 2 == 0 {
+                    [idx[i - 2], idx[i - 1], idx[i]]
+                } else {
+                    [idx[i - 1], idx[i - 2], idx[i]]
+                }
+            })
             .collect(),
         Mode::TriangleFan => (2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect(),
         _ => vec![],
@@ -144,7 +179,11 @@ fn generate_tangents(m: &mut Mesh) {
     // or overflows f32 every vertex lands in the first cell and the same indexing fails. Such a
     // mesh has no area to map (or no finite one) and keeps the default tangents.
     // It also counts down from its non-degenerate triangles (no two positions equal) unchecked.
-    let (lo, hi) = m.indices.iter().map(|&i| finite3(m.positions[i as usize])).fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let (lo, hi) = m
+        .indices
+        .iter()
+        .map(|&i| finite3(m.positions[i as usize]))
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let extent = (hi - lo).max_element();
     let any_triangle = m.indices.chunks_exact(3).any(|t| {
         let [a, b, c] = [0, 1, 2].map(|k| finite3(m.positions[t[k] as usize]));
@@ -161,7 +200,11 @@ fn generate_tangents(m: &mut Mesh) {
 /// Node index -> its animation (translation/rotation/scale channels of every glTF animation).
 /// A channel that cannot be used (unsorted or non-finite keys, a value count that does not match
 /// the keys) is a warning and is ignored; a malformed accessor is an error.
-pub(super) fn animations(imp: &mut Importer, doc: &gltf::Document, data: &Data) -> Result<HashMap<usize, Animation>> {
+pub(super) fn animations(
+    imp: &mut Importer,
+    doc: &gltf::Document,
+    data: &Data,
+) -> Result<HashMap<usize, Animation>> {
     use gltf::animation::{Interpolation, Property};
     let mut map: HashMap<usize, Animation> = HashMap::new();
     for anim in doc.animations() {
@@ -180,20 +223,38 @@ pub(super) fn animations(imp: &mut Importer, doc: &gltf::Document, data: &Data) 
                     continue;
                 }
             };
-            let times: Vec<f64> = accessor::read_f32(data, sampler.input().index(), accessor::KEY_TIMES, &mut imp.budget, &format!("{here} input"))?
-                .into_iter()
-                .map(|t| t as f64)
-                .collect();
-            let values = accessor::read_f32(data, sampler.output().index(), expect, &mut imp.budget, &format!("{here} output"))?;
+            let times: Vec<f64> = accessor::read_f32(
+                data,
+                sampler.input().index(),
+                accessor::KEY_TIMES,
+                &mut imp.budget,
+                &format!("{here} input"),
+            )?
+            .into_iter()
+            .map(|t| t as f64)
+            .collect();
+            let values = accessor::read_f32(
+                data,
+                sampler.output().index(),
+                expect,
+                &mut imp.budget,
+                &format!("{here} output"),
+            )?;
             let k = expect.ty.multiplicity();
             // CUBICSPLINE stores (in-tangent, value, out-tangent) per key: keep the values.
             let per_key = if interp == Interpolation::CubicSpline { 3 } else { 1 };
-            let keys: Vec<&[f32]> = values.chunks_exact(k).skip(per_key / 2).step_by(per_key).collect();
+            let keys: Vec<&[f32]> =
+                values.chunks_exact(k).skip(per_key / 2).step_by(per_key).collect();
             if keys.len() != times.len() || values.len() != times.len() * k * per_key {
-                imp.warn(format!("{here}: {} keys but {} values; ignored", times.len(), values.len() / k));
+                imp.warn(format!(
+                    "{here}: {} keys but {} values; ignored",
+                    times.len(),
+                    values.len() / k
+                ));
                 continue;
             }
-            let sorted = times.windows(2).all(|w| w[0] <= w[1]) && times.iter().all(|t| t.is_finite());
+            let sorted =
+                times.windows(2).all(|w| w[0] <= w[1]) && times.iter().all(|t| t.is_finite());
             if !sorted || !keys.iter().all(|v| v.iter().all(|x| x.is_finite())) {
                 imp.warn(format!("{here} has unsorted or non-finite keys; ignored"));
                 continue;
@@ -212,14 +273,23 @@ pub(super) fn animations(imp: &mut Importer, doc: &gltf::Document, data: &Data) 
                 scale_track: None,
             });
             let step = interp == Interpolation::Step;
-            let v3 = || keys.iter().map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect::<Vec<_>>();
+            let v3 = || {
+                keys.iter()
+                    .map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+                    .collect::<Vec<_>>()
+            };
             match property {
-                Property::Translation => a.translation_track = Some(Track { times, values: v3(), step }),
+                Property::Translation => {
+                    a.translation_track = Some(Track { times, values: v3(), step })
+                }
                 Property::Scale => a.scale_track = Some(Track { times, values: v3(), step }),
                 _ => {
                     let values = keys
                         .iter()
-                        .map(|v| DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64).normalize())
+                        .map(|v| {
+                            DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64)
+                                .normalize()
+                        })
                         .map(|q| if q.is_finite() { q } else { DQuat::IDENTITY })
                         .collect();
                     a.rotation_track = Some(Track { times, values, step });
@@ -227,7 +297,12 @@ pub(super) fn animations(imp: &mut Importer, doc: &gltf::Document, data: &Data) 
             }
         }
     }
-    map.retain(|_, a| a.duration() > 0.0 || a.translation_track.is_some() || a.rotation_track.is_some() || a.scale_track.is_some());
+    map.retain(|_, a| {
+        a.duration() > 0.0
+            || a.translation_track.is_some()
+            || a.rotation_track.is_some()
+            || a.scale_track.is_some()
+    });
     Ok(map)
 }
 
@@ -240,12 +315,28 @@ mod tests {
     /// tangents instead of panicking.
     #[test]
     fn tangents_of_degenerate_meshes_do_not_panic() {
-        for p in [[Vec3::ONE; 3], [Vec3::splat(-3e38), Vec3::splat(3e38), Vec3::ZERO], [Vec3::NAN, Vec3::X, Vec3::INFINITY]] {
-            let mut m = Mesh { positions: p.to_vec(), normals: vec![Vec3::Y; 3], uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y], indices: vec![0, 1, 2], ..Default::default() };
+        for p in [
+            [Vec3::ONE; 3],
+            [Vec3::splat(-3e38), Vec3::splat(3e38), Vec3::ZERO],
+            [Vec3::NAN, Vec3::X, Vec3::INFINITY],
+        ] {
+            let mut m = Mesh {
+                positions: p.to_vec(),
+                normals: vec![Vec3::Y; 3],
+                uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
+                indices: vec![0, 1, 2],
+                ..Default::default()
+            };
             generate_tangents(&mut m);
             assert_eq!(m.tangents.len(), 3);
         }
-        let mut m = Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z], normals: vec![Vec3::Y; 3], uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y], indices: vec![0, 2, 1], ..Default::default() };
+        let mut m = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z],
+            normals: vec![Vec3::Y; 3],
+            uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
+            indices: vec![0, 2, 1],
+            ..Default::default()
+        };
         generate_tangents(&mut m);
         assert!((m.tangents[0].truncate() - Vec3::X).length() < 1e-5, "{:?}", m.tangents);
     }

@@ -5,18 +5,34 @@
 //! files), so it loads in milliseconds; `hush-cli level` writes it as glTF.
 
 use super::default_scene::{cuboid, lambert, metal, quad, uv_sphere};
-use super::{Animation, Camera, Environment, Material, Mesh, Object, Scene, Texture, TextureRef, Track, Wrap, sky};
+use super::{
+    Animation, Camera, Environment, Material, Mesh, Object, Scene, Texture, TextureRef, Track,
+    Wrap, sky,
+};
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
 
 /// A procedural texture: `f(x, y)` -> sRGB bytes.
-pub(super) fn texture(name: &str, size: u32, srgb: bool, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
+pub(super) fn texture(
+    name: &str,
+    size: u32,
+    srgb: bool,
+    f: impl Fn(u32, u32) -> [u8; 4],
+) -> Texture {
     let mut rgba8 = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
         for x in 0..size {
             rgba8.extend_from_slice(&f(x, y));
         }
     }
-    Texture { name: name.into(), width: size, height: size, rgba8, srgb, wrap_s: Wrap::Repeat, wrap_t: Wrap::Repeat }
+    Texture {
+        name: name.into(),
+        width: size,
+        height: size,
+        rgba8,
+        srgb,
+        wrap_s: Wrap::Repeat,
+        wrap_t: Wrap::Repeat,
+    }
 }
 
 pub(super) fn checker(x: u32, y: u32) -> [u8; 4] {
@@ -49,8 +65,15 @@ pub(super) fn tiled(mut m: Mesh, s: Vec2) -> Mesh {
 /// The default level. `sun_dir` is the direction the sunlight travels.
 pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
     let mut materials = vec![
-        Material { base_color_texture: Some(TextureRef { index: 0 }), roughness: 0.12, ..lambert("polished floor", Vec3::ONE) },
-        Material { base_color_texture: Some(TextureRef { index: 1 }), ..lambert("brick", Vec3::ONE) },
+        Material {
+            base_color_texture: Some(TextureRef { index: 0 }),
+            roughness: 0.12,
+            ..lambert("polished floor", Vec3::ONE)
+        },
+        Material {
+            base_color_texture: Some(TextureRef { index: 1 }),
+            ..lambert("brick", Vec3::ONE)
+        },
         lambert("plaster", Vec3::new(0.78, 0.75, 0.7)),
         lambert("stone", Vec3::new(0.55, 0.52, 0.48)),
         metal("mirror", Vec3::ONE, 0.0),
@@ -68,14 +91,26 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
             m.specular_factor = 1.0;
         }
     }
-    let textures = vec![texture("checker", 256, true, checker), texture("bricks", 128, true, bricks)];
+    let textures =
+        vec![texture("checker", 256, true, checker), texture("bricks", 128, true, bricks)];
     let (floor, brick, plaster, stone, mirror) = (0, 1, 2, 3, 4);
     let mut meshes: Vec<Mesh> = vec![];
     let mut add = |m: Mesh| meshes.push(m);
 
     // Courtyard floor (12 x 12 m) and the hall's floor behind it (z from -6 to -14).
-    add(tiled(quad(Vec3::new(0.0, 0.0, 0.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0), floor), Vec2::splat(6.0)));
-    add(tiled(quad(Vec3::new(0.0, 0.0, -10.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0), floor), Vec2::new(6.0, 4.0)));
+    add(tiled(
+        quad(Vec3::new(0.0, 0.0, 0.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0), floor),
+        Vec2::splat(6.0),
+    ));
+    add(tiled(
+        quad(
+            Vec3::new(0.0, 0.0, -10.0),
+            Vec3::new(6.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -4.0),
+            floor,
+        ),
+        Vec2::new(6.0, 4.0),
+    ));
     // Arcade: pillars along the courtyard's east and west sides, a roof slab over each.
     for side in [-1.0f32, 1.0] {
         for k in 0..4 {
@@ -84,13 +119,22 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
         }
         add(cuboid(Vec3::new(side * 5.0, 3.7, 0.0), Vec3::new(0.5, 0.2, 6.0), plaster));
         // Back walls of the arcade, in brick.
-        add(tiled(cuboid(Vec3::new(side * 6.2, 2.0, 0.0), Vec3::new(0.2, 2.0, 6.0), brick), Vec2::new(6.0, 2.0)));
+        add(tiled(
+            cuboid(Vec3::new(side * 6.2, 2.0, 0.0), Vec3::new(0.2, 2.0, 6.0), brick),
+            Vec2::new(6.0, 2.0),
+        ));
     }
     // Hall: walls and a ceiling; its front wall (z = -6) has a doorway and two windows.
     add(cuboid(Vec3::new(0.0, 4.2, -10.0), Vec3::new(6.4, 0.2, 4.2), plaster));
-    add(tiled(cuboid(Vec3::new(0.0, 2.0, -14.2), Vec3::new(6.4, 2.0, 0.2), brick), Vec2::new(6.0, 2.0)));
+    add(tiled(
+        cuboid(Vec3::new(0.0, 2.0, -14.2), Vec3::new(6.4, 2.0, 0.2), brick),
+        Vec2::new(6.0, 2.0),
+    ));
     for side in [-1.0f32, 1.0] {
-        add(tiled(cuboid(Vec3::new(side * 6.2, 2.0, -10.0), Vec3::new(0.2, 2.0, 4.0), brick), Vec2::new(4.0, 2.0)));
+        add(tiled(
+            cuboid(Vec3::new(side * 6.2, 2.0, -10.0), Vec3::new(0.2, 2.0, 4.0), brick),
+            Vec2::new(4.0, 2.0),
+        ));
         // Front wall pieces beside the doorway (|x| < 1.2) with a window at 3.0 < |x| < 4.4.
         add(cuboid(Vec3::new(side * 2.1, 2.0, -6.0), Vec3::new(0.9, 2.0, 0.2), plaster));
         add(cuboid(Vec3::new(side * 5.2, 2.0, -6.0), Vec3::new(0.8, 2.0, 0.2), plaster));
@@ -100,7 +144,12 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
     // Lintel over the doorway.
     add(cuboid(Vec3::new(0.0, 3.4, -6.0), Vec3::new(1.2, 0.6, 0.2), plaster));
     // A mirror on the hall's back wall, facing the doorway.
-    add(quad(Vec3::new(0.0, 1.8, -13.98), Vec3::new(1.2, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), mirror));
+    add(quad(
+        Vec3::new(0.0, 1.8, -13.98),
+        Vec3::new(1.2, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        mirror,
+    ));
     // Rough metal spheres in the hall, roughness 0.05 .. 0.7.
     for (i, m) in (5u32..9).enumerate() {
         add(uv_sphere(Vec3::new(-3.0 + i as f32 * 2.0, 0.6, -11.0), 0.6, m, 32, 16));
@@ -114,7 +163,12 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
     meshes.push(cuboid(Vec3::ZERO, Vec3::splat(0.35), 6));
 
     let mut objects: Vec<Object> = (0..animated_mesh)
-        .map(|i| Object { name: format!("level part {i}"), mesh: i, transform: DMat4::IDENTITY, animation: None })
+        .map(|i| Object {
+            name: format!("level part {i}"),
+            mesh: i,
+            transform: DMat4::IDENTITY,
+            animation: None,
+        })
         .collect();
     // Arches between the pillars: eight tilted voussoirs per arch, from one shared block mesh.
     let block = meshes.len();
@@ -126,22 +180,45 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
                 let a = std::f64::consts::PI * (s as f64 + 0.5) / 8.0;
                 let p = DVec3::new(side * 5.0, 2.25 + 1.25 * a.sin(), zc + 1.25 * a.cos());
                 let r = DQuat::from_rotation_x(-(std::f64::consts::FRAC_PI_2 - a));
-                objects.push(Object { name: format!("arch {side} {k} {s}"), mesh: block, transform: DMat4::from_rotation_translation(r, p), animation: None });
+                objects.push(Object {
+                    name: format!("arch {side} {k} {s}"),
+                    mesh: block,
+                    transform: DMat4::from_rotation_translation(r, p),
+                    animation: None,
+                });
             }
         }
     }
     // The animated object: a copper cube turning above the plinth and bobbing up and down.
-    let turn: Vec<DQuat> = (0..=4).map(|i| DQuat::from_rotation_y(i as f64 * std::f64::consts::FRAC_PI_2)).collect();
+    let turn: Vec<DQuat> =
+        (0..=4).map(|i| DQuat::from_rotation_y(i as f64 * std::f64::consts::FRAC_PI_2)).collect();
     let animation = Animation {
         parent: DMat4::IDENTITY,
         translation: DVec3::new(0.0, 1.4, 0.0),
         rotation: DQuat::IDENTITY,
         scale: DVec3::ONE,
-        translation_track: Some(Track { times: vec![0.0, 2.0, 4.0], values: vec![DVec3::new(0.0, 1.3, 0.0), DVec3::new(0.0, 1.7, 0.0), DVec3::new(0.0, 1.3, 0.0)], step: false }),
-        rotation_track: Some(Track { times: vec![0.0, 1.0, 2.0, 3.0, 4.0], values: turn, step: false }),
+        translation_track: Some(Track {
+            times: vec![0.0, 2.0, 4.0],
+            values: vec![
+                DVec3::new(0.0, 1.3, 0.0),
+                DVec3::new(0.0, 1.7, 0.0),
+                DVec3::new(0.0, 1.3, 0.0),
+            ],
+            step: false,
+        }),
+        rotation_track: Some(Track {
+            times: vec![0.0, 1.0, 2.0, 3.0, 4.0],
+            values: turn,
+            step: false,
+        }),
         scale_track: None,
     };
-    objects.push(Object { name: "spinning cube".into(), mesh: animated_mesh, transform: animation.world_at(0.0), animation: Some(animation) });
+    objects.push(Object {
+        name: "spinning cube".into(),
+        mesh: animated_mesh,
+        transform: animation.world_at(0.0),
+        animation: Some(animation),
+    });
 
     let (sun, sky) = sky::sun_and_sky(sun_dir);
     Scene {

@@ -21,13 +21,16 @@ mod texture;
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::{cuboid, default_scene, quad};
-pub use terrain::{MAX_TERRAIN_TRIANGLES, terrain};
+pub use environment::{EnvMap, Environment};
+pub use files::{MemoryFiles, SceneFiles, SceneFolder};
+pub use gltf_export::save_gltf;
+pub use gltf_import::{
+    DEFAULT_MAX_TEXTURE_SIZE, ImportPanic, LoadOptions, SUPPORTED_EXTENSIONS, load_gltf,
+    load_gltf_from, load_gltf_opts, load_gltf_with,
+};
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
-pub use environment::{EnvMap, Environment};
-pub use gltf_export::save_gltf;
-pub use files::{MemoryFiles, SceneFiles, SceneFolder};
-pub use gltf_import::{DEFAULT_MAX_TEXTURE_SIZE, ImportPanic, LoadOptions, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_from, load_gltf_opts, load_gltf_with};
+pub use terrain::{MAX_TERRAIN_TRIANGLES, terrain};
 pub use texture::{Texture, TextureRef, Wrap, decode_image};
 
 use anyhow::Result;
@@ -128,10 +131,22 @@ impl Material {
 #[derive(Clone, Copy, Debug)]
 pub enum Light {
     /// `direction` is where the light travels (the node's -Z); `irradiance` in W/m^2.
-    Directional { direction: Vec3, irradiance: Vec3 },
+    Directional {
+        direction: Vec3,
+        irradiance: Vec3,
+    },
     /// Radiant intensity in W/sr.
-    Point { position: DVec3, intensity: Vec3 },
-    Spot { position: DVec3, direction: Vec3, intensity: Vec3, inner_cone: f32, outer_cone: f32 },
+    Point {
+        position: DVec3,
+        intensity: Vec3,
+    },
+    Spot {
+        position: DVec3,
+        direction: Vec3,
+        intensity: Vec3,
+        inner_cone: f32,
+        outer_cone: f32,
+    },
 }
 
 /// A pinhole camera: looks down its local -Z, +Y up, +X right.
@@ -159,12 +174,19 @@ impl ThinLens {
     pub fn new(aperture_radius: f64, focus_distance: f64) -> anyhow::Result<ThinLens> {
         let ok = |v: f64| v.is_finite() && v > 0.0 && v < 1e9;
         if !ok(aperture_radius) {
-            anyhow::bail!("the aperture radius must be a finite number of meters > 0, got {aperture_radius}");
+            anyhow::bail!(
+                "the aperture radius must be a finite number of meters > 0, got {aperture_radius}"
+            );
         }
         if !ok(focus_distance) {
-            anyhow::bail!("the focus distance must be a finite number of meters > 0, got {focus_distance}");
+            anyhow::bail!(
+                "the focus distance must be a finite number of meters > 0, got {focus_distance}"
+            );
         }
-        Ok(ThinLens { aperture_radius: aperture_radius as f32, focus_distance: focus_distance as f32 })
+        Ok(ThinLens {
+            aperture_radius: aperture_radius as f32,
+            focus_distance: focus_distance as f32,
+        })
     }
 }
 
@@ -290,7 +312,9 @@ impl Scene {
     /// Point the first directional light along `dir` (regenerating a procedural sky with it).
     /// Returns false when the scene has no directional light.
     pub fn set_sun_direction(&mut self, dir: Vec3) -> bool {
-        let Some(Light::Directional { direction, .. }) = self.lights.iter_mut().find(|l| matches!(l, Light::Directional { .. })) else {
+        let Some(Light::Directional { direction, .. }) =
+            self.lights.iter_mut().find(|l| matches!(l, Light::Directional { .. }))
+        else {
             return false;
         };
         *direction = dir.normalize_or(Vec3::NEG_Y);

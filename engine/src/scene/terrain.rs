@@ -22,7 +22,9 @@ pub fn terrain(n: usize) -> Scene {
     let k = ((n as f64 / 2.0).sqrt().round() as u32).max(1);
     let size = 100.0f32;
     let height = |x: f32, z: f32, i: u32, j: u32| {
-        let hills = 6.0 * (x * 0.07).sin() * (z * 0.05).cos() + 2.5 * (x * 0.23 + z * 0.17).sin() + 0.8 * (z * 0.61 - x * 0.4).cos();
+        let hills = 6.0 * (x * 0.07).sin() * (z * 0.05).cos()
+            + 2.5 * (x * 0.23 + z * 0.17).sin()
+            + 0.8 * (z * 0.61 - x * 0.4).cos();
         // A small hashed jitter per vertex (a tenth of the cell) so that neighbours differ.
         let mut h = i.wrapping_mul(0x9e37_79b9) ^ j.wrapping_mul(0x85eb_ca6b);
         h ^= h >> 15;
@@ -52,7 +54,8 @@ pub fn terrain(n: usize) -> Scene {
     // Smooth normals: the area-weighted sum of the faces around each vertex.
     let mut normals = vec![Vec3::ZERO; positions.len()];
     for t in indices.chunks_exact(3) {
-        let (a, b, c) = (positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]);
+        let (a, b, c) =
+            (positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]);
         let n = (b - a).cross(c - a);
         for &v in t {
             normals[v as usize] += n;
@@ -64,11 +67,20 @@ pub fn terrain(n: usize) -> Scene {
     Scene {
         name: format!("terrain:{n}"),
         meshes: vec![mesh],
-        objects: vec![Object { name: "terrain".into(), mesh: 0, transform: DMat4::IDENTITY, animation: None }],
+        objects: vec![Object {
+            name: "terrain".into(),
+            mesh: 0,
+            transform: DMat4::IDENTITY,
+            animation: None,
+        }],
         materials: vec![lambert("ground", Vec3::new(0.45, 0.4, 0.3))],
         textures: vec![],
         lights: vec![sun],
-        camera: Some(Camera::look_at(DVec3::new(-45.0, 25.0, 45.0), DVec3::new(10.0, 0.0, -10.0), 60.0)),
+        camera: Some(Camera::look_at(
+            DVec3::new(-45.0, 25.0, 45.0),
+            DVec3::new(10.0, 0.0, -10.0),
+            60.0,
+        )),
         environment: Environment::Map(sky),
         resolution: Some((640, 360)),
         max_depth: super::DEFAULT_MAX_DEPTH,
@@ -89,6 +101,10 @@ mod tests {
             assert!((t as f64 - n as f64).abs() <= 0.02 * n as f64 + 2.0, "{n}: {t}");
             assert_eq!(s.meshes[0].normals.len(), s.meshes[0].positions.len());
         }
-        assert!(parse_terrain("terrain:1").is_none() && parse_terrain("terrain:x").is_none() && parse_terrain("terrain:20000000").is_none());
+        assert!(
+            parse_terrain("terrain:1").is_none()
+                && parse_terrain("terrain:x").is_none()
+                && parse_terrain("terrain:20000000").is_none()
+        );
     }
 }

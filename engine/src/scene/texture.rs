@@ -30,7 +30,8 @@ pub struct TextureRef {
 impl Texture {
     /// Half the resolution in each direction (a box-filtered mip level).
     pub fn halved(&self) -> Texture {
-        let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8.clone()).expect("texture size");
+        let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8.clone())
+            .expect("texture size");
         let (w, h) = ((self.width / 2).max(1), (self.height / 2).max(1));
         let img = image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle);
         Texture { width: w, height: h, rgba8: img.into_raw(), name: self.name.clone(), ..*self }
@@ -40,7 +41,13 @@ impl Texture {
     /// scenes with many 4K textures fit a GPU's storage-buffer limits. The size comes from the
     /// image's header and is checked against `budget` (4 bytes a pixel) before anything is
     /// decoded; the decoder is held to that size.
-    pub fn decode(name: &str, bytes: &[u8], srgb: bool, max_size: u32, budget: &mut Budget) -> Result<Texture> {
+    pub fn decode(
+        name: &str,
+        bytes: &[u8],
+        srgb: bool,
+        max_size: u32,
+        budget: &mut Budget,
+    ) -> Result<Texture> {
         let img = decode_image(name, bytes, budget)?;
         let mut img = img.to_rgba8();
         while img.width().max(img.height()) > max_size.max(1) {
@@ -63,7 +70,11 @@ impl Texture {
 /// is kept) before decoding, and the decoder may allocate no more than that image at 16 bytes
 /// a pixel (16-bit RGBA and its conversion), so a header that lies cannot make it allocate more.
 pub fn decode_image(name: &str, bytes: &[u8], budget: &mut Budget) -> Result<image::DynamicImage> {
-    let reader = || image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().with_context(|| format!("reading image {name}"));
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .with_context(|| format!("reading image {name}"))
+    };
     let (w, h) = reader()?.into_dimensions().with_context(|| format!("decoding image {name}"))?;
     budget.image(w as u64, h as u64, 4, format_args!("image {name}"))?;
     let mut r = reader()?;

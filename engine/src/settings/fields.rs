@@ -32,11 +32,20 @@ pub struct Field {
 }
 
 pub(super) fn names<T: serde::Serialize>(all: &[T]) -> Vec<String> {
-    all.iter().map(|v| serde_json::to_value(v).ok().and_then(|v| v.as_str().map(str::to_string)).unwrap_or_default()).collect()
+    all.iter()
+        .map(|v| {
+            serde_json::to_value(v)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_default()
+        })
+        .collect()
 }
 
 fn views() -> Vec<String> {
-    std::iter::once(View::FINAL.name().to_string()).chain(super::all_views().into_iter().map(|v| v.name.to_string())).collect()
+    std::iter::once(View::FINAL.name().to_string())
+        .chain(super::all_views().into_iter().map(|v| v.name.to_string()))
+        .collect()
 }
 fn fractions() -> Vec<String> {
     super::SampleFraction::all().map(|f| f.to_string()).collect()
@@ -45,32 +54,103 @@ fn denoisers() -> Vec<String> {
     super::denoiser_names().into_iter().map(str::to_string).collect()
 }
 
-pub(super) const fn f(path: &'static str, group: &'static str, unit: &'static str, kind: Kind, help: &'static str) -> Field {
+pub(super) const fn f(
+    path: &'static str,
+    group: &'static str,
+    unit: &'static str,
+    kind: Kind,
+    help: &'static str,
+) -> Field {
     Field { path, group, unit, kind, help }
 }
 
 use Kind::{Bool, Choice, Float, Int};
 
-
 /// The frame's own fields (display, trace), in panel order.
 const FRAME_FIELDS: &[Field] = &[
-    f("view", "display", "", Choice(views), "What the display shows: the image or one buffer of the frame."),
-    f("exposure_ev", "display", "EV", Float(-30.0, 30.0, 0.05), "The image is multiplied by 2^EV before tone mapping."),
-    f("accumulate", "frame", "", Bool, "Sum frames while nothing changes and show their mean (the converged image)."),
+    f(
+        "view",
+        "display",
+        "",
+        Choice(views),
+        "What the display shows: the image or one buffer of the frame.",
+    ),
+    f(
+        "exposure_ev",
+        "display",
+        "EV",
+        Float(-30.0, 30.0, 0.05),
+        "The image is multiplied by 2^EV before tone mapping.",
+    ),
+    f(
+        "accumulate",
+        "frame",
+        "",
+        Bool,
+        "Sum frames while nothing changes and show their mean (the converged image).",
+    ),
     f("seed", "frame", "", Int(0, u32::MAX as i64), "Seed of every random sequence."),
-    f("denoiser", "frame", "", Choice(denoisers), "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. svgf: SVGF with Voorhuis's extensions, then TAA. progressive: Dundr's filter, for sample fractions below 1. Others: denoisers the application registered."),
-    f("max_depth", "trace", "bounces", Int(-1, 64), "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded)."),
-    f("paths_per_pixel", "trace", "paths", Int(1, 64), "Indirect paths per pixel per frame (1 is the paper's real-time setting)."),
-    f("samples_per_pixel", "trace", "samples", Int(1, super::MAX_SAMPLES_PER_PIXEL as i64), "Samples per pixel: the raster's guide and k - 1 traced, mixed into their most similar guides (Voorhuis §5)."),
-    f("primary_samples", "gbuffer/primaries", "samples", Int(1, super::MAX_PRIMARY_SAMPLES as i64), "With a thin lens: primary rays traced per pixel, whose mean features are the G-buffer (Moon et al. 2017 §4.2). More: cleaner features, k rays each."),
-    f("prefilter", "prefilter", "", Bool, "With a thin lens: Moon et al. 2017's pre-filter of the traced G-buffer (world-position weights, bandwidth by SURE)."),
-    f("sample_fraction", "trace", "", Choice(fractions), "Fraction of the pixels traced per frame (Dundr §5): 1/N traces one pixel of every N-pixel tile, each pixel once in N frames."),
+    f(
+        "denoiser",
+        "frame",
+        "",
+        Choice(denoisers),
+        "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. svgf: SVGF with Voorhuis's extensions, then TAA. progressive: Dundr's filter, for sample fractions below 1. Others: denoisers the application registered.",
+    ),
+    f(
+        "max_depth",
+        "trace",
+        "bounces",
+        Int(-1, 64),
+        "Path length as Mitsuba counts it (2 = direct light only, -1 = unbounded).",
+    ),
+    f(
+        "paths_per_pixel",
+        "trace",
+        "paths",
+        Int(1, 64),
+        "Indirect paths per pixel per frame (1 is the paper's real-time setting).",
+    ),
+    f(
+        "samples_per_pixel",
+        "trace",
+        "samples",
+        Int(1, super::MAX_SAMPLES_PER_PIXEL as i64),
+        "Samples per pixel: the raster's guide and k - 1 traced, mixed into their most similar guides (Voorhuis §5).",
+    ),
+    f(
+        "primary_samples",
+        "gbuffer/primaries",
+        "samples",
+        Int(1, super::MAX_PRIMARY_SAMPLES as i64),
+        "With a thin lens: primary rays traced per pixel, whose mean features are the G-buffer (Moon et al. 2017 §4.2). More: cleaner features, k rays each.",
+    ),
+    f(
+        "prefilter",
+        "prefilter",
+        "",
+        Bool,
+        "With a thin lens: Moon et al. 2017's pre-filter of the traced G-buffer (world-position weights, bandwidth by SURE).",
+    ),
+    f(
+        "sample_fraction",
+        "trace",
+        "",
+        Choice(fractions),
+        "Fraction of the pixels traced per frame (Dundr §5): 1/N traces one pixel of every N-pixel tile, each pixel once in N frames.",
+    ),
 ];
 
 /// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then
 /// each technique's own slice (matte chain, TAA, glossy chain, SVGF).
 pub fn fields() -> impl Iterator<Item = &'static Field> {
-    FRAME_FIELDS.iter().chain(super::matte::FIELDS).chain(super::taa::FIELDS).chain(super::glossy::FIELDS).chain(super::svgf::FIELDS).chain(super::progressive::FIELDS)
+    FRAME_FIELDS
+        .iter()
+        .chain(super::matte::FIELDS)
+        .chain(super::taa::FIELDS)
+        .chain(super::glossy::FIELDS)
+        .chain(super::svgf::FIELDS)
+        .chain(super::progressive::FIELDS)
 }
 
 /// The value at a dotted path of a serde form.
@@ -111,7 +191,10 @@ impl FrameSettings {
         let known = leaves(&FrameSettings::default().to_value());
         for leaf in leaves(v) {
             if !known.contains(&leaf) {
-                return Err(anyhow!("unknown setting {leaf:?} (settings are: {})", known.join(", ")));
+                return Err(anyhow!(
+                    "unknown setting {leaf:?} (settings are: {})",
+                    known.join(", ")
+                ));
             }
         }
         for field in fields() {
@@ -155,10 +238,15 @@ mod tests {
         let v = FrameSettings::default().to_value();
         let leaves = leaves(&v);
         for leaf in &leaves {
-            assert_eq!(fields().filter(|f| f.path == leaf).count(), 1, "{leaf} must be described exactly once in fields()");
+            assert_eq!(
+                fields().filter(|f| f.path == leaf).count(),
+                1,
+                "{leaf} must be described exactly once in fields()"
+            );
         }
         for f in fields() {
-            let x = get(&v, f.path).unwrap_or_else(|| panic!("{} is described but is not a setting", f.path));
+            let x = get(&v, f.path)
+                .unwrap_or_else(|| panic!("{} is described but is not a setting", f.path));
             check(f, x).unwrap();
         }
         assert_eq!(leaves.len(), fields().count());
@@ -168,10 +256,16 @@ mod tests {
     fn bad_values_are_clear_errors() {
         let mut v = FrameSettings::default().to_value();
         *get_mut(&mut v, "matte.hysteresis").unwrap() = serde_json::json!(1.5);
-        assert!(format!("{:#}", FrameSettings::from_value(&v).unwrap_err()).contains("matte.hysteresis"));
+        assert!(
+            format!("{:#}", FrameSettings::from_value(&v).unwrap_err())
+                .contains("matte.hysteresis")
+        );
         let mut v = FrameSettings::default().to_value();
         v["matte"]["hysterisis"] = serde_json::json!(0.9);
-        assert!(format!("{:#}", FrameSettings::from_value(&v).unwrap_err()).contains("matte.hysterisis"));
+        assert!(
+            format!("{:#}", FrameSettings::from_value(&v).unwrap_err())
+                .contains("matte.hysterisis")
+        );
         let mut v = FrameSettings::default().to_value();
         v["view"] = serde_json::json!("Nope");
         assert!(FrameSettings::from_value(&v).is_err());

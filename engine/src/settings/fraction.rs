@@ -26,7 +26,9 @@ impl SampleFraction {
     /// 1 / `period`; an error unless the period is a power of two in 1..=128.
     pub fn one_in(period: u32) -> Result<SampleFraction> {
         if !period.is_power_of_two() || period > MAX_SAMPLE_PERIOD {
-            bail!("a sample fraction is 1/N with N a power of two up to {MAX_SAMPLE_PERIOD}, not 1/{period}");
+            bail!(
+                "a sample fraction is 1/N with N a power of two up to {MAX_SAMPLE_PERIOD}, not 1/{period}"
+            );
         }
         Ok(SampleFraction { period })
     }

@@ -19,7 +19,8 @@ pub enum ReflectionMv {
 }
 
 impl ReflectionMv {
-    pub const ALL: [ReflectionMv; 3] = [ReflectionMv::Primary, ReflectionMv::Virtual, ReflectionMv::Diamond];
+    pub const ALL: [ReflectionMv; 3] =
+        [ReflectionMv::Primary, ReflectionMv::Virtual, ReflectionMv::Diamond];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -192,8 +193,13 @@ impl GlossySettings {
     /// `footprints` is the secondary hit's ray differential in primary pixel footprints.
     /// shaders/glossy/common.wgsl's glossy_sigma is the same function.
     pub fn sigma_px(&self, roughness: f32, footprints: f32) -> f32 {
-        let base = self.sigma_scale * roughness.clamp(0.0, 1.0).powf(self.sigma_exponent) + self.sigma_epsilon_px;
-        let scale = if roughness < self.roughness_threshold { (-footprints.max(0.0) / self.ray_differential_omega.max(1e-3)).exp() } else { 1.0 };
+        let base = self.sigma_scale * roughness.clamp(0.0, 1.0).powf(self.sigma_exponent)
+            + self.sigma_epsilon_px;
+        let scale = if roughness < self.roughness_threshold {
+            (-footprints.max(0.0) / self.ray_differential_omega.max(1e-3)).exp()
+        } else {
+            1.0
+        };
         (base * scale).clamp(0.0, MAX_GLOSSY_SIGMA_PX)
     }
 }
@@ -201,32 +207,151 @@ impl GlossySettings {
 /// Largest glossy bilateral sigma, pixels (the kernel reaches 2.5 sigma).
 pub const MAX_GLOSSY_SIGMA_PX: f32 = 9.0;
 
-
 fn reflection_mvs() -> Vec<String> {
     super::fields::names(&ReflectionMv::ALL)
 }
 
 /// Its fields, in panel order.
 pub const FIELDS: &[Field] = &[
-    f("glossy.reflection_mv", "glossy/motion", "", Choice(reflection_mvs), "Reflection motion: surface (primary), virtual position, or diamond search."),
-    f("glossy.roughness_threshold", "glossy/motion", "roughness", Float(0.0, 1.0, 0.005), "Reflection motion below this roughness, surface motion above (Voorhuis 0.4)."),
-    f("glossy.mirror_roughness", "glossy/motion", "roughness", Float(0.0, 1.0, 0.001), "At or below this roughness a surface is a mirror (exact reflected hits)."),
-    f("glossy.initial_step", "glossy/motion", "px", Int(1, 64), "First step of the diamond search's large pattern (Appendix A: 4)."),
-    f("glossy.max_search_steps", "glossy/motion", "steps", Int(1, 256), "Most large-pattern iterations per pixel."),
-    f("glossy.trace_representative_ray", "glossy/motion", "", Bool, "Trace the mirror ray of glossy surfaces under the threshold."),
-    f("glossy.temporal", "glossy/temporal", "", Bool, "Stage 8: reprojection of glossy history (off: NoSpecReproj)."),
-    f("glossy.hysteresis", "glossy/temporal", "", Float(0.0, 1.0, 0.001), "h for the glossy history."),
-    f("glossy.reprojection_normal_degrees", "glossy/temporal", "degrees", Float(0.0, 180.0, 0.5), "Surface reprojection rejects a previous texel whose normal differs by more (180: off)."),
-    f("glossy.d0_px", "glossy/temporal", "footprints", Float(0.0, 64.0, 0.05), "Eq. 11's d0 for mirrors, at the reflected distance."),
-    f("glossy.d1_px", "glossy/temporal", "footprints", Float(0.0, 64.0, 0.05), "Eq. 11's d1 for mirrors, at the reflected distance."),
-    f("glossy.clipping", "glossy/temporal", "", Bool, "Neighbourhood clipping of the reprojected history (Voorhuis 4.2.3)."),
-    f("glossy.clip_roughness", "glossy/temporal", "roughness", Float(0.0, 1.0, 0.005), "Clipping applies below this roughness (0.9)."),
+    f(
+        "glossy.reflection_mv",
+        "glossy/motion",
+        "",
+        Choice(reflection_mvs),
+        "Reflection motion: surface (primary), virtual position, or diamond search.",
+    ),
+    f(
+        "glossy.roughness_threshold",
+        "glossy/motion",
+        "roughness",
+        Float(0.0, 1.0, 0.005),
+        "Reflection motion below this roughness, surface motion above (Voorhuis 0.4).",
+    ),
+    f(
+        "glossy.mirror_roughness",
+        "glossy/motion",
+        "roughness",
+        Float(0.0, 1.0, 0.001),
+        "At or below this roughness a surface is a mirror (exact reflected hits).",
+    ),
+    f(
+        "glossy.initial_step",
+        "glossy/motion",
+        "px",
+        Int(1, 64),
+        "First step of the diamond search's large pattern (Appendix A: 4).",
+    ),
+    f(
+        "glossy.max_search_steps",
+        "glossy/motion",
+        "steps",
+        Int(1, 256),
+        "Most large-pattern iterations per pixel.",
+    ),
+    f(
+        "glossy.trace_representative_ray",
+        "glossy/motion",
+        "",
+        Bool,
+        "Trace the mirror ray of glossy surfaces under the threshold.",
+    ),
+    f(
+        "glossy.temporal",
+        "glossy/temporal",
+        "",
+        Bool,
+        "Stage 8: reprojection of glossy history (off: NoSpecReproj).",
+    ),
+    f(
+        "glossy.hysteresis",
+        "glossy/temporal",
+        "",
+        Float(0.0, 1.0, 0.001),
+        "h for the glossy history.",
+    ),
+    f(
+        "glossy.reprojection_normal_degrees",
+        "glossy/temporal",
+        "degrees",
+        Float(0.0, 180.0, 0.5),
+        "Surface reprojection rejects a previous texel whose normal differs by more (180: off).",
+    ),
+    f(
+        "glossy.d0_px",
+        "glossy/temporal",
+        "footprints",
+        Float(0.0, 64.0, 0.05),
+        "Eq. 11's d0 for mirrors, at the reflected distance.",
+    ),
+    f(
+        "glossy.d1_px",
+        "glossy/temporal",
+        "footprints",
+        Float(0.0, 64.0, 0.05),
+        "Eq. 11's d1 for mirrors, at the reflected distance.",
+    ),
+    f(
+        "glossy.clipping",
+        "glossy/temporal",
+        "",
+        Bool,
+        "Neighbourhood clipping of the reprojected history (Voorhuis 4.2.3).",
+    ),
+    f(
+        "glossy.clip_roughness",
+        "glossy/temporal",
+        "roughness",
+        Float(0.0, 1.0, 0.005),
+        "Clipping applies below this roughness (0.9).",
+    ),
     f("glossy.bilateral", "glossy/bilateral", "", Bool, "Stages 9-10: separable bilateral."),
-    f("glossy.sigma_scale", "glossy/bilateral", "px", Float(0.0, 9.0, 0.05), "Sigma = scale x roughness^exponent + epsilon (Mara 7)."),
-    f("glossy.sigma_exponent", "glossy/bilateral", "", Float(0.0, 4.0, 0.005), "Roughness exponent of sigma (Mara 0.1)."),
-    f("glossy.sigma_epsilon_px", "glossy/bilateral", "px", Float(0.0, 9.0, 0.05), "Sigma at roughness 0."),
-    f("glossy.sigma_full_frames", "glossy/bilateral", "frames", Float(0.0, 256.0, 0.1), "Past this history length sigma shrinks as 1/sqrt(length) (0: fixed)."),
-    f("glossy.resampled_history_frames", "glossy/temporal", "frames", Float(0.0, 1024.0, 1.0), "A bilinearly resampled history counts as at most this many frames (0: no cap)."),
-    f("glossy.ray_differential_omega", "glossy/bilateral", "footprints", Float(0.001, 1024.0, 0.1), "Voorhuis eq. 6's omega: sigma x exp(-ray differential / omega)."),
-    f("glossy.roughness_sigma", "glossy/bilateral", "roughness", Float(0.0, 1.0, 0.001), "Bilateral weight on roughness differences."),
+    f(
+        "glossy.sigma_scale",
+        "glossy/bilateral",
+        "px",
+        Float(0.0, 9.0, 0.05),
+        "Sigma = scale x roughness^exponent + epsilon (Mara 7).",
+    ),
+    f(
+        "glossy.sigma_exponent",
+        "glossy/bilateral",
+        "",
+        Float(0.0, 4.0, 0.005),
+        "Roughness exponent of sigma (Mara 0.1).",
+    ),
+    f(
+        "glossy.sigma_epsilon_px",
+        "glossy/bilateral",
+        "px",
+        Float(0.0, 9.0, 0.05),
+        "Sigma at roughness 0.",
+    ),
+    f(
+        "glossy.sigma_full_frames",
+        "glossy/bilateral",
+        "frames",
+        Float(0.0, 256.0, 0.1),
+        "Past this history length sigma shrinks as 1/sqrt(length) (0: fixed).",
+    ),
+    f(
+        "glossy.resampled_history_frames",
+        "glossy/temporal",
+        "frames",
+        Float(0.0, 1024.0, 1.0),
+        "A bilinearly resampled history counts as at most this many frames (0: no cap).",
+    ),
+    f(
+        "glossy.ray_differential_omega",
+        "glossy/bilateral",
+        "footprints",
+        Float(0.001, 1024.0, 0.1),
+        "Voorhuis eq. 6's omega: sigma x exp(-ray differential / omega).",
+    ),
+    f(
+        "glossy.roughness_sigma",
+        "glossy/bilateral",
+        "roughness",
+        Float(0.0, 1.0, 0.001),
+        "Bilateral weight on roughness differences.",
+    ),
 ];

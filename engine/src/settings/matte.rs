@@ -139,7 +139,13 @@ impl Default for MatteSettings {
 impl MatteSettings {
     /// Names accepted by `--disable` and shown in the viewer (the glossy chain's are in
     /// [`super::GlossySettings::STAGES`]).
-    pub const STAGES: [&str; 5] = ["matte.temporal", "matte.history_bilateral", "matte.disocclusion", "matte.firefly", "matte.bilateral"];
+    pub const STAGES: [&str; 5] = [
+        "matte.temporal",
+        "matte.history_bilateral",
+        "matte.disocclusion",
+        "matte.firefly",
+        "matte.bilateral",
+    ];
 
     /// Turn a stage off by name; false for an unknown name.
     pub fn disable(&mut self, name: &str) -> bool {
@@ -166,28 +172,147 @@ impl MatteSettings {
     }
 }
 
-
 /// Its fields, in panel order.
 pub const FIELDS: &[Field] = &[
-    f("matte.temporal", "matte/temporal", "", Bool, "Stage 3: reverse reprojection with confidence (Mara eq. 11)."),
-    f("matte.hysteresis", "matte/temporal", "", Float(0.0, 1.0, 0.001), "h of eq. 11: the history's weight at full confidence (paper 0.98)."),
-    f("matte.d0_px", "matte/temporal", "footprints", Float(0.0, 64.0, 0.05), "Eq. 11's d0: full confidence below this reprojection distance."),
-    f("matte.d1_px", "matte/temporal", "footprints", Float(0.0, 64.0, 0.05), "Eq. 11's d1: zero confidence beyond this reprojection distance."),
-    f("matte.clamp_sigma", "matte/temporal", "sigma", Float(0.0, 16.0, 0.05), "Clamp history to the neighbourhood's mean +- this many deviations (0: off)."),
-    f("matte.reprojection_normal_degrees", "matte/temporal", "degrees", Float(0.0, 180.0, 0.5), "Reprojection rejects a previous texel whose normal differs by more (180: off)."),
-    f("matte.history_bilateral", "matte/history_bilateral", "", Bool, "Stage 4: sparse bilateral on what is written back to history."),
-    f("matte.taps", "matte/history_bilateral", "taps", Int(1, 256), "Taps of both sparse bilaterals (paper 50)."),
-    f("matte.history_diameter_fraction", "matte/history_bilateral", "of width", Float(0.0, 0.2, 0.0005), "Disk diameter of the history bilateral (paper 1%)."),
-    f("matte.history_full_frames", "matte/history_bilateral", "frames", Float(0.0, 1024.0, 0.1), "Past this history length the disk shrinks as 1/sqrt(length) (0: fixed)."),
-    f("matte.resampled_history_frames", "matte/temporal", "frames", Float(0.0, 1024.0, 1.0), "A bilinearly resampled history counts as at most this many frames (0: no cap)."),
-    f("matte.normal_power", "matte/history_bilateral", "exponent", Float(0.0, 512.0, 0.5), "Bilateral normal weight: cos^power (both sparse bilaterals)."),
-    f("matte.plane_sigma_px", "matte/history_bilateral", "footprints", Float(0.0, 64.0, 0.05), "Bilateral plane-distance sigma (both sparse bilaterals)."),
-    f("matte.disocclusion", "matte/disocclusion", "", Bool, "Stage 5: the disocclusion-driven radius r = (1 - min c) R."),
-    f("matte.disocclusion_fraction", "matte/disocclusion", "of width", Float(0.0, 0.5, 0.001), "R as a fraction of the width (paper 1/20)."),
-    f("matte.low_confidence_multiplier", "matte/disocclusion", "x", Float(1.0, 32.0, 0.05), "Radius multiplier where c < 1/2 (paper 6)."),
+    f(
+        "matte.temporal",
+        "matte/temporal",
+        "",
+        Bool,
+        "Stage 3: reverse reprojection with confidence (Mara eq. 11).",
+    ),
+    f(
+        "matte.hysteresis",
+        "matte/temporal",
+        "",
+        Float(0.0, 1.0, 0.001),
+        "h of eq. 11: the history's weight at full confidence (paper 0.98).",
+    ),
+    f(
+        "matte.d0_px",
+        "matte/temporal",
+        "footprints",
+        Float(0.0, 64.0, 0.05),
+        "Eq. 11's d0: full confidence below this reprojection distance.",
+    ),
+    f(
+        "matte.d1_px",
+        "matte/temporal",
+        "footprints",
+        Float(0.0, 64.0, 0.05),
+        "Eq. 11's d1: zero confidence beyond this reprojection distance.",
+    ),
+    f(
+        "matte.clamp_sigma",
+        "matte/temporal",
+        "sigma",
+        Float(0.0, 16.0, 0.05),
+        "Clamp history to the neighbourhood's mean +- this many deviations (0: off).",
+    ),
+    f(
+        "matte.reprojection_normal_degrees",
+        "matte/temporal",
+        "degrees",
+        Float(0.0, 180.0, 0.5),
+        "Reprojection rejects a previous texel whose normal differs by more (180: off).",
+    ),
+    f(
+        "matte.history_bilateral",
+        "matte/history_bilateral",
+        "",
+        Bool,
+        "Stage 4: sparse bilateral on what is written back to history.",
+    ),
+    f(
+        "matte.taps",
+        "matte/history_bilateral",
+        "taps",
+        Int(1, 256),
+        "Taps of both sparse bilaterals (paper 50).",
+    ),
+    f(
+        "matte.history_diameter_fraction",
+        "matte/history_bilateral",
+        "of width",
+        Float(0.0, 0.2, 0.0005),
+        "Disk diameter of the history bilateral (paper 1%).",
+    ),
+    f(
+        "matte.history_full_frames",
+        "matte/history_bilateral",
+        "frames",
+        Float(0.0, 1024.0, 0.1),
+        "Past this history length the disk shrinks as 1/sqrt(length) (0: fixed).",
+    ),
+    f(
+        "matte.resampled_history_frames",
+        "matte/temporal",
+        "frames",
+        Float(0.0, 1024.0, 1.0),
+        "A bilinearly resampled history counts as at most this many frames (0: no cap).",
+    ),
+    f(
+        "matte.normal_power",
+        "matte/history_bilateral",
+        "exponent",
+        Float(0.0, 512.0, 0.5),
+        "Bilateral normal weight: cos^power (both sparse bilaterals).",
+    ),
+    f(
+        "matte.plane_sigma_px",
+        "matte/history_bilateral",
+        "footprints",
+        Float(0.0, 64.0, 0.05),
+        "Bilateral plane-distance sigma (both sparse bilaterals).",
+    ),
+    f(
+        "matte.disocclusion",
+        "matte/disocclusion",
+        "",
+        Bool,
+        "Stage 5: the disocclusion-driven radius r = (1 - min c) R.",
+    ),
+    f(
+        "matte.disocclusion_fraction",
+        "matte/disocclusion",
+        "of width",
+        Float(0.0, 0.5, 0.001),
+        "R as a fraction of the width (paper 1/20).",
+    ),
+    f(
+        "matte.low_confidence_multiplier",
+        "matte/disocclusion",
+        "x",
+        Float(1.0, 32.0, 0.05),
+        "Radius multiplier where c < 1/2 (paper 6).",
+    ),
     f("matte.firefly", "matte/firefly", "", Bool, "Stage 6: 3x3 median outside the history loop."),
-    f("matte.bilateral", "matte/bilateral", "", Bool, "Stage 7: final sparse bilateral with radius r."),
-    f("matte.max_radius_fraction", "matte/bilateral", "of width", Float(0.0, 0.5, 0.001), "Largest final-bilateral radius."),
-    f("matte.min_radius_fraction", "matte/bilateral", "of width", Float(0.0, 0.5, 0.001), "Smallest final-bilateral radius (0: the paper's (1 - c) R alone)."),
-    f("matte.edge_stop_sigmas", "matte/bilateral", "sigma", Float(0.0, 256.0, 0.5), "Final bilateral's luminance edge-stop, in standard deviations of the history's noise (0: none)."),
+    f(
+        "matte.bilateral",
+        "matte/bilateral",
+        "",
+        Bool,
+        "Stage 7: final sparse bilateral with radius r.",
+    ),
+    f(
+        "matte.max_radius_fraction",
+        "matte/bilateral",
+        "of width",
+        Float(0.0, 0.5, 0.001),
+        "Largest final-bilateral radius.",
+    ),
+    f(
+        "matte.min_radius_fraction",
+        "matte/bilateral",
+        "of width",
+        Float(0.0, 0.5, 0.001),
+        "Smallest final-bilateral radius (0: the paper's (1 - c) R alone).",
+    ),
+    f(
+        "matte.edge_stop_sigmas",
+        "matte/bilateral",
+        "sigma",
+        Float(0.0, 256.0, 0.5),
+        "Final bilateral's luminance edge-stop, in standard deviations of the history's noise (0: none).",
+    ),
 ];

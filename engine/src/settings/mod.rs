@@ -18,7 +18,10 @@ pub use matte::MatteSettings;
 pub use progressive::{MAX_LEVELS as PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
 pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, SvgfSettings};
 pub use taa::TaaSettings;
-pub use view::{FRAME_VIEWS, MARA_VIEWS, PROGRESSIVE_VIEWS, SVGF_VIEWS, View, ViewMap, ViewSpec, all_views, register_views};
+pub use view::{
+    FRAME_VIEWS, MARA_VIEWS, PROGRESSIVE_VIEWS, SVGF_VIEWS, View, ViewMap, ViewSpec, all_views,
+    register_views,
+};
 
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -94,7 +97,24 @@ impl FrameSettings {
 
 impl Default for FrameSettings {
     fn default() -> Self {
-        FrameSettings { exposure_ev: 0.0, max_depth: crate::scene::DEFAULT_MAX_DEPTH, seed: 0, accumulate: false, view: View::FINAL, denoiser: Denoiser::NONE, matte: MatteSettings::default(), taa: TaaSettings::default(), glossy: GlossySettings::default(), svgf: SvgfSettings::default(), progressive: ProgressiveSettings::default(), paths_per_pixel: 1, samples_per_pixel: 1, sample_fraction: SampleFraction::ONE, primary_samples: DEFAULT_PRIMARY_SAMPLES, prefilter: true }
+        FrameSettings {
+            exposure_ev: 0.0,
+            max_depth: crate::scene::DEFAULT_MAX_DEPTH,
+            seed: 0,
+            accumulate: false,
+            view: View::FINAL,
+            denoiser: Denoiser::NONE,
+            matte: MatteSettings::default(),
+            taa: TaaSettings::default(),
+            glossy: GlossySettings::default(),
+            svgf: SvgfSettings::default(),
+            progressive: ProgressiveSettings::default(),
+            paths_per_pixel: 1,
+            samples_per_pixel: 1,
+            sample_fraction: SampleFraction::ONE,
+            primary_samples: DEFAULT_PRIMARY_SAMPLES,
+            prefilter: true,
+        }
     }
 }
 
@@ -130,7 +150,10 @@ impl<'de> Deserialize<'de> for Denoiser {
         let name = String::deserialize(d)?;
         let known = denoiser_names();
         if !known.contains(&name.as_str()) {
-            return Err(serde::de::Error::custom(format!("no denoiser {name:?} (there are {})", known.join(", "))));
+            return Err(serde::de::Error::custom(format!(
+                "no denoiser {name:?} (there are {})",
+                known.join(", ")
+            )));
         }
         Ok(Denoiser::named(&name))
     }
@@ -158,10 +181,20 @@ pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
         s.taa.enabled = false;
         return true;
     }
-    s.matte.disable(name) || s.glossy.disable(name) || s.svgf.disable(name) || s.progressive.disable(name)
+    s.matte.disable(name)
+        || s.glossy.disable(name)
+        || s.svgf.disable(name)
+        || s.progressive.disable(name)
 }
 
 /// Every stage name `--disable` accepts.
 pub fn stage_names() -> Vec<&'static str> {
-    MatteSettings::STAGES.iter().chain(&[TaaSettings::STAGE]).chain(GlossySettings::STAGES.iter()).chain(SvgfSettings::STAGES.iter()).chain(ProgressiveSettings::STAGES.iter()).copied().collect()
+    MatteSettings::STAGES
+        .iter()
+        .chain(&[TaaSettings::STAGE])
+        .chain(GlossySettings::STAGES.iter())
+        .chain(SvgfSettings::STAGES.iter())
+        .chain(ProgressiveSettings::STAGES.iter())
+        .copied()
+        .collect()
 }

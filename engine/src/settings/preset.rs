@@ -16,19 +16,23 @@ impl FrameSettings {
     }
 
     pub fn save_preset(&self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.to_toml()?).with_context(|| format!("writing preset {}", path.display()))
+        std::fs::write(path, self.to_toml()?)
+            .with_context(|| format!("writing preset {}", path.display()))
     }
 
     /// The path length a preset file names, if it names one: a preset saved without
     /// `max_depth` keeps the scene's instead of the default's.
     pub fn preset_max_depth(path: &Path) -> Result<Option<i32>> {
-        let text = crate::limits::read_text_file(path).with_context(|| format!("reading preset {}", path.display()))?;
-        let v: toml::Value = toml::from_str(&text).with_context(|| format!("reading TOML settings of preset {}", path.display()))?;
+        let text = crate::limits::read_text_file(path)
+            .with_context(|| format!("reading preset {}", path.display()))?;
+        let v: toml::Value = toml::from_str(&text)
+            .with_context(|| format!("reading TOML settings of preset {}", path.display()))?;
         Ok(v.get("max_depth").and_then(|d| d.as_integer()).map(|d| d as i32))
     }
 
     pub fn load_preset(path: &Path) -> Result<FrameSettings> {
-        let text = crate::limits::read_text_file(path).with_context(|| format!("reading preset {}", path.display()))?;
+        let text = crate::limits::read_text_file(path)
+            .with_context(|| format!("reading preset {}", path.display()))?;
         FrameSettings::from_toml(&text).with_context(|| format!("preset {}", path.display()))
     }
 }
@@ -40,7 +44,15 @@ mod tests {
 
     #[test]
     fn settings_round_trip_through_a_preset_file() {
-        let mut s = FrameSettings { exposure_ev: -1.25, max_depth: 4, seed: 7, denoiser: Denoiser::MARA, paths_per_pixel: 2, view: crate::settings::View::named("glossy/sigma"), ..Default::default() };
+        let mut s = FrameSettings {
+            exposure_ev: -1.25,
+            max_depth: 4,
+            seed: 7,
+            denoiser: Denoiser::MARA,
+            paths_per_pixel: 2,
+            view: crate::settings::View::named("glossy/sigma"),
+            ..Default::default()
+        };
         s.matte.hysteresis = 0.9;
         s.matte.firefly = false;
         s.matte.taps = 32;
@@ -56,15 +68,25 @@ mod tests {
 
     #[test]
     fn a_partial_preset_keeps_the_other_defaults() {
-        let s = FrameSettings::from_toml("denoiser = \"mara\"\n[matte]\nfirefly = false\n").unwrap();
-        assert_eq!(s, FrameSettings { denoiser: Denoiser::MARA, matte: crate::settings::MatteSettings { firefly: false, ..Default::default() }, ..Default::default() });
-        let e = format!("{:#}", FrameSettings::from_toml("[glossy]\nsigma_scael = 3.0\n").unwrap_err());
+        let s =
+            FrameSettings::from_toml("denoiser = \"mara\"\n[matte]\nfirefly = false\n").unwrap();
+        assert_eq!(
+            s,
+            FrameSettings {
+                denoiser: Denoiser::MARA,
+                matte: crate::settings::MatteSettings { firefly: false, ..Default::default() },
+                ..Default::default()
+            }
+        );
+        let e =
+            format!("{:#}", FrameSettings::from_toml("[glossy]\nsigma_scael = 3.0\n").unwrap_err());
         assert!(e.contains("glossy.sigma_scael"), "{e}");
     }
 
     #[test]
     fn a_preset_names_its_path_length_only_when_it_sets_one() {
-        let path = std::env::temp_dir().join(format!("hush-preset-depth-{}.toml", std::process::id()));
+        let path =
+            std::env::temp_dir().join(format!("hush-preset-depth-{}.toml", std::process::id()));
         std::fs::write(&path, "denoiser = \"mara\"\n").unwrap();
         let without = FrameSettings::preset_max_depth(&path).unwrap();
         std::fs::write(&path, "max_depth = 3\n").unwrap();

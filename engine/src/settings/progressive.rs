@@ -34,7 +34,16 @@ pub struct ProgressiveSettings {
 
 impl Default for ProgressiveSettings {
     fn default() -> Self {
-        ProgressiveSettings { temporal: true, alpha: 0.1, still_samples: 64.0, levels: 5, sigma_n: 64.0, sigma_d: 1.0, sigma_l: 4.0, epsilon_l: 0.05 }
+        ProgressiveSettings {
+            temporal: true,
+            alpha: 0.1,
+            still_samples: 64.0,
+            levels: 5,
+            sigma_n: 64.0,
+            sigma_d: 1.0,
+            sigma_l: 4.0,
+            epsilon_l: 0.05,
+        }
     }
 }
 
@@ -55,12 +64,60 @@ impl ProgressiveSettings {
 
 /// Its fields, in panel order.
 pub const FIELDS: &[Field] = &[
-    f("progressive.temporal", "progressive/temporal", "", Bool, "Accumulate light and moments over samples (Dundr §4.2)."),
-    f("progressive.alpha", "progressive/temporal", "", Float(0.01, 1.0, 0.005), "Smallest weight of a new sample, r = max(a, 1/age)."),
-    f("progressive.still_samples", "progressive/temporal", "samples", Float(0.0, 1024.0, 1.0), "In a still view the light becomes a true mean of up to this many samples (0: alpha always)."),
-    f("progressive.levels", "progressive/atrous", "", Int(0, MAX_LEVELS as i64), "A-trous levels of the 3x3 kernel, large scale first (Dundr: 5)."),
-    f("progressive.sigma_n", "progressive/atrous", "", Float(0.0, 256.0, 1.0), "Normal weight exponent (Dundr: 64)."),
-    f("progressive.sigma_d", "progressive/atrous", "", Float(0.01, 16.0, 0.05), "Depth weight in depth gradients (Dundr: 1)."),
-    f("progressive.sigma_l", "progressive/atrous", "", Float(0.0, 64.0, 0.1), "Luminance weight: exp(-|dL| / (sigma_L var + epsilon)) (Dundr: 4)."),
-    f("progressive.epsilon_l", "progressive/atrous", "", Float(0.0, 1.0, 0.005), "epsilon of the luminance weight (Dundr: 0.01 to 0.1)."),
+    f(
+        "progressive.temporal",
+        "progressive/temporal",
+        "",
+        Bool,
+        "Accumulate light and moments over samples (Dundr §4.2).",
+    ),
+    f(
+        "progressive.alpha",
+        "progressive/temporal",
+        "",
+        Float(0.01, 1.0, 0.005),
+        "Smallest weight of a new sample, r = max(a, 1/age).",
+    ),
+    f(
+        "progressive.still_samples",
+        "progressive/temporal",
+        "samples",
+        Float(0.0, 1024.0, 1.0),
+        "In a still view the light becomes a true mean of up to this many samples (0: alpha always).",
+    ),
+    f(
+        "progressive.levels",
+        "progressive/atrous",
+        "",
+        Int(0, MAX_LEVELS as i64),
+        "A-trous levels of the 3x3 kernel, large scale first (Dundr: 5).",
+    ),
+    f(
+        "progressive.sigma_n",
+        "progressive/atrous",
+        "",
+        Float(0.0, 256.0, 1.0),
+        "Normal weight exponent (Dundr: 64).",
+    ),
+    f(
+        "progressive.sigma_d",
+        "progressive/atrous",
+        "",
+        Float(0.01, 16.0, 0.05),
+        "Depth weight in depth gradients (Dundr: 1).",
+    ),
+    f(
+        "progressive.sigma_l",
+        "progressive/atrous",
+        "",
+        Float(0.0, 64.0, 0.1),
+        "Luminance weight: exp(-|dL| / (sigma_L var + epsilon)) (Dundr: 4).",
+    ),
+    f(
+        "progressive.epsilon_l",
+        "progressive/atrous",
+        "",
+        Float(0.0, 1.0, 0.005),
+        "epsilon of the luminance weight (Dundr: 0.01 to 0.1).",
+    ),
 ];

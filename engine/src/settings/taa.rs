@@ -38,7 +38,15 @@ pub struct TaaSettings {
 
 impl Default for TaaSettings {
     fn default() -> Self {
-        TaaSettings { enabled: true, alpha: 0.1, still_frames: 64.0, resampled_frames: 1.0, display_ratio: 4.0, current_light: 1.0, current_glossy: 1.0 }
+        TaaSettings {
+            enabled: true,
+            alpha: 0.1,
+            still_frames: 64.0,
+            resampled_frames: 1.0,
+            display_ratio: 4.0,
+            current_light: 1.0,
+            current_glossy: 1.0,
+        }
     }
 }
 
@@ -54,11 +62,53 @@ impl TaaSettings {
 
 /// Its fields, in panel order.
 pub const FIELDS: &[Field] = &[
-    f("taa.enabled", "taa", "", Bool, "Temporal anti-aliasing with a jittered raster and YCoCg clamping."),
-    f("taa.alpha", "taa", "", Float(0.0, 1.0, 0.005), "Weight of the current frame in TAA's blend."),
-    f("taa.display_ratio", "taa", "", Float(0.0, 64.0, 0.5), "The shown image follows a settled pixel's history with this many times its weight (0: shows it as is)."),
-    f("taa.current_light", "taa", "", Float(0.0, 1.0, 0.05), "Share of a settled pixel's matte-light lag taken out (the denoiser's current matte light in place of TAA's average)."),
-    f("taa.current_glossy", "taa", "", Float(0.0, 1.0, 0.05), "Share of a settled pixel's glossy-light lag taken out (the denoiser's current glossy light in place of TAA's average)."),
-    f("taa.resampled_frames", "taa", "frames", Float(0.0, 64.0, 1.0), "History length a pixel restarts at when it stands still after moving (0: carries on)."),
-    f("taa.still_frames", "taa", "", Float(0.0, 256.0, 1.0), "In a still view the current frame's weight falls to 1 / this (0: always alpha)."),
+    f(
+        "taa.enabled",
+        "taa",
+        "",
+        Bool,
+        "Temporal anti-aliasing with a jittered raster and YCoCg clamping.",
+    ),
+    f(
+        "taa.alpha",
+        "taa",
+        "",
+        Float(0.0, 1.0, 0.005),
+        "Weight of the current frame in TAA's blend.",
+    ),
+    f(
+        "taa.display_ratio",
+        "taa",
+        "",
+        Float(0.0, 64.0, 0.5),
+        "The shown image follows a settled pixel's history with this many times its weight (0: shows it as is).",
+    ),
+    f(
+        "taa.current_light",
+        "taa",
+        "",
+        Float(0.0, 1.0, 0.05),
+        "Share of a settled pixel's matte-light lag taken out (the denoiser's current matte light in place of TAA's average).",
+    ),
+    f(
+        "taa.current_glossy",
+        "taa",
+        "",
+        Float(0.0, 1.0, 0.05),
+        "Share of a settled pixel's glossy-light lag taken out (the denoiser's current glossy light in place of TAA's average).",
+    ),
+    f(
+        "taa.resampled_frames",
+        "taa",
+        "frames",
+        Float(0.0, 64.0, 1.0),
+        "History length a pixel restarts at when it stands still after moving (0: carries on).",
+    ),
+    f(
+        "taa.still_frames",
+        "taa",
+        "",
+        Float(0.0, 256.0, 1.0),
+        "In a still view the current frame's weight falls to 1 / this (0: always alpha).",
+    ),
 ];

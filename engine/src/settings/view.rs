@@ -87,7 +87,9 @@ impl ViewMap {
             ViewMap::Light => (1, 0, 0.0),
             ViewMap::Color => (2, 0, 0.0),
             ViewMap::Grey { channel, divisor } => (3, channel, divisor),
-            ViewMap::GreyPerWidth { channel, fraction } => (3, channel, (width as f32 * fraction).max(1.0)),
+            ViewMap::GreyPerWidth { channel, fraction } => {
+                (3, channel, (width as f32 * fraction).max(1.0))
+            }
             ViewMap::Motion { channel } => (4, channel, 0.0),
             ViewMap::Normal => (5, 0, 0.0),
             ViewMap::Depth => (6, 0, 0.0),
@@ -117,7 +119,10 @@ impl ViewSpec {
 
     /// Views of buffers that exist only in scenes with a specular lobe.
     pub fn needs_glossy(&self) -> bool {
-        self.texture.starts_with("glossy/") || self.texture.starts_with("svgf/glossy") || self.texture.starts_with("progressive/glossy") || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
+        self.texture.starts_with("glossy/")
+            || self.texture.starts_with("svgf/glossy")
+            || self.texture.starts_with("progressive/glossy")
+            || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
     }
 }
 
@@ -160,7 +165,11 @@ pub const MARA_VIEWS: &[ViewSpec] = &[
     v("matte/confidence", "matte/temporal", ViewMap::Grey { channel: 3, divisor: 1.0 }),
     v("matte/history rejection", "matte/reason", ViewMap::Flags),
     // The radius over R (the disocclusion radius at full strength is white).
-    v("matte/disocclusion radius", "matte/radius", ViewMap::GreyPerWidth { channel: 0, fraction: 0.05 }),
+    v(
+        "matte/disocclusion radius",
+        "matte/radius",
+        ViewMap::GreyPerWidth { channel: 0, fraction: 0.05 },
+    ),
     v("matte/firefly", "matte/firefly", ViewMap::Light),
     v("matte/bilateral", "matte/bilateral", ViewMap::Light),
     v("glossy/motion", "glossy/motion", ViewMap::Motion { channel: 0 }),
@@ -182,13 +191,25 @@ pub const SVGF_VIEWS: &[ViewSpec] = &[
     v("svgf/matte integrated", "svgf/matte integrated", ViewMap::Light),
     // The luminance variance that steers the first a-trous level; 1 is white.
     v("svgf/matte variance", "svgf/matte variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
-    v("svgf/matte history length", "svgf/matte moments 0", ViewMap::Grey { channel: 2, divisor: 32.0 }),
-    v("svgf/matte first moment", "svgf/matte moments 0", ViewMap::Grey { channel: 0, divisor: 1.0 }),
+    v(
+        "svgf/matte history length",
+        "svgf/matte moments 0",
+        ViewMap::Grey { channel: 2, divisor: 32.0 },
+    ),
+    v(
+        "svgf/matte first moment",
+        "svgf/matte moments 0",
+        ViewMap::Grey { channel: 0, divisor: 1.0 },
+    ),
     v("svgf/matte history", "svgf/matte history 0", ViewMap::Light),
     v("svgf/matte", "svgf/matte out", ViewMap::Light),
     v("svgf/glossy integrated", "svgf/glossy integrated", ViewMap::Light),
     v("svgf/glossy variance", "svgf/glossy variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
-    v("svgf/glossy history length", "svgf/glossy moments 0", ViewMap::Grey { channel: 2, divisor: 32.0 }),
+    v(
+        "svgf/glossy history length",
+        "svgf/glossy moments 0",
+        ViewMap::Grey { channel: 2, divisor: 32.0 },
+    ),
     v("svgf/glossy history", "svgf/glossy history 0", ViewMap::Light),
     v("svgf/glossy motion", "svgf/glossy motion", ViewMap::Motion { channel: 0 }),
     v("svgf/glossy", "svgf/glossy out", ViewMap::Light),
@@ -198,9 +219,17 @@ pub const SVGF_VIEWS: &[ViewSpec] = &[
 pub const PROGRESSIVE_VIEWS: &[ViewSpec] = &[
     v("progressive/matte accumulated", "progressive/matte history 0", ViewMap::Light),
     // The 3x3-blurred luminance variance; 1 is white (no estimate yet: white).
-    v("progressive/matte variance", "progressive/matte variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v(
+        "progressive/matte variance",
+        "progressive/matte variance",
+        ViewMap::Grey { channel: 3, divisor: 1.0 },
+    ),
     // Samples accumulated per pixel; 32 is white, black where none arrived yet.
-    v("progressive/matte samples", "progressive/matte moments 0", ViewMap::Grey { channel: 2, divisor: 32.0 }),
+    v(
+        "progressive/matte samples",
+        "progressive/matte moments 0",
+        ViewMap::Grey { channel: 2, divisor: 32.0 },
+    ),
     v("progressive/direct accumulated", "progressive/direct history 0", ViewMap::Light),
     v("progressive/glossy accumulated", "progressive/glossy history 0", ViewMap::Light),
 ];
@@ -212,7 +241,14 @@ static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
 pub fn register_views(views: &[ViewSpec]) {
     let mut r = REGISTERED.write().unwrap();
     for v in views {
-        if !FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(PROGRESSIVE_VIEWS).chain(r.iter()).any(|k| k.name == v.name) {
+        if !FRAME_VIEWS
+            .iter()
+            .chain(MARA_VIEWS)
+            .chain(SVGF_VIEWS)
+            .chain(PROGRESSIVE_VIEWS)
+            .chain(r.iter())
+            .any(|k| k.name == v.name)
+        {
             r.push(*v);
         }
     }
@@ -220,5 +256,12 @@ pub fn register_views(views: &[ViewSpec]) {
 
 /// Every view: the frame's, then the denoisers'.
 pub fn all_views() -> Vec<ViewSpec> {
-    FRAME_VIEWS.iter().chain(MARA_VIEWS).chain(SVGF_VIEWS).chain(PROGRESSIVE_VIEWS).chain(REGISTERED.read().unwrap().iter()).copied().collect()
+    FRAME_VIEWS
+        .iter()
+        .chain(MARA_VIEWS)
+        .chain(SVGF_VIEWS)
+        .chain(PROGRESSIVE_VIEWS)
+        .chain(REGISTERED.read().unwrap().iter())
+        .copied()
+        .collect()
 }

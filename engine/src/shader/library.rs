@@ -40,7 +40,12 @@ impl ShaderLibrary {
         let mut texts = HashMap::new();
         for (name, _) in SOURCES {
             let path = dir.join(name);
-            let text = std::fs::read_to_string(&path).with_context(|| format!("reading shader {} (the folder must hold every module of shaders/)", path.display()))?;
+            let text = std::fs::read_to_string(&path).with_context(|| {
+                format!(
+                    "reading shader {} (the folder must hold every module of shaders/)",
+                    path.display()
+                )
+            })?;
             texts.insert(*name, Arc::from(text));
         }
         Ok(ShaderLibrary { dir: Some(dir), texts: RwLock::new(texts) })
@@ -49,7 +54,9 @@ impl ShaderLibrary {
     /// `$HUSH_SHADERS` when set, else `fallback` when given, else the embedded shaders.
     pub fn from_env_or(fallback: Option<&Path>) -> Result<ShaderLibrary> {
         match std::env::var_os(SHADER_DIR_VAR) {
-            Some(d) => ShaderLibrary::from_dir(Path::new(&d)).with_context(|| format!("${SHADER_DIR_VAR}")),
+            Some(d) => {
+                ShaderLibrary::from_dir(Path::new(&d)).with_context(|| format!("${SHADER_DIR_VAR}"))
+            }
             None => fallback.map_or(Ok(ShaderLibrary::embedded()), ShaderLibrary::from_dir),
         }
     }
@@ -64,7 +71,9 @@ impl ShaderLibrary {
     /// `shaders/` or by another text.
     pub fn add(&self, module: &'static str, text: &str) -> Result<()> {
         let mut texts = self.texts.write().unwrap();
-        if SOURCES.iter().any(|(n, _)| *n == module) || texts.get(module).is_some_and(|t| **t != *text) {
+        if SOURCES.iter().any(|(n, _)| *n == module)
+            || texts.get(module).is_some_and(|t| **t != *text)
+        {
             return Err(anyhow!("shader module {module:?} already exists"));
         }
         texts.insert(module, Arc::from(text));
@@ -104,7 +113,8 @@ impl ShaderLibrary {
                         changed.push(*m);
                     }
                 }
-                Err(e) => errors.push(format!("{m}: {}", anyhow!(e).context("reading the changed shader"))),
+                Err(e) => errors
+                    .push(format!("{m}: {}", anyhow!(e).context("reading the changed shader"))),
             }
         }
         (changed, errors)

@@ -27,7 +27,7 @@ mod watch;
 
 pub use library::{SHADER_DIR_VAR, ShaderLibrary, source_tree_dir};
 pub use reflect::{FixedCompute, ProgramBindings, Slot, reflect};
-pub use reload::{Reload, Reloadable, ReloadOutcome};
+pub use reload::{Reload, ReloadOutcome, Reloadable};
 pub use watch::ShaderWatcher;
 
 use anyhow::{Result, anyhow};
@@ -159,7 +159,12 @@ pub fn compose(label: &str, prelude: &str, modules: &[&'static str]) -> Result<P
 /// in group [`SHARED_GROUP`] when their module is one of [`shared_module`]'s and in
 /// [`STAGE_GROUP`] otherwise. Rust binds them by name ([`reflect`]), so no number is kept by
 /// hand, and the attributes go on the declaration's own line, so that errors keep their lines.
-pub fn compose_with(label: &str, prelude: &str, modules: &[&'static str], source: impl Fn(&str) -> Result<std::sync::Arc<str>>) -> Result<Program> {
+pub fn compose_with(
+    label: &str,
+    prelude: &str,
+    modules: &[&'static str],
+    source: impl Fn(&str) -> Result<std::sync::Arc<str>>,
+) -> Result<Program> {
     let mut text = String::from(prelude);
     let mut next = [0u32; 2];
     for m in modules {
@@ -184,7 +189,14 @@ pub const STAGE_GROUP: u32 = 1;
 
 /// Modules whose resources are the scene's or the frame's, shared by every stage.
 pub fn shared_module(path: &str) -> bool {
-    path.starts_with("common/") || matches!(path, "realtime/frame.wgsl" | "realtime/gbuffer_in.wgsl" | "realtime/glossy_in.wgsl" | "realtime/motion_objects.wgsl")
+    path.starts_with("common/")
+        || matches!(
+            path,
+            "realtime/frame.wgsl"
+                | "realtime/gbuffer_in.wgsl"
+                | "realtime/glossy_in.wgsl"
+                | "realtime/motion_objects.wgsl"
+        )
 }
 
 /// A module-scope `var` in the uniform, storage or handle address space (the only ones a
@@ -230,23 +242,30 @@ impl Program {
     /// Validate; also naga's analysis of the module (what each entry point uses).
     pub fn validate_with_info(&self) -> Result<(naga::Module, naga::valid::ModuleInfo)> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
-            let at = self.at(e.location(&self.text).filter(|l| l.length > 0).map(|l| l.line_number as usize));
+            let at = self.at(e
+                .location(&self.text)
+                .filter(|l| l.length > 0)
+                .map(|l| l.line_number as usize));
             anyhow!("{}: WGSL parse error at {at}: {}", self.label, e.message())
         })?;
-        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
-            .validate(&module)
-            .map_err(|e| {
-                let at = self.at(e.spans().next().map(|(s, _)| s.location(&self.text).line_number as usize));
-                // naga nests the cause (an entry point is invalid because a function is, because
-                // one expression is): name every level.
-                let mut why = e.as_inner().to_string();
-                let mut source = std::error::Error::source(e.as_inner());
-                while let Some(s) = source {
-                    why += &format!(": {s}");
-                    source = s.source();
-                }
-                anyhow!("{}: WGSL validation error at {at}: {why}", self.label)
-            })?;
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        )
+        .validate(&module)
+        .map_err(|e| {
+            let at =
+                self.at(e.spans().next().map(|(s, _)| s.location(&self.text).line_number as usize));
+            // naga nests the cause (an entry point is invalid because a function is, because
+            // one expression is): name every level.
+            let mut why = e.as_inner().to_string();
+            let mut source = std::error::Error::source(e.as_inner());
+            while let Some(s) = source {
+                why += &format!(": {s}");
+                source = s.source();
+            }
+            anyhow!("{}: WGSL validation error at {at}: {why}", self.label)
+        })?;
         Ok((module, info))
     }
 
@@ -259,7 +278,10 @@ impl Program {
 
 /// The wgpu module of composed program text (every pipeline's module is made here).
 pub fn create_module(device: &wgpu::Device, label: &str, text: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(text.into()) })
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(text.into()),
+    })
 }
 
 #[cfg(test)]
@@ -267,10 +289,38 @@ mod tests {
     use super::*;
 
     const FEATURE_SETS: &[[&str; 6]] = &[
-        ["common/alpha_none.wgsl", "common/textures_none.wgsl", "common/tangents_none.wgsl", "common/lights_none.wgsl", "common/emitters_none.wgsl", "common/env_none.wgsl"],
-        ["common/alpha_mask.wgsl", "common/textures.wgsl", "common/tangents.wgsl", "common/lights.wgsl", "common/emitters.wgsl", "common/env_map.wgsl"],
-        ["common/alpha_none.wgsl", "common/textures.wgsl", "common/tangents_none.wgsl", "common/lights.wgsl", "common/emitters_none.wgsl", "common/env_constant.wgsl"],
-        ["common/alpha_mask.wgsl", "common/textures.wgsl", "common/tangents.wgsl", "common/lights_none.wgsl", "common/emitters.wgsl", "common/env_none.wgsl"],
+        [
+            "common/alpha_none.wgsl",
+            "common/textures_none.wgsl",
+            "common/tangents_none.wgsl",
+            "common/lights_none.wgsl",
+            "common/emitters_none.wgsl",
+            "common/env_none.wgsl",
+        ],
+        [
+            "common/alpha_mask.wgsl",
+            "common/textures.wgsl",
+            "common/tangents.wgsl",
+            "common/lights.wgsl",
+            "common/emitters.wgsl",
+            "common/env_map.wgsl",
+        ],
+        [
+            "common/alpha_none.wgsl",
+            "common/textures.wgsl",
+            "common/tangents_none.wgsl",
+            "common/lights.wgsl",
+            "common/emitters_none.wgsl",
+            "common/env_constant.wgsl",
+        ],
+        [
+            "common/alpha_mask.wgsl",
+            "common/textures.wgsl",
+            "common/tangents.wgsl",
+            "common/lights_none.wgsl",
+            "common/emitters.wgsl",
+            "common/env_none.wgsl",
+        ],
     ];
 
     /// Every program Hush can compose, over both BVH layouts and the feature alternatives.
@@ -278,72 +328,201 @@ mod tests {
         let mut v = vec![];
         for set in FEATURE_SETS {
             for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
-                let m = ["common/math.wgsl", "common/geometry.wgsl", "common/motion_none.wgsl", "common/scene.wgsl", "common/bsdf.wgsl", set[1], set[2], set[0], "realtime/frame.wgsl", motion, "realtime/gbuffer.wgsl"];
+                let m = [
+                    "common/math.wgsl",
+                    "common/geometry.wgsl",
+                    "common/motion_none.wgsl",
+                    "common/scene.wgsl",
+                    "common/bsdf.wgsl",
+                    set[1],
+                    set[2],
+                    set[0],
+                    "realtime/frame.wgsl",
+                    motion,
+                    "realtime/gbuffer.wgsl",
+                ];
                 v.push(compose("gbuffer", "", &m).unwrap());
             }
         }
         for glossy in ["realtime/glossy_in.wgsl", "realtime/glossy_in_none.wgsl"] {
-            let m = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/composite.wgsl"];
+            let m = [
+                "common/math.wgsl",
+                "common/rng.wgsl",
+                "realtime/frame.wgsl",
+                "realtime/gbuffer_in.wgsl",
+                glossy,
+                "realtime/composite.wgsl",
+            ];
             v.push(compose("realtime/composite.wgsl", "", &m).unwrap());
-            let display = ["common/math.wgsl", "common/rng.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", glossy, "realtime/display.wgsl"];
+            let display = [
+                "common/math.wgsl",
+                "common/rng.wgsl",
+                "realtime/frame.wgsl",
+                "realtime/gbuffer_in.wgsl",
+                glossy,
+                "realtime/display.wgsl",
+            ];
             v.push(compose("realtime/display.wgsl", "", &display).unwrap());
         }
         for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
-            for stage in [&["matte/temporal.wgsl"][..], &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"], &["matte/disocclusion.wgsl"], &["matte/firefly.wgsl"], &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"], &["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl", "taa/matte.wgsl", "taa/taa.wgsl"], &["taa/glossy_none.wgsl", "taa/matte_none.wgsl", "taa/taa.wgsl"]] {
-                let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", "matte/common.wgsl", motion];
+            for stage in [
+                &["matte/temporal.wgsl"][..],
+                &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
+                &["matte/disocclusion.wgsl"],
+                &["matte/firefly.wgsl"],
+                &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"],
+                &[
+                    "realtime/glossy_in.wgsl",
+                    "glossy/common.wgsl",
+                    "taa/glossy.wgsl",
+                    "taa/matte.wgsl",
+                    "taa/taa.wgsl",
+                ],
+                &["taa/glossy_none.wgsl", "taa/matte_none.wgsl", "taa/taa.wgsl"],
+            ] {
+                let mut m = vec![
+                    "common/math.wgsl",
+                    "realtime/frame.wgsl",
+                    "realtime/gbuffer_in.wgsl",
+                    "matte/common.wgsl",
+                    motion,
+                ];
                 m.extend_from_slice(stage);
                 v.push(compose(stage[stage.len() - 1], "", &m).unwrap());
             }
         }
         for animated in [false, true] {
-            for stage in ["glossy/motion.wgsl", "glossy/prefilter.wgsl", "glossy/temporal.wgsl", "glossy/bilateral.wgsl"] {
-                v.push(compose(stage, "", &crate::passes::glossy::modules(stage, animated)).unwrap());
+            for stage in [
+                "glossy/motion.wgsl",
+                "glossy/prefilter.wgsl",
+                "glossy/temporal.wgsl",
+                "glossy/bilateral.wgsl",
+            ] {
+                v.push(
+                    compose(stage, "", &crate::passes::glossy::modules(stage, animated)).unwrap(),
+                );
             }
         }
         for animated in [false, true] {
             for glossy in [false, true] {
-                let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
-                for stage in [temporal, "svgf/variance.wgsl", "svgf/atrous.wgsl", "svgf/final.wgsl"] {
-                    v.push(compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated)).unwrap());
+                let temporal =
+                    if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
+                for stage in [temporal, "svgf/variance.wgsl", "svgf/atrous.wgsl", "svgf/final.wgsl"]
+                {
+                    v.push(
+                        compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated))
+                            .unwrap(),
+                    );
                 }
             }
         }
         for animated in [false, true] {
             for glossy in [false, true] {
                 use crate::denoise::progressive::{Signal, modules};
-                let signals: &[Signal] = if glossy { &[Signal::Matte, Signal::Glossy, Signal::Direct] } else { &[Signal::Matte, Signal::Direct] };
+                let signals: &[Signal] = if glossy {
+                    &[Signal::Matte, Signal::Glossy, Signal::Direct]
+                } else {
+                    &[Signal::Matte, Signal::Direct]
+                };
                 for &signal in signals {
-                    for stage in ["progressive/features.wgsl", "progressive/temporal.wgsl", "progressive/variance.wgsl", "progressive/atrous.wgsl"] {
-                        v.push(compose(stage, "", &modules(stage, signal, glossy, animated)).unwrap());
+                    for stage in [
+                        "progressive/features.wgsl",
+                        "progressive/temporal.wgsl",
+                        "progressive/variance.wgsl",
+                        "progressive/atrous.wgsl",
+                    ] {
+                        v.push(
+                            compose(stage, "", &modules(stage, signal, glossy, animated)).unwrap(),
+                        );
                     }
                 }
             }
         }
         for glossy in [false, true] {
-            for stage in ["supersample/assign.wgsl", "supersample/mix.wgsl", "supersample/resolve.wgsl"] {
-                v.push(compose(stage, "", &crate::passes::supersample::modules(stage, glossy)).unwrap());
+            for stage in
+                ["supersample/assign.wgsl", "supersample/mix.wgsl", "supersample/resolve.wgsl"]
+            {
+                v.push(
+                    compose(stage, "", &crate::passes::supersample::modules(stage, glossy))
+                        .unwrap(),
+                );
             }
         }
-        v.push(compose("gbuffer/resolve", "", &["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"]).unwrap());
-        for stage in ["prefilter/covariance.wgsl", "prefilter/sure.wgsl", "prefilter/features.wgsl"] {
+        v.push(
+            compose(
+                "gbuffer/resolve",
+                "",
+                &["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"],
+            )
+            .unwrap(),
+        );
+        for stage in ["prefilter/covariance.wgsl", "prefilter/sure.wgsl", "prefilter/features.wgsl"]
+        {
             v.push(compose(stage, "", &crate::passes::prefilter::modules(stage)).unwrap());
         }
         for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
             // A scene sets the traversal's stack length (accel::traversal_stack).
             let stack = "const TRAVERSAL_STACK: u32 = 16u;\n";
-            v.push(compose("raycast", stack, &["common/math.wgsl", "common/geometry.wgsl", "common/motion_none.wgsl", bvh, "common/alpha_none.wgsl", "accel/raycast.wgsl"]).unwrap());
+            v.push(
+                compose(
+                    "raycast",
+                    stack,
+                    &[
+                        "common/math.wgsl",
+                        "common/geometry.wgsl",
+                        "common/motion_none.wgsl",
+                        bvh,
+                        "common/alpha_none.wgsl",
+                        "accel/raycast.wgsl",
+                    ],
+                )
+                .unwrap(),
+            );
             for (i, set) in FEATURE_SETS.iter().enumerate() {
-                let mut m = vec!["common/math.wgsl", "common/rng.wgsl", "common/geometry.wgsl", if i % 2 == 0 { "common/motion_none.wgsl" } else { "common/motion_blur.wgsl" }, bvh, "common/scene.wgsl", "common/bsdf.wgsl", "common/params.wgsl", "common/camera.wgsl", "common/path.wgsl"];
+                let mut m = vec![
+                    "common/math.wgsl",
+                    "common/rng.wgsl",
+                    "common/geometry.wgsl",
+                    if i % 2 == 0 { "common/motion_none.wgsl" } else { "common/motion_blur.wgsl" },
+                    bvh,
+                    "common/scene.wgsl",
+                    "common/bsdf.wgsl",
+                    "common/params.wgsl",
+                    "common/camera.wgsl",
+                    "common/path.wgsl",
+                ];
                 m.extend(set.iter());
-                let prelude = format!("const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n{stack}", i % 2 == 1, i != 0);
+                let prelude = format!(
+                    "const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n{stack}",
+                    i % 2 == 1,
+                    i != 0
+                );
                 let mut reference = m.clone();
                 reference.push("reference/trace.wgsl");
                 v.push(compose(&format!("trace {bvh} {i}"), &prelude, &reference).unwrap());
-                let glossy = if i % 2 == 0 { "realtime/trace_glossy.wgsl" } else { "realtime/trace_glossy_none.wgsl" };
+                let glossy = if i % 2 == 0 {
+                    "realtime/trace_glossy.wgsl"
+                } else {
+                    "realtime/trace_glossy_none.wgsl"
+                };
                 let mut primaries = m.clone();
-                primaries.extend(["realtime/frame.wgsl", if i % 2 == 0 { "realtime/motion_static.wgsl" } else { "realtime/motion_objects.wgsl" }, "realtime/lens.wgsl", "realtime/primaries.wgsl"]);
+                primaries.extend([
+                    "realtime/frame.wgsl",
+                    if i % 2 == 0 {
+                        "realtime/motion_static.wgsl"
+                    } else {
+                        "realtime/motion_objects.wgsl"
+                    },
+                    "realtime/lens.wgsl",
+                    "realtime/primaries.wgsl",
+                ]);
                 v.push(compose(&format!("primaries {bvh} {i}"), &prelude, &primaries).unwrap());
-                m.extend(["realtime/frame.wgsl", "realtime/lens.wgsl", glossy, "realtime/trace.wgsl"]);
+                m.extend([
+                    "realtime/frame.wgsl",
+                    "realtime/lens.wgsl",
+                    glossy,
+                    "realtime/trace.wgsl",
+                ]);
                 v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
                 m.extend(["supersample/common.wgsl", "supersample/samples.wgsl"]);
                 v.push(compose(&format!("supersample samples {bvh} {i}"), &prelude, &m).unwrap());
@@ -379,14 +558,22 @@ mod tests {
         let programs = all_programs();
         for f in &files {
             assert!(SOURCES.iter().any(|(p, _)| p == f), "{f} is not embedded in shader::SOURCES");
-            assert!(programs.iter().any(|p| p.modules.contains(&f.as_str())), "{f} is in no validated program");
+            assert!(
+                programs.iter().any(|p| p.modules.contains(&f.as_str())),
+                "{f} is in no validated program"
+            );
         }
         assert_eq!(files.len(), SOURCES.len(), "SOURCES lists a file that does not exist");
     }
 
     #[test]
     fn errors_name_the_file_and_line() {
-        let p = Program { label: "t".into(), modules: vec![], text: "// ---- a.wgsl\nfn f() {}\n// ---- b.wgsl\nfn g() -> u32 {\n  return 1u +;\n}\n".into() };
+        let p = Program {
+            label: "t".into(),
+            modules: vec![],
+            text: "// ---- a.wgsl\nfn f() {}\n// ---- b.wgsl\nfn g() -> u32 {\n  return 1u +;\n}\n"
+                .into(),
+        };
         let e = format!("{:#}", p.validate().unwrap_err());
         assert!(e.contains("b.wgsl:2"), "{e}");
     }
@@ -412,18 +599,63 @@ mod tests {
         use std::mem::{offset_of, size_of};
         let programs = all_programs();
         let p = programs.iter().find(|p| p.label == "trace common/bvh2.wgsl 1").unwrap(); // every feature
-        assert_eq!(wgsl_layout(p, "Material"), (size_of::<GpuMaterial>() as u32, vec![
-            offset_of!(GpuMaterial, base_color), offset_of!(GpuMaterial, emission), offset_of!(GpuMaterial, metallic),
-            offset_of!(GpuMaterial, specular_color), offset_of!(GpuMaterial, roughness), offset_of!(GpuMaterial, specular_factor),
-            offset_of!(GpuMaterial, alpha_cutoff), offset_of!(GpuMaterial, normal_scale), offset_of!(GpuMaterial, flags),
-            offset_of!(GpuMaterial, tex)].into_iter().map(|o| o as u32).collect()));
-        assert_eq!(wgsl_layout(p, "Light"), (size_of::<GpuLight>() as u32, vec![
-            offset_of!(GpuLight, pos), offset_of!(GpuLight, kind), offset_of!(GpuLight, dir), offset_of!(GpuLight, cos_outer),
-            offset_of!(GpuLight, intensity), offset_of!(GpuLight, cos_inner)].into_iter().map(|o| o as u32).collect()));
-        assert_eq!(wgsl_layout(p, "Bvh2Node"), (size_of::<Bvh2GpuNode>() as u32, vec![
-            offset_of!(Bvh2GpuNode, lmin), offset_of!(Bvh2GpuNode, l_index), offset_of!(Bvh2GpuNode, lmax), offset_of!(Bvh2GpuNode, l_count),
-            offset_of!(Bvh2GpuNode, rmin), offset_of!(Bvh2GpuNode, r_index), offset_of!(Bvh2GpuNode, rmax), offset_of!(Bvh2GpuNode, r_count)]
-            .into_iter().map(|o| o as u32).collect()));
+        assert_eq!(
+            wgsl_layout(p, "Material"),
+            (
+                size_of::<GpuMaterial>() as u32,
+                vec![
+                    offset_of!(GpuMaterial, base_color),
+                    offset_of!(GpuMaterial, emission),
+                    offset_of!(GpuMaterial, metallic),
+                    offset_of!(GpuMaterial, specular_color),
+                    offset_of!(GpuMaterial, roughness),
+                    offset_of!(GpuMaterial, specular_factor),
+                    offset_of!(GpuMaterial, alpha_cutoff),
+                    offset_of!(GpuMaterial, normal_scale),
+                    offset_of!(GpuMaterial, flags),
+                    offset_of!(GpuMaterial, tex)
+                ]
+                .into_iter()
+                .map(|o| o as u32)
+                .collect()
+            )
+        );
+        assert_eq!(
+            wgsl_layout(p, "Light"),
+            (
+                size_of::<GpuLight>() as u32,
+                vec![
+                    offset_of!(GpuLight, pos),
+                    offset_of!(GpuLight, kind),
+                    offset_of!(GpuLight, dir),
+                    offset_of!(GpuLight, cos_outer),
+                    offset_of!(GpuLight, intensity),
+                    offset_of!(GpuLight, cos_inner)
+                ]
+                .into_iter()
+                .map(|o| o as u32)
+                .collect()
+            )
+        );
+        assert_eq!(
+            wgsl_layout(p, "Bvh2Node"),
+            (
+                size_of::<Bvh2GpuNode>() as u32,
+                vec![
+                    offset_of!(Bvh2GpuNode, lmin),
+                    offset_of!(Bvh2GpuNode, l_index),
+                    offset_of!(Bvh2GpuNode, lmax),
+                    offset_of!(Bvh2GpuNode, l_count),
+                    offset_of!(Bvh2GpuNode, rmin),
+                    offset_of!(Bvh2GpuNode, r_index),
+                    offset_of!(Bvh2GpuNode, rmax),
+                    offset_of!(Bvh2GpuNode, r_count)
+                ]
+                .into_iter()
+                .map(|o| o as u32)
+                .collect()
+            )
+        );
         let (size, offs) = wgsl_layout(p, "Params");
         assert_eq!(size as usize, size_of::<TraceParams>());
         assert_eq!(offs[8] as usize, offset_of!(TraceParams, cam_pos));

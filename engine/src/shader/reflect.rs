@@ -25,8 +25,14 @@ pub struct ProgramBindings {
 /// (naga's `info` says which). A resource a module declares but the entry point never reaches
 /// (a helper module's texture that this stage does not read) is left out of the layout, so a
 /// stage binds only what it reads and need not be offered the rest.
-pub fn reflect(label: &str, module: &naga::Module, info: &naga::valid::ModuleInfo) -> Result<ProgramBindings> {
-    let used = |h: naga::Handle<naga::GlobalVariable>| (0..module.entry_points.len()).any(|i| !info.get_entry_point(i)[h].is_empty());
+pub fn reflect(
+    label: &str,
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+) -> Result<ProgramBindings> {
+    let used = |h: naga::Handle<naga::GlobalVariable>| {
+        (0..module.entry_points.len()).any(|i| !info.get_entry_point(i)[h].is_empty())
+    };
     let mut slots = vec![];
     for (h, var) in module.global_variables.iter() {
         let Some(rb) = &var.binding else { continue };
@@ -51,11 +57,17 @@ pub fn reflect(label: &str, module: &naga::Module, info: &naga::valid::ModuleInf
 
 fn binding_type(space: naga::AddressSpace, inner: &naga::TypeInner) -> Result<wgpu::BindingType> {
     use naga::{AddressSpace, ImageClass, ScalarKind, StorageAccess, TypeInner};
-    let buffer = |ty| wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None };
+    let buffer =
+        |ty| wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None };
     Ok(match (space, inner) {
         (AddressSpace::Uniform, _) => buffer(wgpu::BufferBindingType::Uniform),
-        (AddressSpace::Storage { access }, _) => buffer(wgpu::BufferBindingType::Storage { read_only: !access.contains(StorageAccess::STORE) }),
-        (AddressSpace::Handle, TypeInner::Image { dim: naga::ImageDimension::D2, arrayed: false, class }) => match class {
+        (AddressSpace::Storage { access }, _) => buffer(wgpu::BufferBindingType::Storage {
+            read_only: !access.contains(StorageAccess::STORE),
+        }),
+        (
+            AddressSpace::Handle,
+            TypeInner::Image { dim: naga::ImageDimension::D2, arrayed: false, class },
+        ) => match class {
             // Every texture is read with textureLoad: no sampler, so no filtering requirement.
             ImageClass::Sampled { kind, multi: false } => {
                 let sample_type = match kind {
@@ -64,16 +76,31 @@ fn binding_type(space: naga::AddressSpace, inner: &naga::TypeInner) -> Result<wg
                     ScalarKind::Sint => wgpu::TextureSampleType::Sint,
                     k => bail!("textures of {k:?} are not supported"),
                 };
-                wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false }
+                wgpu::BindingType::Texture {
+                    sample_type,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                }
             }
-            ImageClass::Depth { multi: false } => wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Depth, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false },
+            ImageClass::Depth { multi: false } => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
             ImageClass::Storage { format, access } => {
-                let access = match (access.contains(StorageAccess::LOAD), access.contains(StorageAccess::STORE)) {
+                let access = match (
+                    access.contains(StorageAccess::LOAD),
+                    access.contains(StorageAccess::STORE),
+                ) {
                     (true, true) => wgpu::StorageTextureAccess::ReadWrite,
                     (true, false) => wgpu::StorageTextureAccess::ReadOnly,
                     _ => wgpu::StorageTextureAccess::WriteOnly,
                 };
-                wgpu::BindingType::StorageTexture { access, format: storage_format(*format)?, view_dimension: wgpu::TextureViewDimension::D2 }
+                wgpu::BindingType::StorageTexture {
+                    access,
+                    format: storage_format(*format)?,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                }
             }
             c => bail!("image class {c:?} is not supported"),
         },
@@ -113,17 +140,39 @@ impl ProgramBindings {
     pub fn check_offered(&self, label: &str, offered: &[&str]) -> Result<()> {
         let missing: Vec<&str> = self.names().filter(|n| !offered.contains(n)).collect();
         if !missing.is_empty() {
-            bail!("{label} binds {}, which the stage does not offer (it offers {})", missing.join(", "), offered.join(", "));
+            bail!(
+                "{label} binds {}, which the stage does not offer (it offers {})",
+                missing.join(", "),
+                offered.join(", ")
+            );
         }
         Ok(())
     }
 
     /// One bind group layout per group, visible to `visibility`.
-    pub fn layouts(&self, device: &wgpu::Device, label: &str, visibility: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayout> {
+    pub fn layouts(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        visibility: wgpu::ShaderStages,
+    ) -> Vec<wgpu::BindGroupLayout> {
         (0..self.group_count())
             .map(|g| {
-                let entries: Vec<_> = self.slots.iter().filter(|s| s.group == g).map(|s| wgpu::BindGroupLayoutEntry { binding: s.binding, visibility, ty: s.ty, count: None }).collect();
-                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(&format!("{label} group {g}")), entries: &entries })
+                let entries: Vec<_> = self
+                    .slots
+                    .iter()
+                    .filter(|s| s.group == g)
+                    .map(|s| wgpu::BindGroupLayoutEntry {
+                        binding: s.binding,
+                        visibility,
+                        ty: s.ty,
+                        count: None,
+                    })
+                    .collect();
+                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(&format!("{label} group {g}")),
+                    entries: &entries,
+                })
             })
             .collect()
     }
@@ -141,21 +190,36 @@ pub struct FixedCompute {
 impl FixedCompute {
     /// `offered`: what the caller will bind (checked by name now, so that a program asking for
     /// more fails here rather than at the first dispatch).
-    pub fn new(gpu: &crate::gpu::Gpu, label: &str, prelude: &str, modules: &[&'static str], offered: &[&str]) -> Result<FixedCompute> {
+    pub fn new(
+        gpu: &crate::gpu::Gpu,
+        label: &str,
+        prelude: &str,
+        modules: &[&'static str],
+        offered: &[&str],
+    ) -> Result<FixedCompute> {
         let program = gpu.shaders.compose(label, prelude, modules)?;
         let (module, info) = program.validate_with_info()?;
         let bindings = reflect(label, &module, &info)?;
         bindings.check_offered(label, offered)?;
         let layouts = bindings.layouts(&gpu.device, label, wgpu::ShaderStages::COMPUTE);
         let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &refs, immediate_size: 0 });
+        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &refs,
+            immediate_size: 0,
+        });
         let module = crate::shader::create_module(&gpu.device, label, &program.text);
-        let pipeline = crate::gpu::scene::compute_pipeline(&gpu.device, label, &module, &pl, "main");
+        let pipeline =
+            crate::gpu::scene::compute_pipeline(&gpu.device, label, &module, &pl, "main");
         Ok(FixedCompute { pipeline, label: label.to_string(), bindings, layouts })
     }
 
     /// Bind groups of `resources`, each found by name.
-    pub fn bind_groups(&self, device: &wgpu::Device, resources: &crate::gpu::Bindings) -> Result<Vec<wgpu::BindGroup>> {
+    pub fn bind_groups(
+        &self,
+        device: &wgpu::Device,
+        resources: &crate::gpu::Bindings,
+    ) -> Result<Vec<wgpu::BindGroup>> {
         resources.create_groups(device, &self.label, &self.bindings, &self.layouts)
     }
 }
@@ -166,7 +230,11 @@ mod tests {
 
     fn program(text: &str) -> ProgramBindings {
         let p = crate::shader::compose_with("t", "", &["common/a.wgsl", "stage/b.wgsl"], |m| {
-            Ok(std::sync::Arc::from(if m == "common/a.wgsl" { "var<uniform> u: vec4f;\nvar<private> p: f32;\n" } else { text }))
+            Ok(std::sync::Arc::from(if m == "common/a.wgsl" {
+                "var<uniform> u: vec4f;\nvar<private> p: f32;\n"
+            } else {
+                text
+            }))
         })
         .unwrap();
         let (m, info) = p.validate_with_info().unwrap();
@@ -175,24 +243,55 @@ mod tests {
 
     #[test]
     fn resources_are_numbered_by_group_in_order() {
-        let b = program("var t: texture_2d<u32>;\nvar<storage, read_write> s: array<u32>;\nvar o: texture_storage_2d<rgba16float, write>;\nvar<workgroup> w: array<f32, 4>;\n@compute @workgroup_size(1) fn main() { s[0] = textureLoad(t, vec2i(0), 0).x + u32(u.x + p + w[0]); textureStore(o, vec2i(0), vec4f(0.0)); }\n");
+        let b = program(
+            "var t: texture_2d<u32>;\nvar<storage, read_write> s: array<u32>;\nvar o: texture_storage_2d<rgba16float, write>;\nvar<workgroup> w: array<f32, 4>;\n@compute @workgroup_size(1) fn main() { s[0] = textureLoad(t, vec2i(0), 0).x + u32(u.x + p + w[0]); textureStore(o, vec2i(0), vec4f(0.0)); }\n",
+        );
         let got: Vec<_> = b.slots.iter().map(|s| (s.name.as_str(), s.group, s.binding)).collect();
         assert_eq!(got, [("u", 0, 0), ("t", 1, 0), ("s", 1, 1), ("o", 1, 2)]);
-        assert_eq!(b.slots[1].ty, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false });
-        assert_eq!(b.slots[2].ty, wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only: false }, has_dynamic_offset: false, min_binding_size: None });
-        assert!(matches!(b.slots[3].ty, wgpu::BindingType::StorageTexture { format: wgpu::TextureFormat::Rgba16Float, access: wgpu::StorageTextureAccess::WriteOnly, .. }));
+        assert_eq!(
+            b.slots[1].ty,
+            wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false
+            }
+        );
+        assert_eq!(
+            b.slots[2].ty,
+            wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None
+            }
+        );
+        assert!(matches!(
+            b.slots[3].ty,
+            wgpu::BindingType::StorageTexture {
+                format: wgpu::TextureFormat::Rgba16Float,
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                ..
+            }
+        ));
         assert_eq!(b.group_count(), 2);
     }
 
     #[test]
     fn an_indented_var_is_not_a_resource() {
-        let b = program("fn f() -> f32 {\n    var x = 1.0;\n    return x;\n}\n@compute @workgroup_size(1) fn main() { let y = f() + u.x; }\n");
+        let b = program(
+            "fn f() -> f32 {\n    var x = 1.0;\n    return x;\n}\n@compute @workgroup_size(1) fn main() { let y = f() + u.x; }\n",
+        );
         assert_eq!(b.names().collect::<Vec<_>>(), ["u"]);
     }
 
     #[test]
     fn a_resource_no_entry_point_reaches_is_left_out() {
-        let b = program("var t: texture_2d<f32>;\nvar unused: texture_2d<u32>;\nfn g() -> f32 { return textureLoad(t, vec2i(0), 0).x; }\nfn h() -> u32 { return textureLoad(unused, vec2i(0), 0).x; }\n@compute @workgroup_size(1) fn main() { let y = g(); }\n");
-        assert_eq!(b.names().collect::<Vec<_>>(), ["t"], "u and `unused` are declared but never reached");
+        let b = program(
+            "var t: texture_2d<f32>;\nvar unused: texture_2d<u32>;\nfn g() -> f32 { return textureLoad(t, vec2i(0), 0).x; }\nfn h() -> u32 { return textureLoad(unused, vec2i(0), 0).x; }\n@compute @workgroup_size(1) fn main() { let y = g(); }\n",
+        );
+        assert_eq!(
+            b.names().collect::<Vec<_>>(),
+            ["t"],
+            "u and `unused` are declared but never reached"
+        );
     }
 }

@@ -10,7 +10,8 @@ use crate::gpu::{Bindings, Gpu};
 use anyhow::{Context, Result};
 use std::time::Instant;
 
-type Build<P> = Box<dyn Fn(&wgpu::Device, &wgpu::ShaderModule, &wgpu::PipelineLayout) -> P + Send + Sync>;
+type Build<P> =
+    Box<dyn Fn(&wgpu::Device, &wgpu::ShaderModule, &wgpu::PipelineLayout) -> P + Send + Sync>;
 
 /// A pipeline with the resources its program declares and the bind group layouts made from them.
 struct Built<P> {
@@ -68,12 +69,25 @@ impl<P> Reloadable<P> {
         modules: &[&'static str],
         visibility: wgpu::ShaderStages,
         offered: &Bindings,
-        build: impl Fn(&wgpu::Device, &wgpu::ShaderModule, &wgpu::PipelineLayout) -> P + Send + Sync + 'static,
+        build: impl Fn(&wgpu::Device, &wgpu::ShaderModule, &wgpu::PipelineLayout) -> P
+        + Send
+        + Sync
+        + 'static,
     ) -> Result<Reloadable<P>> {
         let build: Build<P> = Box::new(build);
         let offered: Vec<String> = offered.names().map(str::to_string).collect();
         let current = make(gpu, label, prelude, modules, visibility, &offered, &build)?;
-        Ok(Reloadable { label: label.to_string(), prelude: prelude.to_string(), modules: modules.to_vec(), visibility, offered, build, current, builds: 1, error: None })
+        Ok(Reloadable {
+            label: label.to_string(),
+            prelude: prelude.to_string(),
+            modules: modules.to_vec(),
+            visibility,
+            offered,
+            build,
+            current,
+            builds: 1,
+            error: None,
+        })
     }
 
     pub fn get(&self) -> &P {
@@ -86,12 +100,24 @@ impl<P> Reloadable<P> {
     }
 
     /// The current build's bind groups, each resource found in `resources` by name.
-    pub fn bind_groups(&self, device: &wgpu::Device, resources: &Bindings) -> Result<Vec<wgpu::BindGroup>> {
+    pub fn bind_groups(
+        &self,
+        device: &wgpu::Device,
+        resources: &Bindings,
+    ) -> Result<Vec<wgpu::BindGroup>> {
         resources.create_groups(device, &self.label, &self.current.bindings, &self.current.layouts)
     }
 }
 
-fn make<P>(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], visibility: wgpu::ShaderStages, offered: &[String], build: &Build<P>) -> Result<Built<P>> {
+fn make<P>(
+    gpu: &Gpu,
+    label: &str,
+    prelude: &str,
+    modules: &[&'static str],
+    visibility: wgpu::ShaderStages,
+    offered: &[String],
+    build: &Build<P>,
+) -> Result<Built<P>> {
     let program = gpu.shaders.compose(label, prelude, modules)?;
     let (module, info) = program.validate_with_info()?;
     let bindings = super::reflect(label, &module, &info)?;
@@ -101,7 +127,11 @@ fn make<P>(gpu: &Gpu, label: &str, prelude: &str, modules: &[&'static str], visi
     gpu.validated(&format!("creating pipeline {label}"), || {
         let layouts = bindings.layouts(&gpu.device, label, visibility);
         let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &refs, immediate_size: 0 });
+        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &refs,
+            immediate_size: 0,
+        });
         let module = crate::shader::create_module(&gpu.device, label, &program.text);
         let pipeline = build(&gpu.device, &module, &pl);
         Ok(Built { pipeline, bindings, layouts })
@@ -132,7 +162,15 @@ impl<P> Reload for Reloadable<P> {
 
     fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome {
         let start = Instant::now();
-        let result = make(gpu, &self.label, &self.prelude, &self.modules, self.visibility, &self.offered, &self.build);
+        let result = make(
+            gpu,
+            &self.label,
+            &self.prelude,
+            &self.modules,
+            self.visibility,
+            &self.offered,
+            &self.build,
+        );
         let ms = start.elapsed().as_secs_f64() * 1e3;
         self.error = match result {
             Ok(p) => {

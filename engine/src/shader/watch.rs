@@ -21,8 +21,12 @@ impl ShaderWatcher {
     pub fn new(library: &ShaderLibrary) -> Result<ShaderWatcher> {
         let dir = library.dir().context("the shaders are embedded in the binary; point Hush at a folder (--shaders DIR or $HUSH_SHADERS) to reload them")?;
         let (tx, events) = channel();
-        let mut debouncer = new_debouncer(DEBOUNCE, tx).context("starting the shader file watcher")?;
-        debouncer.watcher().watch(dir, RecursiveMode::Recursive).with_context(|| format!("watching {}", dir.display()))?;
+        let mut debouncer =
+            new_debouncer(DEBOUNCE, tx).context("starting the shader file watcher")?;
+        debouncer
+            .watcher()
+            .watch(dir, RecursiveMode::Recursive)
+            .with_context(|| format!("watching {}", dir.display()))?;
         Ok(ShaderWatcher { _debouncer: debouncer, events })
     }
 

@@ -57,7 +57,11 @@ pub fn run<S: AsRef<OsStr>>(args: &[S], limit: Duration) -> Outcome {
             let _ = child.kill();
             let _ = child.wait();
             let stderr = String::from_utf8_lossy(&reader.join().unwrap_or_default()).into_owned();
-            panic!("hush-cli {:?} ran past {limit:?}: {}", args.iter().map(|a| a.as_ref().to_owned()).collect::<Vec<_>>(), tail(&stderr));
+            panic!(
+                "hush-cli {:?} ran past {limit:?}: {}",
+                args.iter().map(|a| a.as_ref().to_owned()).collect::<Vec<_>>(),
+                tail(&stderr)
+            );
         }
         std::thread::sleep(Duration::from_millis(10));
     };
