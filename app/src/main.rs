@@ -59,12 +59,12 @@ fn shader_library(arg: Option<&Path>) -> Result<ShaderLibrary> {
     ShaderLibrary::from_env_or(fallback.as_deref())
 }
 
+/// [`Scene::open`], its warnings in the log.
 fn load_scene(path: &str, load: &hush_engine::scene::LoadOptions) -> Result<Scene> {
-    let mut scene = Scene::load_with(path, load)?;
+    let scene = Scene::open(path, load)?;
     for w in &scene.warnings {
         log::warn!("{w}");
     }
-    scene.add_sun_and_sky_if_unlit();
     Ok(scene)
 }
 

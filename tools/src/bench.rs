@@ -1,4 +1,4 @@
-use crate::render::load_scene;
+use crate::cli::load_scene;
 use anyhow::{Context, Result};
 use clap::Args;
 use hush_engine::accel::BvhKind;
@@ -55,7 +55,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub camera: Option<String>,
     #[command(flatten)]
-    pub load: crate::render::LoadArgs,
+    pub load: crate::cli::LoadArgs,
 }
 
 #[derive(Serialize)]
@@ -153,7 +153,6 @@ fn mitsuba_rate(scene: &str) -> Option<f64> {
 pub fn run(a: BenchArgs) -> Result<()> {
     match a.mode.as_str() {
         "reference" => {}
-        "realtime" => return crate::bench_realtime::run(&a),
         m => anyhow::bail!("--mode {m:?}: use reference or realtime"),
     }
     let scene = load_scene(&a.scene, &a.load)?;

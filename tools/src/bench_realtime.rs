@@ -2,7 +2,7 @@
 //! queries (median over frames), the frame total, and the CPU time of a frame.
 
 use crate::bench::BenchArgs;
-use crate::render::{bvh_kind, load_scene};
+use crate::cli::{bvh_kind, load_scene};
 use anyhow::{Result, bail};
 use hush_engine::frame::{DisplayTarget, FrameInput, Renderer};
 use hush_engine::profile::puffin;
@@ -50,7 +50,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         bail!("--frames must be at least 1");
     }
     if let Some(p) = &a.profile {
-        crate::render::check_output(p, &["puffin"], "--profile")?;
+        crate::cli::check_output(p, &["puffin"], "--profile")?;
     }
     let scene = load_scene(&a.scene, &a.load)?;
     let size = (a.width, a.height);
@@ -76,12 +76,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let target = DisplayTarget { view: &view, format, size };
     let settings = match &a.preset {
         Some(p) => FrameSettings {
-            max_depth: crate::realtime::path_length(None, Some(p), r.scene.max_depth)?,
-            ..crate::realtime::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)?
+            max_depth: crate::cli::path_length(None, Some(p), r.scene.max_depth)?,
+            ..crate::cli::preset_settings(Some(p), a.denoiser.as_deref(), &[], None)?
         },
         None => FrameSettings {
             max_depth: r.scene.max_depth,
-            ..crate::realtime::denoiser_settings(
+            ..crate::cli::denoiser_settings(
                 a.denoiser.as_deref().unwrap_or("mara"),
                 &[],
                 "diamond",
@@ -89,7 +89,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         },
     };
     let camera = match &a.camera {
-        Some(c) => crate::render::parse_camera(c)?,
+        Some(c) => crate::cli::parse_camera(c)?,
         None => r.scene.camera_or_default(),
     };
     let mut per_pass: Vec<(&'static str, Vec<f64>)> = vec![];

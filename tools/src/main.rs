@@ -2,6 +2,7 @@
 
 mod bench;
 mod bench_realtime;
+mod cli;
 mod compare;
 mod quality;
 mod realtime;
@@ -80,8 +81,10 @@ fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let r: Result<()> = match cli.command {
+        Command::Render(a) if a.mode == "realtime" => realtime::run(a),
         Command::Render(a) => render::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Bench(a) if a.mode == "realtime" => bench_realtime::run(&a),
         Command::Bench(a) => bench::run(a),
         Command::Level(a) => level(a),
         Command::Quality(a) => quality::run(a),

@@ -8,8 +8,8 @@
 //! EXR) and FLIP heat maps of the last denoised frame and the 64-spp yardstick. `--ablations` repeats
 //! the denoised stream with each stage off and writes ablations.csv.
 
-use crate::realtime::preset_settings;
-use crate::render::{bvh_kind, image_size, load_scene, parse_camera};
+use crate::cli::preset_settings;
+use crate::cli::{bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use hush_engine::frame::{FrameInput, Renderer};
@@ -77,7 +77,7 @@ pub struct QualityArgs {
     #[arg(long, default_value_t = 4)]
     pub yardstick_seeds: u32,
     #[command(flatten)]
-    pub load: crate::render::LoadArgs,
+    pub load: crate::cli::LoadArgs,
 }
 
 /// One stream's per-frame scores against the reference.
@@ -229,7 +229,7 @@ fn stream(
 }
 
 pub fn run(a: QualityArgs) -> Result<()> {
-    crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
+    crate::cli::check_output_dir(&a.out_dir, "--out-dir")?;
     if a.frames == 0 || a.reference_frames == 0 {
         bail!("--frames and --reference-frames must be at least 1");
     }
@@ -316,7 +316,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
         flips64.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &f| (l.min(f), h.max(f)));
     drop(accumulator);
 
-    let max_depth = crate::realtime::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
+    let max_depth = crate::cli::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
     let (den, last) = stream(&s, &base, &references)?;
     let (raw, last_raw) =

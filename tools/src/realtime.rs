@@ -1,81 +1,14 @@
 //! `hush-cli render --mode realtime`: the hybrid frame, headless and deterministic.
 
-use crate::render::{
-    RenderArgs, bvh_kind, check_output, check_output_dir, check_sides, image_size, load_scene,
-    parse_camera,
+use crate::cli::{
+    bvh_kind, check_output, check_output_dir, check_sides, image_size, load_scene, parse_camera,
+    path_length, preset_settings,
 };
+use crate::render::RenderArgs;
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::scene::CameraPath;
-use hush_engine::settings::{
-    Denoiser, FrameSettings, ReflectionMv, SampleFraction, disable_stage, stage_names,
-};
-
-pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
-    match hush_engine::denoise::find(s) {
-        Ok(e) => Ok(Denoiser::named(e.name)),
-        Err(e) => bail!("--denoiser {s:?}: {e}"),
-    }
-}
-
-/// `--denoiser`, `--disable` and `--reflection-mv` applied to default settings.
-pub fn denoiser_settings(
-    denoiser: &str,
-    disable: &[String],
-    reflection_mv: &str,
-) -> Result<FrameSettings> {
-    chain_settings(FrameSettings::default(), Some(denoiser), disable, Some(reflection_mv))
-}
-
-/// The settings of `--preset` (or the defaults) with `--denoiser`, `--disable` and
-/// `--reflection-mv` applied where given.
-pub fn preset_settings(
-    preset: Option<&std::path::Path>,
-    denoiser: Option<&str>,
-    disable: &[String],
-    reflection_mv: Option<&str>,
-) -> Result<FrameSettings> {
-    let base = preset.map(FrameSettings::load_preset).transpose()?.unwrap_or_default();
-    chain_settings(base, denoiser, disable, reflection_mv)
-}
-
-/// The path length of a run: --max-depth, else the preset's if it names one, else the scene's
-/// (a preset that leaves it out must not fall back to the default's, which is not the scene's
-/// and not what its references are rendered with).
-pub fn path_length(
-    max_depth: Option<i32>,
-    preset: Option<&std::path::Path>,
-    scene_depth: i32,
-) -> Result<i32> {
-    if let Some(d) = max_depth {
-        return Ok(d);
-    }
-    Ok(match preset {
-        Some(p) => FrameSettings::preset_max_depth(p)?.unwrap_or(scene_depth),
-        None => scene_depth,
-    })
-}
-
-fn chain_settings(
-    mut s: FrameSettings,
-    denoiser: Option<&str>,
-    disable: &[String],
-    reflection_mv: Option<&str>,
-) -> Result<FrameSettings> {
-    if let Some(d) = denoiser {
-        s.denoiser = parse_denoiser(d)?;
-    }
-    for stage in disable {
-        if !disable_stage(&mut s, stage) {
-            bail!("--disable {stage:?}: the stages are {}", stage_names().join(", "));
-        }
-    }
-    if let Some(mv) = reflection_mv {
-        s.glossy.reflection_mv = ReflectionMv::parse(mv)
-            .with_context(|| format!("--reflection-mv {mv:?}: use diamond, virtual or primary"))?;
-    }
-    Ok(s)
-}
+use hush_engine::settings::{FrameSettings, SampleFraction};
 
 /// Frame `k`'s input: the camera path's key k (its time; the shutter a fraction of the interval
 /// since the key before, or of 1 / fps where keys share a time, the camera at the open
@@ -115,7 +48,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         bail!("--frames must be at least 1");
     }
     let max_spp = hush_engine::settings::MAX_SAMPLES_PER_PIXEL;
-    if let Some(crate::render::Spp::Samples(spp)) = a.spp
+    if let Some(crate::cli::Spp::Samples(spp)) = a.spp
         && spp > max_spp
     {
         bail!(
@@ -174,8 +107,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let max_depth = path_length(a.max_depth, a.preset.as_deref(), scene.max_depth)?;
     let (samples_per_pixel, sample_fraction) = match a.spp {
         None => (chains.samples_per_pixel, chains.sample_fraction),
-        Some(crate::render::Spp::Samples(n)) => (n, SampleFraction::ONE),
-        Some(crate::render::Spp::Fraction(f)) => (1, f),
+        Some(crate::cli::Spp::Samples(n)) => (n, SampleFraction::ONE),
+        Some(crate::cli::Spp::Fraction(f)) => (1, f),
     };
     let max_primary = hush_engine::settings::MAX_PRIMARY_SAMPLES;
     let primary_samples = a.primary_samples.unwrap_or(chains.primary_samples);

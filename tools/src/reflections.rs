@@ -13,8 +13,8 @@
 //!    (2R + 1)^2 window, with and without LDSP scaling, and with the sampled depth of eq. (4)-(5)
 //!    instead of the traced representative ray: mean error and share within one pixel.
 
+use crate::cli::{bvh_kind, image_size, load_scene};
 use crate::quality::new_renderer;
-use crate::render::{bvh_kind, image_size, load_scene};
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::{DMat4, DVec3, Vec3};
@@ -61,7 +61,7 @@ pub struct ReflectionsArgs {
     #[arg(long)]
     pub out_dir: PathBuf,
     #[command(flatten)]
-    pub load: crate::render::LoadArgs,
+    pub load: crate::cli::LoadArgs,
 }
 
 /// Per-pixel G-buffer facts the measurements mask with.
@@ -145,14 +145,14 @@ fn strafed(c: Camera, offset: f64) -> Camera {
 }
 
 pub fn run(a: ReflectionsArgs) -> Result<()> {
-    crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
+    crate::cli::check_output_dir(&a.out_dir, "--out-dir")?;
     std::fs::create_dir_all(&a.out_dir)
         .with_context(|| format!("creating {}", a.out_dir.display()))?;
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, Some(a.width), a.height);
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
-    let base = crate::realtime::denoiser_settings(&a.denoiser, &a.disable, "diamond")?;
+    let base = crate::cli::denoiser_settings(&a.denoiser, &a.disable, "diamond")?;
     let svgf = base.denoiser.name() == "svgf";
     if !svgf && base.denoiser != hush_engine::settings::Denoiser::MARA {
         anyhow::bail!("--denoiser {}: reflections measures mara or svgf", a.denoiser);

@@ -1,82 +1,13 @@
+use crate::cli::{
+    LoadArgs, Spp, bvh_kind, check_output, check_sides, image_size, load_scene, parse_camera,
+    parse_spp,
+};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use hush_engine::accel::BvhKind;
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::passes::{ReferenceTracer, TraceView};
-use hush_engine::scene::{Camera, LoadOptions, Scene};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-
-/// How a scene file is loaded: flags every command that loads one shares.
-#[derive(Args, Clone, Debug)]
-pub struct LoadArgs {
-    /// Largest texture side kept on load (larger textures are halved until they fit).
-    #[arg(long, default_value_t = hush_engine::scene::DEFAULT_MAX_TEXTURE_SIZE, value_parser = clap::value_parser!(u32).range(1..))]
-    pub max_texture_size: u32,
-    /// Set a budget on what a scene file may make Hush read, decode and build, as NAME=VALUE
-    /// (comma-separated or repeated). A file over one is refused with an error naming it.
-    /// Budgets and defaults: file-bytes (any one file, 2 GiB), json-bytes (the glTF JSON,
-    /// 64 MiB), image-pixels (one image, 8192x8192), decoded-bytes (all buffers and images, 4 GiB),
-    /// nodes (1,000,000), hierarchy-depth (1024), triangles (after instancing, 16,777,215).
-    #[arg(long, value_name = "NAME=VALUE")]
-    pub limit: Vec<String>,
-}
-
-impl LoadArgs {
-    pub fn options(&self) -> Result<LoadOptions> {
-        let mut limits = hush_engine::limits::Limits::default();
-        for l in &self.limit {
-            limits.apply(l)?;
-        }
-        Ok(LoadOptions { max_texture_size: self.max_texture_size, limits })
-    }
-}
-
-/// Refuse an output file that could not be written, before any work: `what` names the flag.
-pub fn check_output(path: &Path, extensions: &[&str], what: &str) -> Result<()> {
-    let ext =
-        path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-    if !extensions.contains(&ext.as_str()) {
-        bail!(
-            "{what} {}: the file must end in {}",
-            path.display(),
-            extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or ")
-        );
-    }
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        bail!("{what} {}: the folder {} does not exist", path.display(), dir.display());
-    }
-    if path.is_dir() {
-        bail!("{what} {} is a folder", path.display());
-    }
-    Ok(())
-}
-
-/// Refuse a --width or --height over `max_side` before any work (the other side may come from
-/// the scene's aspect ratio, checked once the scene is loaded).
-pub fn check_sides(
-    width: Option<u32>,
-    height: Option<u32>,
-    max_side: u32,
-    mode: &str,
-) -> Result<()> {
-    for (flag, v) in [("--width", width), ("--height", height)] {
-        if let Some(v) = v.filter(|&v| v > max_side) {
-            bail!("{flag} {v}: {mode} renders at most {max_side} pixels a side");
-        }
-    }
-    Ok(())
-}
-
-/// Refuse an output folder that could not be made, before any work.
-pub fn check_output_dir(dir: &Path, what: &str) -> Result<()> {
-    match dir.ancestors().find(|a| a.exists()) {
-        Some(a) if a.is_dir() => Ok(()),
-        Some(a) => bail!("{what} {}: {} is not a folder", dir.display(), a.display()),
-        None => Ok(()),
-    }
-}
+use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -202,94 +133,10 @@ pub fn fps(a: &RenderArgs) -> Result<f64> {
     Ok(fps)
 }
 
-pub fn parse_camera(s: &str) -> Result<Camera> {
-    let mut eye = None;
-    let mut target = None;
-    let mut fov = 45.0f32;
-    let (mut aperture, mut focus) = (None, None);
-    for part in s.split(';').map(str::trim).filter(|p| !p.is_empty()) {
-        let (k, v) = part
-            .split_once('=')
-            .with_context(|| format!("camera part {part:?} is not key=value"))?;
-        let nums = || -> Result<glam::DVec3> {
-            let n: Vec<f64> = v
-                .split(',')
-                .map(|x| x.trim().parse::<f64>())
-                .collect::<Result<_, _>>()
-                .with_context(|| format!("camera {k}={v:?}: expected x,y,z"))?;
-            if n.len() != 3 || n.iter().any(|x| !x.is_finite()) {
-                bail!("camera {k}={v:?}: expected three finite numbers");
-            }
-            Ok(glam::DVec3::new(n[0], n[1], n[2]))
-        };
-        match k.trim() {
-            "eye" => eye = Some(nums()?),
-            "target" => target = Some(nums()?),
-            "fov" => {
-                fov = v.trim().parse().with_context(|| format!("camera fov={v:?}"))?;
-                if !(fov > 0.0 && fov < 180.0) {
-                    bail!("camera fov must be in (0, 180) degrees, got {fov}");
-                }
-            }
-            "aperture" => {
-                aperture = Some(v.trim().parse::<f64>().with_context(|| {
-                    format!("camera aperture={v:?}: the aperture radius in meters")
-                })?)
-            }
-            "focus" => {
-                focus =
-                    Some(v.trim().parse::<f64>().with_context(|| {
-                        format!("camera focus={v:?}: the focus distance in meters")
-                    })?)
-            }
-            other => bail!("unknown camera key {other:?} (use eye, target, fov, aperture, focus)"),
-        }
-    }
-    let lens = match (aperture, focus) {
-        (None, None) => None,
-        (Some(a), Some(f)) => Some(hush_engine::scene::ThinLens::new(a, f).context("--camera")?),
-        _ => bail!("a thin-lens camera needs both aperture=R and focus=D (meters)"),
-    };
-    let (eye, target) =
-        (eye.context("camera needs eye=x,y,z")?, target.context("camera needs target=x,y,z")?);
-    if (eye - target).length() == 0.0 {
-        bail!("camera eye and target coincide");
-    }
-    Ok(Camera { lens, ..Camera::look_at(eye, target, fov) })
-}
-
-pub fn load_scene(path: &str, load: &LoadArgs) -> Result<Scene> {
-    let mut scene = Scene::load_with(path, &load.options()?)?;
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
-    scene.add_sun_and_sky_if_unlit();
-    Ok(scene)
-}
-
-/// Width and height from the flags, keeping the scene's aspect ratio when one side is given.
-pub fn image_size(scene: &Scene, width: Option<u32>, height: Option<u32>) -> (u32, u32) {
-    let (dw, dh) = scene.resolution.unwrap_or((640, 360));
-    match (width, height) {
-        (Some(w), Some(h)) => (w, h),
-        (Some(w), None) => (w, ((w as f64 * dh as f64 / dw as f64).round() as u32).max(1)),
-        (None, Some(h)) => (((h as f64 * dw as f64 / dh as f64).round() as u32).max(1), h),
-        (None, None) => (dw, dh),
-    }
-}
-
-pub fn bvh_kind(s: &Option<String>) -> Result<BvhKind> {
-    match s {
-        Some(s) => BvhKind::parse(s).with_context(|| format!("--bvh {s:?}: use bvh2 or cwbvh")),
-        None => Ok(BvhKind::DEFAULT),
-    }
-}
-
 pub fn run(a: RenderArgs) -> Result<()> {
     a.load.options()?;
     match a.mode.as_str() {
         "reference" => {}
-        "realtime" => return crate::realtime::run(a),
         m => bail!("--mode {m:?} is not available; use reference or realtime"),
     }
     let realtime_only = [
@@ -390,21 +237,4 @@ pub fn run(a: RenderArgs) -> Result<()> {
         out.display()
     );
     Ok(())
-}
-
-/// `--spp`: whole samples per pixel, or (real-time mode) a fraction of the pixels per frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Spp {
-    Samples(u32),
-    Fraction(hush_engine::settings::SampleFraction),
-}
-
-pub fn parse_spp(s: &str) -> Result<Spp> {
-    if s.contains('/') {
-        return Ok(Spp::Fraction(s.parse()?));
-    }
-    match s.trim().parse::<u32>() {
-        Ok(n) if n >= 1 => Ok(Spp::Samples(n)),
-        _ => bail!("{s:?}: samples per pixel are a whole number from 1, or a fraction 1/N"),
-    }
 }

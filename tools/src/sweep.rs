@@ -3,7 +3,7 @@
 //! second half of its frames) and FLIP against the converged image after those frames (a still
 //! camera). Writes sweep.csv and pareto.png and prints the table with the Pareto front marked.
 
-use crate::render::{bvh_kind, image_size, load_scene, parse_camera};
+use crate::cli::{bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use hush_engine::frame::{FrameInput, Renderer};
@@ -29,7 +29,7 @@ pub struct SweepArgs {
     #[arg(long)]
     pub out_dir: PathBuf,
     #[command(flatten)]
-    pub load: crate::render::LoadArgs,
+    pub load: crate::cli::LoadArgs,
 }
 
 struct Point {
@@ -50,7 +50,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 pub fn run(a: SweepArgs) -> Result<()> {
-    crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
+    crate::cli::check_output_dir(&a.out_dir, "--out-dir")?;
     if a.frames < 2 || a.reference_frames == 0 {
         bail!("--frames must be at least 2 and --reference-frames at least 1");
     }

@@ -16,9 +16,10 @@
 //! time), time_to_quality.png (the curves) and scale_floors.csv (the FLIP of the converged
 //! image at each resolution a run ended at, stretched: what that scale alone costs).
 
+use crate::cli::preset_settings;
+use crate::cli::{Spp, bvh_kind, image_size, load_scene, parse_camera, parse_spp};
 use crate::quality::{new_renderer, reference};
-use crate::realtime::{GovernedFrame, governed_frame, preset_settings};
-use crate::render::{Spp, bvh_kind, image_size, load_scene, parse_camera, parse_spp};
+use crate::realtime::{GovernedFrame, governed_frame};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::{DMat4, DVec3};
@@ -73,7 +74,7 @@ pub struct TimeToQualityArgs {
     #[arg(long)]
     pub out_dir: PathBuf,
     #[command(flatten)]
-    pub load: crate::render::LoadArgs,
+    pub load: crate::cli::LoadArgs,
 }
 
 /// One `--run`.
@@ -184,7 +185,7 @@ impl Runner {
 }
 
 pub fn run(a: TimeToQualityArgs) -> Result<()> {
-    crate::render::check_output_dir(&a.out_dir, "--out-dir")?;
+    crate::cli::check_output_dir(&a.out_dir, "--out-dir")?;
     let runs: Vec<RunSpec> = a.runs.iter().map(|r| parse_run(r)).collect::<Result<_>>()?;
     let scenarios: Vec<Scenario> =
         a.scenarios.iter().map(|s| Scenario::parse(s)).collect::<Result<_>>()?;

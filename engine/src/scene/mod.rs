@@ -25,8 +25,8 @@ pub use environment::{EnvMap, Environment};
 pub use files::{MemoryFiles, SceneFiles, SceneFolder};
 pub use gltf_export::save_gltf;
 pub use gltf_import::{
-    DEFAULT_MAX_TEXTURE_SIZE, ImportPanic, LoadOptions, SUPPORTED_EXTENSIONS, load_gltf,
-    load_gltf_from, load_gltf_opts, load_gltf_with,
+    DEFAULT_MAX_TEXTURE_SIZE, LoadOptions, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_from,
+    load_gltf_opts, load_gltf_with,
 };
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
@@ -240,6 +240,15 @@ impl Scene {
             Some(s) => Ok(s),
             None => load_gltf_opts(Path::new(path_or_default), opts),
         }
+    }
+
+    /// Load a file or a built-in scene as the viewer and the tools show it: under `opts`'
+    /// budgets, with the sun and sky preset added where the scene has no light (the
+    /// conventions' rule). Warnings stay in [`Scene::warnings`] for the caller to show.
+    pub fn open(path_or_default: &str, opts: &LoadOptions) -> Result<Scene> {
+        let mut scene = Scene::load_with(path_or_default, opts)?;
+        scene.add_sun_and_sky_if_unlit();
+        Ok(scene)
     }
 
     pub fn is_animated(&self) -> bool {
