@@ -3,13 +3,14 @@
 //! with TAA after it, and shows a debug view of its own. Everything it needed is in this file
 //! and its one `register` call.
 
+use anyhow::Context;
 use glam::DVec3;
 use hush_engine::accel::BvhKind;
-use hush_engine::denoise::{Denoised, Denoiser, DenoiserScene, Entry, FrameContext};
+use hush_engine::denoise::{
+    Bindings, ChainStage, Denoised, Denoiser, DenoiserScene, Entry, FrameContext, FrameIo, Gpu,
+    GpuMemory, GpuTimer, Parity, PingPong, Tex, made,
+};
 use hush_engine::frame::{FrameInput, Renderer};
-use hush_engine::gpu::{Gpu, GpuMemory, GpuTimer};
-use hush_engine::passes::chain::ChainStage;
-use hush_engine::passes::io::FrameIo;
 use hush_engine::quality::{Image, compare};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser as DenoiserName, FrameSettings, View, ViewMap, ViewSpec};
@@ -45,7 +46,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 
 struct Accumulate {
     animated: bool,
-    history: Option<[(wgpu::Texture, wgpu::TextureView); 2]>,
+    history: Option<PingPong<Tex>>,
     stage: Option<ChainStage>,
 }
 
@@ -54,11 +55,8 @@ fn make(gpu: &Gpu, scene: &DenoiserScene) -> anyhow::Result<Box<dyn Denoiser>> {
     Ok(Box::new(Accumulate { animated: scene.animated, history: None, stage: None }))
 }
 
-impl Accumulate {
-    fn bindings<'a>(&'a self, io: &FrameIo<'a>, parity: usize) -> hush_engine::gpu::Bindings<'a> {
-        let h = self.history.as_ref().unwrap();
-        io.bindings().texture("history", &h[parity].1).texture("out_history", &h[1 - parity].1)
-    }
+fn bindings<'a>(io: &FrameIo<'a>, h: &'a PingPong<Tex>, p: Parity) -> Bindings<'a> {
+    io.bindings().texture("history", &h.history(p).1).texture("out_history", &h.output(p).1)
 }
 
 impl Denoiser for Accumulate {
@@ -72,7 +70,7 @@ impl Denoiser for Accumulate {
             | wgpu::TextureUsages::COPY_SRC;
         let mut t =
             |l: &str| memory.texture(&gpu.device, l, size, wgpu::TextureFormat::Rgba32Float, usage);
-        self.history = Some([t("accumulate/history 0"), t("accumulate/history 1")]);
+        self.history = Some(PingPong::new(|i| t(&format!("accumulate/history {i}"))));
     }
 
     fn record(
@@ -83,33 +81,24 @@ impl Denoiser for Accumulate {
         cx: &FrameContext,
         timer: Option<&mut GpuTimer>,
     ) -> anyhow::Result<()> {
-        if self.stage.is_none() {
-            let motion = if self.animated {
-                "realtime/motion_objects.wgsl"
-            } else {
-                "realtime/motion_static.wgsl"
-            };
-            let modules = [
-                "common/math.wgsl",
-                "realtime/frame.wgsl",
-                "realtime/gbuffer_in.wgsl",
-                motion,
-                MODULE,
-            ];
-            self.stage =
-                Some(ChainStage::new(gpu, "accumulate", &modules, "main", &self.bindings(io, 0))?);
-        }
-        let mut stage = self.stage.take().unwrap();
-        let result =
-            stage.record(gpu, enc, cx.key, cx.parity, io.size, timer, |p| self.bindings(io, p));
-        self.stage = Some(stage);
-        result
+        let h = self.history.as_ref().context("recording before allocating")?;
+        let motion = if self.animated {
+            "realtime/motion_objects.wgsl"
+        } else {
+            "realtime/motion_static.wgsl"
+        };
+        let modules =
+            ["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", motion, MODULE];
+        let offered = bindings(io, h, Parity::default());
+        let stage = made(&mut self.stage, || {
+            ChainStage::new(gpu, "accumulate", &modules, "main", &offered)
+        })?;
+        stage.record(gpu, enc, cx.key, cx.parity, io.size, timer, |p| bindings(io, h, p))
     }
 
-    fn output(&self, parity: usize) -> Denoised<'_> {
-        // Written this frame: history[1 - parity].
+    fn output(&self, parity: Parity) -> Denoised<'_> {
         Denoised {
-            matte: self.history.as_ref().map(|h| &h[1 - parity].1),
+            matte: self.history.as_ref().map(|h| &h.output(parity).1),
             glossy: None,
             direct: None,
         }

@@ -141,7 +141,7 @@ fn run(pixels: &[Pixel]) -> Output {
     let mut prefilter = Prefilter::default();
     let mut enc = d.create_command_encoder(&Default::default());
     let offered = bindings(&frame, &primaries, &targets);
-    prefilter.record(&gpu, &mut enc, 1, size, &offered, None).unwrap();
+    prefilter.record(&gpu, &mut enc, Default::default(), size, &offered, None).unwrap();
     gpu.queue.submit([enc.finish()]);
     let read = |b: &wgpu::Buffer| -> Vec<f32> {
         bytemuck::cast_slice(&readback_buffer(d, &gpu.queue, b, b.size()).unwrap()).to_vec()

@@ -1,4 +1,4 @@
-//! Below one sample per pixel (Dundr et al. §5; hush_engine::frame::schedule and
+//! Below one sample per pixel (Dundr et al. §5; hush_engine::passes::schedule and
 //! hush_engine::denoise::progressive): the trace writes exactly the pixels the schedule names,
 //! denoisers that need every pixel refuse it, and the progressive filter keeps untraced pixels'
 //! history and moments, weighs its taps as a CPU implementation of §4.4 does, and keeps NaN/Inf
@@ -6,8 +6,8 @@
 
 use glam::DVec3;
 use hush_engine::accel::BvhKind;
-use hush_engine::frame::schedule::{scheduled_pixel, tile};
 use hush_engine::frame::{FrameInput, Renderer};
+use hush_engine::passes::schedule::{scheduled_pixel, tile};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{
     Denoiser, FrameSettings, MatteSettings, ProgressiveSettings, SampleFraction, TaaSettings,

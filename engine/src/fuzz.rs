@@ -77,7 +77,9 @@ pub fn scene(data: &[u8]) -> Result<Scene> {
     let (bytes, files) = unpack(data);
     let opts = LoadOptions { max_texture_size: 64, limits: FUZZ_LIMITS };
     let mut scene = match load_gltf_from(bytes, "fuzz", &files, &opts) {
-        Err(e) if e.chain().any(|c| c.is::<crate::scene::ImportPanic>()) => panic!("{e:#}"),
+        Err(e) if matches!(crate::Error::find(&e), Some(crate::Error::ImportPanic(_))) => {
+            panic!("{e:#}")
+        }
         r => r?,
     };
     scene.add_sun_and_sky_if_unlit();

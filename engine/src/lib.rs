@@ -4,8 +4,13 @@
 //! Data flows one way: file -> [`scene`] (CPU) -> GPU scene ([`accel`], [`passes`]) -> image
 //! ([`quality`] for metrics and files).
 
+// No panic on the frame path or on user input: an error the caller can show instead. An
+// `expect` that stays says in its message, or a comment beside it, why it cannot fire.
+#![warn(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 pub mod accel;
 pub mod denoise;
+pub mod error;
 pub mod frame;
 pub mod fuzz;
 pub mod governor;
@@ -17,3 +22,5 @@ pub mod quality;
 pub mod scene;
 pub mod settings;
 pub mod shader;
+
+pub use error::Error;

@@ -34,7 +34,7 @@ pub struct Limits {
     /// Depth of the node hierarchy (a root node is at depth 1). Default 1024.
     pub hierarchy_depth: u64,
     /// Triangles after instancing (a mesh placed by n nodes counts n times). Default 16,777,215,
-    /// the most the GPU's triangle slots address (`gpu::prepare::MAX_TRIANGLES` - 1).
+    /// the most the GPU's triangle slots address ([`MAX_TRIANGLES`] - 1).
     pub triangles: u64,
 }
 
@@ -47,7 +47,7 @@ impl Default for Limits {
             decoded_bytes: 4 << 30,
             nodes: 1_000_000,
             hierarchy_depth: 1024,
-            triangles: crate::gpu::prepare::MAX_TRIANGLES as u64 - 1,
+            triangles: MAX_TRIANGLES as u64 - 1,
         }
     }
 }
@@ -95,55 +95,37 @@ impl Limits {
             })?;
             *slot = value;
         }
-        if self.triangles >= crate::gpu::prepare::MAX_TRIANGLES as u64 {
+        if self.triangles >= MAX_TRIANGLES as u64 {
             bail!(
                 "--limit triangles={}: the GPU addresses at most {} triangles",
                 self.triangles,
-                crate::gpu::prepare::MAX_TRIANGLES - 1
+                MAX_TRIANGLES - 1
             );
         }
         Ok(())
     }
 }
 
-/// A budget overrun: names the budget and how to raise it. Callers that fall back on bad input
-/// (a texture that cannot be read) still refuse an overrun: find it in an error's chain with
-/// [`is_over_budget`].
-#[derive(Debug)]
-pub struct OverBudget {
-    pub budget: &'static str,
-    pub what: String,
-    pub need: u64,
-    pub limit: u64,
-}
-
-impl std::fmt::Display for OverBudget {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        let (name, need, limit) = (self.budget, self.need, self.limit);
-        write!(
-            f,
-            "{} needs {need} against the {name} budget of {limit}; if the file is trusted, raise it with --limit {name}={need}",
-            self.what
-        )
-    }
-}
-
-impl std::error::Error for OverBudget {}
-
-/// The error for `what` needing `need` of the budget `name` whose value is `limit`.
+/// The error for `what` needing `need` of the budget `name` whose value is `limit`
+/// ([`crate::Error::OverBudget`]). Callers that fall back on bad input (a texture that cannot be
+/// read) still refuse an overrun: find it in an error's chain with [`is_over_budget`].
 pub fn over_budget(
     name: &'static str,
     what: impl std::fmt::Display,
     need: u64,
     limit: u64,
 ) -> anyhow::Error {
-    anyhow::Error::new(OverBudget { budget: name, what: what.to_string(), need, limit })
+    crate::Error::OverBudget { budget: name, what: what.to_string(), need, limit }.into()
 }
 
 /// Whether `e` (or an error it wraps) is a budget overrun.
 pub fn is_over_budget(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| c.is::<OverBudget>())
+    matches!(crate::Error::find(e), Some(crate::Error::OverBudget { .. }))
 }
+
+/// Triangle slots the GPU scene addresses: triangle slots and node indices share 24 bits in the
+/// BVH2 traversal stack.
+pub const MAX_TRIANGLES: usize = 1 << 24;
 
 /// A running count of decoded bytes against [`Limits::decoded_bytes`].
 #[derive(Debug)]

@@ -4,7 +4,7 @@
 //! outputs ([`TaaFollow`]).
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Gpu, GpuMemory, GpuTimer};
+use crate::gpu::{Gpu, GpuMemory, GpuTimer, Parity};
 use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
@@ -63,20 +63,11 @@ impl Denoiser for Mara {
         let gp = GlossyParams::new(&s.glossy, self.scene.extent, cx.view.static_view);
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
-        if self.matte.is_none() {
-            self.matte = Some(
-                MatteChain::new(gpu, &inputs, self.scene.animated)
-                    .context("creating the matte chain")?,
-            );
-        }
-        self.matte.as_mut().unwrap().record(
-            gpu,
-            enc,
-            cx.key,
-            &inputs,
-            cx.parity,
-            timer.as_deref_mut(),
-        )?;
+        let animated = self.scene.animated;
+        let matte = super::made(&mut self.matte, || {
+            MatteChain::new(gpu, &inputs, animated).context("creating the matte chain")
+        })?;
+        matte.record(gpu, enc, cx.key, &inputs, cx.parity, timer.as_deref_mut())?;
         if let Some(g) = g {
             let inputs = GlossyInputs {
                 io: *io,
@@ -84,21 +75,15 @@ impl Denoiser for Mara {
                 params: &self.glossy_params,
                 glossy: g,
             };
-            if self.glossy.is_none() {
-                self.glossy = Some(
-                    GlossyChain::new(gpu, &inputs, self.scene.animated)
-                        .context("creating the glossy chain")?,
-                );
-            }
-            self.glossy
-                .as_mut()
-                .unwrap()
-                .record(gpu, enc, cx.key, &inputs, cx.parity, &s.glossy, timer)?;
+            let glossy = super::made(&mut self.glossy, || {
+                GlossyChain::new(gpu, &inputs, animated).context("creating the glossy chain")
+            })?;
+            glossy.record(gpu, enc, cx.key, &inputs, cx.parity, &s.glossy, timer)?;
         }
         Ok(())
     }
 
-    fn output(&self, _parity: usize) -> Denoised<'_> {
+    fn output(&self, _parity: Parity) -> Denoised<'_> {
         let Some((m, g)) = &self.targets else { return Denoised::default() };
         Denoised {
             matte: Some(&m.denoised.1),
@@ -107,15 +92,15 @@ impl Denoiser for Mara {
         }
     }
 
-    fn taa_follow(&self, parity: usize) -> TaaFollow<'_> {
+    fn taa_follow(&self, parity: Parity) -> TaaFollow<'_> {
         let Some((m, g)) = &self.targets else { return TaaFollow::default() };
         TaaFollow {
             matte: Some((&m.temporal.1, &m.reason.1)),
-            // The glossy temporal wrote history[1 - parity] this frame.
+            // What the glossy temporal wrote this frame, and what it read.
             glossy: g.as_ref().map(|g| GlossyFollow {
                 denoised: &g.denoised.1,
-                temporal: &g.history[1 - parity].1,
-                previous: &g.history[parity].1,
+                temporal: &g.history.output(parity).1,
+                previous: &g.history.history(parity).1,
                 info: &g.info.1,
                 params: &self.glossy_params,
             }),

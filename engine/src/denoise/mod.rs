@@ -15,10 +15,11 @@ pub mod mara;
 pub mod progressive;
 pub mod svgf;
 
-use crate::gpu::{Gpu, GpuMemory, GpuTimer};
-use crate::passes::io::FrameIo;
-use crate::passes::matte::ChainView;
-use crate::passes::taa::TaaFollow;
+pub use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+pub use crate::passes::chain::ChainStage;
+pub use crate::passes::io::{FrameIo, PreviousGBuffer};
+pub use crate::passes::matte::ChainView;
+pub use crate::passes::taa::{GlossyFollow, TaaFollow};
 use crate::settings::{FrameSettings, ViewSpec};
 use anyhow::{Result, bail};
 use std::sync::RwLock;
@@ -36,15 +37,16 @@ pub struct DenoiserScene {
 
 /// This frame beyond its I/O.
 pub struct FrameContext<'a> {
-    /// Frames rendered so far (wraps); histories ping-pong on `parity` = index % 2.
+    /// Frames rendered so far (wraps).
     pub index: u32,
-    pub parity: usize,
+    /// Which way round the histories ([`PingPong`]) are this frame: the parity of `index`.
+    pub parity: Parity,
     /// Cameras of this frame and the last, the jitter between them, history validity.
     pub view: ChainView,
     pub settings: &'a FrameSettings,
     /// Changes whenever a resource the frame offers may have been replaced (resize, a scene
     /// buffer reallocated): bind groups keyed on it stay valid while it stays.
-    pub key: u64,
+    pub key: crate::gpu::BindKey,
 }
 
 /// The denoised light for the composite (None: the trace's raw light passes through).
@@ -76,7 +78,7 @@ pub trait Denoiser {
     ) -> Result<()>;
 
     /// The light it produced this frame (after [`Denoiser::record`]).
-    fn output(&self, parity: usize) -> Denoised<'_>;
+    fn output(&self, parity: Parity) -> Denoised<'_>;
 
     /// Whether it takes frames where only some pixels were traced (a sample fraction below 1,
     /// [`crate::settings::SampleFraction`]; `scheduled_pixel` in shaders/realtime/frame.wgsl
@@ -86,12 +88,21 @@ pub trait Denoiser {
     }
 
     /// What TAA may follow (the default, nothing: TAA averages the composite alone).
-    fn taa_follow(&self, _parity: usize) -> TaaFollow<'_> {
+    fn taa_follow(&self, _parity: Parity) -> TaaFollow<'_> {
         TaaFollow::default()
     }
 
     /// Its pipelines, for hot reload.
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload>;
+}
+
+/// The stages in `slot`, made by `make` the first time they are needed (a stage is checked
+/// against the names the frame offers, so a denoiser makes its stages on its first frame).
+pub fn made<T>(slot: &mut Option<T>, make: impl FnOnce() -> Result<T>) -> Result<&mut T> {
+    match slot {
+        Some(t) => Ok(t),
+        None => Ok(slot.insert(make()?)),
+    }
 }
 
 /// Makes a denoiser for a scene.

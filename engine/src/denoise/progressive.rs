@@ -13,7 +13,7 @@
 //! TAA (Dundr's §4.5 blend with a clamped history) follow as for every denoiser.
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
@@ -139,26 +139,16 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     if scene.glossy {
         signals.insert(1, Signal::Glossy);
     }
-    Ok(Box::new(Progressive {
-        scene: *scene,
-        pp,
-        dn,
-        levels,
-        targets: None,
-        features: None,
-        stages: vec![],
-        signals,
-    }))
+    let res = Resources { pp, dn, levels, targets: None };
+    Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
 }
-
-type Tex = (wgpu::Texture, wgpu::TextureView);
 
 /// One signal's textures: 72 bytes per pixel.
 pub struct SignalTargets {
     /// The accumulated light (rgb) by parity: this frame's is next frame's history.
-    pub history: [Tex; 2],
+    pub history: PingPong<Tex>,
     /// Luminance moments and the samples accumulated (m1, m2, age), by parity.
-    pub moments: [Tex; 2],
+    pub moments: PingPong<Tex>,
     /// The variance stage's output (rgb, variance; -1: no sample), then the levels' ping-pong.
     pub variance: Tex,
     pub ping: Tex,
@@ -173,8 +163,8 @@ impl SignalTargets {
         let mut t =
             |label: &str, f| mem.texture(d, &format!("progressive/{name} {label}"), size, f, rw);
         SignalTargets {
-            history: [t("history 0", RGBA16F), t("history 1", RGBA16F)],
-            moments: [t("moments 0", RGBA32F), t("moments 1", RGBA32F)],
+            history: PingPong::new(|i| t(&format!("history {i}"), RGBA16F)),
+            moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
             variance: t("variance", RGBA16F),
             ping: t("ping", RGBA16F),
             pong: t("pong", RGBA16F),
@@ -200,7 +190,6 @@ struct Targets {
 }
 
 struct SignalStages {
-    signal: Signal,
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
@@ -215,15 +204,25 @@ enum Pass {
     Atrous(usize),
 }
 
-struct Progressive {
-    scene: DenoiserScene,
+/// The filter's parameter buffers and per-pixel textures: what its stages bind.
+struct Resources {
     pp: wgpu::Buffer,
     dn: wgpu::Buffer,
     /// Per level, for filtering signals and for the direct light (fill only).
     levels: [[wgpu::Buffer; LEVELS]; 2],
     targets: Option<Targets>,
-    features: Option<ChainStage>,
-    stages: Vec<SignalStages>,
+}
+
+/// The features stage and each signal's stages, made on the first frame.
+struct Stages {
+    features: ChainStage,
+    signals: Vec<SignalStages>,
+}
+
+struct Progressive {
+    scene: DenoiserScene,
+    res: Resources,
+    stages: Option<Stages>,
     signals: Vec<Signal>,
 }
 
@@ -244,17 +243,17 @@ pub fn modules(
     m
 }
 
-impl Progressive {
+impl Resources {
+    #[allow(clippy::too_many_arguments)]
     fn bindings<'a>(
         &'a self,
         io: &FrameIo<'a>,
-        signal: Signal,
+        t: &'a Targets,
+        (signal, s): (Signal, &'a SignalTargets),
         pass: Pass,
-        parity: usize,
+        parity: Parity,
         levels: usize,
     ) -> Bindings<'a> {
-        let t = self.targets.as_ref().unwrap();
-        let s = &t.signals.iter().find(|(g, _)| *g == signal).unwrap().1;
         let b = io
             .bindings()
             .buffer("pp", &self.pp)
@@ -263,13 +262,13 @@ impl Progressive {
         match pass {
             Pass::Features => b.texture("out_features", &t.features.1),
             Pass::Temporal => b
-                .texture("history", &s.history[parity].1)
-                .texture("moments", &s.moments[parity].1)
-                .texture("out_integrated", &s.history[1 - parity].1)
-                .texture("out_moments", &s.moments[1 - parity].1),
+                .texture("history", &s.history.history(parity).1)
+                .texture("moments", &s.moments.history(parity).1)
+                .texture("out_integrated", &s.history.output(parity).1)
+                .texture("out_moments", &s.moments.output(parity).1),
             Pass::Variance => b
-                .texture("integrated", &s.history[1 - parity].1)
-                .texture("moments", &s.moments[1 - parity].1)
+                .texture("integrated", &s.history.output(parity).1)
+                .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.variance.1),
             Pass::Atrous(i) => {
                 let src = if i == 0 { &s.variance } else { s.output(i) };
@@ -295,27 +294,38 @@ impl Progressive {
         gpu.queue.write_buffer(&self.dn, 0, bytemuck::bytes_of(&dp));
     }
 
-    fn offered<'a>(&'a self, io: &FrameIo<'a>, signal: Signal) -> Bindings<'a> {
-        [Pass::Temporal, Pass::Variance, Pass::Atrous(0)]
-            .into_iter()
-            .fold(self.bindings(io, signal, Pass::Features, 0, 1), |b, pass| {
-                b.with(&self.bindings(io, signal, pass, 0, 1))
-            })
-    }
-
-    fn make_stages(&self, gpu: &Gpu, io: &FrameIo, signal: Signal) -> Result<SignalStages> {
-        let (g, a) = (self.scene.glossy, self.scene.animated);
-        let offered = self.offered(io, signal);
-        let [lt, lv, la] = signal.labels();
-        let stage = |label, file| {
-            ChainStage::new(gpu, label, &modules(file, signal, g, a), "main", &offered)
-        };
-        Ok(SignalStages {
-            signal,
-            temporal: stage(lt, "progressive/temporal.wgsl")?,
-            variance: stage(lv, "progressive/variance.wgsl")?,
-            atrous: stage(la, "progressive/atrous.wgsl")?,
-        })
+    /// Every stage's programs, checked against what the frame and the filter offer.
+    fn make_stages(
+        &self,
+        gpu: &Gpu,
+        io: &FrameIo,
+        t: &Targets,
+        scene: &DenoiserScene,
+    ) -> Result<Stages> {
+        let (g, a) = (scene.glossy, scene.animated);
+        let p = Parity::default();
+        let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
+        let m = modules("progressive/features.wgsl", Signal::Matte, g, a);
+        let offered = self.bindings(io, t, matte, Pass::Features, p, t.levels);
+        let features = ChainStage::new(gpu, "progressive/features", &m, "main", &offered)?;
+        let mut signals = vec![];
+        for (signal, s) in &t.signals {
+            let offered = [Pass::Temporal, Pass::Variance, Pass::Atrous(0)]
+                .into_iter()
+                .fold(self.bindings(io, t, (*signal, s), Pass::Features, p, 1), |b, pass| {
+                    b.with(&self.bindings(io, t, (*signal, s), pass, p, 1))
+                });
+            let [lt, lv, la] = signal.labels();
+            let stage = |label, file| {
+                ChainStage::new(gpu, label, &modules(file, *signal, g, a), "main", &offered)
+            };
+            signals.push(SignalStages {
+                temporal: stage(lt, "progressive/temporal.wgsl")?,
+                variance: stage(lv, "progressive/variance.wgsl")?,
+                atrous: stage(la, "progressive/atrous.wgsl")?,
+            });
+        }
+        Ok(Stages { features, signals })
     }
 }
 
@@ -338,7 +348,7 @@ impl Denoiser for Progressive {
             .iter()
             .map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name())))
             .collect();
-        self.targets = Some(Targets { features, signals, levels: 0 });
+        self.res.targets = Some(Targets { features, signals, levels: 0 });
     }
 
     fn record(
@@ -349,83 +359,49 @@ impl Denoiser for Progressive {
         cx: &FrameContext,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        self.targets
-            .as_mut()
-            .context("the progressive filter records before its textures exist")?
-            .levels = cx.settings.progressive.levels.min(PROGRESSIVE_MAX_LEVELS) as usize;
-        self.write_params(gpu, io, cx);
-        let (key, parity, size) = (cx.key, cx.parity, io.size);
-        let levels = self.targets.as_ref().unwrap().levels;
-        if self.features.is_none() {
-            let m = modules(
-                "progressive/features.wgsl",
-                Signal::Matte,
-                self.scene.glossy,
-                self.scene.animated,
-            );
-            self.features = Some(
-                ChainStage::new(
-                    gpu,
-                    "progressive/features",
-                    &m,
-                    "main",
-                    &self.bindings(io, Signal::Matte, Pass::Features, 0, levels),
-                )
-                .context("creating the progressive filter's stages")?,
-            );
-        }
-        if self.stages.is_empty() {
-            self.stages = self
-                .signals
-                .iter()
-                .map(|&s| self.make_stages(gpu, io, s))
-                .collect::<Result<_>>()
-                .context("creating the progressive filter's stages")?;
-        }
-        let mut features = self.features.take().unwrap();
-        let r = features.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-            self.bindings(io, Signal::Matte, Pass::Features, p, levels)
-        });
-        self.features = Some(features);
-        r?;
-        let mut stages = std::mem::take(&mut self.stages);
-        let mut result = Ok(());
-        for st in stages.iter_mut() {
-            let s = st.signal;
-            result = st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-                self.bindings(io, s, Pass::Temporal, p, levels)
-            });
-            result = result.and_then(|_| {
-                st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-                    self.bindings(io, s, Pass::Variance, p, levels)
-                })
-            });
+        let Progressive { scene, res, stages, .. } = self;
+        let missing = "the progressive filter records before its textures exist";
+        res.targets.as_mut().context(missing)?.levels =
+            cx.settings.progressive.levels.min(PROGRESSIVE_MAX_LEVELS) as usize;
+        let t = res.targets.as_ref().context(missing)?;
+        res.write_params(gpu, io, cx);
+        let (key, parity, size, levels) = (cx.key, cx.parity, io.size, t.levels);
+        let stages = super::made(stages, || {
+            res.make_stages(gpu, io, t, scene).context("creating the progressive filter's stages")
+        })?;
+        let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
+        stages.features.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+            res.bindings(io, t, matte, Pass::Features, p, levels)
+        })?;
+        for (st, (signal, s)) in stages.signals.iter_mut().zip(&t.signals) {
+            let sig = (*signal, s);
+            let b = |pass, p| res.bindings(io, t, sig, pass, p, levels);
+            st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+                b(Pass::Temporal, p)
+            })?;
+            st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+                b(Pass::Variance, p)
+            })?;
             for i in 0..levels {
                 // Bind groups are keyed by (parity, level); the level count is in the key, since
                 // it picks each level's step.
-                let k = key.wrapping_mul(8).wrapping_add(levels as u64);
-                result = result.and_then(|_| {
-                    st.atrous.record_variant(
-                        gpu,
-                        enc,
-                        k,
-                        (2 * LEVELS, parity * LEVELS + i),
-                        size,
-                        timer.as_deref_mut(),
-                        |v| self.bindings(io, s, Pass::Atrous(v % LEVELS), v / LEVELS, levels),
-                    )
-                });
-            }
-            if result.is_err() {
-                break;
+                let k = crate::gpu::BindKey { levels, ..key };
+                st.atrous.record_variant(
+                    gpu,
+                    enc,
+                    k,
+                    (2 * LEVELS, parity.index() * LEVELS + i),
+                    size,
+                    timer.as_deref_mut(),
+                    |v| b(Pass::Atrous(v % LEVELS), Parity::BOTH[v / LEVELS]),
+                )?;
             }
         }
-        self.stages = stages;
-        result
+        Ok(())
     }
 
-    fn output(&self, _parity: usize) -> Denoised<'_> {
-        let Some(t) = &self.targets else { return Denoised::default() };
+    fn output(&self, _parity: Parity) -> Denoised<'_> {
+        let Some(t) = &self.res.targets else { return Denoised::default() };
         let out = |s: Signal| {
             t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(t.levels).1)
         };
@@ -438,10 +414,9 @@ impl Denoiser for Progressive {
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
         let mut v: Vec<&mut dyn crate::shader::Reload> = vec![];
-        if let Some(f) = self.features.as_mut() {
-            v.push(&mut f.pipeline);
-        }
-        for s in self.stages.iter_mut() {
+        let Some(stages) = self.stages.as_mut() else { return v };
+        v.push(&mut stages.features.pipeline);
+        for s in stages.signals.iter_mut() {
             v.extend(
                 [&mut s.temporal, &mut s.variance, &mut s.atrous]
                     .into_iter()

@@ -12,7 +12,7 @@
 //! changes.
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::glossy::GlossyParams;
 use crate::passes::io::FrameIo;
@@ -94,27 +94,16 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
         );
         b
     });
-    Ok(Box::new(Svgf {
-        scene: *scene,
-        sv,
-        dn,
-        gp,
-        levels,
-        targets: None,
-        matte: None,
-        glossy: None,
-        motion: None,
-    }))
+    let res = Resources { sv, dn, gp, levels, targets: None };
+    Ok(Box::new(Svgf { scene: *scene, res, matte: None, glossy: None, motion: None }))
 }
-
-type Tex = (wgpu::Texture, wgpu::TextureView);
 
 /// One signal's textures: 104 bytes per pixel.
 pub struct SignalTargets {
     /// The first a-trous level's output, by parity: what the next frame reprojects.
-    pub history: [Tex; 2],
+    pub history: PingPong<Tex>,
     /// Luminance moments and history length (m1, m2, h), by parity.
-    pub moments: [Tex; 2],
+    pub moments: PingPong<Tex>,
     /// This frame's temporally integrated light (rgb, raw luminance).
     pub integrated: Tex,
     /// The variance stage's output (rgb, variance): the first a-trous level's input.
@@ -144,8 +133,8 @@ impl SignalTargets {
         let mut t = |label: &str, f| mem.texture(d, &format!("svgf/{name} {label}"), size, f, rw);
         SignalTargets {
             taps,
-            history: [t("history 0", RGBA16F), t("history 1", RGBA16F)],
-            moments: [t("moments 0", RGBA32F), t("moments 1", RGBA32F)],
+            history: PingPong::new(|i| t(&format!("history {i}"), RGBA16F)),
+            moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
             integrated: t("integrated", RGBA16F),
             variance: t("variance", RGBA16F),
             ping: t("ping", RGBA16F),
@@ -158,7 +147,7 @@ impl SignalTargets {
 /// What the reflection motion search and the clip's neighbourhood need (glossy scenes): 72
 /// bytes per pixel.
 pub struct MotionTargets {
-    pub hit: [Tex; 2],
+    pub hit: PingPong<Tex>,
     pub motion: Tex,
     pub search: Tex,
     pub neighbourhood: Tex,
@@ -189,7 +178,7 @@ impl SvgfTargets {
             let mut t =
                 |label: &str, f| mem.texture(d, &format!("svgf/glossy {label}"), size, f, rw);
             let motion = MotionTargets {
-                hit: [t("hit 0", RGBA32F), t("hit 1", RGBA32F)],
+                hit: PingPong::new(|i| t(&format!("hit {i}"), RGBA32F)),
                 motion: t("motion", RGBA32F),
                 search: t("search", RGBA16F),
                 neighbourhood: t("neighbourhood", RGBA16F),
@@ -268,13 +257,20 @@ struct MotionStages {
     prefilter_v: ChainStage,
 }
 
-struct Svgf {
-    scene: DenoiserScene,
+/// SVGF's parameter buffers and per-pixel textures: what its stages bind.
+struct Resources {
     sv: wgpu::Buffer,
     dn: wgpu::Buffer,
     gp: wgpu::Buffer,
     levels: [wgpu::Buffer; LEVELS],
     targets: Option<SvgfTargets>,
+}
+
+struct Svgf {
+    scene: DenoiserScene,
+    res: Resources,
+    /// Each signal's stages and the glossy motion search, made on the first frame they record
+    /// (a stage is checked against the names the frame offers).
     matte: Option<SignalStages>,
     glossy: Option<SignalStages>,
     motion: Option<MotionStages>,
@@ -291,43 +287,57 @@ enum Pass {
     Final(usize),
 }
 
-impl Svgf {
+/// One signal's textures, and for the glossy signal the reflection motion's.
+#[derive(Clone, Copy)]
+struct Signal<'a> {
+    targets: &'a SignalTargets,
+    motion: Option<&'a MotionTargets>,
+}
+
+impl SvgfTargets {
+    fn signal(&self, glossy: bool) -> Option<Signal<'_>> {
+        match (glossy, &self.glossy) {
+            (false, _) => Some(Signal { targets: &self.matte, motion: None }),
+            (true, Some((targets, motion))) => Some(Signal { targets, motion: Some(motion) }),
+            (true, None) => None,
+        }
+    }
+}
+
+impl Resources {
     /// Everything every SVGF program may bind, plus what `pass` of one signal reads and
-    /// writes for history parity `parity`.
+    /// writes at history parity `parity`.
     fn bindings<'a>(
         &'a self,
         io: &FrameIo<'a>,
-        glossy: bool,
+        t: &'a SvgfTargets,
+        signal: Signal<'a>,
         pass: Pass,
-        parity: usize,
+        parity: Parity,
     ) -> Bindings<'a> {
-        let t = self.targets.as_ref().unwrap();
         let mut b = io
             .bindings()
             .buffer("sv", &self.sv)
             .buffer("dn", &self.dn)
             .texture("features", &t.features.1);
-        let s = if glossy {
-            let (s, m) = t.glossy.as_ref().unwrap();
+        if let Some(m) = signal.motion {
             b = b
                 .buffer("gp", &self.gp)
-                .texture("prev_hit", &m.hit[parity].1)
+                .texture("prev_hit", &m.hit.history(parity).1)
                 .texture("motion", &m.motion.1)
                 .texture("neighbourhood", &m.neighbourhood.1);
-            s
-        } else {
-            &t.matte
-        };
+        }
+        let s = signal.targets;
         match pass {
             Pass::Temporal => b
-                .texture("history", &s.history[parity].1)
-                .texture("moments", &s.moments[parity].1)
+                .texture("history", &s.history.history(parity).1)
+                .texture("moments", &s.moments.history(parity).1)
                 .texture("out_integrated", &s.integrated.1)
-                .texture("out_moments", &s.moments[1 - parity].1)
+                .texture("out_moments", &s.moments.output(parity).1)
                 .texture("out_features", &t.features.1),
             Pass::Variance => b
                 .texture("integrated", &s.integrated.1)
-                .texture("moments", &s.moments[1 - parity].1)
+                .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.variance.1)
                 .buffer("out_taps", &s.taps),
             Pass::Atrous(level) => {
@@ -340,13 +350,13 @@ impl Svgf {
                 b.texture("src", &src.1)
                     .texture("dst", &dst.1)
                     .buffer("taps", &s.taps)
-                    .texture("moments", &s.moments[1 - parity].1)
-                    .texture("out_history", &s.history[1 - parity].1)
+                    .texture("moments", &s.moments.output(parity).1)
+                    .texture("out_history", &s.history.output(parity).1)
                     .buffer("level", &self.levels[level])
             }
             Pass::Final(last) => b
                 .texture("src", &[&s.variance, &s.ping, &s.pong][last].1)
-                .texture("moments", &s.moments[1 - parity].1)
+                .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.out.1),
         }
     }
@@ -355,30 +365,30 @@ impl Svgf {
     fn motion_bindings<'a>(
         &'a self,
         io: &FrameIo<'a>,
+        m: &'a MotionTargets,
         prefilter: Option<bool>,
-        parity: usize,
+        parity: Parity,
     ) -> Bindings<'a> {
-        let (_, m) = self.targets.as_ref().unwrap().glossy.as_ref().unwrap();
         let b = io.bindings().buffer("dn", &self.dn).buffer("gp", &self.gp);
         match prefilter {
             None => b
-                .texture("prev_hit", &m.hit[parity].1)
+                .texture("prev_hit", &m.hit.history(parity).1)
                 .texture("out_motion", &m.motion.1)
                 .texture("out_search", &m.search.1)
-                .texture("out_hit", &m.hit[1 - parity].1),
+                .texture("out_hit", &m.hit.output(parity).1),
             Some(false) => b.texture("src", &m.neighbourhood.1).texture("dst", &m.scratch.1),
             Some(true) => b.texture("src", &m.scratch.1).texture("dst", &m.neighbourhood.1),
         }
     }
 
-    fn write_params(&self, gpu: &Gpu, io: &FrameIo, cx: &FrameContext) {
+    fn write_params(&self, gpu: &Gpu, io: &FrameIo, cx: &FrameContext, extent: f32) {
         let s: &FrameSettings = cx.settings;
         let sv = &s.svgf;
         gpu.queue.write_buffer(&self.sv, 0, bytemuck::bytes_of(&SvgfParams::new(sv)));
         let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
         dp.reprojection_min_cos = crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES);
         gpu.queue.write_buffer(&self.dn, 0, bytemuck::bytes_of(&dp));
-        let mut gp = GlossyParams::new(&s.glossy, self.scene.extent, cx.view.static_view);
+        let mut gp = GlossyParams::new(&s.glossy, extent, cx.view.static_view);
         gp.roughness_threshold = sv.roughness_threshold;
         gp.clip_roughness = sv.clip_roughness;
         gp.mode = if sv.reflection_reprojection { 2 } else { 0 };
@@ -389,138 +399,122 @@ impl Svgf {
         gpu.queue.write_buffer(&self.gp, 0, bytemuck::bytes_of(&gp));
     }
 
-    fn record_signal(
-        &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        io: &FrameIo,
-        cx: &FrameContext,
-        glossy: bool,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
-        let made = if glossy { self.glossy.take() } else { self.matte.take() };
-        let mut stages = match made {
-            Some(s) => s,
-            None => SignalStages::new(gpu, glossy, self.scene.animated, &self.offered(io, glossy))
-                .context("creating SVGF's stages")?,
-        };
-        let result = self.record_stages(gpu, enc, io, cx, glossy, &mut stages, timer);
-        *(if glossy { &mut self.glossy } else { &mut self.matte }) = Some(stages);
-        result
-    }
-
     /// Every resource any stage of a signal binds (only the names matter: each program's
     /// layout is checked against them).
-    fn offered<'a>(&'a self, io: &FrameIo<'a>, glossy: bool) -> Bindings<'a> {
+    fn offered<'a>(&'a self, io: &FrameIo<'a>, t: &'a SvgfTargets, s: Signal<'a>) -> Bindings<'a> {
+        let p = Parity::default();
         [Pass::Variance, Pass::Atrous(0), Pass::Final(0)]
             .into_iter()
-            .fold(self.bindings(io, glossy, Pass::Temporal, 0), |b, pass| {
-                b.with(&self.bindings(io, glossy, pass, 0))
+            .fold(self.bindings(io, t, s, Pass::Temporal, p), |b, pass| {
+                b.with(&self.bindings(io, t, s, pass, p))
             })
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn record_stages(
         &self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Record,
         io: &FrameIo,
         cx: &FrameContext,
-        glossy: bool,
+        signal: Signal,
         st: &mut SignalStages,
-        mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
+        let t = self.targets.as_ref().context("SVGF records before its textures exist")?;
         let (key, parity, size) = (cx.key, cx.parity, io.size);
-        st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-            self.bindings(io, glossy, Pass::Temporal, p)
-        })?;
-        st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-            self.bindings(io, glossy, Pass::Variance, p)
-        })?;
+        let b = |pass, p| self.bindings(io, t, signal, pass, p);
+        let Record { gpu, enc, timer } = rec;
+        st.temporal
+            .record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| b(Pass::Temporal, p))?;
+        st.variance
+            .record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| b(Pass::Variance, p))?;
         let levels = cx.settings.svgf.atrous_levels() as usize;
         for level in 0..levels {
+            // Bind groups by (parity, level).
             st.atrous.record_variant(
                 gpu,
                 enc,
                 key,
-                (2 * LEVELS, parity * LEVELS + level),
+                (2 * LEVELS, parity.index() * LEVELS + level),
                 size,
                 timer.as_deref_mut(),
-                |v| self.bindings(io, glossy, Pass::Atrous(v % LEVELS), v / LEVELS),
+                |v| b(Pass::Atrous(v % LEVELS), Parity::BOTH[v / LEVELS]),
             )?;
         }
-        let t = self.targets.as_ref().unwrap();
-        let s = if glossy { &t.glossy.as_ref().unwrap().0 } else { &t.matte };
+        let s = signal.targets;
         if levels == 0 || !cx.settings.svgf.filtered_history {
             // No level wrote the history: it is the integrated light.
             let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
             enc.copy_texture_to_texture(
                 s.integrated.0.as_image_copy(),
-                s.history[1 - parity].0.as_image_copy(),
+                s.history.output(parity).0.as_image_copy(),
                 extent,
             );
         }
-        // The last level wrote pong when its index was even.
+        // The last level wrote pong when its index was even; bind groups by (last, parity).
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
-        st.last.record_variant(gpu, enc, key, (6, 2 * last + parity), size, timer, |v| {
-            self.bindings(io, glossy, Pass::Final(v / 2), v % 2)
+        let variant = (6, 2 * last + parity.index());
+        st.last.record_variant(gpu, enc, key, variant, size, timer.as_deref_mut(), |v| {
+            b(Pass::Final(v / 2), Parity::BOTH[v % 2])
         })
     }
 
     fn record_motion(
-        &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        &self,
+        rec: &mut Record,
         io: &FrameIo,
         cx: &FrameContext,
-        mut timer: Option<&mut GpuTimer>,
+        m: &MotionTargets,
+        st: &mut MotionStages,
     ) -> Result<()> {
-        use crate::passes::glossy::modules;
-        if self.motion.is_none() {
-            let a = self.scene.animated;
-            let stage = |label, file, entry, b: &Bindings| {
-                ChainStage::new(gpu, label, &modules(file, a), entry, b)
-            };
-            self.motion = Some(MotionStages {
-                motion: stage(
-                    "svgf/glossy motion",
-                    "glossy/motion.wgsl",
-                    "main",
-                    &self.motion_bindings(io, None, 0),
-                )?,
-                prefilter_h: stage(
-                    "svgf/glossy prefilter_h",
-                    "glossy/prefilter.wgsl",
-                    "pre_h",
-                    &self.motion_bindings(io, Some(false), 0),
-                )?,
-                prefilter_v: stage(
-                    "svgf/glossy prefilter_v",
-                    "glossy/prefilter.wgsl",
-                    "pre_v",
-                    &self.motion_bindings(io, Some(true), 0),
-                )?,
-            });
-        }
-        let mut m = self.motion.take().unwrap();
         let (key, parity, size) = (cx.key, cx.parity, io.size);
         let sv = &cx.settings.svgf;
-        let mut result = m.motion.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-            self.motion_bindings(io, None, p)
-        });
-        if result.is_ok() && sv.clipping && sv.temporal {
-            result = m.prefilter_h.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-                self.motion_bindings(io, Some(false), p)
-            });
-            if result.is_ok() {
-                result = m.prefilter_v.record(gpu, enc, key, parity, size, timer, |p| {
-                    self.motion_bindings(io, Some(true), p)
-                });
-            }
+        let b = |prefilter, p| self.motion_bindings(io, m, prefilter, p);
+        let Record { gpu, enc, timer } = rec;
+        st.motion.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| b(None, p))?;
+        if sv.clipping && sv.temporal {
+            let t = timer.as_deref_mut();
+            st.prefilter_h.record(gpu, enc, key, parity, size, t, |p| b(Some(false), p))?;
+            let t = timer.as_deref_mut();
+            st.prefilter_v.record(gpu, enc, key, parity, size, t, |p| b(Some(true), p))?;
         }
-        self.motion = Some(m);
-        result
+        Ok(())
     }
+}
+
+/// What a stage records with: the device, the frame's encoder and its pass timer.
+struct Record<'r> {
+    gpu: &'r Gpu,
+    enc: &'r mut wgpu::CommandEncoder,
+    timer: Option<&'r mut GpuTimer>,
+}
+
+fn motion_stages(
+    gpu: &Gpu,
+    res: &Resources,
+    io: &FrameIo,
+    m: &MotionTargets,
+    animated: bool,
+) -> Result<MotionStages> {
+    use crate::passes::glossy::modules;
+    let p = Parity::default();
+    let stage = |label, file, entry, prefilter| {
+        let offered = res.motion_bindings(io, m, prefilter, p);
+        ChainStage::new(gpu, label, &modules(file, animated), entry, &offered)
+    };
+    Ok(MotionStages {
+        motion: stage("svgf/glossy motion", "glossy/motion.wgsl", "main", None)?,
+        prefilter_h: stage(
+            "svgf/glossy prefilter_h",
+            "glossy/prefilter.wgsl",
+            "pre_h",
+            Some(false),
+        )?,
+        prefilter_v: stage(
+            "svgf/glossy prefilter_v",
+            "glossy/prefilter.wgsl",
+            "pre_v",
+            Some(true),
+        )?,
+    })
 }
 
 impl Denoiser for Svgf {
@@ -529,7 +523,7 @@ impl Denoiser for Svgf {
     }
 
     fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
-        self.targets = Some(SvgfTargets::new(&gpu.device, memory, size, self.scene.glossy));
+        self.res.targets = Some(SvgfTargets::new(&gpu.device, memory, size, self.scene.glossy));
     }
 
     fn record(
@@ -538,20 +532,33 @@ impl Denoiser for Svgf {
         enc: &mut wgpu::CommandEncoder,
         io: &FrameIo,
         cx: &FrameContext,
-        mut timer: Option<&mut GpuTimer>,
+        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        self.targets.as_ref().context("SVGF records before its textures exist")?;
-        self.write_params(gpu, io, cx);
-        self.record_signal(gpu, enc, io, cx, false, timer.as_deref_mut())?;
-        if self.scene.glossy {
-            self.record_motion(gpu, enc, io, cx, timer.as_deref_mut())?;
-            self.record_signal(gpu, enc, io, cx, true, timer)?;
+        let Svgf { scene, res, matte, glossy, motion } = self;
+        let t = res.targets.as_ref().context("SVGF records before its textures exist")?;
+        res.write_params(gpu, io, cx, scene.extent);
+        let mut rec = Record { gpu, enc, timer };
+        let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
+        let stages = |g, s| {
+            let offered = res.offered(io, t, s);
+            SignalStages::new(gpu, g, scene.animated, &offered).context("creating SVGF's stages")
+        };
+        let s = signal(false)?;
+        let st = super::made(matte, || stages(false, s))?;
+        res.record_stages(&mut rec, io, cx, s, st)?;
+        if scene.glossy {
+            let s = signal(true)?;
+            let m = s.motion.context("SVGF's glossy motion textures are missing")?;
+            let st = super::made(motion, || motion_stages(gpu, res, io, m, scene.animated))?;
+            res.record_motion(&mut rec, io, cx, m, st)?;
+            let st = super::made(glossy, || stages(true, s))?;
+            res.record_stages(&mut rec, io, cx, s, st)?;
         }
         Ok(())
     }
 
-    fn output(&self, _parity: usize) -> Denoised<'_> {
-        let Some(t) = &self.targets else { return Denoised::default() };
+    fn output(&self, _parity: Parity) -> Denoised<'_> {
+        let Some(t) = &self.res.targets else { return Denoised::default() };
         Denoised {
             matte: Some(&t.matte.out.1),
             glossy: t.glossy.as_ref().map(|(s, _)| &s.out.1),

@@ -7,14 +7,13 @@
 mod params;
 mod readback;
 mod reload;
-pub mod schedule;
 
 pub use crate::settings::View;
 pub use params::{CameraSetup, FrameParams, random_jitter};
 
 use crate::accel::BvhKind;
 use crate::denoise::{Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Gpu, GpuMemory, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
+use crate::gpu::{BindKey, Gpu, GpuMemory, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
 use crate::passes::composite::{CompositePass, DisplayPass, FrameBuffers};
 use crate::passes::gbuffer::{self, GBufferPass, GBufferTargets};
 use crate::passes::io::{FrameIo, PreviousGBuffer};
@@ -385,6 +384,13 @@ impl Renderer {
         CameraSetup::new(camera, self.prepared.origin, self.targets.size, self.near())
     }
 
+    /// What the frame's bind groups depend on: the scene's buffers, the targets, and for the
+    /// stages after the denoiser, which denoiser ran.
+    fn bind_key(&self, denoiser: Option<usize>) -> BindKey {
+        let (scene, targets) = (self.gpu_scene.generation, self.targets.generation);
+        BindKey { scene, targets, denoiser, ..BindKey::default() }
+    }
+
     /// Render one frame; with `target`, also tone-map (or show `settings.view`) into it.
     pub fn render(
         &mut self,
@@ -673,10 +679,10 @@ impl Renderer {
             t.begin_frame();
         }
         // Bind groups depend on the scene only through its buffers' generation.
-        let key = self.gpu_scene.generation * 1_000_003 + self.targets.generation;
+        let key = self.bind_key(None);
         // Stages after the denoiser also bind its outputs.
-        let output_key = key * 64 + denoiser.map_or(0, |i| i as u64 + 1);
-        let parity = (self.frame_index % 2) as usize;
+        let output_key = self.bind_key(denoiser);
+        let parity = crate::gpu::Parity::of_frame(self.frame_index);
         // gbuffer -> trace -> denoise -> composite -> TAA -> display (Mara et al. 2017, Figure 2).
         let t = &self.targets;
         match t.primaries.as_ref().filter(|_| traced) {
@@ -735,7 +741,7 @@ impl Renderer {
         self.trace.record(
             gpu,
             &mut enc,
-            (self.gpu_scene.generation, t.generation),
+            key,
             &self.gpu_scene,
             &self.params_buf,
             &self.frame_buf,
@@ -776,7 +782,7 @@ impl Renderer {
         }
         let denoiser = denoiser.map(|d| &**d);
         let accumulation = t.accumulation.as_ref().unwrap_or(&self.no_accumulation);
-        let fb = |p: usize| {
+        let fb = |p: crate::gpu::Parity| {
             let out = denoiser.map(|d| d.output(p)).unwrap_or_default();
             FrameBuffers {
                 io,
@@ -828,7 +834,7 @@ impl Renderer {
             d.record(
                 gpu,
                 &mut enc,
-                output_key * 1024 + view_key,
+                BindKey { view: view_key, ..output_key },
                 &shown,
                 view,
                 target.view,
@@ -882,11 +888,10 @@ impl Renderer {
                 self.denoised_last.is_some(),
                 self.taa.output(),
             );
-            let key = (self.gpu_scene.generation * 1_000_003 + t.generation) * 64
-                + self.denoised_last.map_or(0, |i| i as u64 + 1);
             let (view, view_key) = view_texture(t, settings);
+            let key = BindKey { view: view_key, ..self.bind_key(self.denoised_last) };
             if let Some(d) = self.display.as_mut() {
-                d.record(gpu, &mut enc, key * 1024 + view_key, &fb, view, target.view, None)?;
+                d.record(gpu, &mut enc, key, &fb, view, target.view, None)?;
             }
             gpu.queue.submit([enc.finish()]);
             Ok(())
@@ -928,13 +933,16 @@ impl Renderer {
 
 /// The texture `settings.view` shows, if this frame has it (a denoiser's view is black until
 /// the denoiser has run), and a key that changes with it.
-fn view_texture<'a>(t: &'a Targets, settings: &FrameSettings) -> (Option<&'a wgpu::Texture>, u64) {
+fn view_texture<'a>(
+    t: &'a Targets,
+    settings: &FrameSettings,
+) -> (Option<&'a wgpu::Texture>, usize) {
     let views = crate::settings::all_views();
     let Some(i) = views.iter().position(|v| v.name == settings.view.name()) else {
         return (None, 0);
     };
     match t.memory.find_texture(views[i].texture) {
-        Some(tex) => (Some(tex), i as u64 + 1),
+        Some(tex) => (Some(tex), i + 1),
         None => (None, 0),
     }
 }

@@ -60,6 +60,8 @@ pub struct Gpu {
     pub timestamps: bool,
     /// Where shader text comes from (embedded unless `$HUSH_SHADERS` or the caller says).
     pub shaders: crate::shader::ShaderLibrary,
+    /// Why the device was lost (reason, message), set once by wgpu's device-lost callback.
+    lost: std::sync::Arc<std::sync::OnceLock<(String, String)>>,
 }
 
 impl Gpu {
@@ -205,30 +207,55 @@ impl Gpu {
         device.on_uncaptured_error(std::sync::Arc::new(|e| {
             log::error!("wgpu: {e}");
         }));
+        let lost = std::sync::Arc::new(std::sync::OnceLock::new());
+        let on_lost = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            log::error!("wgpu: device lost ({reason:?}): {message}");
+            // Only the first loss is kept: a device is lost once.
+            let _ = on_lost.set((format!("{reason:?}"), message));
+        });
         let shaders = crate::shader::ShaderLibrary::from_env_or(None)?;
-        Ok(Gpu { instance, adapter, device, queue, info, timestamps, shaders })
+        Ok(Gpu { instance, adapter, device, queue, info, timestamps, shaders, lost })
     }
 
     /// Run `f` inside a validation error scope: what wgpu would only log becomes an error with
     /// `what` as its context.
     pub fn validated<T>(&self, what: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let r = f();
-        let e = pollster::block_on(scope.pop());
-        let v = r?;
-        match e {
-            // The error's sources say which binding, entry point or limit was wrong.
-            Some(e) => Err(anyhow::Error::new(e).context(what.to_string())),
-            None => Ok(v),
+        crate::shader::validated(self, what, f)
+    }
+
+    /// [`crate::Error::DeviceLost`] once the device is lost: nothing it records will run.
+    pub fn check_lost(&self) -> Result<()> {
+        match self.lost.get() {
+            Some((reason, message)) => {
+                let (reason, message) = (reason.clone(), message.clone());
+                Err(crate::Error::DeviceLost { reason, message }.into())
+            }
+            None => Ok(()),
         }
     }
 
     /// Block until all submitted work has finished.
     pub fn wait(&self) -> Result<()> {
+        self.check_lost()?;
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
             .map_err(|e| anyhow!("waiting for the GPU: {e}"))
+    }
+}
+
+impl crate::shader::ShaderHost for Gpu {
+    fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    fn shaders(&self) -> &crate::shader::ShaderLibrary {
+        &self.shaders
+    }
+
+    fn check_lost(&self) -> Result<()> {
+        Gpu::check_lost(self)
     }
 }
 

@@ -1,15 +1,18 @@
 //! The GPU context (headless or with a surface), tracked buffer allocation, readback, and the
 //! scene's GPU form.
 
-pub mod binding;
 mod context;
+pub mod history;
 mod memory;
 pub mod prepare;
 pub mod scene;
 mod timestamps;
 
-pub use binding::{BindCache, Bindings, Resource, set_compute_groups, set_render_groups};
+pub use crate::shader::binding::{
+    BindCache, BindKey, Bindings, Resource, set_compute_groups, set_render_groups,
+};
 pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP};
+pub use history::{Parity, PingPong, Tex};
 pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use prepare::{EnvKind, PreparedScene, SceneFeatures};
 pub use scene::GpuScene;

@@ -135,8 +135,7 @@ pub struct PreparedScene {
     open_from_close: Vec<glam::Mat4>,
 }
 
-/// Triangle slots and node indices share 24 bits in the BVH2 traversal stack.
-pub const MAX_TRIANGLES: usize = 1 << 24;
+pub use crate::limits::MAX_TRIANGLES;
 
 /// One object's triangles in rebased world space, before the BVH orders them.
 #[derive(Clone, Default)]

@@ -1,8 +1,8 @@
 //! One compute pass of a denoise chain (matte.rs, glossy.rs): its pipeline, and its bind groups
 //! for history parity 0 and 1, remade when the key of what they bind or the pipeline changes.
 
-use crate::gpu::scene::compute_pipeline;
-use crate::gpu::{BindCache, Bindings, Gpu, GpuTimer, set_compute_groups};
+use crate::gpu::{BindCache, Bindings, Gpu, GpuTimer, Parity, set_compute_groups};
+use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
@@ -40,13 +40,15 @@ impl ChainStage {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
-        parity: usize,
+        key: crate::gpu::BindKey,
+        parity: Parity,
         size: (u32, u32),
         timer: Option<&mut GpuTimer>,
-        bindings: impl Fn(usize) -> Bindings<'a>,
+        bindings: impl Fn(Parity) -> Bindings<'a>,
     ) -> Result<()> {
-        self.record_variant(gpu, enc, key, (2, parity), size, timer, bindings)
+        self.record_variant(gpu, enc, key, (2, parity.index()), size, timer, |v| {
+            bindings(Parity::BOTH[v])
+        })
     }
 
     /// As [`ChainStage::record`] for a stage with `variant.0` sets of bindings (parity, level,
@@ -56,7 +58,7 @@ impl ChainStage {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         variant: (usize, usize),
         size: (u32, u32),
         timer: Option<&mut GpuTimer>,

@@ -3,8 +3,10 @@
 //! Both read the whole G-buffer and the trace outputs through the same bindings.
 
 use super::io::FrameIo;
-use crate::gpu::scene::compute_pipeline;
-use crate::gpu::{BindCache, Bindings, Gpu, GpuTimer, set_compute_groups, set_render_groups};
+use crate::gpu::{
+    BindCache, Bindings, Gpu, GpuTimer, Parity, set_compute_groups, set_render_groups,
+};
+use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
@@ -76,15 +78,15 @@ impl CompositePass {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
-        b: impl Fn(usize) -> FrameBuffers<'a>,
-        parity: usize,
+        key: crate::gpu::BindKey,
+        b: impl Fn(Parity) -> FrameBuffers<'a>,
+        parity: Parity,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let p = &self.pipeline;
         let size = b(parity).io.size;
-        let groups = self.groups.get(key, p.builds(), 2, parity, |v| {
-            let b = b(v);
+        let groups = self.groups.get(key, p.builds(), 2, parity.index(), |v| {
+            let b = b(Parity::BOTH[v]);
             p.bind_groups(&gpu.device, &inputs(&b, b.io.hdr))
         })?;
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -180,7 +182,7 @@ impl DisplayPass {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         b: &FrameBuffers,
         view: Option<&wgpu::Texture>,
         target: &wgpu::TextureView,

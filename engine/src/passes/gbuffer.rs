@@ -16,7 +16,9 @@
 //! WebGPU's render-target accounting (8-bit RGBA counts 8), over its default of 32: the device
 //! asks for 40, which every native backend grants.
 
-use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_render_groups};
+use crate::gpu::{
+    BindCache, BindKey, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_render_groups,
+};
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
@@ -212,9 +214,13 @@ impl GBufferPass {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let p = &self.pipeline;
-        let groups = self.groups.get(scene.generation, p.builds(), 1, 0, |_| {
-            p.bind_groups(&gpu.device, &bindings(scene, frame))
-        })?;
+        let groups = self.groups.get(
+            BindKey { scene: scene.generation, ..BindKey::default() },
+            p.builds(),
+            1,
+            0,
+            |_| p.bind_groups(&gpu.device, &bindings(scene, frame)),
+        )?;
         let mut pass = t.begin_pass(enc, LABEL, timer);
         pass.set_pipeline(p.get());
         set_render_groups(&mut pass, groups);

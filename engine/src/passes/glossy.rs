@@ -7,7 +7,7 @@
 
 use super::chain::ChainStage;
 use super::io::FrameIo;
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
 use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
@@ -87,14 +87,14 @@ impl GlossyParams {
 /// Per-pixel textures of the glossy chain (made with the denoiser's other targets), 120 bytes.
 pub struct GlossyChainTargets {
     /// Representative hits (eq. 4) of this frame and the previous one, by parity.
-    pub hit: [(wgpu::Texture, wgpu::TextureView); 2],
+    pub hit: PingPong<Tex>,
     pub motion: (wgpu::Texture, wgpu::TextureView),
     pub search: (wgpu::Texture, wgpu::TextureView),
     /// The pre-blurred neighbourhood the temporal clips to.
     pub neighbourhood: (wgpu::Texture, wgpu::TextureView),
     /// The prefilter's and the bilateral's horizontal pass (its alpha: sigma).
     pub scratch: (wgpu::Texture, wgpu::TextureView),
-    pub history: [(wgpu::Texture, wgpu::TextureView); 2],
+    pub history: PingPong<Tex>,
     pub info: (wgpu::Texture, wgpu::TextureView),
     /// The chain's output: remodulated glossy light for the composite.
     pub denoised: (wgpu::Texture, wgpu::TextureView),
@@ -107,12 +107,12 @@ impl GlossyChainTargets {
             | wgpu::TextureUsages::COPY_SRC;
         let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
         GlossyChainTargets {
-            hit: [t("glossy/hit 0", RGBA32F), t("glossy/hit 1", RGBA32F)],
+            hit: PingPong::new(|i| t(&format!("glossy/hit {i}"), RGBA32F)),
             motion: t("glossy/motion", RGBA32F),
             search: t("glossy/search", RGBA16F),
             neighbourhood: t("glossy/neighbourhood", RGBA16F),
             scratch: t("glossy/scratch", RGBA16F),
-            history: [t("glossy/history 0", RGBA32F), t("glossy/history 1", RGBA32F)],
+            history: PingPong::new(|i| t(&format!("glossy/history {i}"), RGBA32F)),
             info: t("glossy/info", RGBA16F),
             denoised: t("glossy/denoised", RGBA16F),
         }
@@ -148,25 +148,27 @@ const STAGES: [(Kind, &str, &str, &str); 6] = [
     (Kind::BilateralV, "glossy/bilateral_v", "glossy/bilateral.wgsl", "bilateral_v"),
 ];
 
-fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: usize) -> Bindings<'a> {
+fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: Parity) -> Bindings<'a> {
     let g = i.glossy;
     let b = i.io.bindings().buffer("dn", i.denoise).buffer("gp", i.params);
     match kind {
         Kind::Motion => b
-            .texture("prev_hit", &g.hit[parity].1)
+            .texture("prev_hit", &g.hit.history(parity).1)
             .texture("out_motion", &g.motion.1)
             .texture("out_search", &g.search.1)
-            .texture("out_hit", &g.hit[1 - parity].1),
+            .texture("out_hit", &g.hit.output(parity).1),
         Kind::PrefilterH => b.texture("src", &g.neighbourhood.1).texture("dst", &g.scratch.1),
         Kind::PrefilterV => b.texture("src", &g.scratch.1).texture("dst", &g.neighbourhood.1),
         Kind::Temporal => b
-            .texture("history", &g.history[parity].1)
-            .texture("prev_hit", &g.hit[parity].1)
+            .texture("history", &g.history.history(parity).1)
+            .texture("prev_hit", &g.hit.history(parity).1)
             .texture("neighbourhood", &g.neighbourhood.1)
-            .texture("dst", &g.history[1 - parity].1)
+            .texture("dst", &g.history.output(parity).1)
             .texture("motion", &g.motion.1)
             .texture("out_info", &g.info.1),
-        Kind::BilateralH => b.texture("src", &g.history[1 - parity].1).texture("dst", &g.scratch.1),
+        Kind::BilateralH => {
+            b.texture("src", &g.history.output(parity).1).texture("dst", &g.scratch.1)
+        }
         Kind::BilateralV => b.texture("src", &g.scratch.1).texture("dst", &g.denoised.1),
     }
 }
@@ -209,7 +211,7 @@ impl GlossyChain {
                     label,
                     &modules(file, animated),
                     entry,
-                    &bindings(kind, i, 0),
+                    &bindings(kind, i, Parity::default()),
                 )?,
             ));
         }
@@ -222,9 +224,9 @@ impl GlossyChain {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         i: &GlossyInputs,
-        parity: usize,
+        parity: Parity,
         settings: &GlossySettings,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {

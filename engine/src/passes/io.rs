@@ -20,7 +20,7 @@ pub struct FrameIo<'a> {
     pub previous: Option<&'a PreviousGBuffer>,
     pub trace: &'a TraceTargets,
     /// With supersampling (k > 1), the guides' light after eq. (7): offered as the trace's.
-    pub mixed: Option<&'a super::supersample::MixedLight>,
+    pub mixed: Option<&'a MixedLight>,
     /// The composite's linear HDR image, one vec4 per pixel.
     pub hdr: &'a wgpu::Buffer,
     /// Every per-pixel allocation of the frame, textures findable by label.
@@ -67,6 +67,14 @@ impl<'a> FrameIo<'a> {
         }
         b
     }
+}
+
+/// With k > 1 samples per pixel (Voorhuis §5), the guide light after eq. (7): what the denoiser
+/// and the composite read as `tr_matte`, `tr_direct` and `tr_glossy` in place of the trace's.
+pub struct MixedLight {
+    pub matte: crate::gpu::Tex,
+    pub direct: crate::gpu::Tex,
+    pub glossy: Option<crate::gpu::Tex>,
 }
 
 /// The previous frame's depth, normal and object ids: copied from the G-buffer after each frame

@@ -5,7 +5,7 @@
 
 use super::chain::ChainStage;
 use super::io::FrameIo;
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
 use crate::settings::{MatteSettings, TaaSettings};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
@@ -149,7 +149,7 @@ pub fn history_rejected(reason: &[u8]) -> Vec<bool> {
 
 /// Per-pixel textures of the chain, 76 bytes per pixel.
 pub struct MatteTargets {
-    pub history: [(wgpu::Texture, wgpu::TextureView); 2],
+    pub history: PingPong<Tex>,
     pub temporal: (wgpu::Texture, wgpu::TextureView),
     pub reason: (wgpu::Texture, wgpu::TextureView),
     pub min: (wgpu::Texture, wgpu::TextureView),
@@ -164,7 +164,7 @@ impl MatteTargets {
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         let mut t = |label: &str, f| mem.texture(device, label, size, f, rw);
-        let history = [t("matte/history 0", RGBA32F), t("matte/history 1", RGBA32F)];
+        let history = PingPong::new(|i| t(&format!("matte/history {i}"), RGBA32F));
         let temporal = t("matte/temporal", RGBA32F);
         let reason = t("matte/reason", R32U);
         let min = t("matte/disocclusion min", R32F);
@@ -201,18 +201,18 @@ const STAGES: [(Kind, &str); 6] = [
     (Kind::Bilateral, "matte/bilateral"),
 ];
 
-fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: usize) -> Bindings<'a> {
+fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: Parity) -> Bindings<'a> {
     let m = i.matte;
     let b = i.io.bindings().buffer("dn", i.params);
     match kind {
         Kind::Temporal => b
-            .texture("history", &m.history[parity].1)
+            .texture("history", &m.history.history(parity).1)
             .texture("out_temporal", &m.temporal.1)
             .texture("out_reason", &m.reason.1),
         Kind::HistoryBilateral => b
             .texture("filter_in", &m.temporal.1)
             .texture("reason_in", &m.reason.1)
-            .texture("out_history", &m.history[1 - parity].1),
+            .texture("out_history", &m.history.output(parity).1),
         Kind::MinH => b
             .texture("filter_in", &m.temporal.1)
             .texture("min_in", &m.radius.1)
@@ -275,7 +275,7 @@ impl MatteChain {
                     label,
                     &modules(kind, animated),
                     entry,
-                    &bindings(kind, i, 0),
+                    &bindings(kind, i, Parity::default()),
                 )?,
             ));
         }
@@ -287,9 +287,9 @@ impl MatteChain {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         i: &ChainInputs,
-        parity: usize,
+        parity: Parity,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         for (kind, s) in self.stages.iter_mut() {

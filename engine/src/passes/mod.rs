@@ -14,6 +14,7 @@ pub mod io;
 pub mod matte;
 pub mod prefilter;
 pub mod primaries;
+pub mod schedule;
 pub mod supersample;
 pub mod taa;
 pub mod trace;

@@ -121,7 +121,7 @@ impl Prefilter {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         size: (u32, u32),
         offered: &Bindings,
         mut timer: Option<&mut GpuTimer>,

@@ -7,11 +7,11 @@
 //!
 //! Per pixel: 80 bytes of features and 64 of position moments (144 bytes).
 
-use crate::gpu::scene::compute_pipeline;
 use crate::gpu::{
     BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups, set_render_groups,
 };
 use crate::passes::gbuffer::{GBufferTargets, render_pipeline};
+use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
@@ -91,7 +91,7 @@ impl Primaries {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         scene: &GpuScene,
         params: &wgpu::Buffer,
         frame: &wgpu::Buffer,
@@ -142,7 +142,7 @@ impl Primaries {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         frame: &wgpu::Buffer,
         t: &PrimaryTargets,
         edges: Option<&wgpu::Buffer>,

@@ -9,24 +9,14 @@
 //! light and 16 for the resolved image (k = 4 in a glossy scene: 224 bytes).
 
 use super::chain::ChainStage;
-use super::io::FrameIo;
-use crate::gpu::scene::compute_pipeline;
+use super::io::{FrameIo, MixedLight};
 use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups};
+use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
 pub const SAMPLES: &str = "supersample/samples";
 const RECORD_BYTES: u64 = 56;
-
-type Tex = (wgpu::Texture, wgpu::TextureView);
-
-/// The guide light after eq. (7): what the denoiser and the composite read as `tr_matte`,
-/// `tr_direct` and `tr_glossy`.
-pub struct MixedLight {
-    pub matte: Tex,
-    pub direct: Tex,
-    pub glossy: Option<Tex>,
-}
 
 pub struct SupersampleTargets {
     /// Samples per pixel these were made for, and the frame targets' epoch.
@@ -150,7 +140,7 @@ impl Supersample {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         scene: &GpuScene,
         trace_bindings: Bindings,
         io: &FrameIo,
@@ -208,7 +198,7 @@ impl Supersample {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         io: &FrameIo,
         t: &SupersampleTargets,
         timer: Option<&mut GpuTimer>,

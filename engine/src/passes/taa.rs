@@ -7,8 +7,8 @@
 use super::chain::ChainStage;
 use super::io::FrameIo;
 use super::matte::DenoiseParams;
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
-use anyhow::Result;
+use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+use anyhow::{Context, Result};
 
 pub const LABEL: &str = "taa";
 const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -39,10 +39,10 @@ pub struct GlossyFollow<'a> {
 /// TAA's per-pixel textures: its history (with its length), the averaged matte and glossy
 /// factors and residual it follows the chains with, and the image shown. 144 bytes per pixel.
 struct TaaTargets {
-    history: [(wgpu::Texture, wgpu::TextureView); 2],
-    material: [(wgpu::Texture, wgpu::TextureView); 2],
-    residual: [(wgpu::Texture, wgpu::TextureView); 2],
-    glossy: [(wgpu::Texture, wgpu::TextureView); 2],
+    history: PingPong<Tex>,
+    material: PingPong<Tex>,
+    residual: PingPong<Tex>,
+    glossy: PingPong<Tex>,
     final_image: wgpu::Buffer,
 }
 
@@ -52,10 +52,7 @@ impl TaaTargets {
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         let mut pair = |l: &str| {
-            [
-                mem.texture(device, &format!("taa/{l} 0"), size, RGBA32F, rw),
-                mem.texture(device, &format!("taa/{l} 1"), size, RGBA32F, rw),
-            ]
+            PingPong::new(|i| mem.texture(device, &format!("taa/{l} {i}"), size, RGBA32F, rw))
         };
         let (history, material, residual, glossy) =
             (pair("history"), pair("material"), pair("residual"), pair("glossy"));
@@ -115,29 +112,29 @@ impl TaaStage {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: u64,
+        key: crate::gpu::BindKey,
         io: &FrameIo<'a>,
-        follow: impl Fn(usize) -> TaaFollow<'a>,
+        follow: impl Fn(Parity) -> TaaFollow<'a>,
         params: &DenoiseParams,
-        parity: usize,
+        parity: Parity,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
-        let (_, t) = self.targets.as_ref().expect("TaaStage::allocate runs before record");
+        let (_, t) = self.targets.as_ref().context("TAA records before its textures exist")?;
         let f = follow(parity);
         let variant = (f.matte.is_some(), f.glossy.is_some());
-        let bindings = |p: usize| taa_bindings(io, t, &self.params, &follow(p), p);
-        if !self.programs.iter().any(|(v, _)| *v == variant) {
-            let stage = ChainStage::new(
-                gpu,
-                LABEL,
-                &modules(variant, self.animated),
-                "main",
-                &bindings(0),
-            )?;
-            self.programs.push((variant, stage));
-        }
-        let (_, stage) = self.programs.iter_mut().find(|(v, _)| *v == variant).expect("made above");
+        let bindings = |p: Parity| taa_bindings(io, t, &self.params, &follow(p), p);
+        let i = match self.programs.iter().position(|(v, _)| *v == variant) {
+            Some(i) => i,
+            None => {
+                let modules = modules(variant, self.animated);
+                let offered = bindings(Parity::default());
+                let stage = ChainStage::new(gpu, LABEL, &modules, "main", &offered)?;
+                self.programs.push((variant, stage));
+                self.programs.len() - 1
+            }
+        };
+        let stage = &mut self.programs[i].1;
         stage.record(gpu, enc, key, parity, io.size, timer, bindings)
     }
 }
@@ -147,21 +144,21 @@ fn taa_bindings<'a>(
     t: &'a TaaTargets,
     params: &'a wgpu::Buffer,
     follow: &TaaFollow<'a>,
-    parity: usize,
+    parity: Parity,
 ) -> Bindings<'a> {
     let mut b = io
         .bindings()
         .buffer("dn", params)
         .buffer("hdr", io.hdr)
         .buffer("final_image", &t.final_image)
-        .texture("history", &t.history[parity].1)
-        .texture("out_history", &t.history[1 - parity].1)
-        .texture("material_history", &t.material[parity].1)
-        .texture("out_material", &t.material[1 - parity].1)
-        .texture("residual_history", &t.residual[parity].1)
-        .texture("out_residual", &t.residual[1 - parity].1)
-        .texture("glossy_factor_history", &t.glossy[parity].1)
-        .texture("out_glossy_factor", &t.glossy[1 - parity].1);
+        .texture("history", &t.history.history(parity).1)
+        .texture("out_history", &t.history.output(parity).1)
+        .texture("material_history", &t.material.history(parity).1)
+        .texture("out_material", &t.material.output(parity).1)
+        .texture("residual_history", &t.residual.history(parity).1)
+        .texture("out_residual", &t.residual.output(parity).1)
+        .texture("glossy_factor_history", &t.glossy.history(parity).1)
+        .texture("out_glossy_factor", &t.glossy.output(parity).1);
     if let Some((light, state)) = follow.matte {
         b = b.texture("matte_temporal", light).texture("matte_reason", state);
     }

@@ -8,8 +8,8 @@
 //! mirrors (Voorhuis §4.1).
 
 use super::gbuffer::GBufferTargets;
-use crate::gpu::scene::compute_pipeline;
 use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups};
+use crate::shader::compute_pipeline;
 use anyhow::Result;
 
 pub const LABEL: &str = "trace";
@@ -124,7 +124,7 @@ impl TracePass {
         Ok(TracePass { pipeline, groups: BindCache::default(), moving: None })
     }
 
-    /// `key`: (scene generation, frame target generation); bind groups are rebuilt when it changes.
+    /// `key`: bind groups are rebuilt when it changes.
     /// `period`: 1 / f, the frames between two samples of a pixel. `moving`: objects move during
     /// the shutter (the motion-blur program).
     #[allow(clippy::too_many_arguments)]
@@ -132,7 +132,7 @@ impl TracePass {
         &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        key: (u64, u64),
+        key: crate::gpu::BindKey,
         scene: &GpuScene,
         params: &wgpu::Buffer,
         frame: &wgpu::Buffer,
@@ -154,7 +154,7 @@ impl TracePass {
             Some((p, c)) => (&*p, c),
             None => (&self.pipeline, &mut self.groups),
         };
-        let groups = cache.get(key.0 * 1_000_003 + key.1, p.builds(), 1, 0, |_| {
+        let groups = cache.get(key, p.builds(), 1, 0, |_| {
             p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t))
         })?;
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -164,7 +164,7 @@ impl TracePass {
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         // Below one sample per pixel one thread per tile (frame/schedule.rs), so the cost falls as f.
-        let (tw, th) = crate::frame::schedule::tile(period);
+        let (tw, th) = super::schedule::tile(period);
         pass.dispatch_workgroups(
             size.0.div_ceil(tw).div_ceil(8),
             size.1.div_ceil(th).div_ceil(8),

@@ -85,26 +85,9 @@ pub fn load_gltf_from(
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
             .or_else(|| p.downcast_ref::<String>().cloned());
-        Err(anyhow::Error::new(ImportPanic(msg.unwrap_or_else(|| "panic".into()))))
+        Err(crate::Error::ImportPanic(msg.unwrap_or_else(|| "panic".into())).into())
     })
 }
-
-/// A panic caught at the import boundary: a bug in Hush or a library it uses, which the fuzz
-/// targets and the corpus replay treat as the failure it is.
-#[derive(Debug)]
-pub struct ImportPanic(pub String);
-
-impl std::fmt::Display for ImportPanic {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        write!(
-            f,
-            "internal error while importing (a bug in Hush or a library it uses; please report it with the file): {}",
-            self.0
-        )
-    }
-}
-
-impl std::error::Error for ImportPanic {}
 
 /// JSON (from a .gltf or a .glb's JSON chunk) -> validated document, refusing unsupported
 /// required extensions by name (the `gltf` crate's own error only says "Unsupported").
@@ -144,11 +127,8 @@ fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8
         }
     }
     if !unsupported.is_empty() {
-        bail!(
-            "the file requires glTF extensions Hush does not support: {} (supported: {})",
-            unsupported.join(", "),
-            SUPPORTED_EXTENSIONS.join(", ")
-        );
+        let supported = SUPPORTED_EXTENSIONS.iter().map(|e| e.to_string()).collect();
+        return Err(crate::Error::UnsupportedExtension { unsupported, supported }.into());
     }
     // `scene.nodes` is optional in glTF 2.0, but the `gltf` crate's schema requires it.
     if let Some(scenes) = v.get_mut("scenes").and_then(|s| s.as_array_mut()) {

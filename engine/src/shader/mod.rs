@@ -20,16 +20,21 @@
 //! rebuild exactly the pipelines a changed file feeds (`reload.rs`); `library.rs` says where the
 //! text comes from (embedded, or a folder on disk that `watch.rs` watches).
 
+pub mod binding;
 mod library;
+mod pipeline;
 mod reflect;
 mod reload;
 mod watch;
 
+pub use binding::{BindCache, BindKey, Bindings, Resource, set_compute_groups, set_render_groups};
 pub use library::{SHADER_DIR_VAR, ShaderLibrary, source_tree_dir};
+pub use pipeline::{ShaderHost, compute_pipeline, validated};
 pub use reflect::{FixedCompute, ProgramBindings, Slot, reflect};
 pub use reload::{Reload, ReloadOutcome, Reloadable};
 pub use watch::ShaderWatcher;
 
+use crate::error::ShaderStep;
 use anyhow::{Result, anyhow};
 
 macro_rules! embed {
@@ -226,12 +231,11 @@ impl Program {
         (file, line.saturating_sub(start))
     }
 
-    /// "file:line" of a line of the composed text, as editors and terminals link it.
-    fn at(&self, line: Option<usize>) -> String {
-        line.map_or("an unknown line".to_string(), |l| {
-            let (file, line) = self.locate(l);
-            format!("{file}:{line}")
-        })
+    /// The error for `message` at a line of the composed text, located in its source file
+    /// ("file:line", as editors and terminals link it; line 0 where naga gave no line).
+    fn error(&self, step: ShaderStep, line: Option<usize>, message: String) -> anyhow::Error {
+        let (file, line) = line.map_or(("<unknown>".to_string(), 0), |l| self.locate(l));
+        crate::Error::Shader { program: self.label.clone(), step, file, line, message }.into()
     }
 
     /// Parse and validate with naga; errors name the source file and line.
@@ -242,11 +246,9 @@ impl Program {
     /// Validate; also naga's analysis of the module (what each entry point uses).
     pub fn validate_with_info(&self) -> Result<(naga::Module, naga::valid::ModuleInfo)> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
-            let at = self.at(e
-                .location(&self.text)
-                .filter(|l| l.length > 0)
-                .map(|l| l.line_number as usize));
-            anyhow!("{}: WGSL parse error at {at}: {}", self.label, e.message())
+            let line =
+                e.location(&self.text).filter(|l| l.length > 0).map(|l| l.line_number as usize);
+            self.error(ShaderStep::Parse, line, e.message().to_string())
         })?;
         let info = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
@@ -254,8 +256,7 @@ impl Program {
         )
         .validate(&module)
         .map_err(|e| {
-            let at =
-                self.at(e.spans().next().map(|(s, _)| s.location(&self.text).line_number as usize));
+            let line = e.spans().next().map(|(s, _)| s.location(&self.text).line_number as usize);
             // naga nests the cause (an entry point is invalid because a function is, because
             // one expression is): name every level.
             let mut why = e.as_inner().to_string();
@@ -264,7 +265,7 @@ impl Program {
                 why += &format!(": {s}");
                 source = s.source();
             }
-            anyhow!("{}: WGSL validation error at {at}: {why}", self.label)
+            self.error(ShaderStep::Validation, line, why)
         })?;
         Ok((module, info))
     }

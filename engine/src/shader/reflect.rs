@@ -1,6 +1,6 @@
 //! What a composed program binds, read from naga's module of it: every resource's name, group,
 //! number and binding type. Layouts are made from this, and bind groups by looking each name up
-//! among the resources a stage offers ([`crate::gpu::Bindings`]), so the numbers the composer
+//! among the resources a stage offers ([`super::Bindings`]), so the numbers the composer
 //! gave never reach Rust.
 
 use anyhow::{Result, bail};
@@ -191,26 +191,25 @@ impl FixedCompute {
     /// `offered`: what the caller will bind (checked by name now, so that a program asking for
     /// more fails here rather than at the first dispatch).
     pub fn new(
-        gpu: &crate::gpu::Gpu,
+        gpu: &dyn super::ShaderHost,
         label: &str,
         prelude: &str,
         modules: &[&'static str],
         offered: &[&str],
     ) -> Result<FixedCompute> {
-        let program = gpu.shaders.compose(label, prelude, modules)?;
+        let program = gpu.shaders().compose(label, prelude, modules)?;
         let (module, info) = program.validate_with_info()?;
         let bindings = reflect(label, &module, &info)?;
         bindings.check_offered(label, offered)?;
-        let layouts = bindings.layouts(&gpu.device, label, wgpu::ShaderStages::COMPUTE);
+        let layouts = bindings.layouts(gpu.device(), label, wgpu::ShaderStages::COMPUTE);
         let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        let pl = gpu.device().create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
             bind_group_layouts: &refs,
             immediate_size: 0,
         });
-        let module = crate::shader::create_module(&gpu.device, label, &program.text);
-        let pipeline =
-            crate::gpu::scene::compute_pipeline(&gpu.device, label, &module, &pl, "main");
+        let module = super::create_module(gpu.device(), label, &program.text);
+        let pipeline = super::compute_pipeline(gpu.device(), label, &module, &pl, "main");
         Ok(FixedCompute { pipeline, label: label.to_string(), bindings, layouts })
     }
 
@@ -218,7 +217,7 @@ impl FixedCompute {
     pub fn bind_groups(
         &self,
         device: &wgpu::Device,
-        resources: &crate::gpu::Bindings,
+        resources: &super::Bindings,
     ) -> Result<Vec<wgpu::BindGroup>> {
         resources.create_groups(device, &self.label, &self.bindings, &self.layouts)
     }

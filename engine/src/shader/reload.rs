@@ -6,7 +6,7 @@
 //! until a later reload of the same pipeline succeeds.
 
 use super::ProgramBindings;
-use crate::gpu::{Bindings, Gpu};
+use super::{Bindings, ShaderHost};
 use anyhow::{Context, Result};
 use std::time::Instant;
 
@@ -53,9 +53,9 @@ pub trait Reload {
     fn builds(&self) -> u32;
     /// The error of the last failed reload, cleared by a successful one.
     fn error(&self) -> Option<&str>;
-    fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome;
+    fn reload(&mut self, gpu: &dyn ShaderHost) -> ReloadOutcome;
     /// The program as it would be built now (the text the driver gets).
-    fn program(&self, gpu: &Gpu) -> Result<super::Program>;
+    fn program(&self, gpu: &dyn ShaderHost) -> Result<super::Program>;
 }
 
 impl<P> Reloadable<P> {
@@ -63,7 +63,7 @@ impl<P> Reloadable<P> {
     /// reflected from it (and is kept to make it again). `offered`: what the stage can bind
     /// (only the names count here), seen by `visibility`.
     pub fn new(
-        gpu: &Gpu,
+        gpu: &dyn ShaderHost,
         label: &str,
         prelude: &str,
         modules: &[&'static str],
@@ -110,7 +110,7 @@ impl<P> Reloadable<P> {
 }
 
 fn make<P>(
-    gpu: &Gpu,
+    gpu: &dyn ShaderHost,
     label: &str,
     prelude: &str,
     modules: &[&'static str],
@@ -118,22 +118,22 @@ fn make<P>(
     offered: &[String],
     build: &Build<P>,
 ) -> Result<Built<P>> {
-    let program = gpu.shaders.compose(label, prelude, modules)?;
+    let program = gpu.shaders().compose(label, prelude, modules)?;
     let (module, info) = program.validate_with_info()?;
     let bindings = super::reflect(label, &module, &info)?;
     bindings.check_offered(label, &offered.iter().map(String::as_str).collect::<Vec<_>>())?;
     // naga accepts some programs the pipeline still rejects (an entry point that is gone); the
     // error scope turns those into errors too.
-    gpu.validated(&format!("creating pipeline {label}"), || {
-        let layouts = bindings.layouts(&gpu.device, label, visibility);
+    super::validated(gpu, &format!("creating pipeline {label}"), || {
+        let layouts = bindings.layouts(gpu.device(), label, visibility);
         let refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
-        let pl = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        let pl = gpu.device().create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
             bind_group_layouts: &refs,
             immediate_size: 0,
         });
-        let module = crate::shader::create_module(&gpu.device, label, &program.text);
-        let pipeline = build(&gpu.device, &module, &pl);
+        let module = super::create_module(gpu.device(), label, &program.text);
+        let pipeline = build(gpu.device(), &module, &pl);
         Ok(Built { pipeline, bindings, layouts })
     })
     .with_context(|| format!("pipeline {label} ({})", modules.join(", ")))
@@ -156,11 +156,11 @@ impl<P> Reload for Reloadable<P> {
         self.error.as_deref()
     }
 
-    fn program(&self, gpu: &Gpu) -> Result<super::Program> {
-        gpu.shaders.compose(&self.label, &self.prelude, &self.modules)
+    fn program(&self, gpu: &dyn ShaderHost) -> Result<super::Program> {
+        gpu.shaders().compose(&self.label, &self.prelude, &self.modules)
     }
 
-    fn reload(&mut self, gpu: &Gpu) -> ReloadOutcome {
+    fn reload(&mut self, gpu: &dyn ShaderHost) -> ReloadOutcome {
         let start = Instant::now();
         let result = make(
             gpu,

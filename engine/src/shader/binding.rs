@@ -3,8 +3,8 @@
 //! resources is looked up here by name, so a stage may offer more than a program uses, and a
 //! program that asks for a name nobody offers is an error that names it.
 
-use crate::shader::ProgramBindings;
-use anyhow::Result;
+use super::ProgramBindings;
+use anyhow::{Context, Result};
 
 #[derive(Clone, Copy)]
 pub enum Resource<'a> {
@@ -125,27 +125,47 @@ pub fn set_render_groups(pass: &mut wgpu::RenderPass, groups: &[wgpu::BindGroup]
     }
 }
 
+/// What a stage's bind groups depend on besides its pipeline: they are remade when any part
+/// changes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct BindKey {
+    /// The scene's buffers' generation (bumped when one is reallocated).
+    pub scene: u64,
+    /// The frame targets' generation (bumped on resize and when a target is added).
+    pub targets: u64,
+    /// Which of the frame's made denoisers ran: the stages after it bind its outputs.
+    pub denoiser: Option<usize>,
+    /// The debug view the display shows (its index in the view list; 0: the final image).
+    pub view: usize,
+    /// A stage's own choice that changes what it binds (the progressive filter's level count).
+    pub levels: usize,
+}
+
 /// A pass's bind groups for each of its variants (history parity 0 and 1, or one), remade
 /// when the key of what they bind or the pipeline's build changes.
 #[derive(Default)]
 pub struct BindCache {
-    cached: Option<(u64, u32, Vec<Vec<wgpu::BindGroup>>)>,
+    cached: Option<(BindKey, u32, Vec<Vec<wgpu::BindGroup>>)>,
 }
 
 impl BindCache {
     /// The groups of variant `v`, making all variants with `make(v)` if `key` or `builds` changed.
     pub fn get(
         &mut self,
-        key: u64,
+        key: BindKey,
         builds: u32,
         variants: usize,
         v: usize,
         make: impl Fn(usize) -> Result<Vec<wgpu::BindGroup>>,
     ) -> Result<&[wgpu::BindGroup]> {
-        if self.cached.as_ref().is_none_or(|(k, b, _)| *k != key || *b != builds) {
-            let groups = (0..variants).map(&make).collect::<Result<Vec<_>>>()?;
-            self.cached = Some((key, builds, groups));
-        }
-        Ok(&self.cached.as_ref().unwrap().2[v])
+        let cached = match self.cached.take() {
+            Some(c) if c.0 == key && c.1 == builds => c,
+            _ => (key, builds, (0..variants).map(&make).collect::<Result<_>>()?),
+        };
+        let (_, _, groups) = self.cached.insert(cached);
+        groups
+            .get(v)
+            .map(Vec::as_slice)
+            .with_context(|| format!("bind-group variant {v} of {variants}"))
     }
 }
