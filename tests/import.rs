@@ -96,10 +96,10 @@ fn punctual_lights_follow_the_radiometric_conventions() {
         // Point and spot: 2 m above the floor under a parent node (hierarchy composes). The sun
         // travels along its node's -Z, rotated to come down at 60 degrees from the zenith.
         let rot60 = [
-            -(0.5f32 * 1.0472 + 0.5 * std::f32::consts::FRAC_PI_2).sin(),
+            -(0.5f32 * std::f32::consts::FRAC_PI_3 + 0.5 * std::f32::consts::FRAC_PI_2).sin(),
             0.0,
             0.0,
-            (0.5f32 * 1.0472 + 0.5 * std::f32::consts::FRAC_PI_2).cos(),
+            (0.5f32 * std::f32::consts::FRAC_PI_3 + 0.5 * std::f32::consts::FRAC_PI_2).cos(),
         ];
         let down = [
             -(0.5f32 * std::f32::consts::FRAC_PI_2).sin(),

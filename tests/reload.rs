@@ -57,7 +57,7 @@ fn wait_for(w: &ShaderWatcher, lib: &ShaderLibrary, module: &str) -> Vec<&'stati
     let mut seen = vec![];
     while start.elapsed() < Duration::from_secs(20) {
         seen.extend(w.changed(lib));
-        if seen.iter().any(|m| *m == module) {
+        if seen.contains(&module) {
             return seen;
         }
         std::thread::sleep(Duration::from_millis(20));

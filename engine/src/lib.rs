@@ -22,5 +22,6 @@ pub mod quality;
 pub mod scene;
 pub mod settings;
 pub mod shader;
+pub(crate) mod sync;
 
 pub use error::Error;

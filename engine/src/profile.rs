@@ -52,9 +52,10 @@ pub fn scope(label: &'static str) -> Option<puffin::ProfilerScope> {
         return None;
     }
     static IDS: OnceLock<Mutex<HashMap<&'static str, ScopeId>>> = OnceLock::new();
-    let id = *IDS.get_or_init(Default::default).lock().unwrap().entry(label).or_insert_with(|| {
-        puffin::ThreadProfiler::call(|tp| tp.register_named_scope(label, "pass", "hush", 0))
-    });
+    let id =
+        *crate::sync::lock(IDS.get_or_init(Default::default)).entry(label).or_insert_with(|| {
+            puffin::ThreadProfiler::call(|tp| tp.register_named_scope(label, "pass", "hush", 0))
+        });
     Some(puffin::ProfilerScope::new(id, ""))
 }
 
@@ -109,14 +110,14 @@ impl Capture {
         let collected = Arc::new(Mutex::new(vec![]));
         let c = collected.clone();
         let mut profiler = GlobalProfiler::lock();
-        let sink = profiler.add_sink(Box::new(move |f| c.lock().unwrap().push(f)));
+        let sink = profiler.add_sink(Box::new(move |f| crate::sync::lock(&c).push(f)));
         // The first collected frame then carries every scope's name, so the file stands alone.
         profiler.emit_scope_snapshot();
         Capture { frames: collected, sink, want: frames.max(1) }
     }
 
     pub fn captured(&self) -> usize {
-        self.frames.lock().unwrap().len().min(self.want)
+        crate::sync::lock(&self.frames).len().min(self.want)
     }
 
     pub fn done(&self) -> bool {
@@ -126,7 +127,7 @@ impl Capture {
     /// Stop collecting and write what was captured; returns the number of frames written.
     pub fn write(self, path: &Path) -> Result<usize> {
         GlobalProfiler::lock().remove_sink(self.sink);
-        let frames = self.frames.lock().unwrap();
+        let frames = crate::sync::lock(&self.frames);
         let mut view = FrameView::default();
         view.set_max_recent(usize::MAX);
         for f in frames.iter().take(self.want) {

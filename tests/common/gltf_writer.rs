@@ -27,7 +27,7 @@ pub struct Prim<'a> {
 
 impl GltfWriter {
     fn push_data(&mut self, bytes: &[u8], target: u32) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let off = self.bin.len();

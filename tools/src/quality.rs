@@ -159,9 +159,9 @@ impl Scores {
         let (flip, n) = region.unwrap_or((f64::NAN, 0));
         self.uncovered_flip.push(flip);
         self.uncovered_pixels.push(n);
-        self.flip.push(m.flip as f64);
+        self.flip.push(m.flip);
         self.relmse.push(m.relmse);
-        self.ssim.push(m.ssim as f64);
+        self.ssim.push(m.ssim);
         self.temporal.push(prev.map_or(0.0, |p| temporal_error(img, p)));
         self.gpu_ms.push(ms);
         Ok(())
@@ -487,7 +487,7 @@ fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> 
         f,
         "frame,time,flip,relmse,ssim,temporal_error,gpu_ms,raw_flip,raw_relmse,raw_ssim,raw_temporal_error,raw_gpu_ms,uncovered_flip,uncovered_pixels"
     )?;
-    for k in 0..inputs.len() {
+    for (k, input) in inputs.iter().enumerate() {
         // The denoised stream's uncovered pixels; blank where there are none.
         let uncovered = if den.uncovered_pixels[k] > 0 {
             format!("{:.5}", den.uncovered_flip[k])
@@ -497,7 +497,7 @@ fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> 
         writeln!(
             f,
             "{k},{:.4},{:.5},{:.6},{:.5},{:.6},{:.3},{:.5},{:.6},{:.5},{:.6},{:.3},{uncovered},{}",
-            inputs[k].time,
+            input.time,
             den.flip[k],
             den.relmse[k],
             den.ssim[k],

@@ -97,12 +97,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let scene = load_scene(&a.scene, &a.load)?;
     let size = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
-    if let Some(v) = &view {
-        if v.spec().is_some_and(|s| s.needs_glossy())
-            && !hush_engine::gpu::PreparedScene::glossy_materials(&scene)
-        {
-            bail!("--view {}: the scene has no glossy buffers", v.name());
-        }
+    if let Some(v) = &view
+        && v.spec().is_some_and(|s| s.needs_glossy())
+        && !hush_engine::gpu::PreparedScene::glossy_materials(&scene)
+    {
+        bail!("--view {}: the scene has no glossy buffers", v.name());
     }
     let max_depth = path_length(a.max_depth, a.preset.as_deref(), scene.max_depth)?;
     let (samples_per_pixel, sample_fraction) = match a.spp {

@@ -194,7 +194,7 @@ pub fn run(a: TimeToQualityArgs) -> Result<()> {
         preset_settings(None, Some(&r.denoiser), &[], None)
             .with_context(|| format!("--run {:?}", r.label))?;
     }
-    if !(a.seconds > 0.0 && a.seconds <= 600.0) || !(a.lead_in >= 0.0 && a.lead_in <= 600.0) {
+    if !(a.seconds > 0.0 && a.seconds <= 600.0 && a.lead_in >= 0.0 && a.lead_in <= 600.0) {
         bail!("--seconds must be in (0, 600] and --lead-in in [0, 600]");
     }
     if !a.speed.is_finite()

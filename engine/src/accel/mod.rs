@@ -585,7 +585,7 @@ mod tests {
             let a = build(&chain, kind);
             let stack = traversal_stack(kind, a.depth, chain.len(), false) as usize;
             assert!(
-                stack >= a.depth && stack % 4 == 0 && stack < a.depth + 4,
+                stack >= a.depth && stack.is_multiple_of(4) && stack < a.depth + 4,
                 "{kind:?}: depth {} stack {stack}",
                 a.depth
             );

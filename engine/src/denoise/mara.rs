@@ -64,7 +64,7 @@ impl Denoiser for Mara {
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
         let animated = self.scene.animated;
-        let matte = super::made(&mut self.matte, || {
+        let matte = crate::passes::chain::made(&mut self.matte, || {
             MatteChain::new(gpu, &inputs, animated).context("creating the matte chain")
         })?;
         matte.record(gpu, enc, cx.key, &inputs, cx.parity, timer.as_deref_mut())?;
@@ -75,7 +75,7 @@ impl Denoiser for Mara {
                 params: &self.glossy_params,
                 glossy: g,
             };
-            let glossy = super::made(&mut self.glossy, || {
+            let glossy = crate::passes::chain::made(&mut self.glossy, || {
                 GlossyChain::new(gpu, &inputs, animated).context("creating the glossy chain")
             })?;
             glossy.record(gpu, enc, cx.key, &inputs, cx.parity, &s.glossy, timer)?;

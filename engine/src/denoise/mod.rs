@@ -16,7 +16,7 @@ pub mod progressive;
 pub mod svgf;
 
 pub use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
-pub use crate::passes::chain::ChainStage;
+pub use crate::passes::chain::{ChainStage, made};
 pub use crate::passes::io::{FrameIo, PreviousGBuffer};
 pub use crate::passes::matte::ChainView;
 pub use crate::passes::taa::{GlossyFollow, TaaFollow};
@@ -96,15 +96,6 @@ pub trait Denoiser {
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload>;
 }
 
-/// The stages in `slot`, made by `make` the first time they are needed (a stage is checked
-/// against the names the frame offers, so a denoiser makes its stages on its first frame).
-pub fn made<T>(slot: &mut Option<T>, make: impl FnOnce() -> Result<T>) -> Result<&mut T> {
-    match slot {
-        Some(t) => Ok(t),
-        None => Ok(slot.insert(make()?)),
-    }
-}
-
 /// Makes a denoiser for a scene.
 pub type MakeDenoiser = fn(&Gpu, &DenoiserScene) -> Result<Box<dyn Denoiser>>;
 
@@ -161,7 +152,7 @@ static REGISTERED: RwLock<Vec<Entry>> = RwLock::new(Vec::new());
 /// Add a denoiser beside the built-in ones (an application's or a test's own); an error if the
 /// name is taken.
 pub fn register(entry: Entry) -> Result<()> {
-    let mut r = REGISTERED.write().unwrap();
+    let mut r = crate::sync::write(&REGISTERED);
     if entries_in(&r).iter().any(|e| e.name == entry.name) {
         bail!("a denoiser named {:?} is already registered", entry.name);
     }
@@ -177,16 +168,7 @@ fn entries_in(registered: &[Entry]) -> Vec<Entry> {
 
 /// Every denoiser, built-in first.
 pub fn entries() -> Vec<Entry> {
-    entries_in(&REGISTERED.read().unwrap())
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn settings_know_every_built_in_name() {
-        let names: Vec<&str> = super::BUILT_IN.iter().map(|e| e.name).collect();
-        assert_eq!(crate::settings::denoiser_names()[..names.len()], names[..]);
-    }
+    entries_in(&crate::sync::read(&REGISTERED))
 }
 
 /// The denoiser called `name`.
@@ -198,5 +180,14 @@ pub fn find(name: &str) -> Result<Entry> {
             "no denoiser {name:?} (there are {})",
             all.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn settings_know_every_built_in_name() {
+        let names: Vec<&str> = super::BUILT_IN.iter().map(|e| e.name).collect();
+        assert_eq!(crate::settings::denoiser_names()[..names.len()], names[..]);
     }
 }

@@ -366,7 +366,7 @@ impl Denoiser for Progressive {
         let t = res.targets.as_ref().context(missing)?;
         res.write_params(gpu, io, cx);
         let (key, parity, size, levels) = (cx.key, cx.parity, io.size, t.levels);
-        let stages = super::made(stages, || {
+        let stages = crate::passes::chain::made(stages, || {
             res.make_stages(gpu, io, t, scene).context("creating the progressive filter's stages")
         })?;
         let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;

@@ -544,14 +544,16 @@ impl Denoiser for Svgf {
             SignalStages::new(gpu, g, scene.animated, &offered).context("creating SVGF's stages")
         };
         let s = signal(false)?;
-        let st = super::made(matte, || stages(false, s))?;
+        let st = crate::passes::chain::made(matte, || stages(false, s))?;
         res.record_stages(&mut rec, io, cx, s, st)?;
         if scene.glossy {
             let s = signal(true)?;
             let m = s.motion.context("SVGF's glossy motion textures are missing")?;
-            let st = super::made(motion, || motion_stages(gpu, res, io, m, scene.animated))?;
+            let st = crate::passes::chain::made(motion, || {
+                motion_stages(gpu, res, io, m, scene.animated)
+            })?;
             res.record_motion(&mut rec, io, cx, m, st)?;
-            let st = super::made(glossy, || stages(true, s))?;
+            let st = crate::passes::chain::made(glossy, || stages(true, s))?;
             res.record_stages(&mut rec, io, cx, s, st)?;
         }
         Ok(())

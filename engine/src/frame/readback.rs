@@ -112,7 +112,9 @@ impl Renderer {
         }
         let (bytes, _) = self.read_texture(gpu, "gbuffer/depth")?;
         let i = (pixel.1 * w + pixel.0) as usize * 4;
-        let d = f32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
+        let Some(d) = bytes.get(i..i + 4).map(bytemuck::pod_read_unaligned::<f32>) else {
+            return Ok(None);
+        };
         // Reversed infinite Z: depth = near / view depth, 0 where nothing was drawn.
         Ok((d > 0.0 && d.is_finite()).then(|| self.near() as f64 / d as f64))
     }

@@ -36,7 +36,7 @@ impl Default for GpuRequirements {
         let d = wgpu::Limits::default();
         Self {
             features: wgpu::Features::empty(),
-            max_storage_buffer_binding_size: d.max_storage_buffer_binding_size as u64,
+            max_storage_buffer_binding_size: d.max_storage_buffer_binding_size,
             output_bytes: 0,
             output_pixels: 0,
             max_storage_buffers_per_shader_stage: d.max_storage_buffers_per_shader_stage,

@@ -583,8 +583,8 @@ impl EnvPack {
         }
         data.push(0.0);
         let mut acc = 0f64;
-        for r in 0..h {
-            acc += rows[r];
+        for (r, row) in rows.iter().enumerate().take(h) {
+            acc += row;
             data.push(if r + 1 == h { 1.0 } else { (acc / total) as f32 });
         }
         data.extend_from_slice(&cond);
@@ -613,7 +613,11 @@ fn pack_textures(scene: &Scene) -> Vec<u32> {
         if textures[largest].width <= 1 && textures[largest].height <= 1 {
             break;
         }
-        textures[largest] = std::borrow::Cow::Owned(textures[largest].halved());
+        let Some(half) = textures[largest].halved() else {
+            log::error!("texture {:?}: its texels do not fill its size", textures[largest].name);
+            break;
+        };
+        textures[largest] = std::borrow::Cow::Owned(half);
     }
     if bytes(&textures) != before {
         log::warn!(

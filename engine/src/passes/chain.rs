@@ -6,6 +6,16 @@ use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
 
+/// The stages in `slot`, made by `make` the first time they are needed (a stage is checked
+/// against the names the frame offers, so a pass or a denoiser makes its stages on its first
+/// frame).
+pub fn made<T>(slot: &mut Option<T>, make: impl FnOnce() -> Result<T>) -> Result<&mut T> {
+    match slot {
+        Some(t) => Ok(t),
+        None => Ok(slot.insert(make()?)),
+    }
+}
+
 pub struct ChainStage {
     pub label: &'static str,
     pub pipeline: Reloadable<wgpu::ComputePipeline>,

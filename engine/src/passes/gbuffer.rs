@@ -35,10 +35,21 @@ pub const COLOR_FORMATS: [(&str, wgpu::TextureFormat); 6] = [
 /// Render-target bytes per sample of the colour attachments (WebGPU's accounting).
 pub const COLOR_BYTES_PER_SAMPLE: u32 = 40;
 
+/// A colour channel of the G-buffer, as [`COLOR_FORMATS`] orders them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Channel {
+    Normal = 0,
+    Motion = 1,
+    BaseColor = 2,
+    Specular = 3,
+    Emission = 4,
+    Ids = 5,
+}
+
 pub struct GBufferTargets {
     pub depth: (wgpu::Texture, wgpu::TextureView),
     /// In the order of [`COLOR_FORMATS`].
-    pub color: Vec<(wgpu::Texture, wgpu::TextureView)>,
+    pub color: [(wgpu::Texture, wgpu::TextureView); COLOR_FORMATS.len()],
 }
 
 impl GBufferTargets {
@@ -47,24 +58,16 @@ impl GBufferTargets {
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         let depth = mem.texture(&gpu.device, "gbuffer/depth", size, DEPTH_FORMAT, usage);
-        let color = COLOR_FORMATS
-            .iter()
-            .map(|(l, f)| mem.texture(&gpu.device, l, size, *f, usage))
-            .collect();
+        let color = COLOR_FORMATS.map(|(l, f)| mem.texture(&gpu.device, l, size, f, usage));
         GBufferTargets { depth, color }
     }
 
-    pub fn view(&self, name: &str) -> &wgpu::TextureView {
-        &self.channel(name).1
+    pub fn view(&self, c: Channel) -> &wgpu::TextureView {
+        &self.channel(c).1
     }
 
-    /// A colour channel by name (`normal`, `ids`, ...).
-    pub fn channel(&self, name: &str) -> &(wgpu::Texture, wgpu::TextureView) {
-        let i = COLOR_FORMATS
-            .iter()
-            .position(|(l, _)| l.strip_prefix("gbuffer/") == Some(name))
-            .expect("G-buffer channel");
-        &self.color[i]
+    pub fn channel(&self, c: Channel) -> &(wgpu::Texture, wgpu::TextureView) {
+        &self.color[c as usize]
     }
 
     /// A render pass writing every channel and the depth, cleared (ids to "no surface", depth to
@@ -111,13 +114,9 @@ impl GBufferTargets {
         })
     }
 
-    /// A colour channel's format by name.
-    pub fn format(name: &str) -> wgpu::TextureFormat {
-        COLOR_FORMATS
-            .iter()
-            .find(|(l, _)| l.strip_prefix("gbuffer/") == Some(name))
-            .expect("G-buffer channel")
-            .1
+    /// A colour channel's format.
+    pub fn format(c: Channel) -> wgpu::TextureFormat {
+        COLOR_FORMATS[c as usize].1
     }
 }
 

@@ -2,7 +2,7 @@
 //! the G-buffer of this frame and the previous one, the trace's signals and the composite's
 //! image, offered by the names the WGSL binds them by. A stage adds its own resources on top.
 
-use super::gbuffer::GBufferTargets;
+use super::gbuffer::{Channel, GBufferTargets};
 use super::trace::TraceTargets;
 use crate::gpu::{Bindings, GpuMemory};
 
@@ -38,12 +38,12 @@ impl<'a> FrameIo<'a> {
             .buffer("frame", self.frame)
             .buffer_opt("prev_from_current", self.objects)
             .texture("gb_depth", &g.depth.1)
-            .texture("gb_normal", g.view("normal"))
-            .texture("gb_motion", g.view("motion"))
-            .texture("gb_base_color", g.view("base_color"))
-            .texture("gb_specular", g.view("specular"))
-            .texture("gb_emission", g.view("emission"))
-            .texture("gb_object", g.view("ids"))
+            .texture("gb_normal", g.view(Channel::Normal))
+            .texture("gb_motion", g.view(Channel::Motion))
+            .texture("gb_base_color", g.view(Channel::BaseColor))
+            .texture("gb_specular", g.view(Channel::Specular))
+            .texture("gb_emission", g.view(Channel::Emission))
+            .texture("gb_object", g.view(Channel::Ids))
             .texture("tr_matte", &t.matte.1)
             .texture("tr_direct", &t.direct.1);
         if let Some(gl) = &t.glossy {
@@ -104,14 +104,14 @@ impl PreviousGBuffer {
                 device,
                 "gbuffer/previous normal",
                 size,
-                GBufferTargets::format("normal"),
+                GBufferTargets::format(Channel::Normal),
                 usage,
             ),
             ids: mem.texture(
                 device,
                 "gbuffer/previous ids",
                 size,
-                GBufferTargets::format("ids"),
+                GBufferTargets::format(Channel::Ids),
                 usage,
             ),
         }
@@ -130,7 +130,7 @@ impl PreviousGBuffer {
             self.depth.0.as_image_copy(),
             extent,
         );
-        for (from, to) in [("normal", &self.normal), ("ids", &self.ids)] {
+        for (from, to) in [(Channel::Normal, &self.normal), (Channel::Ids, &self.ids)] {
             enc.copy_texture_to_texture(
                 g.channel(from).0.as_image_copy(),
                 to.0.as_image_copy(),

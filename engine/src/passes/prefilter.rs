@@ -126,15 +126,15 @@ impl Prefilter {
         offered: &Bindings,
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        if self.stages.is_none() {
+        let stages = super::chain::made(&mut self.stages, || {
             let stage = |label, file| ChainStage::new(gpu, label, &modules(file), "main", offered);
-            self.stages = Some([
+            Ok([
                 stage(COVARIANCE, "prefilter/covariance.wgsl")?,
                 stage(SURE, "prefilter/sure.wgsl")?,
                 stage(FEATURES, "prefilter/features.wgsl")?,
-            ]);
-        }
-        for s in self.stages.as_mut().unwrap() {
+            ])
+        })?;
+        for s in stages {
             s.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| {
                 offered.clone()
             })?;

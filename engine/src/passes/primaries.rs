@@ -101,8 +101,7 @@ impl Primaries {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let offered = trace_bindings(scene, params, frame, t);
-        let slot = &mut self.trace[moving as usize];
-        if slot.is_none() {
+        let (p, cache) = super::chain::made(&mut self.trace[moving as usize], || {
             let mut modules = scene.shading_modules_for(moving);
             modules.push("realtime/frame.wgsl");
             modules.push(if scene.features.animated {
@@ -120,9 +119,8 @@ impl Primaries {
                 &offered,
                 |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),
             )?;
-            *slot = Some((p, BindCache::default()));
-        }
-        let (p, cache) = slot.as_mut().unwrap();
+            Ok((p, BindCache::default()))
+        })?;
         let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(LABEL);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -154,7 +152,7 @@ impl Primaries {
             .buffer("frame", frame)
             .buffer("features", &t.features)
             .buffer("edges", edges.unwrap_or(&t.features));
-        if self.resolve.is_none() {
+        let (p, caches) = super::chain::made(&mut self.resolve, || {
             let modules =
                 ["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"];
             // Every pixel is written: the depth is the resolved one, not a nearest surface.
@@ -169,9 +167,8 @@ impl Primaries {
                     render_pipeline(d, RESOLVE, module, pl, wgpu::CompareFunction::Always)
                 },
             )?;
-            self.resolve = Some((p, Default::default()));
-        }
-        let (p, caches) = self.resolve.as_mut().unwrap();
+            Ok((p, Default::default()))
+        })?;
         let groups = caches[filtered as usize]
             .get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(RESOLVE);

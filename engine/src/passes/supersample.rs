@@ -149,7 +149,7 @@ impl Supersample {
     ) -> Result<()> {
         let size = io.size;
         let sample_bindings = Self::own(t, trace_bindings);
-        if self.samples.is_none() {
+        let (p, cache) = super::chain::made(&mut self.samples, || {
             let p = Reloadable::new(
                 gpu,
                 SAMPLES,
@@ -159,9 +159,8 @@ impl Supersample {
                 &sample_bindings,
                 |d, m, l| compute_pipeline(d, SAMPLES, m, l, "samples"),
             )?;
-            self.samples = Some((p, BindCache::default()));
-        }
-        let (p, cache) = self.samples.as_mut().unwrap();
+            Ok((p, BindCache::default()))
+        })?;
         let groups =
             cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &sample_bindings))?;
         {
@@ -175,17 +174,16 @@ impl Supersample {
             pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
         }
         let offered = Self::own(t, io.bindings().buffer("hdr", io.hdr));
-        if self.stages.is_none() {
+        let [assign, mix, _] = super::chain::made(&mut self.stages, || {
             let glossy = t.mixed.glossy.is_some();
             let stage =
                 |label, file| ChainStage::new(gpu, label, &modules(file, glossy), "main", &offered);
-            self.stages = Some([
+            Ok([
                 stage("supersample/assign", "supersample/assign.wgsl")?,
                 stage("supersample/mix", "supersample/mix.wgsl")?,
                 stage("supersample/resolve", "supersample/resolve.wgsl")?,
-            ]);
-        }
-        let [assign, mix, _] = self.stages.as_mut().unwrap();
+            ])
+        })?;
         assign.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| {
             offered.clone()
         })?;

@@ -7,7 +7,7 @@
 //! path hit first: its reflectance and normal (Rg32Uint, 8), which the glossy chain uses behind
 //! mirrors (Voorhuis §4.1).
 
-use super::gbuffer::GBufferTargets;
+use super::gbuffer::{Channel, GBufferTargets};
 use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups};
 use crate::shader::compute_pipeline;
 use anyhow::Result;
@@ -98,7 +98,7 @@ pub fn bindings<'a>(
         .bindings()
         .buffer("params", params)
         .buffer("frame", frame)
-        .texture("gb_ids", g.view("ids"))
+        .texture("gb_ids", g.view(Channel::Ids))
         .texture("out_matte", &t.matte.1)
         .texture("out_direct", &t.direct.1);
     if let Some(gl) = &t.glossy {

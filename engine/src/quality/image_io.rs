@@ -52,7 +52,8 @@ impl Image {
     /// Mean of `factor` x `factor` blocks (a box filter): how a low-resolution render of the same
     /// view relates to a high-resolution reference.
     pub fn box_downsample(&self, factor: u32) -> Result<Image> {
-        if factor == 0 || self.width % factor != 0 || self.height % factor != 0 {
+        if factor == 0 || !self.width.is_multiple_of(factor) || !self.height.is_multiple_of(factor)
+        {
             bail!("cannot box-downsample {}x{} by {factor}", self.width, self.height);
         }
         let (w, h) = (self.width / factor, self.height / factor);

@@ -143,6 +143,9 @@ fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8
     Ok((document, blob))
 }
 
+/// Where each (glTF texture, sRGB) pair went in the scene's texture list.
+type TextureSlots = HashMap<(usize, bool), u32>;
+
 pub(super) struct Importer<'a> {
     files: &'a dyn SceneFiles,
     pub(super) warnings: Vec<String>,
@@ -246,9 +249,11 @@ impl Importer<'_> {
             if let Some(light) = node.light() {
                 scene.lights.push(self.light(&light, &world));
             }
-            if let Some(cam) = node.camera() {
-                if scene.camera.is_none() && ortho.is_none() {
-                    match camera_pose(world, rotation) {
+            if let Some(cam) = node.camera()
+                && scene.camera.is_none()
+                && ortho.is_none()
+            {
+                match camera_pose(world, rotation) {
                         None => self.warn(format!("nodes[{}] places cameras[{}] with a degenerate transform; using a default view", node.index(), cam.index())),
                         Some(pose) => match cam.projection() {
                             gltf::camera::Projection::Perspective(p) => scene.camera = Some(Camera { world: pose, yfov: p.yfov(), lens: camera_lens(&cam)? }),
@@ -257,7 +262,6 @@ impl Importer<'_> {
                             }
                         },
                     }
-                }
             }
             let moving = moving_parent || animation.is_some();
             if animation.is_some() && node.children().next().is_some() {
@@ -362,16 +366,16 @@ impl Importer<'_> {
         &mut self,
         doc: &gltf::Document,
         buffers: &[Vec<u8>],
-    ) -> Result<(Vec<Texture>, HashMap<(usize, bool), u32>)> {
+    ) -> Result<(Vec<Texture>, TextureSlots)> {
         // Which textures are colour (sRGB) and which are data.
         let mut uses: Vec<(usize, bool)> = vec![];
         for m in doc.materials() {
             let pbr = m.pbr_metallic_roughness();
             let mut add = |t: Option<gltf::Texture>, srgb: bool| {
-                if let Some(t) = t {
-                    if !uses.contains(&(t.index(), srgb)) {
-                        uses.push((t.index(), srgb));
-                    }
+                if let Some(t) = t
+                    && !uses.contains(&(t.index(), srgb))
+                {
+                    uses.push((t.index(), srgb));
                 }
             };
             add(pbr.base_color_texture().map(|i| i.texture()), true);

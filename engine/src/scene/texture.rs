@@ -28,13 +28,19 @@ pub struct TextureRef {
 }
 
 impl Texture {
-    /// Half the resolution in each direction (a box-filtered mip level).
-    pub fn halved(&self) -> Texture {
-        let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8.clone())
-            .expect("texture size");
+    /// Half the resolution in each direction (a box-filtered mip level); None if the texels do
+    /// not fill width x height.
+    pub fn halved(&self) -> Option<Texture> {
+        let img = image::RgbaImage::from_raw(self.width, self.height, self.rgba8.clone())?;
         let (w, h) = ((self.width / 2).max(1), (self.height / 2).max(1));
         let img = image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle);
-        Texture { width: w, height: h, rgba8: img.into_raw(), name: self.name.clone(), ..*self }
+        Some(Texture {
+            width: w,
+            height: h,
+            rgba8: img.into_raw(),
+            name: self.name.clone(),
+            ..*self
+        })
     }
 
     /// Decode a PNG/JPEG, shrinking it (by halving) until neither side exceeds `max_size`, so

@@ -183,6 +183,9 @@ pub fn leaves(v: &Value) -> Vec<String> {
 impl FrameSettings {
     /// The settings as a JSON value (the form panels edit and presets store).
     pub fn to_value(&self) -> Value {
+        // serde_json fails only on maps with non-string keys and on failing Serialize impls;
+        // the settings are structs of numbers, booleans and strings.
+        #[allow(clippy::expect_used)]
         serde_json::to_value(self).expect("settings serialize")
     }
 

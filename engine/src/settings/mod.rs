@@ -166,13 +166,13 @@ static DENOISER_NAMES: RwLock<Vec<&'static str>> = RwLock::new(Vec::new());
 
 pub fn denoiser_names() -> Vec<&'static str> {
     let mut v = vec![Denoiser::NONE.0.as_ref(), "mara", "svgf", "progressive"];
-    v.extend(DENOISER_NAMES.read().unwrap().iter());
+    v.extend(crate::sync::read(&DENOISER_NAMES).iter());
     v
 }
 
 /// Called by `crate::denoise::register` only.
 pub(crate) fn add_denoiser_name(name: &'static str) {
-    DENOISER_NAMES.write().unwrap().push(name);
+    crate::sync::write(&DENOISER_NAMES).push(name);
 }
 
 /// Disable a stage of any denoiser or TAA by its `--disable` name; false for an unknown name.

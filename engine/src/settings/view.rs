@@ -239,7 +239,7 @@ static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
 
 /// Add a stage's views (names already known are skipped).
 pub fn register_views(views: &[ViewSpec]) {
-    let mut r = REGISTERED.write().unwrap();
+    let mut r = crate::sync::write(&REGISTERED);
     for v in views {
         if !FRAME_VIEWS
             .iter()
@@ -261,7 +261,7 @@ pub fn all_views() -> Vec<ViewSpec> {
         .chain(MARA_VIEWS)
         .chain(SVGF_VIEWS)
         .chain(PROGRESSIVE_VIEWS)
-        .chain(REGISTERED.read().unwrap().iter())
+        .chain(crate::sync::read(&REGISTERED).iter())
         .copied()
         .collect()
 }

@@ -86,29 +86,24 @@ impl<'a> Bindings<'a> {
         layouts: &[wgpu::BindGroupLayout],
     ) -> Result<Vec<wgpu::BindGroup>> {
         self.check(label, program)?;
-        Ok(layouts
-            .iter()
-            .enumerate()
-            .map(|(g, layout)| {
-                let entries: Vec<_> = program
-                    .slots
-                    .iter()
-                    .filter(|s| s.group == g as u32)
-                    .map(|s| {
-                        let resource = match self.get(&s.name).expect("checked above") {
-                            Resource::Buffer(b) => b.as_entire_binding(),
-                            Resource::Texture(v) => wgpu::BindingResource::TextureView(v),
-                        };
-                        wgpu::BindGroupEntry { binding: s.binding, resource }
-                    })
-                    .collect();
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(label),
-                    layout,
-                    entries: &entries,
+        let group = |(g, layout): (usize, &wgpu::BindGroupLayout)| {
+            let entries = program
+                .slots
+                .iter()
+                .filter(|s| s.group == g as u32)
+                .map(|s| {
+                    let resource = match self.get(&s.name) {
+                        Some(Resource::Buffer(b)) => b.as_entire_binding(),
+                        Some(Resource::Texture(v)) => wgpu::BindingResource::TextureView(v),
+                        None => anyhow::bail!("{label}: nothing is offered as {:?}", s.name),
+                    };
+                    Ok(wgpu::BindGroupEntry { binding: s.binding, resource })
                 })
-            })
-            .collect())
+                .collect::<Result<Vec<_>>>()?;
+            let desc = wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries };
+            Ok(device.create_bind_group(&desc))
+        };
+        layouts.iter().enumerate().map(group).collect()
     }
 }
 

@@ -70,7 +70,7 @@ impl ShaderLibrary {
     /// composed into programs by its path like any other; an error if the path is taken by
     /// `shaders/` or by another text.
     pub fn add(&self, module: &'static str, text: &str) -> Result<()> {
-        let mut texts = self.texts.write().unwrap();
+        let mut texts = crate::sync::write(&self.texts);
         if SOURCES.iter().any(|(n, _)| *n == module)
             || texts.get(module).is_some_and(|t| **t != *text)
         {
@@ -81,7 +81,7 @@ impl ShaderLibrary {
     }
 
     pub fn source(&self, module: &str) -> Result<Arc<str>> {
-        if let Some(t) = self.texts.read().unwrap().get(module) {
+        if let Some(t) = crate::sync::read(&self.texts).get(module) {
             return Ok(t.clone());
         }
         super::source(module).map(Arc::from)
@@ -107,7 +107,7 @@ impl ShaderLibrary {
         for m in modules {
             match std::fs::read_to_string(dir.join(m)) {
                 Ok(text) => {
-                    let mut texts = self.texts.write().unwrap();
+                    let mut texts = crate::sync::write(&self.texts);
                     if texts.get(m).is_none_or(|t| **t != *text) {
                         texts.insert(m, Arc::from(text));
                         changed.push(*m);

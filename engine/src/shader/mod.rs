@@ -583,10 +583,10 @@ mod tests {
     fn wgsl_layout(p: &Program, name: &str) -> (u32, Vec<u32>) {
         let m = p.validate().unwrap();
         for (_, t) in m.types.iter() {
-            if t.name.as_deref() == Some(name) {
-                if let naga::TypeInner::Struct { members, span } = &t.inner {
-                    return (*span, members.iter().map(|m| m.offset).collect());
-                }
+            if t.name.as_deref() == Some(name)
+                && let naga::TypeInner::Struct { members, span } = &t.inner
+            {
+                return (*span, members.iter().map(|m| m.offset).collect());
             }
         }
         panic!("no struct {name}");

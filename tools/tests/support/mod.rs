@@ -110,10 +110,12 @@ pub fn quad_bin() -> Vec<u8> {
 /// A scene of one emissive quad seen from above through a perspective camera, its buffer in
 /// `scene.bin`: every hostile case starts from it and breaks one thing.
 pub fn quad_doc() -> Value {
+    // Looking straight down: a -90 degree turn about +X.
+    let s = std::f64::consts::FRAC_1_SQRT_2;
     json!({
         "asset": {"version": "2.0"},
         "scene": 0, "scenes": [{"nodes": [0, 1]}],
-        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 3, 0.01], "rotation": [-0.7071068, 0, 0, 0.7071068]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 3, 0.01], "rotation": [-s, 0, 0, s]}],
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
         "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}, "emissiveFactor": [1, 1, 1]}],
