@@ -8,7 +8,7 @@ use glam::DVec3;
 use hush_engine::accel::BvhKind;
 use hush_engine::denoise::{
     Bindings, ChainStage, Denoised, Denoiser, DenoiserScene, Entry, FrameContext, FrameIo, Gpu,
-    GpuMemory, GpuTimer, Parity, PingPong, Tex, made,
+    GpuMemory, Parity, PingPong, Recorder, Tex, made,
 };
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::quality::{Image, compare};
@@ -75,11 +75,9 @@ impl Denoiser for Accumulate {
 
     fn record(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         io: &FrameIo,
         cx: &FrameContext,
-        timer: Option<&mut GpuTimer>,
     ) -> anyhow::Result<()> {
         let h = self.history.as_ref().context("recording before allocating")?;
         let motion = if self.animated {
@@ -91,9 +89,9 @@ impl Denoiser for Accumulate {
             ["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", motion, MODULE];
         let offered = bindings(io, h, Parity::default());
         let stage = made(&mut self.stage, || {
-            ChainStage::new(gpu, "accumulate", &modules, "main", &offered)
+            ChainStage::new(rec.gpu, "accumulate", &modules, "main", &offered)
         })?;
-        stage.record(gpu, enc, cx.key, cx.parity, io.size, timer, |p| bindings(io, h, p))
+        stage.record(rec, cx.key, cx.parity, io.size, |p| bindings(io, h, p))
     }
 
     fn output(&self, parity: Parity) -> Denoised<'_> {

@@ -141,7 +141,8 @@ fn run(pixels: &[Pixel]) -> Output {
     let mut prefilter = Prefilter::default();
     let mut enc = d.create_command_encoder(&Default::default());
     let offered = bindings(&frame, &primaries, &targets);
-    prefilter.record(&gpu, &mut enc, Default::default(), size, &offered, None).unwrap();
+    let mut rec = hush_engine::gpu::Recorder::new(&gpu, &mut enc, None);
+    prefilter.record(&mut rec, Default::default(), size, &offered).unwrap();
     gpu.queue.submit([enc.finish()]);
     let read = |b: &wgpu::Buffer| -> Vec<f32> {
         bytemuck::cast_slice(&readback_buffer(d, &gpu.queue, b, b.size()).unwrap()).to_vec()

@@ -408,3 +408,22 @@ fn punctual_direct_light_carries_no_noise() {
         / n as f64;
     println!("frame-to-frame relMSE: trace/direct 0 (bitwise equal), trace/matte {rel:.3}");
 }
+
+/// A lost device is an error a caller can tell from the others (`hush_engine::Error::DeviceLost`),
+/// not a panic or a frame that silently does nothing. wgpu reports the loss of a destroyed device
+/// once its queue is idle (a poll), as after a driver reset.
+#[test]
+fn a_lost_device_is_a_device_lost_error() {
+    use hush_engine::Error;
+    let scene = hush_engine::scene::default_level();
+    let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (16, 16)).unwrap();
+    let camera = Camera::look_at(DVec3::new(0.0, 1.7, 8.5), DVec3::new(0.0, 1.4, -6.0), 60.0);
+    let input = FrameInput { camera, time: 0.0, shutter: None };
+    r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
+    gpu.device.destroy();
+    let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
+    let e = r.render(&gpu, &input, &FrameSettings::default(), None).unwrap_err();
+    assert!(matches!(Error::find(&e), Some(Error::DeviceLost { .. })), "{e:#}");
+    let e = gpu.wait().unwrap_err();
+    assert!(matches!(Error::find(&e), Some(Error::DeviceLost { .. })), "{e:#}");
+}

@@ -4,7 +4,7 @@
 //! outputs ([`TaaFollow`]).
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Gpu, GpuMemory, GpuTimer, Parity};
+use crate::gpu::{Gpu, GpuMemory, Parity, Recorder};
 use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
@@ -47,14 +47,8 @@ impl Denoiser for Mara {
         self.targets = Some((MatteTargets::new(d, memory, size), glossy));
     }
 
-    fn record(
-        &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        io: &FrameIo,
-        cx: &FrameContext,
-        mut timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
+        let gpu = rec.gpu;
         let (m, g) =
             self.targets.as_ref().context("the Mara denoiser records before its textures exist")?;
         let s = cx.settings;
@@ -67,7 +61,7 @@ impl Denoiser for Mara {
         let matte = crate::passes::chain::made(&mut self.matte, || {
             MatteChain::new(gpu, &inputs, animated).context("creating the matte chain")
         })?;
-        matte.record(gpu, enc, cx.key, &inputs, cx.parity, timer.as_deref_mut())?;
+        matte.record(rec, cx.key, &inputs, cx.parity)?;
         if let Some(g) = g {
             let inputs = GlossyInputs {
                 io: *io,
@@ -78,7 +72,7 @@ impl Denoiser for Mara {
             let glossy = crate::passes::chain::made(&mut self.glossy, || {
                 GlossyChain::new(gpu, &inputs, animated).context("creating the glossy chain")
             })?;
-            glossy.record(gpu, enc, cx.key, &inputs, cx.parity, &s.glossy, timer)?;
+            glossy.record(rec, cx.key, &inputs, cx.parity, &s.glossy)?;
         }
         Ok(())
     }

@@ -15,7 +15,7 @@ pub mod mara;
 pub mod progressive;
 pub mod svgf;
 
-pub use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+pub use crate::gpu::{BindKey, Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 pub use crate::passes::chain::{ChainStage, made};
 pub use crate::passes::io::{FrameIo, PreviousGBuffer};
 pub use crate::passes::matte::ChainView;
@@ -68,14 +68,7 @@ pub trait Denoiser {
     fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32));
 
     /// Record its passes for this frame.
-    fn record(
-        &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        io: &FrameIo,
-        cx: &FrameContext,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()>;
+    fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()>;
 
     /// The light it produced this frame (after [`Denoiser::record`]).
     fn output(&self, parity: Parity) -> Denoised<'_>;

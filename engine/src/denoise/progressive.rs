@@ -13,7 +13,7 @@
 //! TAA (Dundr's §4.5 blend with a clamped history) follow as for every denoiser.
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
@@ -244,7 +244,6 @@ pub fn modules(
 }
 
 impl Resources {
-    #[allow(clippy::too_many_arguments)]
     fn bindings<'a>(
         &'a self,
         io: &FrameIo<'a>,
@@ -351,14 +350,8 @@ impl Denoiser for Progressive {
         self.res.targets = Some(Targets { features, signals, levels: 0 });
     }
 
-    fn record(
-        &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        io: &FrameIo,
-        cx: &FrameContext,
-        mut timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
+        let gpu = rec.gpu;
         let Progressive { scene, res, stages, .. } = self;
         let missing = "the progressive filter records before its textures exist";
         res.targets.as_mut().context(missing)?.levels =
@@ -370,29 +363,23 @@ impl Denoiser for Progressive {
             res.make_stages(gpu, io, t, scene).context("creating the progressive filter's stages")
         })?;
         let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
-        stages.features.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
+        stages.features.record(rec, key, parity, size, |p| {
             res.bindings(io, t, matte, Pass::Features, p, levels)
         })?;
         for (st, (signal, s)) in stages.signals.iter_mut().zip(&t.signals) {
             let sig = (*signal, s);
             let b = |pass, p| res.bindings(io, t, sig, pass, p, levels);
-            st.temporal.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-                b(Pass::Temporal, p)
-            })?;
-            st.variance.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| {
-                b(Pass::Variance, p)
-            })?;
+            st.temporal.record(rec, key, parity, size, |p| b(Pass::Temporal, p))?;
+            st.variance.record(rec, key, parity, size, |p| b(Pass::Variance, p))?;
             for i in 0..levels {
                 // Bind groups are keyed by (parity, level); the level count is in the key, since
                 // it picks each level's step.
                 let k = crate::gpu::BindKey { levels, ..key };
                 st.atrous.record_variant(
-                    gpu,
-                    enc,
+                    rec,
                     k,
                     (2 * LEVELS, parity.index() * LEVELS + i),
                     size,
-                    timer.as_deref_mut(),
                     |v| b(Pass::Atrous(v % LEVELS), Parity::BOTH[v / LEVELS]),
                 )?;
             }

@@ -12,7 +12,7 @@
 //! changes.
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::glossy::GlossyParams;
 use crate::passes::io::FrameIo;
@@ -412,7 +412,7 @@ impl Resources {
 
     fn record_stages(
         &self,
-        rec: &mut Record,
+        rec: &mut Recorder,
         io: &FrameIo,
         cx: &FrameContext,
         signal: Signal,
@@ -421,21 +421,16 @@ impl Resources {
         let t = self.targets.as_ref().context("SVGF records before its textures exist")?;
         let (key, parity, size) = (cx.key, cx.parity, io.size);
         let b = |pass, p| self.bindings(io, t, signal, pass, p);
-        let Record { gpu, enc, timer } = rec;
-        st.temporal
-            .record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| b(Pass::Temporal, p))?;
-        st.variance
-            .record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| b(Pass::Variance, p))?;
+        st.temporal.record(rec, key, parity, size, |p| b(Pass::Temporal, p))?;
+        st.variance.record(rec, key, parity, size, |p| b(Pass::Variance, p))?;
         let levels = cx.settings.svgf.atrous_levels() as usize;
         for level in 0..levels {
             // Bind groups by (parity, level).
             st.atrous.record_variant(
-                gpu,
-                enc,
+                rec,
                 key,
                 (2 * LEVELS, parity.index() * LEVELS + level),
                 size,
-                timer.as_deref_mut(),
                 |v| b(Pass::Atrous(v % LEVELS), Parity::BOTH[v / LEVELS]),
             )?;
         }
@@ -443,7 +438,7 @@ impl Resources {
         if levels == 0 || !cx.settings.svgf.filtered_history {
             // No level wrote the history: it is the integrated light.
             let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
-            enc.copy_texture_to_texture(
+            rec.enc.copy_texture_to_texture(
                 s.integrated.0.as_image_copy(),
                 s.history.output(parity).0.as_image_copy(),
                 extent,
@@ -452,14 +447,13 @@ impl Resources {
         // The last level wrote pong when its index was even; bind groups by (last, parity).
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
         let variant = (6, 2 * last + parity.index());
-        st.last.record_variant(gpu, enc, key, variant, size, timer.as_deref_mut(), |v| {
-            b(Pass::Final(v / 2), Parity::BOTH[v % 2])
-        })
+        st.last
+            .record_variant(rec, key, variant, size, |v| b(Pass::Final(v / 2), Parity::BOTH[v % 2]))
     }
 
     fn record_motion(
         &self,
-        rec: &mut Record,
+        rec: &mut Recorder,
         io: &FrameIo,
         cx: &FrameContext,
         m: &MotionTargets,
@@ -468,23 +462,13 @@ impl Resources {
         let (key, parity, size) = (cx.key, cx.parity, io.size);
         let sv = &cx.settings.svgf;
         let b = |prefilter, p| self.motion_bindings(io, m, prefilter, p);
-        let Record { gpu, enc, timer } = rec;
-        st.motion.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| b(None, p))?;
+        st.motion.record(rec, key, parity, size, |p| b(None, p))?;
         if sv.clipping && sv.temporal {
-            let t = timer.as_deref_mut();
-            st.prefilter_h.record(gpu, enc, key, parity, size, t, |p| b(Some(false), p))?;
-            let t = timer.as_deref_mut();
-            st.prefilter_v.record(gpu, enc, key, parity, size, t, |p| b(Some(true), p))?;
+            st.prefilter_h.record(rec, key, parity, size, |p| b(Some(false), p))?;
+            st.prefilter_v.record(rec, key, parity, size, |p| b(Some(true), p))?;
         }
         Ok(())
     }
-}
-
-/// What a stage records with: the device, the frame's encoder and its pass timer.
-struct Record<'r> {
-    gpu: &'r Gpu,
-    enc: &'r mut wgpu::CommandEncoder,
-    timer: Option<&'r mut GpuTimer>,
 }
 
 fn motion_stages(
@@ -526,18 +510,11 @@ impl Denoiser for Svgf {
         self.res.targets = Some(SvgfTargets::new(&gpu.device, memory, size, self.scene.glossy));
     }
 
-    fn record(
-        &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        io: &FrameIo,
-        cx: &FrameContext,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
+    fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
+        let gpu = rec.gpu;
         let Svgf { scene, res, matte, glossy, motion } = self;
         let t = res.targets.as_ref().context("SVGF records before its textures exist")?;
         res.write_params(gpu, io, cx, scene.extent);
-        let mut rec = Record { gpu, enc, timer };
         let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
         let stages = |g, s| {
             let offered = res.offered(io, t, s);
@@ -545,16 +522,16 @@ impl Denoiser for Svgf {
         };
         let s = signal(false)?;
         let st = crate::passes::chain::made(matte, || stages(false, s))?;
-        res.record_stages(&mut rec, io, cx, s, st)?;
+        res.record_stages(rec, io, cx, s, st)?;
         if scene.glossy {
             let s = signal(true)?;
             let m = s.motion.context("SVGF's glossy motion textures are missing")?;
             let st = crate::passes::chain::made(motion, || {
                 motion_stages(gpu, res, io, m, scene.animated)
             })?;
-            res.record_motion(&mut rec, io, cx, m, st)?;
+            res.record_motion(rec, io, cx, m, st)?;
             let st = crate::passes::chain::made(glossy, || stages(true, s))?;
-            res.record_stages(&mut rec, io, cx, s, st)?;
+            res.record_stages(rec, io, cx, s, st)?;
         }
         Ok(())
     }

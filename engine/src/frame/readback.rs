@@ -69,16 +69,20 @@ impl Renderer {
 
     /// Frames summed in accumulate mode (0 when off).
     pub fn accumulated(&self) -> u32 {
-        self.accumulated
+        self.history.accumulated
     }
 
     /// The last frame's linear HDR image (after composite), or in accumulate mode the mean.
     pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
         let (w, h) = self.targets.size;
         let n = w as u64 * h as u64 * 16;
-        let shown =
-            self.taa.output().filter(|_| self.denoised_last.is_some()).unwrap_or(&self.targets.hdr);
-        let (buf, scale) = match (&self.targets.accumulation, self.accumulated) {
+        let shown = self
+            .stages
+            .taa
+            .output()
+            .filter(|_| self.history.denoised_last.is_some())
+            .unwrap_or(&self.targets.hdr);
+        let (buf, scale) = match (&self.targets.accumulation, self.history.accumulated) {
             (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
             _ => (shown, 1.0),
         };

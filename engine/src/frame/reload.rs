@@ -10,20 +10,20 @@ impl Renderer {
     /// first use).
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
         let mut v: Vec<&mut dyn Reload> = vec![
-            &mut self.gbuffer.pipeline,
-            &mut self.trace.pipeline,
-            &mut self.composite.pipeline,
+            &mut self.stages.gbuffer.pipeline,
+            &mut self.stages.trace.pipeline,
+            &mut self.stages.composite.pipeline,
         ];
-        if let Some(d) = self.display.as_mut() {
+        if let Some(d) = self.stages.display.as_mut() {
             v.push(&mut d.pipeline);
         }
-        v.extend(self.taa.pipelines());
-        v.extend(self.supersample.pipelines());
-        v.extend(self.primaries.pipelines());
-        if let Some((p, _)) = self.trace.moving.as_mut() {
+        v.extend(self.stages.taa.pipelines());
+        v.extend(self.stages.supersample.pipelines());
+        v.extend(self.stages.primaries.pipelines());
+        if let Some((p, _)) = self.stages.trace.moving.as_mut() {
             v.push(p);
         }
-        v.extend(self.prefilter.pipelines());
+        v.extend(self.stages.prefilter.pipelines());
         for d in &mut self.denoisers {
             v.extend(d.denoiser.pipelines());
         }

@@ -5,6 +5,7 @@ mod context;
 pub mod history;
 mod memory;
 pub mod prepare;
+mod record;
 pub mod scene;
 mod timestamps;
 
@@ -15,5 +16,6 @@ pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP};
 pub use history::{Parity, PingPong, Tex};
 pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use prepare::{EnvKind, PreparedScene, SceneFeatures};
+pub use record::Recorder;
 pub use scene::GpuScene;
 pub use timestamps::GpuTimer;

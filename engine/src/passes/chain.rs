@@ -1,7 +1,7 @@
 //! One compute pass of a denoise chain (matte.rs, glossy.rs): its pipeline, and its bind groups
 //! for history parity 0 and 1, remade when the key of what they bind or the pipeline changes.
 
-use crate::gpu::{BindCache, Bindings, Gpu, GpuTimer, Parity, set_compute_groups};
+use crate::gpu::{BindCache, BindKey, Bindings, Gpu, Parity, Recorder, set_compute_groups};
 use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
@@ -45,44 +45,33 @@ impl ChainStage {
     }
 
     /// Dispatch one thread per pixel in 8x8 groups; `bindings(p)` gives what parity p binds.
-    #[allow(clippy::too_many_arguments)]
     pub fn record<'a>(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        key: crate::gpu::BindKey,
+        rec: &mut Recorder,
+        key: BindKey,
         parity: Parity,
         size: (u32, u32),
-        timer: Option<&mut GpuTimer>,
         bindings: impl Fn(Parity) -> Bindings<'a>,
     ) -> Result<()> {
-        self.record_variant(gpu, enc, key, (2, parity.index()), size, timer, |v| {
-            bindings(Parity::BOTH[v])
-        })
+        self.record_variant(rec, key, (2, parity.index()), size, |v| bindings(Parity::BOTH[v]))
     }
 
     /// As [`ChainStage::record`] for a stage with `variant.0` sets of bindings (parity, level,
     /// ...), recording set `variant.1`; `bindings(v)` gives set v.
-    #[allow(clippy::too_many_arguments)]
     pub fn record_variant<'a>(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        key: crate::gpu::BindKey,
+        rec: &mut Recorder,
+        key: BindKey,
         variant: (usize, usize),
         size: (u32, u32),
-        timer: Option<&mut GpuTimer>,
         bindings: impl Fn(usize) -> Bindings<'a>,
     ) -> Result<()> {
         let p = &self.pipeline;
         let groups = self.groups.get(key, p.builds(), variant.0, variant.1, |v| {
-            p.bind_groups(&gpu.device, &bindings(v))
+            p.bind_groups(&rec.gpu.device, &bindings(v))
         })?;
         let _scope = crate::profile::scope(self.label);
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(self.label),
-            timestamp_writes: timer.and_then(|t| t.compute(self.label)),
-        });
+        let mut pass = rec.compute_pass(self.label);
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);

@@ -4,7 +4,7 @@
 
 use super::io::FrameIo;
 use crate::gpu::{
-    BindCache, Bindings, Gpu, GpuTimer, Parity, set_compute_groups, set_render_groups,
+    BindCache, Bindings, Gpu, Parity, Recorder, set_compute_groups, set_render_groups,
 };
 use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
@@ -72,27 +72,21 @@ impl CompositePass {
         Ok(CompositePass { pipeline, groups: BindCache::default() })
     }
 
-    #[allow(clippy::too_many_arguments)]
     /// `b(p)`: what it binds at history parity p (a denoiser's output may ping-pong).
     pub fn record<'a>(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         b: impl Fn(Parity) -> FrameBuffers<'a>,
         parity: Parity,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let p = &self.pipeline;
         let size = b(parity).io.size;
         let groups = self.groups.get(key, p.builds(), 2, parity.index(), |v| {
             let b = b(Parity::BOTH[v]);
-            p.bind_groups(&gpu.device, &inputs(&b, b.io.hdr))
+            p.bind_groups(&rec.gpu.device, &inputs(&b, b.io.hdr))
         })?;
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(COMPOSITE),
-            timestamp_writes: timer.and_then(|t| t.compute(COMPOSITE)),
-        });
+        let mut pass = rec.compute_pass(COMPOSITE);
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
@@ -177,16 +171,13 @@ impl DisplayPass {
     }
 
     /// `view`: the texture the debug view shows (None for the image); `key` must change with it.
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         b: &FrameBuffers,
         view: Option<&wgpu::Texture>,
         target: &wgpu::TextureView,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let p = &self.pipeline;
         let (zf, zu) = (&self.zero_float.1, &self.zero_uint.1);
@@ -196,8 +187,9 @@ impl DisplayPass {
             if let Some((Some(slot), v)) = &shown {
                 r = r.texture(slot, v);
             }
-            p.bind_groups(&gpu.device, &r)
+            p.bind_groups(&rec.gpu.device, &r)
         })?;
+        let (enc, timestamp_writes) = rec.render_parts(DISPLAY);
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(DISPLAY),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -210,7 +202,7 @@ impl DisplayPass {
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: timer.and_then(|t| t.render(DISPLAY)),
+            timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,
         });

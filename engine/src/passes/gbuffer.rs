@@ -17,7 +17,7 @@
 //! asks for 40, which every native backend grants.
 
 use crate::gpu::{
-    BindCache, BindKey, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_render_groups,
+    BindCache, BindKey, Bindings, Gpu, GpuMemory, GpuScene, Recorder, set_render_groups,
 };
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
@@ -74,9 +74,8 @@ impl GBufferTargets {
     /// 0, reversed Z's far): the raster's, and the traced primaries' resolve.
     pub fn begin_pass<'e>(
         &self,
-        enc: &'e mut wgpu::CommandEncoder,
+        rec: &'e mut Recorder,
         label: &'static str,
-        timer: Option<&mut GpuTimer>,
     ) -> wgpu::RenderPass<'e> {
         let clear_ids = wgpu::Color { r: u32::MAX as f64, g: u32::MAX as f64, b: 0.0, a: 0.0 };
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = self
@@ -97,6 +96,7 @@ impl GBufferTargets {
                 })
             })
             .collect();
+        let (enc, timestamp_writes) = rec.render_parts(label);
         enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &attachments,
@@ -108,7 +108,7 @@ impl GBufferTargets {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: timer.and_then(|t| t.render(label)),
+            timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,
         })
@@ -205,12 +205,10 @@ impl GBufferPass {
 
     pub fn record(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         scene: &GpuScene,
         frame: &wgpu::Buffer,
         t: &GBufferTargets,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let p = &self.pipeline;
         let groups = self.groups.get(
@@ -218,9 +216,9 @@ impl GBufferPass {
             p.builds(),
             1,
             0,
-            |_| p.bind_groups(&gpu.device, &bindings(scene, frame)),
+            |_| p.bind_groups(&rec.gpu.device, &bindings(scene, frame)),
         )?;
-        let mut pass = t.begin_pass(enc, LABEL, timer);
+        let mut pass = t.begin_pass(rec, LABEL);
         pass.set_pipeline(p.get());
         set_render_groups(&mut pass, groups);
         pass.draw(0..scene.triangle_count * 3, 0..1);

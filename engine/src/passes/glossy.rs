@@ -7,7 +7,7 @@
 
 use super::chain::ChainStage;
 use super::io::FrameIo;
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
@@ -219,16 +219,13 @@ impl GlossyChain {
     }
 
     /// Record the chain. The prefilter runs only when the clip uses it.
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         i: &GlossyInputs,
         parity: Parity,
         settings: &GlossySettings,
-        mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let size = i.io.size;
         let clip = settings.temporal && settings.clipping;
@@ -237,7 +234,7 @@ impl GlossyChain {
             .iter_mut()
             .filter(|(k, _)| clip || !matches!(k, Kind::PrefilterH | Kind::PrefilterV))
         {
-            s.record(gpu, enc, key, parity, size, timer.as_deref_mut(), |p| bindings(*kind, i, p))?;
+            s.record(rec, key, parity, size, |p| bindings(*kind, i, p))?;
         }
         Ok(())
     }

@@ -5,7 +5,7 @@
 
 use super::chain::ChainStage;
 use super::io::FrameIo;
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::settings::{MatteSettings, TaaSettings};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
@@ -70,6 +70,7 @@ pub struct DenoiseParams {
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
+#[derive(Clone, Copy, Debug)]
 pub struct ChainView {
     /// Rebased world from clip, this frame and the previous one (both with their jitter, as
     /// their depth buffers were rasterised).
@@ -285,17 +286,13 @@ impl MatteChain {
     /// Record stages 3-7.
     pub fn record(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         i: &ChainInputs,
         parity: Parity,
-        mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         for (kind, s) in self.stages.iter_mut() {
-            s.record(gpu, enc, key, parity, i.io.size, timer.as_deref_mut(), |p| {
-                bindings(*kind, i, p)
-            })?;
+            s.record(rec, key, parity, i.io.size, |p| bindings(*kind, i, p))?;
         }
         Ok(())
     }

@@ -10,7 +10,7 @@
 
 use super::chain::ChainStage;
 use super::primaries::{FEATURE_WORDS, PrimaryTargets};
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer};
+use crate::gpu::{Bindings, GpuMemory, Recorder};
 use crate::shader::Reload;
 use anyhow::Result;
 
@@ -119,13 +119,12 @@ impl Prefilter {
     /// have been replaced.
     pub fn record(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         size: (u32, u32),
         offered: &Bindings,
-        mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
+        let gpu = rec.gpu;
         let stages = super::chain::made(&mut self.stages, || {
             let stage = |label, file| ChainStage::new(gpu, label, &modules(file), "main", offered);
             Ok([
@@ -135,9 +134,7 @@ impl Prefilter {
             ])
         })?;
         for s in stages {
-            s.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| {
-                offered.clone()
-            })?;
+            s.record_variant(rec, key, (1, 0), size, |_| offered.clone())?;
         }
         Ok(())
     }

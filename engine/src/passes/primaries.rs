@@ -7,10 +7,9 @@
 //!
 //! Per pixel: 80 bytes of features and 64 of position moments (144 bytes).
 
-use crate::gpu::{
-    BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups, set_render_groups,
-};
+use crate::gpu::{BindCache, Bindings, GpuMemory, Recorder, set_compute_groups, set_render_groups};
 use crate::passes::gbuffer::{GBufferTargets, render_pipeline};
+use crate::passes::trace::SceneInputs;
 use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
@@ -58,18 +57,8 @@ pub struct Primaries {
     resolve: Option<(Reloadable<wgpu::RenderPipeline>, [BindCache; 2])>,
 }
 
-fn trace_bindings<'a>(
-    scene: &'a GpuScene,
-    params: &'a wgpu::Buffer,
-    frame: &'a wgpu::Buffer,
-    t: &'a PrimaryTargets,
-) -> Bindings<'a> {
-    scene
-        .bindings()
-        .buffer("params", params)
-        .buffer("frame", frame)
-        .buffer("pr_features", &t.features)
-        .buffer("pr_moments", &t.moments)
+fn trace_bindings<'a>(scene: SceneInputs<'a>, t: &'a PrimaryTargets) -> Bindings<'a> {
+    scene.bindings().buffer("pr_features", &t.features).buffer("pr_moments", &t.moments)
 }
 
 impl Primaries {
@@ -84,23 +73,17 @@ impl Primaries {
         v
     }
 
-    /// Trace frame.primary_samples lens rays per pixel into `t`; `moving`: objects move during
-    /// the shutter.
-    #[allow(clippy::too_many_arguments)]
+    /// Trace frame.primary_samples lens rays per pixel into `t`.
     pub fn record_trace(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
-        scene: &GpuScene,
-        params: &wgpu::Buffer,
-        frame: &wgpu::Buffer,
+        inputs: SceneInputs,
         t: &PrimaryTargets,
         size: (u32, u32),
-        moving: bool,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let offered = trace_bindings(scene, params, frame, t);
+        let (gpu, scene, moving) = (rec.gpu, inputs.scene, inputs.moving);
+        let offered = trace_bindings(inputs, t);
         let (p, cache) = super::chain::made(&mut self.trace[moving as usize], || {
             let mut modules = scene.shading_modules_for(moving);
             modules.push("realtime/frame.wgsl");
@@ -123,10 +106,7 @@ impl Primaries {
         })?;
         let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(LABEL);
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(LABEL),
-            timestamp_writes: timer.and_then(|t| t.compute(LABEL)),
-        });
+        let mut pass = rec.compute_pass(LABEL);
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
         pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
@@ -135,18 +115,15 @@ impl Primaries {
 
     /// Write the raw features of `t` into the G-buffer targets, the normal and depth from
     /// `edges` where given (the pre-filter's, in the same layout).
-    #[allow(clippy::too_many_arguments)]
     pub fn record_resolve(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         frame: &wgpu::Buffer,
-        t: &PrimaryTargets,
-        edges: Option<&wgpu::Buffer>,
+        (t, edges): (&PrimaryTargets, Option<&wgpu::Buffer>),
         g: &GBufferTargets,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
+        let gpu = rec.gpu;
         let filtered = edges.is_some();
         let offered = Bindings::new()
             .buffer("frame", frame)
@@ -172,7 +149,7 @@ impl Primaries {
         let groups = caches[filtered as usize]
             .get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(RESOLVE);
-        let mut pass = g.begin_pass(enc, RESOLVE, timer);
+        let mut pass = g.begin_pass(rec, RESOLVE);
         pass.set_pipeline(p.get());
         set_render_groups(&mut pass, groups);
         pass.draw(0..3, 0..1);

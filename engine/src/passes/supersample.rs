@@ -10,7 +10,8 @@
 
 use super::chain::ChainStage;
 use super::io::{FrameIo, MixedLight};
-use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups};
+use crate::gpu::{BindCache, Bindings, GpuMemory, GpuScene, Recorder, set_compute_groups};
+use crate::passes::trace::TraceInputs;
 use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;
@@ -135,20 +136,16 @@ impl Supersample {
 
     /// Trace the extra samples, assign and mix them (before the denoiser). `io`: the frame's
     /// I/O with the trace's own light.
-    #[allow(clippy::too_many_arguments)]
     pub fn record_mix(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
-        scene: &GpuScene,
-        trace_bindings: Bindings,
+        trace: &TraceInputs,
         io: &FrameIo,
         t: &SupersampleTargets,
-        mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let size = io.size;
-        let sample_bindings = Self::own(t, trace_bindings);
+        let (gpu, scene, size) = (rec.gpu, trace.scene.scene, io.size);
+        let sample_bindings = Self::own(t, trace.bindings());
         let (p, cache) = super::chain::made(&mut self.samples, || {
             let p = Reloadable::new(
                 gpu,
@@ -165,10 +162,7 @@ impl Supersample {
             cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &sample_bindings))?;
         {
             let _scope = crate::profile::scope(SAMPLES);
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(SAMPLES),
-                timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute(SAMPLES)),
-            });
+            let mut pass = rec.compute_pass(SAMPLES);
             pass.set_pipeline(p.get());
             set_compute_groups(&mut pass, groups);
             pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
@@ -184,29 +178,25 @@ impl Supersample {
                 stage("supersample/resolve", "supersample/resolve.wgsl")?,
             ])
         })?;
-        assign.record_variant(gpu, enc, key, (1, 0), size, timer.as_deref_mut(), |_| {
-            offered.clone()
-        })?;
-        mix.record_variant(gpu, enc, key, (1, 0), size, timer, |_| offered.clone())
+        assign.record_variant(rec, key, (1, 0), size, |_| offered.clone())?;
+        mix.record_variant(rec, key, (1, 0), size, |_| offered.clone())
     }
 
     /// After the composite: each pixel the mean of its samples' guides, copied back into the
     /// composite's image for TAA and the display.
     pub fn record_resolve(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         io: &FrameIo,
         t: &SupersampleTargets,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let offered = Self::own(t, io.bindings().buffer("hdr", io.hdr));
         let Some([_, _, resolve]) = self.stages.as_mut() else {
             anyhow::bail!("the supersampling resolves before it mixed")
         };
-        resolve.record_variant(gpu, enc, key, (1, 0), io.size, timer, |_| offered.clone())?;
-        enc.copy_buffer_to_buffer(
+        resolve.record_variant(rec, key, (1, 0), io.size, |_| offered.clone())?;
+        rec.enc.copy_buffer_to_buffer(
             &t.resolved,
             0,
             io.hdr,

@@ -7,7 +7,7 @@
 use super::chain::ChainStage;
 use super::io::FrameIo;
 use super::matte::DenoiseParams;
-use crate::gpu::{Bindings, Gpu, GpuMemory, GpuTimer, Parity, PingPong, Tex};
+use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use anyhow::{Context, Result};
 
 pub const LABEL: &str = "taa";
@@ -106,19 +106,17 @@ impl TaaStage {
 
     /// Record TAA of `io.hdr`; `params` as the denoisers write them (its `taa*` and `stages`).
     /// `key` changes whenever a bound resource may have (scene, targets, denoiser).
-    #[allow(clippy::too_many_arguments)]
     /// `follow(p)`: what TAA follows at history parity p.
     pub fn record<'a>(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
         io: &FrameIo<'a>,
         follow: impl Fn(Parity) -> TaaFollow<'a>,
         params: &DenoiseParams,
         parity: Parity,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
+        let gpu = rec.gpu;
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let (_, t) = self.targets.as_ref().context("TAA records before its textures exist")?;
         let f = follow(parity);
@@ -135,7 +133,7 @@ impl TaaStage {
             }
         };
         let stage = &mut self.programs[i].1;
-        stage.record(gpu, enc, key, parity, io.size, timer, bindings)
+        stage.record(rec, key, parity, io.size, bindings)
     }
 }
 

@@ -8,7 +8,7 @@
 //! mirrors (Voorhuis §4.1).
 
 use super::gbuffer::{Channel, GBufferTargets};
-use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, GpuTimer, set_compute_groups};
+use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, Recorder, set_compute_groups};
 use crate::shader::compute_pipeline;
 use anyhow::Result;
 
@@ -86,18 +86,41 @@ fn program(
     )
 }
 
-/// What the trace (and the supersampling's samples pass, which shades as it does) binds.
-pub fn bindings<'a>(
-    scene: &'a GpuScene,
-    params: &'a wgpu::Buffer,
-    frame: &'a wgpu::Buffer,
-    g: &'a GBufferTargets,
-    t: &'a TraceTargets,
-) -> Bindings<'a> {
-    let mut b = scene
+/// The scene as the frame's shading stages bind it: its buffers, the trace uniform
+/// (`TraceParams`) and the frame uniform (`FrameParams`).
+#[derive(Clone, Copy)]
+pub struct SceneInputs<'a> {
+    pub scene: &'a GpuScene,
+    pub params: &'a wgpu::Buffer,
+    pub frame: &'a wgpu::Buffer,
+    /// Objects move during the shutter: the motion-blur programs.
+    pub moving: bool,
+}
+
+impl<'a> SceneInputs<'a> {
+    pub fn bindings(&self) -> Bindings<'a> {
+        self.scene.bindings().buffer("params", self.params).buffer("frame", self.frame)
+    }
+}
+
+/// What the trace reads and writes: the scene, the G-buffer and its own outputs.
+#[derive(Clone, Copy)]
+pub struct TraceInputs<'a> {
+    pub scene: SceneInputs<'a>,
+    pub g: &'a GBufferTargets,
+    pub t: &'a TraceTargets,
+}
+
+impl<'a> TraceInputs<'a> {
+    /// What the trace (and the supersampling's samples pass, which shades as it does) binds.
+    pub fn bindings(&self) -> Bindings<'a> {
+        bindings(self.scene, self.g, self.t)
+    }
+}
+
+fn bindings<'a>(s: SceneInputs<'a>, g: &'a GBufferTargets, t: &'a TraceTargets) -> Bindings<'a> {
+    let mut b = s
         .bindings()
-        .buffer("params", params)
-        .buffer("frame", frame)
         .texture("gb_ids", g.view(Channel::Ids))
         .texture("out_matte", &t.matte.1)
         .texture("out_direct", &t.direct.1);
@@ -112,58 +135,37 @@ pub fn bindings<'a>(
 }
 
 impl TracePass {
-    pub fn new(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        params: &wgpu::Buffer,
-        frame: &wgpu::Buffer,
-        g: &GBufferTargets,
-        t: &TraceTargets,
-    ) -> Result<TracePass> {
-        let pipeline = program(gpu, scene, &bindings(scene, params, frame, g, t), false)?;
+    pub fn new(gpu: &Gpu, inputs: &TraceInputs) -> Result<TracePass> {
+        let pipeline = program(gpu, inputs.scene.scene, &inputs.bindings(), false)?;
         Ok(TracePass { pipeline, groups: BindCache::default(), moving: None })
     }
 
-    /// `key`: bind groups are rebuilt when it changes.
-    /// `period`: 1 / f, the frames between two samples of a pixel. `moving`: objects move during
-    /// the shutter (the motion-blur program).
-    #[allow(clippy::too_many_arguments)]
+    /// `key`: bind groups are rebuilt when it changes. `period`: 1 / f, the frames between two
+    /// samples of a pixel.
     pub fn record(
         &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
+        rec: &mut Recorder,
         key: crate::gpu::BindKey,
-        scene: &GpuScene,
-        params: &wgpu::Buffer,
-        frame: &wgpu::Buffer,
-        g: &GBufferTargets,
-        t: &TraceTargets,
+        inputs: &TraceInputs,
         size: (u32, u32),
         period: u32,
-        moving: bool,
-        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         use crate::shader::Reload;
+        let moving = inputs.scene.moving;
         if moving && self.moving.is_none() {
-            self.moving = Some((
-                program(gpu, scene, &bindings(scene, params, frame, g, t), true)?,
-                BindCache::default(),
-            ));
+            let p = program(rec.gpu, inputs.scene.scene, &inputs.bindings(), true)?;
+            self.moving = Some((p, BindCache::default()));
         }
         let (p, cache) = match self.moving.as_mut().filter(|_| moving) {
             Some((p, c)) => (&*p, c),
             None => (&self.pipeline, &mut self.groups),
         };
-        let groups = cache.get(key, p.builds(), 1, 0, |_| {
-            p.bind_groups(&gpu.device, &bindings(scene, params, frame, g, t))
-        })?;
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(LABEL),
-            timestamp_writes: timer.and_then(|t| t.compute(LABEL)),
-        });
+        let groups = cache
+            .get(key, p.builds(), 1, 0, |_| p.bind_groups(&rec.gpu.device, &inputs.bindings()))?;
+        let mut pass = rec.compute_pass(LABEL);
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
-        // Below one sample per pixel one thread per tile (frame/schedule.rs), so the cost falls as f.
+        // Below one sample per pixel one thread per tile (passes/schedule.rs), so the cost falls as f.
         let (tw, th) = super::schedule::tile(period);
         pass.dispatch_workgroups(
             size.0.div_ceil(tw).div_ceil(8),

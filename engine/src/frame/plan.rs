@@ -1,0 +1,293 @@
+//! Planning a frame: from the settings and the input to what the frame will record, with every
+//! allocation made and every refusal returned before the first pass.
+
+use super::{DisplayTarget, FrameInput, FrameParams, MadeDenoiser, Renderer, halton_jitter};
+use crate::denoise::DenoiserScene;
+use crate::gpu::{BindKey, Gpu, Parity};
+use crate::passes::matte::ChainView;
+use crate::passes::reference::{TraceView, make_params};
+use crate::settings::{FrameSettings, MAX_PRIMARY_SAMPLES, MAX_SAMPLES_PER_PIXEL};
+use anyhow::{Context, Result, bail};
+use glam::{Mat4, Vec2};
+
+/// What one frame records, decided from its settings and input.
+pub(super) struct FramePlan<'s> {
+    pub settings: &'s FrameSettings,
+    /// The index in the renderer's denoisers of the one that runs (None: the raw frame).
+    pub denoiser: Option<usize>,
+    /// Samples per pixel k (Voorhuis §5): k > 1 mixes traced samples into their guides.
+    pub samples: u32,
+    /// 1 / f: every frame traces one pixel in `period` (Dundr §5).
+    pub period: u32,
+    /// The G-buffer is traced (thin lens, moving shutter), not rasterised.
+    pub traced: bool,
+    /// Moon et al. 2017's pre-filter runs between the traced features and the G-buffer.
+    pub prefilter: bool,
+    /// The cameras of this frame and the last, as the denoisers and TAA see them.
+    pub view: ChainView,
+    /// This frame's jittered view-projection, its jitter and its unjittered view-projection:
+    /// the next frame's "previous".
+    pub jittered: Mat4,
+    pub jitter: Vec2,
+    pub view_proj: Mat4,
+    /// Bind groups of the stages before the denoiser, and after it (which bind its output).
+    pub key: BindKey,
+    pub output_key: BindKey,
+    /// Frames rendered before this one (wraps), and its parity.
+    pub frame_index: u32,
+    pub parity: Parity,
+}
+
+impl Renderer {
+    /// Animate, allocate what the settings need, refuse what they cannot have, and write the
+    /// frame's uniforms.
+    pub(super) fn plan<'s>(
+        &mut self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &'s FrameSettings,
+        target: Option<&DisplayTarget>,
+    ) -> Result<FramePlan<'s>> {
+        let mut moved = false;
+        if self.prepared.features.animated {
+            puffin::profile_scope!("animate");
+            moved = self.prepared.expose(&self.scene, input.time, input.shutter.map(|s| s.time));
+            self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
+        }
+        let _setup = crate::profile::scope("upload");
+        self.update_accumulation(gpu, input, settings);
+        let denoiser = self.denoiser_for(gpu, settings)?;
+        if denoiser.is_some() {
+            let t = &mut self.targets;
+            if self.stages.taa.allocate(gpu, &mut t.memory, t.size, t.epoch) {
+                t.generation += 1;
+            }
+        }
+        let (samples, period) = self.sampling(gpu, settings, denoiser)?;
+        let (traced, primary_samples, prefilter) = self.primaries(gpu, input, settings, samples)?;
+        let cam = self.camera_setup(&input.camera);
+        let h = &self.history;
+        // Samples per pixel: the raster's guide jittered for TAA, a random position for the
+        // accumulate mode's box filter, the pixel centre otherwise.
+        let jitter = if settings.accumulate {
+            super::random_jitter(h.frame_index, settings.seed)
+        } else if denoiser.is_some() && settings.taa.enabled {
+            halton_jitter(h.frame_index)
+        } else {
+            Vec2::splat(0.5)
+        };
+        let jittered = cam.jittered(jitter, self.targets.size);
+        let (prev_jittered, prev_jitter) = h.prev_jittered.unwrap_or((jittered, jitter));
+        let view = ChainView {
+            inv_view_proj: jittered.inverse(),
+            prev_inv_view_proj: prev_jittered.inverse(),
+            jitter_shift: prev_jitter - jitter,
+            history_valid: denoiser.is_some()
+                && h.denoised_last == denoiser
+                && h.prev_jittered.is_some(),
+            static_view: !moved && h.prev_view_proj == Some(cam.view_proj),
+        };
+        let denoised = denoiser.is_some();
+        self.upload(gpu, input, settings, (&cam, jittered, jitter), denoised, primary_samples);
+        self.history.denoised_last = denoiser;
+        if let Some(target) = target {
+            self.prepare_display(gpu, target, settings)?;
+        }
+        Ok(FramePlan {
+            settings,
+            denoiser,
+            samples,
+            period,
+            traced,
+            prefilter,
+            view,
+            jittered,
+            jitter,
+            view_proj: cam.view_proj,
+            key: self.bind_key(None),
+            output_key: self.bind_key(denoiser),
+            frame_index: self.history.frame_index,
+            parity: Parity::of_frame(self.history.frame_index),
+        })
+    }
+
+    /// The index in `denoisers` of the one `settings` asks for (made and allocated on first
+    /// use), or None for the raw frame; None also in accumulate mode.
+    pub(super) fn denoiser_for(
+        &mut self,
+        gpu: &Gpu,
+        settings: &FrameSettings,
+    ) -> Result<Option<usize>> {
+        if settings.accumulate {
+            return Ok(None);
+        }
+        let name = settings.denoiser.name();
+        let i = match self.denoisers.iter().position(|d| d.name == name) {
+            Some(i) => i,
+            None => {
+                let Some(make) = crate::denoise::find(name)?.make else { return Ok(None) };
+                let scene = DenoiserScene {
+                    glossy: self.prepared.features.glossy,
+                    animated: self.prepared.features.animated,
+                    extent: self.prepared.extent as f32,
+                };
+                let denoiser =
+                    make(gpu, &scene).with_context(|| format!("creating the {name} denoiser"))?;
+                self.denoisers.push(MadeDenoiser { name: name.to_string(), epoch: None, denoiser });
+                self.denoisers.len() - 1
+            }
+        };
+        let t = &mut self.targets;
+        let d = &mut self.denoisers[i];
+        if d.epoch != Some(t.epoch) {
+            d.denoiser.allocate(gpu, &mut t.memory, t.size);
+            d.epoch = Some(t.epoch);
+            t.generation += 1;
+        }
+        if d.denoiser.needs_previous_gbuffer() {
+            t.ensure_previous(gpu);
+        }
+        Ok(Some(i))
+    }
+
+    /// Accumulation restarts whenever anything that changes the image changes.
+    fn update_accumulation(&mut self, gpu: &Gpu, input: &FrameInput, settings: &FrameSettings) {
+        let h = &mut self.history;
+        if !settings.accumulate {
+            h.accumulated = 0;
+            h.accumulated_state = None;
+            return;
+        }
+        let same = h.accumulated_state.as_ref().is_some_and(|(i, s)| {
+            i == input && s.max_depth == settings.max_depth && s.seed == settings.seed
+        });
+        h.accumulated = if same { h.accumulated + 1 } else { 1 };
+        h.accumulated_state = Some((*input, settings.clone()));
+        self.targets.ensure_accumulation(gpu);
+    }
+
+    /// Samples per pixel k and the sample period 1 / f, refusing what cannot go together.
+    fn sampling(
+        &mut self,
+        gpu: &Gpu,
+        settings: &FrameSettings,
+        denoiser: Option<usize>,
+    ) -> Result<(u32, u32)> {
+        // Samples per pixel (Voorhuis §5); the accumulate mode box-filters by itself.
+        let samples = match settings.accumulate {
+            true => 1,
+            false => settings.samples_per_pixel.clamp(1, MAX_SAMPLES_PER_PIXEL),
+        };
+        // Below one sample per pixel (Dundr §5): only denoisers that fill the untraced pixels.
+        let period = if settings.accumulate { 1 } else { settings.sample_fraction.period() };
+        if period > 1 && samples > 1 {
+            bail!(
+                "sample fraction {} traces some pixels each frame and {samples} samples per pixel \
+                 traces every pixel {samples} times: choose one",
+                settings.sample_fraction
+            );
+        }
+        let refuses = |i: &usize| !self.denoisers[*i].denoiser.fills_untraced_pixels();
+        if let Some(i) = denoiser.filter(refuses).filter(|_| period > 1) {
+            let fills: Vec<&str> = crate::denoise::entries()
+                .into_iter()
+                .filter(|e| e.fractions)
+                .map(|e| e.name)
+                .collect();
+            bail!(
+                "the {} denoiser needs every pixel traced each frame; sample fraction {} needs one \
+                 that fills untraced pixels ({})",
+                self.denoisers[i].name,
+                settings.sample_fraction,
+                fills.join(", ")
+            );
+        }
+        if samples > 1 {
+            self.targets.ensure_supersample(gpu, samples, self.prepared.features.glossy);
+        }
+        Ok((samples, period))
+    }
+
+    /// Whether the G-buffer is traced, with how many primary samples, and whether the
+    /// pre-filter runs; allocates their targets.
+    fn primaries(
+        &mut self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        samples: u32,
+    ) -> Result<(bool, u32, bool)> {
+        // A thin lens or motion blur (a stochastic primary hit): the G-buffer is traced (k rays
+        // per pixel, each through its own lens point at its own time), not rasterised; the
+        // accumulate mode traces one, so that its mean over frames is exact.
+        let blurred = input.shutter.is_some_and(|s| s.camera != input.camera)
+            || self.prepared.shutter_moves();
+        let traced = input.camera.lens.is_some_and(|l| l.aperture_radius > 0.0) || blurred;
+        let primary_samples = match (traced, settings.accumulate) {
+            (false, _) => 0,
+            (true, true) => 1,
+            (true, false) => settings.primary_samples.clamp(1, MAX_PRIMARY_SAMPLES),
+        };
+        let prefilter = traced && settings.prefilter && !settings.accumulate;
+        if traced {
+            if samples > 1 {
+                bail!(
+                    "{samples} samples per pixel (guide rays) need the raster's G-buffer, which \
+                     depth of field and motion blur replace by traced primaries: set samples per \
+                     pixel to 1 (they trace {} primary samples per pixel)",
+                    settings.primary_samples
+                );
+            }
+            self.targets.ensure_primaries(gpu, prefilter);
+        }
+        Ok((traced, primary_samples, prefilter))
+    }
+
+    /// Write the frame and trace uniforms for the camera `cam`, jittered by `jitter`.
+    fn upload(
+        &self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        (cam, jittered, jitter): (&super::CameraSetup, Mat4, Vec2),
+        denoised: bool,
+        primary_samples: u32,
+    ) {
+        let (size, h) = (self.targets.size, &self.history);
+        let g = &settings.glossy;
+        // The glossy chain's reflection motion wants the representative ray of glossy surfaces.
+        let representative = if denoised
+            && g.trace_representative_ray
+            && g.reflection_mv != crate::settings::ReflectionMv::Primary
+        {
+            g.roughness_threshold
+        } else {
+            0.0
+        };
+        let prev = h.prev_view_proj.unwrap_or(cam.view_proj);
+        let mut fp = FrameParams::new(
+            cam,
+            jittered,
+            prev,
+            jitter,
+            size,
+            h.frame_index,
+            settings,
+            h.accumulated,
+            self.prepared.ray_epsilon(),
+            representative,
+        );
+        fp.primary_samples = primary_samples;
+        let trace_view = TraceView {
+            camera: input.camera,
+            width: size.0,
+            height: size.1,
+            max_depth: settings.max_depth,
+            seed: settings.seed,
+            shutter_camera: input.shutter.map(|s| s.camera),
+        };
+        let tp = make_params(&self.prepared, &trace_view);
+        gpu.queue.write_buffer(&self.uniforms.params, 0, bytemuck::bytes_of(&tp));
+        gpu.queue.write_buffer(&self.uniforms.frame, 0, bytemuck::bytes_of(&fp));
+    }
+}

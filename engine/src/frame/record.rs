@@ -1,0 +1,301 @@
+//! Recording a planned frame: one line per stage, in the order of Mara et al. 2017's Figure 2
+//! with the primaries' pre-filter of Moon et al. 2017 before the trace.
+
+use super::plan::FramePlan;
+use super::targets::{Targets, Uniforms};
+use super::{DisplayTarget, FrameInput, MadeDenoiser, Renderer};
+use crate::denoise::{Denoiser, FrameContext};
+use crate::gpu::{BindKey, Gpu, Recorder};
+use crate::passes::composite::{self, CompositePass, DisplayPass, FrameBuffers};
+use crate::passes::gbuffer::{self, GBufferPass};
+use crate::passes::io::FrameIo;
+use crate::passes::matte::DenoiseParams;
+use crate::passes::prefilter::Prefilter;
+use crate::passes::primaries::Primaries;
+use crate::passes::supersample::Supersample;
+use crate::passes::taa::TaaStage;
+use crate::passes::trace::{self, SceneInputs, TraceInputs, TracePass};
+use crate::settings::FrameSettings;
+use anyhow::{Context, Result};
+use glam::{Mat4, Vec2};
+
+/// The frame's own stages (a denoiser's are its own).
+pub(super) struct Stages {
+    pub gbuffer: GBufferPass,
+    pub trace: TracePass,
+    pub composite: CompositePass,
+    /// Made for the first display target's format.
+    pub display: Option<DisplayPass>,
+    pub taa: TaaStage,
+    pub supersample: Supersample,
+    pub primaries: Primaries,
+    pub prefilter: Prefilter,
+}
+
+/// What the next frame needs of the ones before it.
+#[derive(Default)]
+pub(super) struct FrameHistory {
+    /// The index in the renderer's denoisers of the one that ran last frame (its image is
+    /// then TAA's).
+    pub denoised_last: Option<usize>,
+    pub prev_view_proj: Option<Mat4>,
+    /// The previous frame's jittered view-projection (its depth buffer was rasterised with it)
+    /// and its jitter.
+    pub prev_jittered: Option<(Mat4, Vec2)>,
+    pub frame_index: u32,
+    pub accumulated: u32,
+    pub accumulated_state: Option<(FrameInput, FrameSettings)>,
+}
+
+impl Renderer {
+    pub(super) fn record_frame(
+        &mut self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        target: Option<&DisplayTarget>,
+    ) -> Result<()> {
+        puffin::profile_function!();
+        let plan = self.plan(gpu, input, settings, target)?;
+        let encode = crate::profile::scope("encode");
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        let moving = self.prepared.shutter_moves();
+        let Renderer { gpu_scene, targets: t, uniforms: u, stages: s, denoisers, timer, .. } = self;
+        if let Some(t) = timer.as_mut() {
+            t.begin_frame();
+        }
+        let mut rec = Recorder::new(gpu, &mut enc, timer.as_mut());
+        let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
+        let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace };
+        let io = t.io(&u.frame, gpu_scene.objects.as_ref());
+        // primaries [-> pre-filter] -> trace [-> mix] -> denoise -> composite [-> resolve] -> TAA
+        // -> display; then this frame's G-buffer becomes the next one's previous.
+        s.record_primaries(&mut rec, &plan, scene, t)?;
+        s.record_trace(&mut rec, &plan, &trace, t.size)?;
+        let io = s.record_mix(&mut rec, &plan, &trace, t, io)?;
+        let denoiser = record_denoiser(&mut rec, &plan, denoisers, &io)?;
+        s.record_composite(&mut rec, &plan, &io, denoiser, u.shown(t, &io, None))?;
+        s.record_resolve(&mut rec, &plan, &io, t)?;
+        s.record_taa(&mut rec, &plan, &io, denoiser)?;
+        s.record_display(&mut rec, &plan, (&io, u, t), target)?;
+        if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
+            p.record_copy(rec.enc, &t.gbuffer, t.size);
+        }
+        drop(encode);
+        self.submit(gpu, enc, &plan);
+        Ok(())
+    }
+
+    /// Resolve the pass times, submit, and make this frame the next one's previous.
+    fn submit(&mut self, gpu: &Gpu, mut enc: wgpu::CommandEncoder, plan: &FramePlan) {
+        if let Some(timer) = self.timer.as_mut() {
+            timer.resolve(&gpu.device, &mut enc, self.async_timings);
+        }
+        let _submit = crate::profile::scope("submit");
+        if let Some(timer) = self.timer.as_mut() {
+            timer.submitted_ns = puffin::now_ns();
+        }
+        gpu.queue.submit([enc.finish()]);
+        if let Some(timer) = self.timer.as_mut() {
+            timer.submitted();
+        }
+        let h = &mut self.history;
+        h.prev_view_proj = Some(plan.view_proj);
+        h.prev_jittered = Some((plan.jittered, plan.jitter));
+        h.frame_index = h.frame_index.wrapping_add(1);
+    }
+
+    /// Draw the last frame again into `target` (another view, a screenshot) without rendering.
+    pub fn redisplay(
+        &mut self,
+        gpu: &Gpu,
+        settings: &FrameSettings,
+        target: &DisplayTarget,
+    ) -> Result<()> {
+        gpu.validated("displaying the frame", || {
+            self.prepare_display(gpu, target, settings)?;
+            // Only the exposure changes; the rest of the uniform is the last frame's.
+            gpu.queue.write_buffer(
+                &self.uniforms.frame,
+                std::mem::offset_of!(super::FrameParams, exposure) as u64,
+                bytemuck::bytes_of(&settings.exposure_scale()),
+            );
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            let (t, u) = (&self.targets, &self.uniforms);
+            let io = t.io(&u.frame, self.gpu_scene.objects.as_ref());
+            let denoised = self.history.denoised_last;
+            let fb = u.shown(t, &io, self.stages.taa.output().filter(|_| denoised.is_some()));
+            let (view, view_key) = t.view_texture(settings);
+            let key = BindKey { view: view_key, ..self.bind_key(denoised) };
+            if let Some(d) = self.stages.display.as_mut() {
+                d.record(&mut Recorder::new(gpu, &mut enc, None), key, &fb, view, target.view)?;
+            }
+            gpu.queue.submit([enc.finish()]);
+            Ok(())
+        })
+    }
+
+    /// Make the display pass for `target`'s format and write its options (the view's map).
+    pub(super) fn prepare_display(
+        &mut self,
+        gpu: &Gpu,
+        target: &DisplayTarget,
+        settings: &FrameSettings,
+    ) -> Result<()> {
+        let (t, u) = (&self.targets, &self.uniforms);
+        if self.stages.display.as_ref().is_none_or(|d| d.format != target.format) {
+            let io = t.io(&u.frame, self.gpu_scene.objects.as_ref());
+            let pass = DisplayPass::new(gpu, &u.shown(t, &io, None), target.format);
+            self.stages.display = Some(pass.context("creating the display pass")?);
+        }
+        let spec = match settings.view.is_final() {
+            true => None,
+            false => Some(
+                settings
+                    .view
+                    .spec()
+                    .with_context(|| format!("no view {:?}", settings.view.name()))?,
+            ),
+        };
+        let (map, channel, param) = spec.map_or((0, 0, 0.0), |s| s.map.encode(t.size.0));
+        let srgb = !target.format.is_srgb() as u32;
+        let options: [u32; 8] =
+            [srgb, map, target.size.0, target.size.1, channel, param.to_bits(), 0, 0];
+        gpu.queue.write_buffer(&u.display, 0, bytemuck::cast_slice(&options));
+        Ok(())
+    }
+}
+
+/// The denoiser the plan chose, recorded on the frame's I/O.
+fn record_denoiser<'d>(
+    rec: &mut Recorder,
+    plan: &FramePlan,
+    denoisers: &'d mut [MadeDenoiser],
+    io: &FrameIo,
+) -> Result<Option<&'d dyn Denoiser>> {
+    let Some(d) = plan.denoiser.and_then(|i| denoisers.get_mut(i)) else { return Ok(None) };
+    let cx = FrameContext {
+        index: plan.frame_index,
+        parity: plan.parity,
+        view: plan.view,
+        settings: plan.settings,
+        key: plan.key,
+    };
+    d.denoiser.record(rec, io, &cx)?;
+    Ok(Some(&*d.denoiser))
+}
+
+impl Stages {
+    /// The G-buffer: rasterised, or with a thin lens or an open shutter traced, pre-filtered
+    /// (Moon et al. 2017) and resolved.
+    fn record_primaries(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        scene: SceneInputs,
+        t: &Targets,
+    ) -> Result<()> {
+        let Some(p) = t.primaries.as_ref().filter(|_| plan.traced) else {
+            let _pass = crate::profile::scope(gbuffer::LABEL);
+            return self.gbuffer.record(rec, scene.scene, scene.frame, &t.gbuffer);
+        };
+        self.primaries.record_trace(rec, plan.key, scene, p, t.size)?;
+        let mut edges = None;
+        if let Some(pf) = t.prefilter.as_ref().filter(|_| plan.prefilter) {
+            let offered = crate::passes::prefilter::bindings(scene.frame, p, pf);
+            self.prefilter.record(rec, plan.key, t.size, &offered)?;
+            edges = Some(&pf.features);
+        }
+        self.primaries.record_resolve(rec, plan.key, scene.frame, (p, edges), &t.gbuffer)
+    }
+
+    fn record_trace(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        inputs: &TraceInputs,
+        size: (u32, u32),
+    ) -> Result<()> {
+        let _pass = crate::profile::scope(trace::LABEL);
+        self.trace.record(rec, plan.key, inputs, size, plan.period)
+    }
+
+    /// With k > 1 samples per pixel, the extra samples mixed into their guides (Voorhuis §5,
+    /// eq. 7): the I/O then offers the mixed light as the trace's.
+    fn record_mix<'a>(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        trace: &TraceInputs,
+        t: &'a Targets,
+        mut io: FrameIo<'a>,
+    ) -> Result<FrameIo<'a>> {
+        if let Some(ss) = t.supersample.as_ref().filter(|s| s.k == plan.samples) {
+            self.supersample.record_mix(rec, plan.key, trace, &io, ss)?;
+            io.mixed = Some(&ss.mixed);
+        }
+        Ok(io)
+    }
+
+    fn record_composite(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        io: &FrameIo,
+        denoiser: Option<&dyn Denoiser>,
+        shown: FrameBuffers,
+    ) -> Result<()> {
+        let fb = |p| {
+            let out = denoiser.map(|d| d.output(p)).unwrap_or_default();
+            let (matte, glossy, direct) = (out.matte, out.glossy, out.direct);
+            let (shown, accumulation, display) = (shown.shown, shown.accumulation, shown.display);
+            FrameBuffers { io: *io, shown, accumulation, display, matte, glossy, direct }
+        };
+        let _pass = crate::profile::scope(composite::COMPOSITE);
+        self.composite.record(rec, plan.output_key, fb, plan.parity)
+    }
+
+    /// After the composite, with k > 1: each pixel the mean of its samples' guides.
+    fn record_resolve(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        io: &FrameIo,
+        t: &Targets,
+    ) -> Result<()> {
+        match t.supersample.as_ref().filter(|s| s.k == plan.samples) {
+            Some(ss) => self.supersample.record_resolve(rec, plan.key, io, ss),
+            None => Ok(()),
+        }
+    }
+
+    /// TAA after any denoiser; with its stage off it passes the composite on.
+    fn record_taa(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        io: &FrameIo,
+        denoiser: Option<&dyn Denoiser>,
+    ) -> Result<()> {
+        let Some(d) = denoiser else { return Ok(()) };
+        let s = plan.settings;
+        let dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, plan.frame_index, &plan.view);
+        self.taa.record(rec, plan.output_key, io, |p| d.taa_follow(p), &dp, plan.parity)
+    }
+
+    /// The image after TAA when a denoiser ran, else the composite's, tone-mapped (or the
+    /// debug view) into `target`.
+    fn record_display(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        (io, u, t): (&FrameIo, &Uniforms, &Targets),
+        target: Option<&DisplayTarget>,
+    ) -> Result<()> {
+        let (Some(target), Some(d)) = (target, self.display.as_mut()) else { return Ok(()) };
+        let _pass = crate::profile::scope(composite::DISPLAY);
+        let shown = u.shown(t, io, self.taa.output().filter(|_| plan.denoiser.is_some()));
+        let (view, view_key) = t.view_texture(plan.settings);
+        d.record(rec, BindKey { view: view_key, ..plan.output_key }, &shown, view, target.view)
+    }
+}
