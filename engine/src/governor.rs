@@ -38,6 +38,21 @@ pub struct Choice {
     pub fraction: SampleFraction,
 }
 
+impl FrameCost {
+    /// A frame rendered at `choice` that took `wall_ms`, from its passes' GPU times (label, ms;
+    /// the trace's is the part a sample fraction scales).
+    pub fn from_passes(
+        wall_ms: f64,
+        passes: &[(&'static str, f64)],
+        choice: Choice,
+        moving: bool,
+    ) -> FrameCost {
+        let trace = crate::passes::trace::LABEL;
+        let trace_ms = passes.iter().filter(|(l, _)| *l == trace).map(|(_, ms)| ms).sum();
+        FrameCost { wall_ms, trace_ms, choice, moving }
+    }
+}
+
 /// One finished frame as the governor sees it.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameCost {

@@ -226,11 +226,9 @@ pub fn governed_frame(
     r.render(gpu, input, &s, None)?;
     let passes = r.pass_times(gpu)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let trace_ms =
-        passes.iter().filter(|p| p.0 == hush_engine::passes::trace::LABEL).map(|p| p.1).sum();
     let moving = last_camera.is_some_and(|l| l != input.camera);
     *last_camera = Some(input.camera);
-    g.record(hush_engine::governor::FrameCost { wall_ms, trace_ms, choice: c, moving });
+    g.record(hush_engine::governor::FrameCost::from_passes(wall_ms, &passes, c, moving));
     Ok(GovernedFrame {
         wall_ms,
         gpu_ms: passes.iter().map(|p| p.1).sum(),

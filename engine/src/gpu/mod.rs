@@ -4,6 +4,7 @@
 mod context;
 pub mod history;
 mod memory;
+mod pack;
 pub mod prepare;
 mod record;
 pub mod scene;
@@ -15,6 +16,7 @@ pub use crate::shader::binding::{
 pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP};
 pub use history::{Parity, PingPong, Tex};
 pub use memory::{GpuMemory, readback_buffer, readback_texture};
+pub use pack::TEXTURE_BUDGET_BYTES;
 pub use prepare::{EnvKind, PreparedScene, SceneFeatures};
 pub use record::Recorder;
 pub use scene::GpuScene;

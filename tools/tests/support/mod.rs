@@ -1,5 +1,6 @@
-//! Support for the hostile-input suite: writing bad scenes, and running `hush-cli` on them with a
-//! time limit while measuring its peak memory.
+//! Support for the command-line suites: writing bad scenes, and running `hush-cli` on them with
+//! a time limit while measuring its peak memory. Each suite uses a part of it.
+#![allow(dead_code)]
 
 use serde_json::{Value, json};
 use std::ffi::OsStr;
@@ -214,4 +215,77 @@ pub fn exr_header(w: i32, h: i32) -> Vec<u8> {
     attr(&mut out, "screenWindowWidth", "float", &1f32.to_le_bytes());
     out.push(0);
     out
+}
+
+/// `hush-cli`, built for these tests.
+pub fn hush_cli() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_hush-cli"))
+}
+
+/// A fresh folder for one test's files.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hush-cli-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Long enough for any case on a loaded 2-core CI machine; the hangs these cases caught ran
+/// until killed.
+pub const LIMIT: Duration = Duration::from_secs(60);
+/// Peak memory of a run refused while loading: the process itself takes about 10 MiB.
+pub const REFUSED_MIB: f64 = 64.0;
+
+/// `hush-cli render SCENE --width 8 --height 8 --spp 1 --out OUT.png` plus `extra` flags.
+pub fn render(scene: &Path, extra: &[&str]) -> (Outcome, PathBuf) {
+    let out = scene.with_file_name("out.png");
+    let _ = std::fs::remove_file(&out);
+    let mut args: Vec<String> = vec![
+        "render".into(),
+        scene.display().to_string(),
+        "--width".into(),
+        "8".into(),
+        "--height".into(),
+        "8".into(),
+    ];
+    if !extra.contains(&"realtime") {
+        args.extend(["--spp".into(), "1".into()]);
+    }
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args.extend(["--out".into(), out.display().to_string()]);
+    (run(&args, LIMIT), out)
+}
+
+/// Refused with `needle` in the error, nothing written, little memory spent.
+#[track_caller]
+pub fn assert_refused(name: &str, scene: &Path, extra: &[&str], needle: &str) -> Outcome {
+    let (o, out) = render(scene, extra);
+    assert!(
+        o.refused(needle),
+        "{name}: expected exit 1 with {needle:?}, got {:?}: {}",
+        o.code,
+        tail(&o.stderr)
+    );
+    assert!(!out.exists(), "{name}: an output was written");
+    assert!(o.peak_mib < REFUSED_MIB, "{name}: {:.1} MiB to refuse a file", o.peak_mib);
+    o
+}
+
+/// Rendered (exit 0, an image written) with `needle` among the warnings, if one is given.
+#[track_caller]
+pub fn assert_renders(name: &str, scene: &Path, extra: &[&str], needle: &str) -> Outcome {
+    let (o, out) = render(scene, extra);
+    assert!(
+        o.code == Some(0) && out.exists() && !o.panicked(),
+        "{name}: expected a render, got {:?}: {}",
+        o.code,
+        tail(&o.stderr)
+    );
+    assert!(o.stderr.contains(needle), "{name}: expected {needle:?} in: {}", tail(&o.stderr));
+    o
+}
+
+pub fn case(name: &str, mutate: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let mut doc = quad_doc();
+    mutate(&mut doc);
+    write_case(name, &doc, &[])
 }

@@ -1,0 +1,388 @@
+use super::*;
+
+const FEATURE_SETS: &[[&str; 6]] = &[
+    [
+        "common/alpha_none.wgsl",
+        "common/textures_none.wgsl",
+        "common/tangents_none.wgsl",
+        "common/lights_none.wgsl",
+        "common/emitters_none.wgsl",
+        "common/env_none.wgsl",
+    ],
+    [
+        "common/alpha_mask.wgsl",
+        "common/textures.wgsl",
+        "common/tangents.wgsl",
+        "common/lights.wgsl",
+        "common/emitters.wgsl",
+        "common/env_map.wgsl",
+    ],
+    [
+        "common/alpha_none.wgsl",
+        "common/textures.wgsl",
+        "common/tangents_none.wgsl",
+        "common/lights.wgsl",
+        "common/emitters_none.wgsl",
+        "common/env_constant.wgsl",
+    ],
+    [
+        "common/alpha_mask.wgsl",
+        "common/textures.wgsl",
+        "common/tangents.wgsl",
+        "common/lights_none.wgsl",
+        "common/emitters.wgsl",
+        "common/env_none.wgsl",
+    ],
+];
+
+/// Every program Hush can compose, over both BVH layouts and the feature alternatives.
+fn all_programs() -> Vec<Program> {
+    let mut v = vec![];
+    for set in FEATURE_SETS {
+        for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
+            let m = [
+                "common/math.wgsl",
+                "common/geometry.wgsl",
+                "common/motion_none.wgsl",
+                "common/scene.wgsl",
+                "common/bsdf.wgsl",
+                set[1],
+                set[2],
+                set[0],
+                "realtime/frame.wgsl",
+                motion,
+                "realtime/gbuffer.wgsl",
+            ];
+            v.push(compose("gbuffer", "", &m).unwrap());
+        }
+    }
+    for glossy in ["realtime/glossy_in.wgsl", "realtime/glossy_in_none.wgsl"] {
+        let m = [
+            "common/math.wgsl",
+            "common/rng.wgsl",
+            "realtime/frame.wgsl",
+            "realtime/gbuffer_in.wgsl",
+            glossy,
+            "realtime/composite.wgsl",
+        ];
+        v.push(compose("realtime/composite.wgsl", "", &m).unwrap());
+        let display = [
+            "common/math.wgsl",
+            "common/rng.wgsl",
+            "realtime/frame.wgsl",
+            "realtime/gbuffer_in.wgsl",
+            glossy,
+            "realtime/display.wgsl",
+        ];
+        v.push(compose("realtime/display.wgsl", "", &display).unwrap());
+    }
+    for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
+        for stage in [
+            &["matte/temporal.wgsl"][..],
+            &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
+            &["matte/disocclusion.wgsl"],
+            &["matte/firefly.wgsl"],
+            &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"],
+            &[
+                "realtime/glossy_in.wgsl",
+                "glossy/common.wgsl",
+                "taa/glossy.wgsl",
+                "taa/matte.wgsl",
+                "taa/taa.wgsl",
+            ],
+            &["taa/glossy_none.wgsl", "taa/matte_none.wgsl", "taa/taa.wgsl"],
+        ] {
+            let mut m = vec![
+                "common/math.wgsl",
+                "realtime/frame.wgsl",
+                "realtime/gbuffer_in.wgsl",
+                "matte/common.wgsl",
+                motion,
+            ];
+            m.extend_from_slice(stage);
+            v.push(compose(stage[stage.len() - 1], "", &m).unwrap());
+        }
+    }
+    for animated in [false, true] {
+        for stage in [
+            "glossy/motion.wgsl",
+            "glossy/prefilter.wgsl",
+            "glossy/temporal.wgsl",
+            "glossy/bilateral.wgsl",
+        ] {
+            v.push(compose(stage, "", &crate::passes::glossy::modules(stage, animated)).unwrap());
+        }
+    }
+    for animated in [false, true] {
+        for glossy in [false, true] {
+            let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
+            for stage in [temporal, "svgf/variance.wgsl", "svgf/atrous.wgsl", "svgf/final.wgsl"] {
+                v.push(
+                    compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated))
+                        .unwrap(),
+                );
+            }
+        }
+    }
+    for animated in [false, true] {
+        for glossy in [false, true] {
+            use crate::denoise::progressive::{Signal, modules};
+            let signals: &[Signal] = if glossy {
+                &[Signal::Matte, Signal::Glossy, Signal::Direct]
+            } else {
+                &[Signal::Matte, Signal::Direct]
+            };
+            for &signal in signals {
+                for stage in [
+                    "progressive/features.wgsl",
+                    "progressive/temporal.wgsl",
+                    "progressive/variance.wgsl",
+                    "progressive/atrous.wgsl",
+                ] {
+                    v.push(compose(stage, "", &modules(stage, signal, glossy, animated)).unwrap());
+                }
+            }
+        }
+    }
+    for glossy in [false, true] {
+        for stage in ["supersample/assign.wgsl", "supersample/mix.wgsl", "supersample/resolve.wgsl"]
+        {
+            v.push(
+                compose(stage, "", &crate::passes::supersample::modules(stage, glossy)).unwrap(),
+            );
+        }
+    }
+    v.push(
+        compose(
+            "gbuffer/resolve",
+            "",
+            &["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"],
+        )
+        .unwrap(),
+    );
+    for stage in ["prefilter/covariance.wgsl", "prefilter/sure.wgsl", "prefilter/features.wgsl"] {
+        v.push(compose(stage, "", &crate::passes::prefilter::modules(stage)).unwrap());
+    }
+    for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
+        // A scene sets the traversal's stack length (accel::traversal_stack).
+        let stack = "const TRAVERSAL_STACK: u32 = 16u;\n";
+        v.push(
+            compose(
+                "raycast",
+                stack,
+                &[
+                    "common/math.wgsl",
+                    "common/geometry.wgsl",
+                    "common/motion_none.wgsl",
+                    bvh,
+                    "common/alpha_none.wgsl",
+                    "accel/raycast.wgsl",
+                ],
+            )
+            .unwrap(),
+        );
+        for (i, set) in FEATURE_SETS.iter().enumerate() {
+            let mut m = vec![
+                "common/math.wgsl",
+                "common/rng.wgsl",
+                "common/geometry.wgsl",
+                if i % 2 == 0 { "common/motion_none.wgsl" } else { "common/motion_blur.wgsl" },
+                bvh,
+                "common/scene.wgsl",
+                "common/bsdf.wgsl",
+                "common/params.wgsl",
+                "common/camera.wgsl",
+                "common/path.wgsl",
+            ];
+            m.extend(set.iter());
+            let prelude = format!(
+                "const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n{stack}",
+                i % 2 == 1,
+                i != 0
+            );
+            let mut reference = m.clone();
+            reference.push("reference/trace.wgsl");
+            v.push(compose(&format!("trace {bvh} {i}"), &prelude, &reference).unwrap());
+            let glossy = if i % 2 == 0 {
+                "realtime/trace_glossy.wgsl"
+            } else {
+                "realtime/trace_glossy_none.wgsl"
+            };
+            let mut primaries = m.clone();
+            primaries.extend([
+                "realtime/frame.wgsl",
+                if i % 2 == 0 {
+                    "realtime/motion_static.wgsl"
+                } else {
+                    "realtime/motion_objects.wgsl"
+                },
+                "realtime/lens.wgsl",
+                "realtime/primaries.wgsl",
+            ]);
+            v.push(compose(&format!("primaries {bvh} {i}"), &prelude, &primaries).unwrap());
+            m.extend(["realtime/frame.wgsl", "realtime/lens.wgsl", glossy, "realtime/trace.wgsl"]);
+            v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
+            m.extend(["supersample/common.wgsl", "supersample/samples.wgsl"]);
+            v.push(compose(&format!("supersample samples {bvh} {i}"), &prelude, &m).unwrap());
+        }
+    }
+    v
+}
+
+#[test]
+fn every_program_validates_with_naga() {
+    for p in all_programs() {
+        if let Err(e) = p.validate() {
+            panic!("{e:#}");
+        }
+    }
+}
+
+#[test]
+fn every_wgsl_file_is_embedded_and_used() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+    let mut files = vec![];
+    let mut stack = vec![dir.clone()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|e| e == "wgsl") {
+                files.push(p.strip_prefix(&dir).unwrap().to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let programs = all_programs();
+    for f in &files {
+        assert!(SOURCES.iter().any(|(p, _)| p == f), "{f} is not embedded in shader::SOURCES");
+        assert!(
+            programs.iter().any(|p| p.modules.contains(&f.as_str())),
+            "{f} is in no validated program"
+        );
+    }
+    assert_eq!(files.len(), SOURCES.len(), "SOURCES lists a file that does not exist");
+}
+
+#[test]
+fn errors_name_the_file_and_line() {
+    let p = Program {
+        label: "t".into(),
+        modules: vec![],
+        text: "// ---- a.wgsl\nfn f() {}\n// ---- b.wgsl\nfn g() -> u32 {\n  return 1u +;\n}\n"
+            .into(),
+    };
+    let e = format!("{:#}", p.validate().unwrap_err());
+    assert!(e.contains("b.wgsl:2"), "{e}");
+}
+
+/// Size and member offsets of a WGSL struct as naga lays it out for storage/uniform use.
+fn wgsl_layout(p: &Program, name: &str) -> (u32, Vec<u32>) {
+    let m = p.validate().unwrap();
+    for (_, t) in m.types.iter() {
+        if t.name.as_deref() == Some(name)
+            && let naga::TypeInner::Struct { members, span } = &t.inner
+        {
+            return (*span, members.iter().map(|m| m.offset).collect());
+        }
+    }
+    panic!("no struct {name}");
+}
+
+#[test]
+fn gpu_structs_match_their_wgsl_mirrors() {
+    use crate::accel::Bvh2GpuNode;
+    use crate::gpu::prepare::{GpuLight, GpuMaterial};
+    use crate::passes::reference::TraceParams;
+    use std::mem::{offset_of, size_of};
+    let programs = all_programs();
+    let p = programs.iter().find(|p| p.label == "trace common/bvh2.wgsl 1").unwrap(); // every feature
+    assert_eq!(
+        wgsl_layout(p, "Material"),
+        (
+            size_of::<GpuMaterial>() as u32,
+            vec![
+                offset_of!(GpuMaterial, base_color),
+                offset_of!(GpuMaterial, emission),
+                offset_of!(GpuMaterial, metallic),
+                offset_of!(GpuMaterial, specular_color),
+                offset_of!(GpuMaterial, roughness),
+                offset_of!(GpuMaterial, specular_factor),
+                offset_of!(GpuMaterial, alpha_cutoff),
+                offset_of!(GpuMaterial, normal_scale),
+                offset_of!(GpuMaterial, flags),
+                offset_of!(GpuMaterial, tex)
+            ]
+            .into_iter()
+            .map(|o| o as u32)
+            .collect()
+        )
+    );
+    assert_eq!(
+        wgsl_layout(p, "Light"),
+        (
+            size_of::<GpuLight>() as u32,
+            vec![
+                offset_of!(GpuLight, pos),
+                offset_of!(GpuLight, kind),
+                offset_of!(GpuLight, dir),
+                offset_of!(GpuLight, cos_outer),
+                offset_of!(GpuLight, intensity),
+                offset_of!(GpuLight, cos_inner)
+            ]
+            .into_iter()
+            .map(|o| o as u32)
+            .collect()
+        )
+    );
+    assert_eq!(
+        wgsl_layout(p, "Bvh2Node"),
+        (
+            size_of::<Bvh2GpuNode>() as u32,
+            vec![
+                offset_of!(Bvh2GpuNode, lmin),
+                offset_of!(Bvh2GpuNode, l_index),
+                offset_of!(Bvh2GpuNode, lmax),
+                offset_of!(Bvh2GpuNode, l_count),
+                offset_of!(Bvh2GpuNode, rmin),
+                offset_of!(Bvh2GpuNode, r_index),
+                offset_of!(Bvh2GpuNode, rmax),
+                offset_of!(Bvh2GpuNode, r_count)
+            ]
+            .into_iter()
+            .map(|o| o as u32)
+            .collect()
+        )
+    );
+    let (size, offs) = wgsl_layout(p, "Params");
+    assert_eq!(size as usize, size_of::<TraceParams>());
+    assert_eq!(offs[8] as usize, offset_of!(TraceParams, cam_pos));
+    assert_eq!(offs[15] as usize, offset_of!(TraceParams, emit));
+    let composite = programs.iter().find(|p| p.label == "realtime/composite.wgsl").unwrap();
+    let (size, offs) = wgsl_layout(composite, "Frame");
+    use crate::frame::FrameParams;
+    assert_eq!(size as usize, size_of::<FrameParams>());
+    assert_eq!(offs[7] as usize, offset_of!(FrameParams, jitter));
+    assert_eq!(offs[11] as usize, offset_of!(FrameParams, accumulated));
+    assert_eq!(offs[12] as usize, offset_of!(FrameParams, paths));
+    let taa = programs.iter().find(|p| p.label == "taa/taa.wgsl").unwrap();
+    let (size, offs) = wgsl_layout(taa, "DenoiseParams");
+    use crate::passes::matte::DenoiseParams;
+    assert_eq!(size as usize, size_of::<DenoiseParams>());
+    assert_eq!(offs[2] as usize, offset_of!(DenoiseParams, stages));
+    assert_eq!(offs[17] as usize, offset_of!(DenoiseParams, history_valid));
+    let temporal = programs.iter().find(|p| p.label == "glossy/temporal.wgsl").unwrap();
+    let (size, offs) = wgsl_layout(temporal, "GlossyParams");
+    use crate::passes::glossy::GlossyParams;
+    assert_eq!(size as usize, size_of::<GlossyParams>());
+    assert_eq!(offs[5] as usize, offset_of!(GlossyParams, roughness_threshold));
+    assert_eq!(offs[17] as usize, offset_of!(GlossyParams, max_sigma_px));
+    let atrous = programs.iter().find(|p| p.label == "svgf/atrous.wgsl").unwrap();
+    use crate::denoise::svgf::SvgfParams;
+    let (size, offs) = wgsl_layout(atrous, "SvgfParams");
+    assert_eq!(size as usize, size_of::<SvgfParams>());
+    assert_eq!(offs[8] as usize, offset_of!(SvgfParams, settled_levels));
+    assert_eq!(wgsl_layout(atrous, "Level").0, 16);
+    // obvhs's CWBVH node is read as five vec4u.
+    assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
+}
