@@ -95,7 +95,7 @@ fn denoised_frames_beat_raw_ones() {
     for stage in
         std::env::var("HUSH_TEST_DISABLE").unwrap_or_default().split(',').filter(|s| !s.is_empty())
     {
-        assert!(s.matte.disable(stage), "{stage}");
+        assert!(hush_engine::settings::disable_stage(&mut s, stage), "{stage}");
     }
     let denoised = frames(&mut r, &gpu, &s, cam, frames_env("HUSH_TEST_FRAMES", 30));
     if std::env::var("HUSH_TEST_ACC64").is_ok() {
@@ -145,7 +145,9 @@ fn nonfinite_input_never_reaches_history_or_screen() {
         ..Default::default()
     };
     let mut cases = vec![base.clone()];
-    for stage in MatteSettings::STAGES.into_iter().chain([TaaSettings::STAGE]) {
+    for stage in
+        hush_engine::settings::mara::INFO.stages.iter().map(|s| s.name).chain([TaaSettings::STAGE])
+    {
         let mut s = base.clone();
         assert!(hush_engine::settings::disable_stage(&mut s, stage));
         cases.push(s);

@@ -5,23 +5,32 @@
 
 use anyhow::Context;
 use glam::DVec3;
-use hush_engine::accel::BvhKind;
+
 use hush_engine::denoise::{
-    Bindings, ChainStage, Denoised, Denoiser, DenoiserScene, Entry, FrameContext, FrameIo, Gpu,
-    GpuMemory, Parity, PingPong, Recorder, Tex, made,
+    Bindings, ChainStage, Denoised, Denoiser, DenoiserInfo, DenoiserScene, Entry, Field,
+    FrameContext, FrameIo, FrameSettings, Gpu, GpuMemory, Kind, Parity, PingPong, Recorder,
+    Section, Stage, Tex, ViewMap, ViewSpec, made,
 };
-use hush_engine::frame::{FrameInput, Renderer};
+use hush_engine::frame::{BvhKind, DenoiserName, FrameInput, Renderer, View};
 use hush_engine::quality::{Image, compare};
 use hush_engine::scene::Camera;
-use hush_engine::settings::{Denoiser as DenoiserName, FrameSettings, View, ViewMap, ViewSpec};
 use std::sync::Once;
 
 const NAME: &str = "accumulate-test";
 const MODULE: &str = "test/accumulate.wgsl";
+/// Its settings' section: `[accumulate_test]` in a preset.
+const SECTION: &str = "accumulate_test";
 
 /// Reprojects its history with the G-buffer's motion vectors and keeps a running mean of up to
-/// 32 frames (the history's alpha counts them); off screen or without a surface it starts over.
+/// `max_frames` frames (the history's alpha counts them; with `temporal` off, one); off screen
+/// or without a surface it starts over.
 const WGSL: &str = r#"
+struct AccumulateParams {
+    max_frames: f32,
+    temporal: u32,
+    _pad: vec2u,
+}
+var<uniform> acc: AccumulateParams;
 var history: texture_2d<f32>;
 var out_history: texture_storage_2d<rgba32float, write>;
 
@@ -35,28 +44,63 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
     var n = 0.0;
     var mean = vec3f(0.0);
-    if gbuffer_at(p).hit && all(prev >= vec2f(0.0)) && all(prev < vec2f(frame.size)) {
+    let inside = all(prev >= vec2f(0.0)) && all(prev < vec2f(frame.size));
+    if acc.temporal != 0u && gbuffer_at(p).hit && inside {
         let h = textureLoad(history, vec2i(prev), 0);
-        n = min(h.a, 31.0);
+        n = min(h.a, acc.max_frames - 1.0);
         mean = half_safe(h.rgb);
     }
     textureStore(out_history, p, vec4f(mix(mean, current, 1.0 / (n + 1.0)), n + 1.0));
 }
 "#;
 
+/// Mirror of `AccumulateParams`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct AccumulateParams {
+    max_frames: f32,
+    temporal: u32,
+    _pad: [u32; 2],
+}
+
+impl AccumulateParams {
+    /// From its section of the frame's settings (complete: presets fill in the defaults).
+    fn new(s: &FrameSettings) -> anyhow::Result<AccumulateParams> {
+        let section = s.sections.get(SECTION).context("no accumulate_test settings")?;
+        let max_frames = section["max_frames"].as_u64().context("max_frames")? as f32;
+        let temporal = section["temporal"].as_bool().context("temporal")? as u32;
+        Ok(AccumulateParams { max_frames, temporal, _pad: [0; 2] })
+    }
+}
+
 struct Accumulate {
     animated: bool,
+    params: wgpu::Buffer,
     history: Option<PingPong<Tex>>,
     stage: Option<ChainStage>,
 }
 
 fn make(gpu: &Gpu, scene: &DenoiserScene) -> anyhow::Result<Box<dyn Denoiser>> {
     gpu.shaders.add(MODULE, WGSL)?;
-    Ok(Box::new(Accumulate { animated: scene.animated, history: None, stage: None }))
+    let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("accumulate/params"),
+        size: size_of::<AccumulateParams>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    Ok(Box::new(Accumulate { animated: scene.animated, params, history: None, stage: None }))
 }
 
-fn bindings<'a>(io: &FrameIo<'a>, h: &'a PingPong<Tex>, p: Parity) -> Bindings<'a> {
-    io.bindings().texture("history", &h.history(p).1).texture("out_history", &h.output(p).1)
+fn bindings<'a>(
+    io: &FrameIo<'a>,
+    params: &'a wgpu::Buffer,
+    h: &'a PingPong<Tex>,
+    p: Parity,
+) -> Bindings<'a> {
+    io.bindings()
+        .buffer("acc", params)
+        .texture("history", &h.history(p).1)
+        .texture("out_history", &h.output(p).1)
 }
 
 impl Denoiser for Accumulate {
@@ -80,6 +124,8 @@ impl Denoiser for Accumulate {
         cx: &FrameContext,
     ) -> anyhow::Result<()> {
         let h = self.history.as_ref().context("recording before allocating")?;
+        let params = AccumulateParams::new(cx.settings)?;
+        rec.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let motion = if self.animated {
             "realtime/motion_objects.wgsl"
         } else {
@@ -87,11 +133,11 @@ impl Denoiser for Accumulate {
         };
         let modules =
             ["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", motion, MODULE];
-        let offered = bindings(io, h, Parity::default());
+        let offered = bindings(io, &self.params, h, Parity::default());
         let stage = made(&mut self.stage, || {
             ChainStage::new(rec.gpu, "accumulate", &modules, "main", &offered)
         })?;
-        stage.record(rec, cx.key, cx.parity, io.size, |p| bindings(io, h, p))
+        stage.record(rec, cx.key, cx.parity, io.size, |p| bindings(io, &self.params, h, p))
     }
 
     fn output(&self, parity: Parity) -> Denoised<'_> {
@@ -117,15 +163,45 @@ const VIEWS: &[ViewSpec] = &[ViewSpec {
     map: ViewMap::Grey { channel: 3, divisor: 32.0 },
 }];
 
+/// Its settings, as the viewer draws them and presets check them.
+const FIELDS: &[Field] = &[
+    Field {
+        path: "accumulate_test.temporal",
+        group: "accumulate",
+        unit: "",
+        kind: Kind::Bool,
+        help: "Keep a history (off: each frame alone).",
+    },
+    Field {
+        path: "accumulate_test.max_frames",
+        group: "accumulate",
+        unit: "frames",
+        kind: Kind::Int(1, 1024),
+        help: "The most frames the running mean holds.",
+    },
+];
+
+/// What `--disable` may switch off: its history.
+const STAGES: &[Stage] = &[Stage::switch("accumulate_test.temporal")];
+
+fn defaults() -> serde_json::Value {
+    serde_json::json!({ "temporal": true, "max_frames": 32 })
+}
+
 fn register() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         hush_engine::denoise::register(Entry {
-            name: NAME,
-            summary: "a running mean of the matte light (test only)",
+            info: DenoiserInfo {
+                name: NAME,
+                summary: "a running mean of the matte light (test only)",
+                fields: &[FIELDS],
+                section: Some(Section { name: SECTION, defaults }),
+                stages: STAGES,
+                views: VIEWS,
+                fractions: false,
+            },
             make: Some(make),
-            views: VIEWS,
-            fractions: false,
         })
         .unwrap()
     });
@@ -157,7 +233,7 @@ fn render(r: &mut Renderer, gpu: &Gpu, s: &FrameSettings, frames: u32) -> Image 
 #[test]
 fn a_denoiser_written_for_a_test_renders_through_the_contract_with_taa() {
     register();
-    assert!(hush_engine::settings::denoiser_names().contains(&NAME));
+    assert!(hush_engine::denoise::entries().iter().any(|e| e.info.name == NAME));
     let preset: FrameSettings = toml_settings(&format!("denoiser = \"{NAME}\""));
     assert_eq!(preset.denoiser, DenoiserName::named(NAME));
     let (gpu, mut r) =
@@ -194,6 +270,48 @@ fn a_denoiser_written_for_a_test_renders_through_the_contract_with_taa() {
             assert!(passes.contains(&p), "{p} did not run: {passes:?}");
         }
         assert!(!passes.iter().any(|p| p.starts_with("matte/")), "the Mara chain ran: {passes:?}");
+    }
+}
+
+/// A registered denoiser's settings go where the built-in ones go: a TOML preset sets them (what
+/// it leaves out keeps its default), an out-of-range or unknown one is refused by name,
+/// `--disable` (`disable_stage`) switches its stage off, the viewer's field list holds them, a
+/// saved preset round-trips them, and the frame reads them: `max_frames` caps the history's
+/// length at 4, `temporal` off keeps it at one frame.
+#[test]
+fn a_registered_denoisers_settings_reach_presets_disable_and_the_frame() {
+    use serde_json::json;
+    register();
+    let preset = format!("denoiser = \"{NAME}\"\n[{SECTION}]\nmax_frames = 4\n");
+    let s = toml_settings(&preset);
+    assert_eq!(s.sections[SECTION], json!({ "temporal": true, "max_frames": 4 }));
+    for (bad, needle) in [
+        ("max_frames = 0", "accumulate_test.max_frames"),
+        ("max_frame = 3", "accumulate_test.max_frame"),
+        ("temporal = 2", "accumulate_test.temporal"),
+    ] {
+        let e = FrameSettings::from_toml(&format!("[{SECTION}]\n{bad}\n")).unwrap_err();
+        assert!(format!("{e:#}").contains(needle), "{bad}: {e:#}");
+    }
+    assert!(hush_engine::denoise::fields().any(|f| f.path == "accumulate_test.max_frames"));
+    assert!(hush_engine::denoise::stage_names().contains(&"accumulate_test.temporal"));
+    let mut off = s.clone();
+    assert!(hush_engine::denoise::disable_stage(&mut off, "accumulate_test.temporal"));
+    assert_eq!(off.sections[SECTION], json!({ "temporal": false, "max_frames": 4 }));
+    assert_eq!(FrameSettings::from_toml(&off.to_toml().unwrap()).unwrap(), off);
+    let scene = hush_engine::scene::default_level();
+    let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (32, 18)).unwrap();
+    for (settings, want) in [(s, 4.0), (off, 1.0)] {
+        for _ in 0..8 {
+            r.render(&gpu, &view(), &settings, None).unwrap();
+        }
+        let mut longest = 0.0f32;
+        for slot in 0..2 {
+            let (texels, _) = r.read_texture(&gpu, &format!("accumulate/history {slot}")).unwrap();
+            let texels: &[f32] = bytemuck::cast_slice(&texels);
+            longest = texels.chunks_exact(4).map(|t| t[3]).fold(longest, f32::max);
+        }
+        assert_eq!(longest, want, "history length with {:?}", settings.sections[SECTION]);
     }
 }
 

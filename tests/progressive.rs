@@ -312,7 +312,7 @@ fn progressive_nonfinite_input_never_reaches_history_or_screen() {
             ..progressive(period, Default::default())
         };
         cases.push(base.clone());
-        for stage in ProgressiveSettings::STAGES {
+        for stage in hush_engine::settings::progressive::INFO.stages.iter().map(|s| s.name) {
             let mut s = base.clone();
             assert!(hush_engine::settings::disable_stage(&mut s, stage));
             cases.push(s);

@@ -239,9 +239,9 @@ fn the_default_level_renders_without_nan() {
         r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures
     );
     // Each built-in denoiser in turn: the frame's views and its own.
-    for entry in hush_engine::denoise::BUILT_IN.iter().filter(|e| e.make.is_some()) {
+    for entry in hush_engine::denoise::entries().iter().filter(|e| e.make.is_some()) {
         let mut denoised = FrameSettings {
-            denoiser: hush_engine::settings::Denoiser::named(entry.name),
+            denoiser: hush_engine::settings::Denoiser::named(entry.info.name),
             ..Default::default()
         };
         // Off by default; on here so that the glossy/clipping view has something to show.
@@ -257,14 +257,14 @@ fn the_default_level_renders_without_nan() {
             assert!(
                 img.data.iter().all(|p| p.is_finite()),
                 "NaN or Inf in the default level with {}",
-                entry.name
+                entry.info.name
             );
         }
         // Emission may be off screen; every other view shows something from the level's camera.
         let own = hush_engine::settings::FRAME_VIEWS
             .iter()
             .filter(|v| !v.needs_traced_primaries())
-            .chain(entry.views);
+            .chain(entry.info.views);
         let views: Vec<View> =
             std::iter::once(View::FINAL).chain(own.map(|v| View::named(v.name))).collect();
         for v in views.into_iter().filter(|v| v.name() != "gbuffer/emission") {
@@ -274,7 +274,7 @@ fn the_default_level_renders_without_nan() {
                 shown.pixels().any(|p| p.0[..3] != [0, 0, 0]),
                 "view {} is black with {}",
                 v.name(),
-                entry.name
+                entry.info.name
             );
         }
     }

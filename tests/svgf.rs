@@ -258,7 +258,9 @@ fn svgf_nonfinite_input_never_reaches_history_or_screen() {
     };
     let mut cases =
         vec![base.clone(), FrameSettings { svgf: SvgfSettings::schied(), ..base.clone() }];
-    for stage in SvgfSettings::STAGES.into_iter().chain([TaaSettings::STAGE]) {
+    for stage in
+        hush_engine::settings::svgf::INFO.stages.iter().map(|s| s.name).chain([TaaSettings::STAGE])
+    {
         let mut s = base.clone();
         assert!(hush_engine::settings::disable_stage(&mut s, stage));
         cases.push(s);

@@ -118,7 +118,7 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
 /// that needs every pixel each frame; on a GPU Mara's chains.
 fn default_denoiser(gpu: &Gpu) -> hush_engine::settings::Denoiser {
     if gpu.info.device_type == wgpu::DeviceType::Cpu {
-        hush_engine::settings::Denoiser::named("progressive")
+        hush_engine::settings::Denoiser::PROGRESSIVE
     } else {
         hush_engine::settings::Denoiser::MARA
     }

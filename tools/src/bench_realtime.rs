@@ -6,7 +6,7 @@ use crate::cli::{bvh_kind, load_scene};
 use anyhow::{Result, bail};
 use hush_engine::frame::{DisplayTarget, FrameInput, Renderer};
 use hush_engine::profile::puffin;
-use hush_engine::settings::FrameSettings;
+use hush_engine::settings::{Denoiser, FrameSettings};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -82,7 +82,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         None => FrameSettings {
             max_depth: r.scene.max_depth,
             ..crate::cli::denoiser_settings(
-                a.denoiser.as_deref().unwrap_or("mara"),
+                a.denoiser.as_deref().unwrap_or(Denoiser::MARA.name()),
                 &[],
                 "diamond",
             )?

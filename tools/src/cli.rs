@@ -181,7 +181,7 @@ pub fn parse_spp(s: &str) -> Result<Spp> {
 
 pub fn parse_denoiser(s: &str) -> Result<Denoiser> {
     match hush_engine::denoise::find(s) {
-        Ok(e) => Ok(Denoiser::named(e.name)),
+        Ok(e) => Ok(Denoiser::named(e.info.name)),
         Err(e) => bail!("--denoiser {s:?}: {e}"),
     }
 }

@@ -124,7 +124,7 @@ impl Uncovered {
                 .context("reading the matte temporal's flags")?;
             history_rejected(&reason)
         } else {
-            let name = format!("svgf/matte moments {}", 1 - index % 2);
+            let name = hush_engine::denoise::svgf::moments_label("matte", 1 - index % 2);
             let (moments, _) =
                 r.read_texture(gpu, &name).with_context(|| format!("reading {name}"))?;
             moments
@@ -216,7 +216,7 @@ fn stream(
         let ms: f64 = r.pass_times(&s.gpu)?.iter().map(|p| p.1).sum();
         let img = r.read_hdr(&s.gpu)?;
         let tracked = (settings.denoiser == Denoiser::MARA && settings.matte.temporal)
-            || (settings.denoiser.name() == "svgf" && settings.svgf.temporal);
+            || (settings.denoiser == Denoiser::SVGF && settings.svgf.temporal);
         let mask =
             if tracked { Some(uncovered.update(&r, &s.gpu, &settings.denoiser, k)?) } else { None };
         scores.push(&img, prev.as_ref(), &references[k], ms, mask.as_deref())?;
@@ -233,7 +233,11 @@ pub fn run(a: QualityArgs) -> Result<()> {
     if a.frames == 0 || a.reference_frames == 0 {
         bail!("--frames and --reference-frames must be at least 1");
     }
-    let denoiser = a.denoiser.as_deref().or(if a.preset.is_none() { Some("mara") } else { None });
+    let denoiser = a.denoiser.as_deref().or(if a.preset.is_none() {
+        Some(Denoiser::MARA.name())
+    } else {
+        None
+    });
     let chains =
         preset_settings(a.preset.as_deref(), denoiser, &a.disable, a.reflection_mv.as_deref())?;
     let denoiser = chains.denoiser.clone();

@@ -18,11 +18,12 @@ use crate::quality::new_renderer;
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::{DMat4, DVec3, Vec3};
+use hush_engine::denoise::svgf;
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::quality::{Image, flip_map, luminance};
 use hush_engine::scene::Camera;
-use hush_engine::settings::{FrameSettings, ReflectionMv};
+use hush_engine::settings::{Denoiser, FrameSettings, ReflectionMv};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -53,7 +54,7 @@ pub struct ReflectionsArgs {
     #[arg(long, default_value_t = 32)]
     pub search_radius: u32,
     /// The denoiser measured: `mara` (its glossy chain) or `svgf` (its glossy signal).
-    #[arg(long, default_value = "mara")]
+    #[arg(long, default_value = Denoiser::MARA.name())]
     pub denoiser: String,
     /// Stages to switch off in every configuration (see `render --disable`), for ablations.
     #[arg(long, value_delimiter = ',')]
@@ -117,7 +118,7 @@ fn masked_mean(values: impl Iterator<Item = f64>, mask: &[bool]) -> f64 {
 /// with no glossy accumulation ("NoSpecReproj").
 fn configs(base: &FrameSettings) -> Vec<(&'static str, FrameSettings)> {
     let mut v = vec![];
-    if base.denoiser.name() == "svgf" {
+    if base.denoiser == Denoiser::SVGF {
         v.push(("diamond", base.clone()));
         let mut primary = base.clone();
         primary.svgf.reflection_reprojection = false;
@@ -153,14 +154,15 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
     let base = crate::cli::denoiser_settings(&a.denoiser, &a.disable, "diamond")?;
-    let svgf = base.denoiser.name() == "svgf";
-    if !svgf && base.denoiser != hush_engine::settings::Denoiser::MARA {
-        anyhow::bail!("--denoiser {}: reflections measures mara or svgf", a.denoiser);
+    let svgf = base.denoiser == Denoiser::SVGF;
+    if !svgf && base.denoiser != Denoiser::MARA {
+        let (m, s) = (Denoiser::MARA.name(), Denoiser::SVGF.name());
+        anyhow::bail!("--denoiser {}: reflections measures {m} or {s}", a.denoiser);
     }
     let threshold =
         if svgf { base.svgf.roughness_threshold } else { base.glossy.roughness_threshold };
     // What the glossy denoiser writes for the composite.
-    let glossy_output = if svgf { "svgf/glossy out" } else { "glossy/denoised" };
+    let glossy_output = if svgf { svgf::GLOSSY_OUTPUT } else { "glossy/denoised" };
     let camera = scene.camera_or_default();
     let mut csv = std::fs::File::create(a.out_dir.join("reflections.csv"))?;
     writeln!(csv, "part,config,metric,value")?;
@@ -328,7 +330,7 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
             }
             let m = mask(&r, &gpu, threshold)?;
             // SVGF runs the glossy chain's search on textures of its own.
-            let prefix = if svgf { "svgf/glossy " } else { "glossy/" };
+            let prefix = if svgf { svgf::GLOSSY_PREFIX } else { "glossy/" };
             let motion = read_vec4(&r, &gpu, &format!("{prefix}motion"))?;
             let search = read_vec4(&r, &gpu, &format!("{prefix}search"))?;
             for i in 0..motion.len() {

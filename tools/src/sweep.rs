@@ -91,7 +91,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
         } else {
             reference.box_downsample(full.0 / size.0)?
         };
-        for denoiser in [Denoiser::NONE, Denoiser::MARA, Denoiser::named("svgf")] {
+        for denoiser in [Denoiser::NONE, Denoiser::MARA, Denoiser::SVGF] {
             // More paths at one primary hit, or (one path) more samples per pixel.
             for (paths, samples) in [(1u32, 1u32), (2, 1), (4, 1), (1, 4)] {
                 for max_depth in [3, depth] {
@@ -191,9 +191,7 @@ fn plot(path: &std::path::Path, points: &[Point], title: &str) -> Result<()> {
         .y_desc("FLIP against the converged image")
         .draw()
         .map_err(|x| e(&x))?;
-    for (den, color) in
-        [(Denoiser::NONE, RED), (Denoiser::MARA, BLUE), (Denoiser::named("svgf"), GREEN)]
-    {
+    for (den, color) in [(Denoiser::NONE, RED), (Denoiser::MARA, BLUE), (Denoiser::SVGF, GREEN)] {
         let name = format!("denoiser: {}", den.name());
         chart
             .draw_series(points.iter().filter(|p| p.denoiser == den).map(|p| {

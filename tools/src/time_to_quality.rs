@@ -105,7 +105,8 @@ fn parse_run(s: &str) -> Result<RunSpec> {
         None => (rest, None),
     };
     if denoiser.trim().is_empty() {
-        bail!("--run {s:?}: name a denoiser (none, mara, svgf, progressive)");
+        let names = hush_engine::settings::denoiser_names().join(", ");
+        bail!("--run {s:?}: name a denoiser ({names})");
     }
     Ok(RunSpec { label: s.to_string(), denoiser: denoiser.trim().to_string(), spp, target_ms })
 }

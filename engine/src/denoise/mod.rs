@@ -8,8 +8,12 @@
 //! follow. TAA and the composite belong to the frame and run after any denoiser.
 //!
 //! Adding a denoiser: one module implementing [`Denoiser`] (its WGSL in `shaders/`, or given to
-//! [`crate::shader::ShaderLibrary::add`]) and one [`Entry`] (in [`BUILT_IN`], or passed to
-//! [`register`]). Its name then works in `--denoiser`, presets and the viewer.
+//! [`crate::shader::ShaderLibrary::add`]) and one [`Entry`]: what it declares
+//! ([`DenoiserInfo`]: name, settings fields and preset section, `--disable` stages, debug views)
+//! and its maker. A built-in one declares itself in `settings/<name>.rs` and adds its maker to
+//! one line here; an application passes its entry to [`register`]. Its name then works in
+//! `--denoiser`, presets, the viewer's panels and the quality tools. Every type a denoiser uses
+//! is here or re-exported here.
 
 pub mod mara;
 pub mod progressive;
@@ -20,9 +24,12 @@ pub use crate::passes::chain::{ChainStage, made};
 pub use crate::passes::io::{FrameIo, PreviousGBuffer};
 pub use crate::passes::matte::ChainView;
 pub use crate::passes::taa::{GlossyFollow, TaaFollow};
-use crate::settings::{FrameSettings, ViewSpec};
-use anyhow::{Result, bail};
-use std::sync::RwLock;
+pub use crate::settings::FrameSettings;
+pub use crate::settings::{
+    DenoiserInfo, Field, Kind, Off, Section, Stage, ViewMap, ViewSpec, disable_stage, fields,
+    stage_names,
+};
+use anyhow::Result;
 
 /// What a denoiser knows about the scene when it is made.
 #[derive(Clone, Copy, Debug)]
@@ -92,95 +99,57 @@ pub trait Denoiser {
 /// Makes a denoiser for a scene.
 pub type MakeDenoiser = fn(&Gpu, &DenoiserScene) -> Result<Box<dyn Denoiser>>;
 
-/// A denoiser the frame can be asked for by name.
+/// A denoiser the frame can be asked for by name: what it declares (name, summary, settings
+/// fields and preset section, `--disable` stages, debug views) and how to make it.
 #[derive(Clone, Copy)]
 pub struct Entry {
-    /// As `--denoiser`, presets and the viewer spell it (lower case).
-    pub name: &'static str,
-    /// One line for the viewer and `--help`.
-    pub summary: &'static str,
+    pub info: DenoiserInfo,
     /// Make it for a scene (None: no denoiser, the raw frame).
     pub make: Option<MakeDenoiser>,
-    /// Its debug views: textures it allocates, by label, and how to show them.
-    pub views: &'static [ViewSpec],
-    /// It takes sample fractions below 1 (as [`Denoiser::fills_untraced_pixels`] says once made;
-    /// here so that an error can name the denoisers that do without making them).
-    pub fractions: bool,
 }
 
-/// The denoisers built into Hush.
-pub const BUILT_IN: &[Entry] = &[
-    Entry {
-        name: "none",
-        summary: "the raw 1-sample frame (composite only)",
-        make: None,
-        views: &[],
-        fractions: true,
-    },
-    Entry {
-        name: "mara",
-        summary: "Mara et al. 2017: the matte and glossy chains, then TAA",
-        make: Some(mara::make),
-        views: crate::settings::MARA_VIEWS,
-        fractions: false,
-    },
-    Entry {
-        name: "svgf",
-        summary: "SVGF (Schied et al. 2017) with Voorhuis's reflections and robustness, then TAA",
-        make: Some(svgf::make),
-        views: crate::settings::SVGF_VIEWS,
-        fractions: false,
-    },
-    Entry {
-        name: "progressive",
-        summary: "Dundr et al.'s progressive SVGF, for sample fractions below 1 (--spp 1/N), then TAA",
-        make: Some(progressive::make),
-        views: crate::settings::PROGRESSIVE_VIEWS,
-        fractions: true,
-    },
+/// How each built-in denoiser is made (what it declares is in `settings/<name>.rs`).
+const BUILT_IN_MAKERS: &[(&str, MakeDenoiser)] = &[
+    (crate::settings::mara::INFO.name, mara::make),
+    (crate::settings::svgf::INFO.name, svgf::make),
+    (crate::settings::progressive::INFO.name, progressive::make),
 ];
 
-static REGISTERED: RwLock<Vec<Entry>> = RwLock::new(Vec::new());
-
-/// Add a denoiser beside the built-in ones (an application's or a test's own); an error if the
-/// name is taken.
+/// Add a denoiser beside the built-in ones (an application's or a test's own): its name then
+/// works in `--denoiser`, presets and the viewer, its settings in presets, panels and
+/// `--disable`. An error if its name, a view, a stage or its settings section is taken.
 pub fn register(entry: Entry) -> Result<()> {
-    let mut r = crate::sync::write(&REGISTERED);
-    if entries_in(&r).iter().any(|e| e.name == entry.name) {
-        bail!("a denoiser named {:?} is already registered", entry.name);
-    }
-    r.push(entry);
-    crate::settings::add_denoiser_name(entry.name);
-    crate::settings::register_views(entry.views);
-    Ok(())
-}
-
-fn entries_in(registered: &[Entry]) -> Vec<Entry> {
-    BUILT_IN.iter().chain(registered).copied().collect()
+    let make = entry.make.map(|m| std::sync::Arc::new(m) as crate::settings::registry::Maker);
+    crate::settings::registry::register(entry.info, make)
 }
 
 /// Every denoiser, built-in first.
 pub fn entries() -> Vec<Entry> {
-    entries_in(&crate::sync::read(&REGISTERED))
+    crate::settings::registry::denoisers().into_iter().map(entry).collect()
 }
 
 /// The denoiser called `name`.
 pub fn find(name: &str) -> Result<Entry> {
-    let all = entries();
-    match all.iter().find(|e| e.name == name) {
-        Some(e) => Ok(*e),
-        None => bail!(
-            "no denoiser {name:?} (there are {})",
-            all.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")
-        ),
-    }
+    crate::settings::registry::denoiser(name).map(entry)
+}
+
+fn entry(info: DenoiserInfo) -> Entry {
+    let built_in = BUILT_IN_MAKERS.iter().find(|(n, _)| *n == info.name).map(|(_, m)| *m);
+    let registered = || {
+        crate::settings::registry::registered_maker(info.name)
+            .and_then(|m| m.downcast_ref::<MakeDenoiser>().copied())
+    };
+    Entry { info, make: built_in.or_else(registered) }
 }
 
 #[cfg(test)]
 mod tests {
+    /// Every built-in denoiser but `none` can be made.
     #[test]
-    fn settings_know_every_built_in_name() {
-        let names: Vec<&str> = super::BUILT_IN.iter().map(|e| e.name).collect();
-        assert_eq!(crate::settings::denoiser_names()[..names.len()], names[..]);
+    fn every_built_in_denoiser_has_a_maker() {
+        for info in crate::settings::registry::BUILT_IN {
+            let made = super::find(info.name).map(|e| e.make.is_some());
+            assert_eq!(made.ok(), Some(info.name != crate::settings::registry::NONE.name));
+        }
     }
 }

@@ -26,6 +26,17 @@ const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 const RG32F: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 const LEVELS: usize = crate::settings::SVGF_MAX_LEVELS as usize;
 
+/// The label of the glossy signal's output (what the composite reads).
+pub const GLOSSY_OUTPUT: &str = "svgf/glossy out";
+/// The start of the glossy signal's labels (its reflection motion's `motion`, `search`, ...).
+pub const GLOSSY_PREFIX: &str = "svgf/glossy ";
+
+/// The label of a signal's (`matte`, `glossy`) luminance moments and history length in history
+/// slot 0 or 1.
+pub fn moments_label(signal: &str, slot: usize) -> String {
+    format!("svgf/{signal} moments {slot}")
+}
+
 /// Mirror of `SvgfParams` in shaders/svgf/common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]

@@ -11,10 +11,10 @@ mod record;
 mod reload;
 mod targets;
 
-pub use crate::settings::View;
+pub use crate::accel::BvhKind;
+pub use crate::settings::{Denoiser as DenoiserName, FrameSettings, View};
 pub use params::{CameraSetup, FrameParams, random_jitter};
 
-use crate::accel::BvhKind;
 use crate::denoise::Denoiser;
 use crate::gpu::{BindKey, Gpu, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
 use crate::passes::composite::CompositePass;
@@ -25,7 +25,6 @@ use crate::passes::supersample::Supersample;
 use crate::passes::taa::TaaStage;
 use crate::passes::trace::{SceneInputs, TraceInputs, TracePass};
 use crate::scene::{Camera, Scene};
-use crate::settings::FrameSettings;
 use anyhow::{Context, Result, bail};
 use glam::{Vec2, Vec3};
 use record::{FrameHistory, Stages};

@@ -191,8 +191,8 @@ impl Renderer {
         if let Some(i) = denoiser.filter(refuses).filter(|_| period > 1) {
             let fills: Vec<&str> = crate::denoise::entries()
                 .into_iter()
-                .filter(|e| e.fractions)
-                .map(|e| e.name)
+                .filter(|e| e.info.fractions)
+                .map(|e| e.info.name)
                 .collect();
             bail!(
                 "the {} denoiser needs every pixel traced each frame; sample fraction {} needs one \

@@ -55,7 +55,9 @@ impl Renderer {
         settings: &FrameSettings,
         target: Option<&DisplayTarget>,
     ) -> Result<()> {
-        puffin::profile_function!();
+        // Named by hand: puffin's function scope would read this impl's path as
+        // "Renderer>::record_frame".
+        puffin::profile_scope!("Renderer::record_frame");
         let plan = self.plan(gpu, input, settings, target)?;
         let encode = crate::profile::scope("encode");
         let mut enc = gpu.device.create_command_encoder(&Default::default());

@@ -95,7 +95,7 @@ const FRAME_FIELDS: &[Field] = &[
         "frame",
         "",
         Choice(denoisers),
-        "none: the raw 1-sample frame. mara: the matte and glossy chains and TAA. svgf: SVGF with Voorhuis's extensions, then TAA. progressive: Dundr's filter, for sample fractions below 1. Others: denoisers the application registered.",
+        "Which denoiser filters the frame: none (the raw 1-sample frame), a built-in one or one the application registered; each says what it is in its summary.",
     ),
     f(
         "max_depth",
@@ -142,15 +142,12 @@ const FRAME_FIELDS: &[Field] = &[
 ];
 
 /// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then
-/// each technique's own slice (matte chain, TAA, glossy chain, SVGF).
+/// each denoiser's as the registry lists them ([`super::registry`]), then TAA's.
 pub fn fields() -> impl Iterator<Item = &'static Field> {
-    FRAME_FIELDS
-        .iter()
-        .chain(super::matte::FIELDS)
-        .chain(super::taa::FIELDS)
-        .chain(super::glossy::FIELDS)
-        .chain(super::svgf::FIELDS)
-        .chain(super::progressive::FIELDS)
+    let denoisers = super::registry::denoisers();
+    let own: Vec<&'static Field> =
+        denoisers.iter().flat_map(|d| d.fields.iter().flat_map(|f| f.iter())).collect();
+    FRAME_FIELDS.iter().chain(own).chain(super::taa::FIELDS)
 }
 
 /// The value at a dotted path of a serde form.
@@ -189,9 +186,11 @@ impl FrameSettings {
         serde_json::to_value(self).expect("settings serialize")
     }
 
-    /// Settings from a JSON value; every field must be one [`fields`] describes, in range.
+    /// Settings from a JSON value; every field must be one [`fields`] describes, in range. What
+    /// `v` leaves out keeps its default.
     pub fn from_value(v: &Value) -> Result<FrameSettings> {
-        let known = leaves(&FrameSettings::default().to_value());
+        let mut full = FrameSettings::default().to_value();
+        let known = leaves(&full);
         for leaf in leaves(v) {
             if !known.contains(&leaf) {
                 return Err(anyhow!(
@@ -205,7 +204,25 @@ impl FrameSettings {
                 check(field, x)?;
             }
         }
-        serde_json::from_value(v.clone()).map_err(|e| anyhow!("bad settings: {e}"))
+        merge(&mut full, v);
+        serde_json::from_value(full).map_err(|e| anyhow!("bad settings: {e}"))
+    }
+}
+
+/// `over`'s leaves written into `base`.
+fn merge(base: &mut Value, over: &Value) {
+    match (base, over) {
+        (Value::Object(b), Value::Object(o)) => {
+            for (k, v) in o {
+                match b.get_mut(k) {
+                    Some(slot) => merge(slot, v),
+                    None => {
+                        b.insert(k.clone(), v.clone());
+                    }
+                }
+            }
+        }
+        (b, o) => *b = o.clone(),
     }
 }
 

@@ -170,19 +170,6 @@ impl Default for GlossySettings {
 }
 
 impl GlossySettings {
-    pub const STAGES: [&str; 3] = ["glossy.temporal", "glossy.clipping", "glossy.bilateral"];
-
-    pub fn disable(&mut self, name: &str) -> bool {
-        let f = match name {
-            "glossy.temporal" => &mut self.temporal,
-            "glossy.clipping" => &mut self.clipping,
-            "glossy.bilateral" => &mut self.bilateral,
-            _ => return false,
-        };
-        *f = false;
-        true
-    }
-
     /// Stage bits as shaders/glossy/common.wgsl reads them.
     pub fn stage_bits(&self) -> u32 {
         self.temporal as u32 | (self.clipping as u32) << 1 | (self.bilateral as u32) << 2

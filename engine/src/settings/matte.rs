@@ -137,30 +137,6 @@ impl Default for MatteSettings {
 }
 
 impl MatteSettings {
-    /// Names accepted by `--disable` and shown in the viewer (the glossy chain's are in
-    /// [`super::GlossySettings::STAGES`]).
-    pub const STAGES: [&str; 5] = [
-        "matte.temporal",
-        "matte.history_bilateral",
-        "matte.disocclusion",
-        "matte.firefly",
-        "matte.bilateral",
-    ];
-
-    /// Turn a stage off by name; false for an unknown name.
-    pub fn disable(&mut self, name: &str) -> bool {
-        let f = match name {
-            "matte.temporal" => &mut self.temporal,
-            "matte.history_bilateral" => &mut self.history_bilateral,
-            "matte.disocclusion" => &mut self.disocclusion,
-            "matte.firefly" => &mut self.firefly,
-            "matte.bilateral" => &mut self.bilateral,
-            _ => return false,
-        };
-        *f = false;
-        true
-    }
-
     /// Stage bits as the shaders read them (shaders/matte/common.wgsl: STAGE_*; TAA's bit is
     /// [`super::TaaSettings::stage_bit`]).
     pub fn stage_bits(&self) -> u32 {

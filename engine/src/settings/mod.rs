@@ -4,10 +4,12 @@
 mod fields;
 mod fraction;
 mod glossy;
+pub mod mara;
 mod matte;
 mod preset;
-mod progressive;
-mod svgf;
+pub mod progressive;
+pub mod registry;
+pub mod svgf;
 mod taa;
 mod view;
 
@@ -16,16 +18,15 @@ pub use fraction::{MAX_SAMPLE_PERIOD, SampleFraction};
 pub use glossy::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 pub use matte::MatteSettings;
 pub use progressive::{MAX_LEVELS as PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
+pub use registry::{DenoiserInfo, Off, Section, Stage};
 pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, SvgfSettings};
 pub use taa::TaaSettings;
-pub use view::{
-    FRAME_VIEWS, MARA_VIEWS, PROGRESSIVE_VIEWS, SVGF_VIEWS, View, ViewMap, ViewSpec, all_views,
-    register_views,
-};
+pub use view::{FRAME_VIEWS, View, ViewMap, ViewSpec, all_views};
 
 use serde::{Deserialize, Serialize};
+use serde_json::Value;
 use std::borrow::Cow;
-use std::sync::RwLock;
+use std::collections::BTreeMap;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -76,6 +77,10 @@ pub struct FrameSettings {
     /// per-pixel bandwidth chosen by SURE (eq. 6), so that a defocused region's noisy normals,
     /// colours and depths stop cutting the denoisers' filters while in-focus detail stays.
     pub prefilter: bool,
+    /// The settings of denoisers an application registered, by their section's name: `[name]`
+    /// in a preset, `name.field` in a field path ([`registry::Section`]).
+    #[serde(flatten)]
+    pub sections: BTreeMap<String, Value>,
 }
 
 /// Traced primary samples per pixel by default (Moon et al. use 4 in their interactive tests'
@@ -96,7 +101,20 @@ impl FrameSettings {
 }
 
 impl Default for FrameSettings {
+    /// Every setting at its default, registered denoisers' sections included.
     fn default() -> Self {
+        let sections = registry::denoisers()
+            .iter()
+            .filter_map(|d| d.section)
+            .map(|s| (s.name.to_string(), (s.defaults)()))
+            .collect();
+        FrameSettings { sections, ..FrameSettings::typed_default() }
+    }
+}
+
+impl FrameSettings {
+    /// The built-in settings at their defaults (no registered sections).
+    fn typed_default() -> FrameSettings {
         FrameSettings {
             exposure_ev: 0.0,
             max_depth: crate::scene::DEFAULT_MAX_DEPTH,
@@ -114,6 +132,15 @@ impl Default for FrameSettings {
             sample_fraction: SampleFraction::ONE,
             primary_samples: DEFAULT_PRIMARY_SAMPLES,
             prefilter: true,
+            sections: BTreeMap::new(),
+        }
+    }
+
+    /// The names the built-in settings take at the top of a preset: no section may use one.
+    pub(crate) fn typed_sections() -> Vec<String> {
+        match FrameSettings::typed_default().to_value() {
+            Value::Object(m) => m.keys().cloned().collect(),
+            _ => vec![],
         }
     }
 }
@@ -126,9 +153,7 @@ pub struct Denoiser(Cow<'static, str>);
 
 impl Denoiser {
     /// The raw frame (composite only).
-    pub const NONE: Denoiser = Denoiser(Cow::Borrowed("none"));
-    /// Mara et al. 2017: the matte and glossy chains, then TAA.
-    pub const MARA: Denoiser = Denoiser(Cow::Borrowed("mara"));
+    pub const NONE: Denoiser = Denoiser(Cow::Borrowed(registry::NONE.name));
 
     pub fn named(name: &str) -> Denoiser {
         Denoiser(Cow::Owned(name.to_string()))
@@ -159,42 +184,40 @@ impl<'de> Deserialize<'de> for Denoiser {
     }
 }
 
-/// Names of the denoisers the frame can make: the built-in ones, and those
-/// `crate::denoise::register` added (it keeps this list, which settings read without depending
-/// on the denoisers themselves).
-static DENOISER_NAMES: RwLock<Vec<&'static str>> = RwLock::new(Vec::new());
-
+/// Names of the denoisers the frame can make, built-in first ([`registry::denoisers`]).
 pub fn denoiser_names() -> Vec<&'static str> {
-    let mut v = vec![Denoiser::NONE.0.as_ref(), "mara", "svgf", "progressive"];
-    v.extend(crate::sync::read(&DENOISER_NAMES).iter());
-    v
+    registry::denoisers().iter().map(|d| d.name).collect()
 }
 
-/// Called by `crate::denoise::register` only.
-pub(crate) fn add_denoiser_name(name: &'static str) {
-    crate::sync::write(&DENOISER_NAMES).push(name);
-}
+/// TAA's `--disable` name: TAA runs after any denoiser.
+pub const TAA_STAGE: &str = TaaSettings::STAGE;
 
-/// Disable a stage of any denoiser or TAA by its `--disable` name; false for an unknown name.
-pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
-    if name == TaaSettings::STAGE {
-        s.taa.enabled = false;
-        return true;
-    }
-    s.matte.disable(name)
-        || s.glossy.disable(name)
-        || s.svgf.disable(name)
-        || s.progressive.disable(name)
+/// Every stage `--disable` accepts: each denoiser's, then TAA's.
+pub fn stages() -> Vec<Stage> {
+    let taa = Stage { name: TAA_STAGE, path: "taa.enabled", off: Off::False };
+    registry::denoisers().iter().flat_map(|d| d.stages.iter().copied()).chain([taa]).collect()
 }
 
 /// Every stage name `--disable` accepts.
 pub fn stage_names() -> Vec<&'static str> {
-    MatteSettings::STAGES
-        .iter()
-        .chain(&[TaaSettings::STAGE])
-        .chain(GlossySettings::STAGES.iter())
-        .chain(SvgfSettings::STAGES.iter())
-        .chain(ProgressiveSettings::STAGES.iter())
-        .copied()
-        .collect()
+    stages().iter().map(|s| s.name).collect()
+}
+
+/// Switch off a stage of any denoiser or TAA by its `--disable` name: its setting set to its
+/// off value. False for an unknown name.
+pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
+    let Some(stage) = stages().into_iter().find(|st| st.name == name) else { return false };
+    let mut v = s.to_value();
+    let Some(field) = get_field_mut(&mut v, stage.path) else { return false };
+    *field = match stage.off {
+        Off::False => Value::Bool(false),
+        Off::Zero => Value::from(0),
+    };
+    match FrameSettings::from_value(&v) {
+        Ok(changed) => {
+            *s = changed;
+            true
+        }
+        Err(_) => false,
+    }
 }

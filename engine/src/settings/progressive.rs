@@ -3,6 +3,9 @@
 //! sample fractions below 1, which also runs at one sample per pixel.
 
 use super::fields::{Field, Kind::*, f};
+use super::registry::{DenoiserInfo, Off, Stage};
+use super::view::v;
+use super::{ViewMap, ViewSpec};
 use serde::{Deserialize, Serialize};
 
 /// The most a-trous levels (steps 1 to 2^(levels - 1) pixels).
@@ -44,21 +47,6 @@ impl Default for ProgressiveSettings {
             sigma_l: 4.0,
             epsilon_l: 0.05,
         }
-    }
-}
-
-impl ProgressiveSettings {
-    /// Its stages' `--disable` names.
-    pub const STAGES: [&str; 2] = ["progressive.temporal", "progressive.atrous"];
-
-    /// Switch off the stage `name`; false for a name that is not one of [`Self::STAGES`].
-    pub fn disable(&mut self, name: &str) -> bool {
-        match name {
-            "progressive.temporal" => self.temporal = false,
-            "progressive.atrous" => self.levels = 0,
-            _ => return false,
-        }
-        true
     }
 }
 
@@ -120,4 +108,41 @@ pub const FIELDS: &[Field] = &[
         Float(0.0, 1.0, 0.005),
         "epsilon of the luminance weight (Dundr: 0.01 to 0.1).",
     ),
+];
+
+impl super::Denoiser {
+    /// Dundr et al.'s progressive filter, then TAA.
+    pub const PROGRESSIVE: super::Denoiser = super::Denoiser(std::borrow::Cow::Borrowed(INFO.name));
+}
+
+pub const INFO: DenoiserInfo = DenoiserInfo {
+    name: "progressive",
+    summary: "Dundr et al.'s progressive SVGF, for sample fractions below 1 (--spp 1/N), then TAA",
+    fields: &[FIELDS],
+    section: None,
+    stages: &[
+        Stage::switch("progressive.temporal"),
+        Stage { name: "progressive.atrous", path: "progressive.levels", off: Off::Zero },
+    ],
+    views: VIEWS,
+    fractions: true,
+};
+
+/// The progressive filter's views (`crate::denoise::progressive`).
+pub const VIEWS: &[ViewSpec] = &[
+    v("progressive/matte accumulated", "progressive/matte history 0", ViewMap::Light),
+    // The 3x3-blurred luminance variance; 1 is white (no estimate yet: white).
+    v(
+        "progressive/matte variance",
+        "progressive/matte variance",
+        ViewMap::Grey { channel: 3, divisor: 1.0 },
+    ),
+    // Samples accumulated per pixel; 32 is white, black where none arrived yet.
+    v(
+        "progressive/matte samples",
+        "progressive/matte moments 0",
+        ViewMap::Grey { channel: 2, divisor: 32.0 },
+    ),
+    v("progressive/direct accumulated", "progressive/direct history 0", ViewMap::Light),
+    v("progressive/glossy accumulated", "progressive/glossy history 0", ViewMap::Light),
 ];

@@ -3,6 +3,9 @@
 //! a switch, so that `hush-cli quality` can ablate each.
 
 use super::fields::{Field, Kind::*, f};
+use super::registry::{DenoiserInfo, Off, Stage};
+use super::view::v;
+use super::{ViewMap, ViewSpec};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -113,42 +116,6 @@ impl Default for SvgfSettings {
 }
 
 impl SvgfSettings {
-    /// Its `--disable` names.
-    pub const STAGES: [&str; 10] = [
-        "svgf.temporal",
-        "svgf.glossy_temporal",
-        "svgf.spatial_variance",
-        "svgf.atrous",
-        "svgf.accumulated_moments",
-        "svgf.bandwidth_boost",
-        "svgf.firefly",
-        "svgf.reflection_reprojection",
-        "svgf.clipping",
-        "svgf.mirror_features",
-    ];
-
-    /// Turn a stage off by name; false for an unknown name.
-    pub fn disable(&mut self, name: &str) -> bool {
-        let f = match name {
-            "svgf.temporal" => &mut self.temporal,
-            "svgf.glossy_temporal" => &mut self.glossy_temporal,
-            "svgf.spatial_variance" => &mut self.spatial_variance,
-            "svgf.atrous" => {
-                self.levels = 0;
-                return true;
-            }
-            "svgf.accumulated_moments" => &mut self.accumulated_moments,
-            "svgf.bandwidth_boost" => &mut self.bandwidth_boost,
-            "svgf.firefly" => &mut self.firefly,
-            "svgf.reflection_reprojection" => &mut self.reflection_reprojection,
-            "svgf.clipping" => &mut self.clipping,
-            "svgf.mirror_features" => &mut self.mirror_features,
-            _ => return false,
-        };
-        *f = false;
-        true
-    }
-
     /// Base SVGF (Schied et al. 2017) without Voorhuis's changes: variance filtered at every
     /// level, no moment averages, no bandwidth boost, no firefly median, reflections reprojected
     /// with the surface's motion and not clipped.
@@ -357,4 +324,59 @@ pub const FIELDS: &[Field] = &[
         Bool,
         "Voorhuis §6: unsettled diffuse light (matte, glossy behind mirrors) brighter than all 8 neighbours is brought down to the brightest.",
     ),
+];
+
+impl super::Denoiser {
+    /// SVGF with Voorhuis's extensions, then TAA.
+    pub const SVGF: super::Denoiser = super::Denoiser(std::borrow::Cow::Borrowed(INFO.name));
+}
+
+pub const INFO: DenoiserInfo = DenoiserInfo {
+    name: "svgf",
+    summary: "SVGF (Schied et al. 2017) with Voorhuis's reflections and robustness, then TAA",
+    fields: &[FIELDS],
+    section: None,
+    stages: &[
+        Stage::switch("svgf.temporal"),
+        Stage::switch("svgf.glossy_temporal"),
+        Stage::switch("svgf.spatial_variance"),
+        Stage { name: "svgf.atrous", path: "svgf.levels", off: Off::Zero },
+        Stage::switch("svgf.accumulated_moments"),
+        Stage::switch("svgf.bandwidth_boost"),
+        Stage::switch("svgf.firefly"),
+        Stage::switch("svgf.reflection_reprojection"),
+        Stage::switch("svgf.clipping"),
+        Stage::switch("svgf.mirror_features"),
+    ],
+    views: VIEWS,
+    fractions: false,
+};
+
+/// The views of SVGF (`crate::denoise::svgf`): every intermediate of both signals.
+pub const VIEWS: &[ViewSpec] = &[
+    v("svgf/matte integrated", "svgf/matte integrated", ViewMap::Light),
+    // The luminance variance that steers the first a-trous level; 1 is white.
+    v("svgf/matte variance", "svgf/matte variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v(
+        "svgf/matte history length",
+        "svgf/matte moments 0",
+        ViewMap::Grey { channel: 2, divisor: 32.0 },
+    ),
+    v(
+        "svgf/matte first moment",
+        "svgf/matte moments 0",
+        ViewMap::Grey { channel: 0, divisor: 1.0 },
+    ),
+    v("svgf/matte history", "svgf/matte history 0", ViewMap::Light),
+    v("svgf/matte", "svgf/matte out", ViewMap::Light),
+    v("svgf/glossy integrated", "svgf/glossy integrated", ViewMap::Light),
+    v("svgf/glossy variance", "svgf/glossy variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
+    v(
+        "svgf/glossy history length",
+        "svgf/glossy moments 0",
+        ViewMap::Grey { channel: 2, divisor: 32.0 },
+    ),
+    v("svgf/glossy history", "svgf/glossy history 0", ViewMap::Light),
+    v("svgf/glossy motion", "svgf/glossy motion", ViewMap::Motion { channel: 0 }),
+    v("svgf/glossy", "svgf/glossy out", ViewMap::Light),
 ];

@@ -4,7 +4,6 @@
 
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
-use std::sync::RwLock;
 
 /// A debug view's name (`gbuffer/normal`, `matte/confidence`, ...), or `final`: the image.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -117,16 +116,19 @@ impl ViewSpec {
         self.texture.starts_with("prefilter/")
     }
 
-    /// Views of buffers that exist only in scenes with a specular lobe.
+    /// Views of buffers that exist only in scenes with a specular lobe: the glossy chain's
+    /// (`glossy/...`), a denoiser's glossy signal (`name/glossy ...`) and the trace's glossy
+    /// outputs.
     pub fn needs_glossy(&self) -> bool {
-        self.texture.starts_with("glossy/")
-            || self.texture.starts_with("svgf/glossy")
-            || self.texture.starts_with("progressive/glossy")
-            || matches!(self.texture, "trace/glossy" | "trace/reflection" | "trace/mirror")
+        let mut parts = self.texture.split('/');
+        let (first, second) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
+        first == "glossy"
+            || second.starts_with("glossy")
+            || matches!(self.texture, "trace/reflection" | "trace/mirror")
     }
 }
 
-const fn v(name: &'static str, texture: &'static str, map: ViewMap) -> ViewSpec {
+pub(super) const fn v(name: &'static str, texture: &'static str, map: ViewMap) -> ViewSpec {
     ViewSpec { name, texture, map }
 }
 
@@ -158,110 +160,8 @@ pub const FRAME_VIEWS: &[ViewSpec] = &[
     v("trace/mirror direction", "trace/mirror", ViewMap::PackedDirection),
 ];
 
-/// The views of the Mara denoiser's chains (`crate::denoise::mara`), kept here beside their
-/// settings so that presets can name them before any denoiser exists.
-pub const MARA_VIEWS: &[ViewSpec] = &[
-    v("matte/temporal", "matte/temporal", ViewMap::Light),
-    v("matte/confidence", "matte/temporal", ViewMap::Grey { channel: 3, divisor: 1.0 }),
-    v("matte/history rejection", "matte/reason", ViewMap::Flags),
-    // The radius over R (the disocclusion radius at full strength is white).
-    v(
-        "matte/disocclusion radius",
-        "matte/radius",
-        ViewMap::GreyPerWidth { channel: 0, fraction: 0.05 },
-    ),
-    v("matte/firefly", "matte/firefly", ViewMap::Light),
-    v("matte/bilateral", "matte/bilateral", ViewMap::Light),
-    v("glossy/motion", "glossy/motion", ViewMap::Motion { channel: 0 }),
-    v("glossy/virtual motion", "glossy/motion", ViewMap::Motion { channel: 2 }),
-    // Pixels between the diamond search and the virtual position (or the brute-force search
-    // when it runs); 4 px is white.
-    v("glossy/motion disagreement", "glossy/search", ViewMap::Grey { channel: 1, divisor: 4.0 }),
-    // Large-pattern iterations; 16 is white.
-    v("glossy/search steps", "glossy/search", ViewMap::Grey { channel: 0, divisor: 16.0 }),
-    v("glossy/confidence", "glossy/info", ViewMap::Grey { channel: 0, divisor: 1.0 }),
-    v("glossy/clipping", "glossy/info", ViewMap::Grey { channel: 1, divisor: 1.0 }),
-    // The bilateral's sigma over 9 px (GlossySettings' largest).
-    v("glossy/sigma", "glossy/scratch", ViewMap::Grey { channel: 3, divisor: 9.0 }),
-    v("glossy/bilateral", "glossy/denoised", ViewMap::Light),
-];
-
-/// The views of SVGF (`crate::denoise::svgf`): every intermediate of both signals.
-pub const SVGF_VIEWS: &[ViewSpec] = &[
-    v("svgf/matte integrated", "svgf/matte integrated", ViewMap::Light),
-    // The luminance variance that steers the first a-trous level; 1 is white.
-    v("svgf/matte variance", "svgf/matte variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
-    v(
-        "svgf/matte history length",
-        "svgf/matte moments 0",
-        ViewMap::Grey { channel: 2, divisor: 32.0 },
-    ),
-    v(
-        "svgf/matte first moment",
-        "svgf/matte moments 0",
-        ViewMap::Grey { channel: 0, divisor: 1.0 },
-    ),
-    v("svgf/matte history", "svgf/matte history 0", ViewMap::Light),
-    v("svgf/matte", "svgf/matte out", ViewMap::Light),
-    v("svgf/glossy integrated", "svgf/glossy integrated", ViewMap::Light),
-    v("svgf/glossy variance", "svgf/glossy variance", ViewMap::Grey { channel: 3, divisor: 1.0 }),
-    v(
-        "svgf/glossy history length",
-        "svgf/glossy moments 0",
-        ViewMap::Grey { channel: 2, divisor: 32.0 },
-    ),
-    v("svgf/glossy history", "svgf/glossy history 0", ViewMap::Light),
-    v("svgf/glossy motion", "svgf/glossy motion", ViewMap::Motion { channel: 0 }),
-    v("svgf/glossy", "svgf/glossy out", ViewMap::Light),
-];
-
-/// The progressive filter's views (`crate::denoise::progressive`).
-pub const PROGRESSIVE_VIEWS: &[ViewSpec] = &[
-    v("progressive/matte accumulated", "progressive/matte history 0", ViewMap::Light),
-    // The 3x3-blurred luminance variance; 1 is white (no estimate yet: white).
-    v(
-        "progressive/matte variance",
-        "progressive/matte variance",
-        ViewMap::Grey { channel: 3, divisor: 1.0 },
-    ),
-    // Samples accumulated per pixel; 32 is white, black where none arrived yet.
-    v(
-        "progressive/matte samples",
-        "progressive/matte moments 0",
-        ViewMap::Grey { channel: 2, divisor: 32.0 },
-    ),
-    v("progressive/direct accumulated", "progressive/direct history 0", ViewMap::Light),
-    v("progressive/glossy accumulated", "progressive/glossy history 0", ViewMap::Light),
-];
-
-/// Views that denoisers registered beside the built-in ones.
-static REGISTERED: RwLock<Vec<ViewSpec>> = RwLock::new(Vec::new());
-
-/// Add a stage's views (names already known are skipped).
-pub fn register_views(views: &[ViewSpec]) {
-    let mut r = crate::sync::write(&REGISTERED);
-    for v in views {
-        if !FRAME_VIEWS
-            .iter()
-            .chain(MARA_VIEWS)
-            .chain(SVGF_VIEWS)
-            .chain(PROGRESSIVE_VIEWS)
-            .chain(r.iter())
-            .any(|k| k.name == v.name)
-        {
-            r.push(*v);
-        }
-    }
-}
-
-/// Every view: the frame's, then the denoisers'.
+/// Every view: the frame's, then each denoiser's ([`super::registry`]).
 pub fn all_views() -> Vec<ViewSpec> {
-    FRAME_VIEWS
-        .iter()
-        .chain(MARA_VIEWS)
-        .chain(SVGF_VIEWS)
-        .chain(PROGRESSIVE_VIEWS)
-        .chain(crate::sync::read(&REGISTERED).iter())
-        .copied()
-        .collect()
+    let denoisers = super::registry::denoisers();
+    FRAME_VIEWS.iter().chain(denoisers.iter().flat_map(|d| d.views)).copied().collect()
 }

@@ -1,0 +1,160 @@
+//! The one registry of denoisers: what each declares (its name, summary, settings fields and
+//! preset section, `--disable` stages and debug views) and how to make it. The viewer's panels,
+//! presets, `--disable`, the quality tools and the frame all find a denoiser here: the built-in
+//! ones (declared in `settings/<name>.rs`) and any an application registers through
+//! `crate::denoise::register`.
+//!
+//! The registry holds a denoiser's maker without naming its type (`crate::denoise` stores and
+//! reads it), so that settings, which every stage reads, depend on no stage.
+
+use super::{Field, ViewSpec};
+use anyhow::{Result, bail};
+use serde_json::Value;
+use std::any::Any;
+use std::sync::{Arc, RwLock};
+
+/// A stage a user may switch off by name (`--disable NAME`, the quality tool's ablations): the
+/// setting that turns it off, and the value that does.
+#[derive(Clone, Copy, Debug)]
+pub struct Stage {
+    pub name: &'static str,
+    /// Dotted path of the setting (`svgf.temporal`, `accumulate.clamp`).
+    pub path: &'static str,
+    pub off: Off,
+}
+
+/// What a stage's setting is set to when the stage is switched off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Off {
+    False,
+    Zero,
+}
+
+impl Stage {
+    /// A stage switched off by setting the boolean at `path` (its name) to false.
+    pub const fn switch(path: &'static str) -> Stage {
+        Stage { name: path, path, off: Off::False }
+    }
+}
+
+/// The preset section of a denoiser whose settings are not a field of
+/// [`super::FrameSettings`] (an application's): `[name]` in TOML, `name.*` in field paths, held
+/// in [`super::FrameSettings::sections`].
+#[derive(Clone, Copy, Debug)]
+pub struct Section {
+    pub name: &'static str,
+    /// The section's default values, as a JSON object (every field the section has).
+    pub defaults: fn() -> Value,
+}
+
+/// Everything a denoiser declares, except how it is made.
+#[derive(Clone, Copy, Debug)]
+pub struct DenoiserInfo {
+    /// As `--denoiser`, presets and the viewer spell it (lower case).
+    pub name: &'static str,
+    /// One line for the viewer and `--help`.
+    pub summary: &'static str,
+    /// Its settings' descriptions, in panel order (slices of [`Field`], one per technique).
+    pub fields: &'static [&'static [Field]],
+    /// Its own preset section, for settings that are not a field of `FrameSettings`.
+    pub section: Option<Section>,
+    /// What `--disable` may switch off.
+    pub stages: &'static [Stage],
+    /// Its debug views: textures it allocates, by label, and how to show them.
+    pub views: &'static [ViewSpec],
+    /// It takes sample fractions below 1 (it fills the pixels a frame did not trace).
+    pub fractions: bool,
+}
+
+/// The raw frame: no denoiser.
+pub const NONE: DenoiserInfo = DenoiserInfo {
+    name: "none",
+    summary: "the raw 1-sample frame (composite only)",
+    fields: &[],
+    section: None,
+    stages: &[],
+    views: &[],
+    fractions: true,
+};
+
+/// The denoisers built into Hush, in the order the viewer lists them.
+pub const BUILT_IN: &[DenoiserInfo] =
+    &[NONE, super::mara::INFO, super::svgf::INFO, super::progressive::INFO];
+
+/// A maker as `crate::denoise` stores it (a `MakeDenoiser` fn pointer).
+pub type Maker = Arc<dyn Any + Send + Sync>;
+
+struct Registered {
+    info: DenoiserInfo,
+    make: Option<Maker>,
+}
+
+static REGISTERED: RwLock<Vec<Registered>> = RwLock::new(Vec::new());
+
+/// Every denoiser, built-in first.
+pub fn denoisers() -> Vec<DenoiserInfo> {
+    let registered = crate::sync::read(&REGISTERED);
+    BUILT_IN.iter().copied().chain(registered.iter().map(|r| r.info)).collect()
+}
+
+/// The denoiser called `name`.
+pub fn denoiser(name: &str) -> Result<DenoiserInfo> {
+    let all = denoisers();
+    match all.iter().find(|e| e.name == name) {
+        Some(e) => Ok(*e),
+        None => {
+            let names: Vec<&str> = all.iter().map(|e| e.name).collect();
+            bail!("no denoiser {name:?} (there are {})", names.join(", "))
+        }
+    }
+}
+
+/// The maker an application registered for `name` (None for the built-in ones, whose makers
+/// `crate::denoise` knows).
+pub(crate) fn registered_maker(name: &str) -> Option<Maker> {
+    let registered = crate::sync::read(&REGISTERED);
+    registered.iter().find(|r| r.info.name == name).and_then(|r| r.make.clone())
+}
+
+/// Add a denoiser beside the built-in ones; an error if its name, a view's name, a stage's
+/// name or its section is taken, or a field lies outside its section.
+pub(crate) fn register(info: DenoiserInfo, make: Option<Maker>) -> Result<()> {
+    let mut registered = crate::sync::write(&REGISTERED);
+    let all: Vec<DenoiserInfo> =
+        BUILT_IN.iter().copied().chain(registered.iter().map(|r| r.info)).collect();
+    let name = info.name;
+    if all.iter().any(|e| e.name == name) {
+        bail!("a denoiser named {name:?} is already registered");
+    }
+    let views = all.iter().flat_map(|e| e.views).chain(super::FRAME_VIEWS);
+    if let Some(v) = views.clone().find(|v| info.views.iter().any(|n| n.name == v.name)) {
+        bail!("denoiser {name:?}: the view {:?} exists already", v.name);
+    }
+    let mut stages = all.iter().flat_map(|e| e.stages).map(|s| s.name).chain([super::TAA_STAGE]);
+    if let Some(s) = stages.find(|s| info.stages.iter().any(|n| n.name == *s)) {
+        bail!("denoiser {name:?}: the stage {s:?} exists already");
+    }
+    let taken = super::FrameSettings::typed_sections();
+    let sections: Vec<&str> = all.iter().filter_map(|e| e.section.map(|s| s.name)).collect();
+    match info.section {
+        Some(s) if taken.iter().any(|t| t == s.name) || sections.contains(&s.name) => {
+            bail!("denoiser {name:?}: the settings section {:?} is taken", s.name)
+        }
+        Some(s) => {
+            let prefix = format!("{}.", s.name);
+            let fields = info.fields.iter().flat_map(|f| f.iter());
+            if let Some(f) = fields.clone().find(|f| !f.path.starts_with(&prefix)) {
+                bail!("denoiser {name:?}: field {:?} is outside its section {:?}", f.path, s.name);
+            }
+            if !(s.defaults)().is_object() {
+                bail!("denoiser {name:?}: the defaults of section {:?} are not a table", s.name);
+            }
+        }
+        None if !info.fields.is_empty() => {
+            bail!("denoiser {name:?}: settings fields need a section to hold them")
+        }
+        None => {}
+    }
+    registered.push(Registered { info, make });
+    Ok(())
+}
