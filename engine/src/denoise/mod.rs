@@ -120,7 +120,8 @@ const BUILT_IN_MAKERS: &[(&str, MakeDenoiser)] = &[
 /// `--disable`. An error if its name, a view, a stage or its settings section is taken.
 pub fn register(entry: Entry) -> Result<()> {
     let make = entry.make.map(|m| std::sync::Arc::new(m) as crate::settings::registry::Maker);
-    crate::settings::registry::register(entry.info, make)
+    let taken = FrameSettings::typed_sections();
+    crate::settings::registry::register(entry.info, make, &taken)
 }
 
 /// Every denoiser, built-in first.

@@ -1,9 +1,21 @@
 //! Packing lights, the environment map's sampling tables and textures into the layouts the
 //! shaders read (`shaders/common/lights.wgsl`, `env_map.wgsl`, `textures.wgsl`).
 
-use super::prepare::GpuLight;
 use crate::scene::{Light, Scene, Wrap};
+use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3};
+
+/// A light as shaders/common/lights.wgsl reads it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLight {
+    pub pos: [f32; 3],
+    pub kind: u32,
+    pub dir: [f32; 3],
+    pub cos_outer: f32,
+    pub intensity: [f32; 3],
+    pub cos_inner: f32,
+}
 
 pub(super) fn pack_light(l: &Light, origin: DVec3) -> GpuLight {
     match *l {

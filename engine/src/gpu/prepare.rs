@@ -2,6 +2,7 @@
 //! the scene's centre, build the BVH, pack materials, lights, emitters, the environment and
 //! textures into the layouts the shaders read (`shaders/common/*.wgsl`).
 
+pub use super::pack::GpuLight;
 use super::pack::{EnvPack, pack_light, pack_textures};
 use crate::accel::{self, Accel, BvhKind};
 use crate::scene::{AlphaMode, Environment, Scene};
@@ -46,17 +47,6 @@ pub struct GpuMaterial {
     pub normal_scale: f32,
     pub flags: u32,
     pub tex: [i32; 4],
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuLight {
-    pub pos: [f32; 3],
-    pub kind: u32,
-    pub dir: [f32; 3],
-    pub cos_outer: f32,
-    pub intensity: [f32; 3],
-    pub cos_inner: f32,
 }
 
 impl From<&crate::scene::Material> for GpuMaterial {

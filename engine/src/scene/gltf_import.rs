@@ -8,6 +8,7 @@
 
 use super::files::{SceneFiles, SceneFolder, read_uri, short};
 use super::gltf_camera::{camera_pose, local_rotation};
+use super::gltf_importer::Importer;
 use super::gltf_mesh::{animations, primitive};
 use super::{Camera, DEFAULT_MAX_DEPTH, EnvMap, Environment, Light, Material, Mesh, Object, Scene};
 use crate::limits::{Budget, Limits, over_budget, read_regular_file};
@@ -140,18 +141,6 @@ fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8
     Ok((document, blob))
 }
 
-/// Where each (glTF texture, sRGB) pair went in the scene's texture list.
-pub(super) type TextureSlots = HashMap<(usize, bool), u32>;
-
-pub(super) struct Importer<'a> {
-    pub(super) files: &'a dyn SceneFiles,
-    pub(super) warnings: Vec<String>,
-    pub(super) max_texture_size: u32,
-    pub(super) budget: Budget,
-    /// Triangles placed so far (instances counted), against `Limits::triangles`.
-    triangles: u64,
-}
-
 /// An orthographic camera, rendered through a perspective one once the scene's bounds are known.
 struct Orthographic {
     index: usize,
@@ -160,11 +149,6 @@ struct Orthographic {
 }
 
 impl Importer<'_> {
-    pub(super) fn warn(&mut self, msg: String) {
-        log::warn!("{msg}");
-        self.warnings.push(msg);
-    }
-
     fn import(
         mut self,
         doc: &gltf::Document,

@@ -3,7 +3,7 @@
 //! space under the load budget.
 
 use super::files::{read_uri, short};
-use super::gltf_import::{Importer, TextureSlots};
+use super::gltf_importer::{Importer, TextureSlots};
 use super::{Material, Texture, TextureRef, Wrap};
 use crate::limits::is_over_budget;
 use anyhow::Result;

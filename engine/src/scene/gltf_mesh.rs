@@ -1,7 +1,7 @@
 //! glTF mesh primitives and node animations, read through the checked accessors of `accessor`.
 
 use super::accessor::{self, Data, Expect};
-use super::gltf_import::Importer;
+use super::gltf_importer::Importer;
 use super::{Animation, Mesh, Track};
 use anyhow::{Result, bail};
 use glam::{DQuat, DVec3, Vec2, Vec3, Vec4};

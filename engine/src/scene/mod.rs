@@ -11,6 +11,7 @@ mod gltf_camera;
 mod gltf_check;
 mod gltf_export;
 mod gltf_import;
+mod gltf_importer;
 mod gltf_material;
 mod gltf_mesh;
 mod level;

@@ -1,7 +1,7 @@
 //! The glossy chain's settings (Mara et al. 2017 §3.4 stages 8-10, Voorhuis §4) and their
 //! descriptions.
 
-use super::fields::{Field, Kind::*, f};
+use super::field::{Field, Kind::*, f};
 use serde::{Deserialize, Serialize};
 
 /// How the glossy chain finds where a reflection was in the previous frame.
@@ -195,7 +195,7 @@ impl GlossySettings {
 pub const MAX_GLOSSY_SIGMA_PX: f32 = 9.0;
 
 fn reflection_mvs() -> Vec<String> {
-    super::fields::names(&ReflectionMv::ALL)
+    super::field::names(&ReflectionMv::ALL)
 }
 
 /// Its fields, in panel order.

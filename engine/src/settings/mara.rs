@@ -2,8 +2,8 @@
 //! settings are the matte chain's ([`super::MatteSettings`]) and the glossy chain's
 //! ([`super::GlossySettings`]); TAA's belong to the frame, which runs TAA after any denoiser.
 
-use super::registry::{DenoiserInfo, Stage};
-use super::view::v;
+use super::denoiser_info::{DenoiserInfo, Stage};
+use super::view_spec::v;
 use super::{Denoiser, ViewMap, ViewSpec};
 use std::borrow::Cow;
 

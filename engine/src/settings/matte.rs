@@ -1,6 +1,6 @@
 //! The matte chain's settings (Mara et al. 2017 §3.4, stages 3-7) and their descriptions.
 
-use super::fields::{Field, Kind::*, f};
+use super::field::{Field, Kind::*, f};
 use serde::{Deserialize, Serialize};
 
 /// The matte chain of Mara et al. 2017, §3.4 (stages 3-7 of Figure 2).

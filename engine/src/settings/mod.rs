@@ -1,6 +1,8 @@
 //! Tunables of the real-time frame, with their units and defaults. `fields.rs` describes each
 //! one for panels and presets; `preset.rs` saves and loads them as TOML.
 
+mod denoiser_info;
+mod field;
 mod fields;
 mod fraction;
 mod glossy;
@@ -12,16 +14,19 @@ pub mod registry;
 pub mod svgf;
 mod taa;
 mod view;
+mod view_spec;
 
 pub use fields::{Field, Kind, fields, get as get_field, get_mut as get_field_mut, leaves};
 pub use fraction::{MAX_SAMPLE_PERIOD, SampleFraction};
 pub use glossy::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
 pub use matte::MatteSettings;
 pub use progressive::{MAX_LEVELS as PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
+pub use registry::all_views;
 pub use registry::{DenoiserInfo, Off, Section, Stage};
 pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, SvgfSettings};
 pub use taa::TaaSettings;
-pub use view::{FRAME_VIEWS, View, ViewMap, ViewSpec, all_views};
+pub use view::View;
+pub use view_spec::{FRAME_VIEWS, ViewMap, ViewSpec};
 
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -137,7 +142,7 @@ impl FrameSettings {
     }
 
     /// The names the built-in settings take at the top of a preset: no section may use one.
-    pub(crate) fn typed_sections() -> Vec<String> {
+    pub fn typed_sections() -> Vec<String> {
         match FrameSettings::typed_default().to_value() {
             Value::Object(m) => m.keys().cloned().collect(),
             _ => vec![],

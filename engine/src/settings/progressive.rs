@@ -2,9 +2,9 @@
 //! filtering", §4-5; `denoise/progressive.rs`, shaders/progressive/*.wgsl): the denoiser for
 //! sample fractions below 1, which also runs at one sample per pixel.
 
-use super::fields::{Field, Kind::*, f};
-use super::registry::{DenoiserInfo, Off, Stage};
-use super::view::v;
+use super::denoiser_info::{DenoiserInfo, Off, Stage};
+use super::field::{Field, Kind::*, f};
+use super::view_spec::v;
 use super::{ViewMap, ViewSpec};
 use serde::{Deserialize, Serialize};
 

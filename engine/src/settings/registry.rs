@@ -7,64 +7,12 @@
 //! The registry holds a denoiser's maker without naming its type (`crate::denoise` stores and
 //! reads it), so that settings, which every stage reads, depend on no stage.
 
-use super::{Field, ViewSpec};
+pub use super::denoiser_info::{DenoiserInfo, Off, Section, Stage};
+use super::taa::TaaSettings;
+use super::view_spec::{FRAME_VIEWS, ViewSpec};
 use anyhow::{Result, bail};
-use serde_json::Value;
 use std::any::Any;
 use std::sync::{Arc, RwLock};
-
-/// A stage a user may switch off by name (`--disable NAME`, the quality tool's ablations): the
-/// setting that turns it off, and the value that does.
-#[derive(Clone, Copy, Debug)]
-pub struct Stage {
-    pub name: &'static str,
-    /// Dotted path of the setting (`svgf.temporal`, `accumulate.clamp`).
-    pub path: &'static str,
-    pub off: Off,
-}
-
-/// What a stage's setting is set to when the stage is switched off.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Off {
-    False,
-    Zero,
-}
-
-impl Stage {
-    /// A stage switched off by setting the boolean at `path` (its name) to false.
-    pub const fn switch(path: &'static str) -> Stage {
-        Stage { name: path, path, off: Off::False }
-    }
-}
-
-/// The preset section of a denoiser whose settings are not a field of
-/// [`super::FrameSettings`] (an application's): `[name]` in TOML, `name.*` in field paths, held
-/// in [`super::FrameSettings::sections`].
-#[derive(Clone, Copy, Debug)]
-pub struct Section {
-    pub name: &'static str,
-    /// The section's default values, as a JSON object (every field the section has).
-    pub defaults: fn() -> Value,
-}
-
-/// Everything a denoiser declares, except how it is made.
-#[derive(Clone, Copy, Debug)]
-pub struct DenoiserInfo {
-    /// As `--denoiser`, presets and the viewer spell it (lower case).
-    pub name: &'static str,
-    /// One line for the viewer and `--help`.
-    pub summary: &'static str,
-    /// Its settings' descriptions, in panel order (slices of [`Field`], one per technique).
-    pub fields: &'static [&'static [Field]],
-    /// Its own preset section, for settings that are not a field of `FrameSettings`.
-    pub section: Option<Section>,
-    /// What `--disable` may switch off.
-    pub stages: &'static [Stage],
-    /// Its debug views: textures it allocates, by label, and how to show them.
-    pub views: &'static [ViewSpec],
-    /// It takes sample fractions below 1 (it fills the pixels a frame did not trace).
-    pub fractions: bool,
-}
 
 /// The raw frame: no denoiser.
 pub const NONE: DenoiserInfo = DenoiserInfo {
@@ -97,6 +45,12 @@ pub fn denoisers() -> Vec<DenoiserInfo> {
     BUILT_IN.iter().copied().chain(registered.iter().map(|r| r.info)).collect()
 }
 
+/// Every view: the frame's, then each denoiser's.
+pub fn all_views() -> Vec<ViewSpec> {
+    let denoisers = denoisers();
+    FRAME_VIEWS.iter().chain(denoisers.iter().flat_map(|d| d.views)).copied().collect()
+}
+
 /// The denoiser called `name`.
 pub fn denoiser(name: &str) -> Result<DenoiserInfo> {
     let all = denoisers();
@@ -117,8 +71,9 @@ pub(crate) fn registered_maker(name: &str) -> Option<Maker> {
 }
 
 /// Add a denoiser beside the built-in ones; an error if its name, a view's name, a stage's
-/// name or its section is taken, or a field lies outside its section.
-pub(crate) fn register(info: DenoiserInfo, make: Option<Maker>) -> Result<()> {
+/// name or its section is taken (`taken`: the names the built-in settings use), or a field lies
+/// outside its section.
+pub(crate) fn register(info: DenoiserInfo, make: Option<Maker>, taken: &[String]) -> Result<()> {
     let mut registered = crate::sync::write(&REGISTERED);
     let all: Vec<DenoiserInfo> =
         BUILT_IN.iter().copied().chain(registered.iter().map(|r| r.info)).collect();
@@ -126,15 +81,14 @@ pub(crate) fn register(info: DenoiserInfo, make: Option<Maker>) -> Result<()> {
     if all.iter().any(|e| e.name == name) {
         bail!("a denoiser named {name:?} is already registered");
     }
-    let views = all.iter().flat_map(|e| e.views).chain(super::FRAME_VIEWS);
+    let views = all.iter().flat_map(|e| e.views).chain(FRAME_VIEWS);
     if let Some(v) = views.clone().find(|v| info.views.iter().any(|n| n.name == v.name)) {
         bail!("denoiser {name:?}: the view {:?} exists already", v.name);
     }
-    let mut stages = all.iter().flat_map(|e| e.stages).map(|s| s.name).chain([super::TAA_STAGE]);
+    let mut stages = all.iter().flat_map(|e| e.stages).map(|s| s.name).chain([TaaSettings::STAGE]);
     if let Some(s) = stages.find(|s| info.stages.iter().any(|n| n.name == *s)) {
         bail!("denoiser {name:?}: the stage {s:?} exists already");
     }
-    let taken = super::FrameSettings::typed_sections();
     let sections: Vec<&str> = all.iter().filter_map(|e| e.section.map(|s| s.name)).collect();
     match info.section {
         Some(s) if taken.iter().any(|t| t == s.name) || sections.contains(&s.name) => {

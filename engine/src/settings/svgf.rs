@@ -2,9 +2,9 @@
 //! `denoise/svgf.rs`, shaders/svgf/*.wgsl). Every stage and every one of Voorhuis's changes is
 //! a switch, so that `hush-cli quality` can ablate each.
 
-use super::fields::{Field, Kind::*, f};
-use super::registry::{DenoiserInfo, Off, Stage};
-use super::view::v;
+use super::denoiser_info::{DenoiserInfo, Off, Stage};
+use super::field::{Field, Kind::*, f};
+use super::view_spec::v;
 use super::{ViewMap, ViewSpec};
 use serde::{Deserialize, Serialize};
 

@@ -1,7 +1,7 @@
 //! TAA's settings (passes/taa.rs, shaders/taa/taa.wgsl): a stage of its own after any
 //! denoiser's composite. The measurements behind each default are in `docs/decisions.md`.
 
-use super::fields::{Field, Kind::*, f};
+use super::field::{Field, Kind::*, f};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

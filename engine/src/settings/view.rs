@@ -1,7 +1,9 @@
 //! What the display shows: the image, or any labelled texture of the frame through a small
 //! mapping (shaders/realtime/display.wgsl). A stage offers a debug view by naming one of its
-//! textures and a [`ViewMap`]: no WGSL and no enum variant per view.
+//! textures and a [`super::ViewMap`]: no WGSL and no enum variant per view.
 
+use super::registry::all_views;
+use super::view_spec::ViewSpec;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
@@ -45,123 +47,4 @@ impl<'de> Deserialize<'de> for View {
         }
         Ok(View::named(&name))
     }
-}
-
-/// How the display turns a texel into a colour (`display.map` in shaders/realtime/display.wgsl;
-/// the numbers are that shader's).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ViewMap {
-    /// Radiance in rgb: exposed and tone-mapped like the image.
-    Light,
-    /// Data in rgb, clamped to [0, 1].
-    Color,
-    /// One channel divided by `divisor`, as grey.
-    Grey { channel: u32, divisor: f32 },
-    /// One channel over this fraction of the frame's width (at least 1), as grey.
-    GreyPerWidth { channel: u32, fraction: f32 },
-    /// Two channels from `channel` as pixels of motion: hue = direction, brightness = length
-    /// (1 px = 0.25).
-    Motion { channel: u32 },
-    /// The G-buffer's octahedral normal, black off the surface.
-    Normal,
-    /// The G-buffer's reversed-Z depth, near bright (depth^0.25).
-    Depth,
-    /// A u32 id (channel 0) hashed to a colour, black off the surface.
-    Id,
-    /// History rejection flags in the low bits of a u32 (`matte/reason`): red disoccluded,
-    /// yellow low confidence, plus blue where clamped.
-    Flags,
-    /// An octahedral direction packed as two snorm16 in a u32.
-    PackedDirection,
-    /// A distance in alpha over 2^17 ray offsets (the scene's extent), white from 65000 on.
-    Distance,
-    /// A position in rgb over the scene's extent, as bands (black where alpha marks a miss).
-    Position,
-}
-
-impl ViewMap {
-    /// (map, channel, parameter) as the display's uniform carries them.
-    pub fn encode(self, width: u32) -> (u32, u32, f32) {
-        match self {
-            ViewMap::Light => (1, 0, 0.0),
-            ViewMap::Color => (2, 0, 0.0),
-            ViewMap::Grey { channel, divisor } => (3, channel, divisor),
-            ViewMap::GreyPerWidth { channel, fraction } => {
-                (3, channel, (width as f32 * fraction).max(1.0))
-            }
-            ViewMap::Motion { channel } => (4, channel, 0.0),
-            ViewMap::Normal => (5, 0, 0.0),
-            ViewMap::Depth => (6, 0, 0.0),
-            ViewMap::Id => (7, 0, 0.0),
-            ViewMap::Flags => (8, 0, 0.0),
-            ViewMap::PackedDirection => (9, 0, 0.0),
-            ViewMap::Distance => (10, 3, 0.0),
-            ViewMap::Position => (11, 0, 0.0),
-        }
-    }
-}
-
-/// A debug view: a name, the label of the texture it shows, and how.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ViewSpec {
-    pub name: &'static str,
-    pub texture: &'static str,
-    pub map: ViewMap,
-}
-
-impl ViewSpec {
-    /// Views of the pre-filter's textures, which exist once a thin lens or an open shutter has
-    /// been rendered.
-    pub fn needs_traced_primaries(&self) -> bool {
-        self.texture.starts_with("prefilter/")
-    }
-
-    /// Views of buffers that exist only in scenes with a specular lobe: the glossy chain's
-    /// (`glossy/...`), a denoiser's glossy signal (`name/glossy ...`) and the trace's glossy
-    /// outputs.
-    pub fn needs_glossy(&self) -> bool {
-        let mut parts = self.texture.split('/');
-        let (first, second) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
-        first == "glossy"
-            || second.starts_with("glossy")
-            || matches!(self.texture, "trace/reflection" | "trace/mirror")
-    }
-}
-
-pub(super) const fn v(name: &'static str, texture: &'static str, map: ViewMap) -> ViewSpec {
-    ViewSpec { name, texture, map }
-}
-
-/// The frame's own views: the G-buffer and the trace's outputs.
-pub const FRAME_VIEWS: &[ViewSpec] = &[
-    v("gbuffer/depth", "gbuffer/depth", ViewMap::Depth),
-    v("gbuffer/normal", "gbuffer/normal", ViewMap::Normal),
-    v("gbuffer/base_color", "gbuffer/base_color", ViewMap::Color),
-    v("gbuffer/metallic", "gbuffer/base_color", ViewMap::Grey { channel: 3, divisor: 1.0 }),
-    v("gbuffer/roughness", "gbuffer/specular", ViewMap::Grey { channel: 3, divisor: 1.0 }),
-    v("gbuffer/specular F0", "gbuffer/specular", ViewMap::Color),
-    v("gbuffer/emission", "gbuffer/emission", ViewMap::Light),
-    v("gbuffer/object id", "gbuffer/ids", ViewMap::Id),
-    v("gbuffer/motion", "gbuffer/motion", ViewMap::Motion { channel: 0 }),
-    // The pre-filter's (Moon et al. 2017), with a thin lens: the bandwidth after smoothing
-    // (white: h = 2), the world positions' spread (white: 8 pixels), the filtered normal's and
-    // view depth's variances from dual buffers (white: 0.05, and 1e-4 relative), the raw normal
-    // (gbuffer/normal shows the filtered).
-    v("prefilter/bandwidth", "prefilter/view", ViewMap::Grey { channel: 1, divisor: 2.0 }),
-    v("prefilter/position spread", "prefilter/view", ViewMap::Grey { channel: 2, divisor: 8.0 }),
-    v("prefilter/normal variance", "prefilter/view", ViewMap::Grey { channel: 3, divisor: 0.05 }),
-    v("prefilter/depth variance", "prefilter/normals", ViewMap::Grey { channel: 2, divisor: 1e-4 }),
-    v("prefilter/raw normal", "prefilter/normals", ViewMap::Normal),
-    v("trace/matte", "trace/matte", ViewMap::Light),
-    v("trace/direct", "trace/direct", ViewMap::Light),
-    v("trace/glossy", "trace/glossy", ViewMap::Light),
-    v("trace/glossy hit distance", "trace/glossy", ViewMap::Distance),
-    v("trace/virtual position", "trace/reflection", ViewMap::Position),
-    v("trace/mirror direction", "trace/mirror", ViewMap::PackedDirection),
-];
-
-/// Every view: the frame's, then each denoiser's ([`super::registry`]).
-pub fn all_views() -> Vec<ViewSpec> {
-    let denoisers = super::registry::denoisers();
-    FRAME_VIEWS.iter().chain(denoisers.iter().flat_map(|d| d.views)).copied().collect()
 }
