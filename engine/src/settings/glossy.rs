@@ -42,15 +42,9 @@ impl ReflectionMv {
 pub struct GlossySettings {
     /// Stage switches. Without `temporal` nothing is reprojected (Voorhuis's "NoSpecReproj").
     pub temporal: bool,
-    /// Neighbourhood clipping of the reprojected history (Voorhuis §4.2.3), off by default as
-    /// the matte clamp is: at one sample per pixel the 5x5 box of the blurred current frame
-    /// rarely holds the rare bright paths a converged history averages, so clipping drains
-    /// energy from every glossy surface. Measured with it on and off (jitter-aware
-    /// reprojection): the level at 160x90 (60 still frames, 256-frame reference) 0.0738 and
-    /// 0.0694 FLIP (a mirror in the hall's doorway lost a fifth of its reflection's brightness);
-    /// `hush-cli reflections`, strafe with diamond vectors: reflective FLIP 0.1470 and 0.1371,
-    /// ghost region 0.2576 and 0.2395; still camera, chain-output temporal error 0.00537 and
-    /// 0.00302. Ghosts are left to the confidence tests.
+    /// Neighbourhood clipping of the reprojected history (Voorhuis §4.2.3), default off: at one
+    /// sample per pixel the box rarely holds the bright paths a converged history averages (level
+    /// FLIP 0.0738 on, 0.0694 off); ghosts are left to the confidence tests.
     pub clipping: bool,
     /// The separable bilateral (stages 9 and 10).
     pub bilateral: bool,
@@ -66,19 +60,10 @@ pub struct GlossySettings {
     pub clip_roughness: f32,
     /// Hysteresis h, as the matte temporal's (Mara: the same confidence and clamping).
     pub hysteresis: f32,
-    /// The surface reprojection (rough surfaces, and every surface in a static view) rejects a
-    /// previous texel whose normal is more than this many degrees from the surface's (180: off).
-    /// With the jitter a crease's two faces, or a ledge thinner than a pixel and the face behind
-    /// it, take turns under one pixel; eq. (11) passes both, but they reflect different things
-    /// under different F(w_s), and the chain filters light divided by F: the staircase's table
-    /// edge came out 10x too bright. FLIP at 160x90, 60 still frames (second half / last frame;
-    /// references of 512 frames for the staircase at 160x284, 2048 for the living room, 1024
-    /// otherwise) with the test off, at 25, 10 and 5 degrees: staircase 0.0726 / 0.0702,
-    /// 0.0655 / 0.0627, 0.0645 / 0.0615, 0.0644 / 0.0614; FlightHelmet 0.0096 / 0.0091,
-    /// 0.0091 / 0.0086, 0.0081 / 0.0072, 0.0080 / 0.0071; Lantern 0.0023 / 0.0023, then
-    /// 0.0019 / 0.0018 at every angle; level 0.0486 / 0.0462, then 0.0481 / 0.0456 at every
-    /// angle; the living room 0.1603 / 0.1479, 0.1632 / 0.1506, 0.1632 / 0.1502 (its shorter
-    /// histories cost more than the mix did).
+    /// The surface reprojection rejects a texel whose normal is more than this many degrees off,
+    /// [0, 180], default 10 (180: off): a crease's faces reflect different things under one
+    /// pixel (staircase FLIP 0.0645 at 10, 0.0726 off; the living room's shorter histories cost
+    /// 0.1632 against 0.1603).
     pub reprojection_normal_degrees: f32,
     /// First step of the diamond search's large pattern, pixels (Appendix A: 4; 1 = no LDSP
     /// scaling).
@@ -94,32 +79,12 @@ pub struct GlossySettings {
     pub sigma_scale: f32,
     pub sigma_exponent: f32,
     pub sigma_epsilon_px: f32,
-    /// Beyond this many frames of history the bilateral's sigma shrinks as 1 / history length:
-    /// a converged history needs no spatial blur, a fresh one (disocclusion, motion) gets all
-    /// of it, as the matte chain's disocclusion-driven radius. 0: Mara's fixed sigma. FLIP on
-    /// the level (160x90, 40 still frames, 128-frame reference): fixed sigma 0.0994, no glossy
-    /// bilateral 0.0790, 1 / sqrt(n) past 4 frames 0.0864, past 1 frame 0.0816: the fixed blur
-    /// of a converged history costs more than the noise it removes. 1 / n past 1 frame (60
-    /// still frames, 256-frame reference, TAA's still blend): 0.0652 against 0.0673 with
-    /// 1 / sqrt(n) and 0.0651 with no glossy bilateral; on a path of 20 still, 20 strafing and 20
-    /// still frames (128-frame references) FLIP still / moving / settled 0.0942 / 0.1085 /
-    /// 0.0946 against 0.0970 / 0.1092 / 0.0950 with 1 / sqrt(n).
+    /// Frames of history past which the bilateral's sigma shrinks as 1 / n, default 1 (0: Mara's
+    /// fixed sigma): a converged history needs no spatial blur (level FLIP 0.0652, fixed 0.0994).
     pub sigma_full_frames: f32,
-    /// A history resampled bilinearly (by surface or reflection motion) counts as at most this
-    /// many frames, as MatteSettings::resampled_history_frames (0: no cap). A moving glossy
-    /// history holds the reflections seen on the way, and once the camera stops it weighs
-    /// cap / (cap + k) after k still frames: what a fast move uncovered stayed worse than a
-    /// fresh start for over 20 frames with a cap of 8. Level at 160x90, 20 still frames, a
-    /// 1.2 m strafe in 5 frames, 35 still frames, 128-frame reference: FLIP over the 487
-    /// pixels flagged on the last moving frame (grown by one) 10 and 20 frames after the stop,
-    /// against 0.1117 and 0.1018 for a fresh start at that view: uncapped 0.1593 / 0.1406, 8
-    /// frames 0.1367 / 0.1170, 4 frames 0.1226 / 0.1047, 2 frames 0.1124 / 0.0977, 1 frame
-    /// 0.1071 / 0.0943 (whole frame 10 frames after: 0.0807, 0.0749, 0.0717, 0.0701, 0.0695).
-    /// The slow strafe of MatteSettings::resampled_history_frames (matte capped at 8), FLIP 10
-    /// frames after the stop / moving mean: uncapped 0.0805 / 0.1014, 8 frames 0.0720 / 0.1002,
-    /// 2 frames 0.0709 / 0.0999, 1 frame 0.0714 / 0.1013. `hush-cli reflections`, strafe with
-    /// diamond vectors, 8 frames and 1: reflective FLIP 0.1256 and 0.1197, ghost region 0.2234
-    /// and 0.2111 (primary vectors: 0.1622 and 0.1282); the still camera's are unchanged.
+    /// The most frames a resampled glossy history counts as, default 1 (0: no cap): what a move
+    /// uncovered recovers like a fresh start (FLIP 10 frames after a strafe: 0.1071, uncapped
+    /// 0.1593) and reflections ghost less (ghost region 0.2111, 8 frames 0.2234).
     pub resampled_history_frames: f32,
     /// Voorhuis eq. (6)'s omega, with the ray differential at the secondary hit measured in
     /// pixel footprints of the primary surface (scale-free, unlike the paper's world units):

@@ -11,11 +11,8 @@ pub struct MatteSettings {
     pub temporal: bool,
     pub history_bilateral: bool,
     pub disocclusion: bool,
-    /// The 3x3 median (stage 6) is off by default: on the level it cost FLIP everywhere it was
-    /// measured (160x90, 128-frame references, a 60-frame path of 20 still, 20 strafing and 20
-    /// still frames; with the 1 / sqrt(n) history disk): still 0.1188 on, 0.0890 off; moving
-    /// 0.1146 and 0.1058; settled 0.0940 and 0.0892. The median removes energy that fireflies
-    /// carry and the reference keeps.
+    /// Stage 6, the 3x3 firefly median; default off: on the level it raised FLIP (60 still
+    /// frames: 0.1188 on, 0.0890 off), removing energy that fireflies carry and the reference keeps.
     pub firefly: bool,
     pub bilateral: bool,
     /// Hysteresis h of eq. (11) (paper: 0.98).
@@ -25,46 +22,25 @@ pub struct MatteSettings {
     /// the same at any scene scale and resolution).
     pub d0_px: f32,
     pub d1_px: f32,
-    /// History is clamped to the current neighbourhood's mean +- this many standard deviations
-    /// (Mara et al. §3.4); 0 switches the clamp off, the default. At one sample per pixel the
-    /// neighbourhood of an indirectly lit pixel is mostly zeros, and the clamp erases a correct
-    /// history: the living room's interior (160x90, 60 frames) came out at 0.049 of a reference
-    /// mean of 0.176 with a 4-sigma clamp over 3x3, 0.112 over 33 samples, and 0.173 with no
-    /// clamp; cornell_diffuse's FLIP went from 0.081 (4 sigma) to 0.074. Without it, history
-    /// lags lighting changes by about 1 / (1 - h) frames; geometric changes still reset it
-    /// through the confidence c.
+    /// History clamp to the neighbourhood's mean +- k standard deviations (Mara §3.4), k in [0, 16],
+    /// default 0 (off): at one sample per pixel it erases correct indirect history (living room
+    /// interior 0.049 of a 0.176 mean at 4 sigma); off, lighting changes lag about 1 / (1 - h) frames.
     pub clamp_sigma: f32,
-    /// Eq. (11)'s reprojection also rejects a previous texel whose normal is more than this
-    /// many degrees from the surface's (180: no normal test, the paper's position test alone,
-    /// the default). Matte light varies slowly across a crease, and the test only shortens
-    /// histories: FLIP at 160x90, 60 still frames (as GlossySettings::reprojection_normal_degrees
-    /// measures, glossy test at 25 degrees) off, at 25 and at 45 degrees: staircase 0.0655,
-    /// 0.0675, 0.0688; level 0.0481, 0.0493, 0.0492; living room 0.1632, 0.1728 at 25.
+    /// Reprojection also rejects a texel whose normal is more than this many degrees off, [0, 180],
+    /// default 180 (off): matte light varies slowly across a crease and the test only shortens
+    /// histories (staircase FLIP 0.0655 off, 0.0675 at 25 degrees).
     pub reprojection_normal_degrees: f32,
     /// Taps of the sparse bilateral filters (paper: 50).
     pub taps: u32,
     /// Disk diameter of the history-loop bilateral as a fraction of the screen width (paper: 1%).
     pub history_diameter_fraction: f32,
-    /// Beyond this many frames of history the history bilateral's disk shrinks as
-    /// 1 / sqrt(history length). The filter runs on the history every frame, so with a fixed
-    /// disk its blur compounds: a sample n frames old has been blurred n times, a radius that
-    /// grows as sqrt(n). Shrinking the disk as 1 / sqrt(n) keeps that growth logarithmic, while
-    /// a fresh history (disocclusion, motion) gets the whole disk. 0: the paper's fixed disk.
-    /// Level, 320x180, 60 still frames, 256-frame reference (glossy clipping and bilateral off,
-    /// firefly off): FLIP 0.0644 with the fixed disk, 0.0618 past 4 frames, 0.0605 past 1 (the
-    /// default).
+    /// Frames of history past which the history bilateral's disk shrinks as 1 / sqrt(n), default 1
+    /// (0: the paper's fixed disk): keeps the loop's compounding blur logarithmic (level FLIP
+    /// 0.0605, 0.0644 with the fixed disk).
     pub history_full_frames: f32,
-    /// A history resampled bilinearly (the surface moved on screen since the last frame) counts
-    /// as at most this many frames, so that its new sample weighs at least 1 / (this + 1). Each
-    /// resampling blurs the history a little, and at the paper's 1 - h = 2% a strafe's blur
-    /// outlived it: when the camera stopped, the level took over 20 frames to reach the FLIP a
-    /// fresh start reached in 10. Texels read exactly (a still view) keep their whole length.
-    /// 0: no cap (the paper's blend). Level at 160x90, 20 still, 20 strafing (1.2 m) and 20
-    /// still frames, 128-frame references, FLIP 10 frames after the stop (fresh start at the
-    /// same view after 10 frames: 0.0774) / moving mean: no cap 0.0830 / 0.1030, 24 frames
-    /// 0.0811 / 0.1028, 8 frames 0.0805 / 0.1014, 4 frames 0.0820 / 0.1020 (TAA restarting as
-    /// TaaSettings::resampled_frames; the glossy chain uncapped; these caps counted the
-    /// new frame among the 8). As shipped, with the glossy chain's cap too: 0.0720 / 0.1002.
+    /// The most frames a bilinearly resampled history counts as, default 8 (0: no cap): a strafe's
+    /// blur fades within frames of a stop (level FLIP 10 frames after: 0.0720, uncapped 0.0830)
+    /// at a noisier moving image.
     pub resampled_history_frames: f32,
     /// R of the disocclusion radius as a fraction of the screen width (paper: 1/20).
     pub disocclusion_fraction: f32,
@@ -72,31 +48,13 @@ pub struct MatteSettings {
     pub low_confidence_multiplier: f32,
     /// Largest final-bilateral radius as a fraction of the screen width.
     pub max_radius_fraction: f32,
-    /// Smallest final-bilateral radius as a fraction of the screen width (0: the paper's
-    /// r = (1 - c) R alone, which at full confidence is 2% of R, a fraction of a pixel). Stage
-    /// (7) is outside the history loop, so its blur does not compound; a still view's history
-    /// of tens of frames still carries noise it removes. FLIP at 160x90, 60 still frames,
-    /// 256-frame references (living room, level, FlightHelmet): 0 gives 0.1778, 0.0601 and
-    /// 0.0113; 3% without an edge-stop 0.1652, 0.0565 and 0.0125; 5% (with edge_stop_sigmas
-    /// 4) 0.1710 and 0.0586 on the first two: the 50 taps spread thinner.
+    /// Smallest final-bilateral radius, [0, 0.5] of the screen width, default 0.03 (0: Mara's
+    /// r = (1 - c) R): outside the history loop it removes a still history's residual noise (living
+    /// room FLIP 0.1652 against 0.1778) at a cost on fine detail (FlightHelmet 0.0125 against 0.0113).
     pub min_radius_fraction: f32,
-    /// The final bilateral also weighs taps by exp(-|luminance difference| / (k sigma)), sigma
-    /// the standard deviation of the history's mean (the input's spread over 16 taps on the
-    /// surface, over sqrt(history length)): SVGF's luminance edge-stop. A converged history
-    /// then keeps the fine shading (FlightHelmet's contact shadows) that the minimum radius
-    /// would blur, while a noisy one is still filtered. 0: no edge-stop. FLIP as above (living
-    /// room, level, FlightHelmet) for k = 4, 8, 16: 0.1676 / 0.0574 / 0.0116, 0.1664 / 0.0567 /
-    /// 0.0119, 0.1657 / 0.0560 / 0.0122; Lantern 0.0023 with 4 and 16, 0.0025 with none.
-    /// The luminance difference is now taken on a guide, each pixel's 3x3 mean on its surface,
-    /// against the guide's noise (sigma / 3), and sigma comes from the input minus the
-    /// history's mean, not the input's spread (shaders/matte/bilateral.wgsl). FLIP at 160x90,
-    /// 60 still frames (second half / last frame; staircase 160x284), taps' own luminance and
-    /// spread against the guide and residual, k = 8: living room 0.1541 / 0.1414 and 0.1467 /
-    /// 0.1358, staircase 0.0642 / 0.0610 and 0.0591 / 0.0562, level 0.0483 / 0.0458 and
-    /// 0.0469 / 0.0444. The residual alone: living room 0.1567 / 0.1441, staircase 0.0634 /
-    /// 0.0602; with k = 2 as well, staircase 0.0609 / 0.0566, but the spread with k = 2 took
-    /// the living room to 0.1566 / 0.1423: a smaller k kept the staircase's contact shadows,
-    /// and the noise differences between single taps cost the living room its filtering.
+    /// The final bilateral's luminance edge-stop, k standard deviations of the guide's noise,
+    /// default 8 (0: none): keeps converged shading the minimum radius would blur (second half /
+    /// last frame FLIP: living room 0.1467 / 0.1358, level 0.0469 / 0.0444).
     pub edge_stop_sigmas: f32,
     /// Bilateral weights: cosine power on normals, plane-distance sigma in pixel footprints.
     pub normal_power: f32,

@@ -12,27 +12,23 @@ pub struct TaaSettings {
     pub enabled: bool,
     /// Weight of the current frame while a pixel moves or its history is clamped (0.1).
     pub alpha: f32,
-    /// A still, unclamped pixel weighs the current frame 2 / (n + 1) for a history of n frames,
-    /// falling to 1 / this: it converges to the box-filtered pixel where `alpha` alone keeps an
-    /// edge pixel flickering with the latest offsets (level, 160x90, 60 still frames: temporal
-    /// error 0.00270 against 0.00449, FLIP 0.0601 against 0.0599). 0: `alpha` always.
+    /// A still, unclamped pixel weighs the current frame 2 / (n + 1), down to 1 / this, default 64
+    /// (0: `alpha` always): converges edges to the box-filtered pixel (temporal error 0.00270
+    /// against 0.00449) at no FLIP cost.
     pub still_frames: f32,
-    /// History length a pixel restarts at when it stands still after moving, so the sharp still
-    /// frames replace what resampling blurred (FLIP 10 frames after a strafe stops: 0.0830,
-    /// carrying on 0.0932). 0: the length carries on.
+    /// History length a pixel restarts at when it stops after moving, default 1 (0: carries on):
+    /// sharp still frames replace the resampling's blur (FLIP 10 frames after a strafe 0.0830,
+    /// 0.0932 carrying on).
     pub resampled_frames: f32,
-    /// A settled pixel shows the last image shown blended towards the history by this many
-    /// times the history's weight (at most 1): damps a sub-pixel edge's flicker under the
-    /// Halton offsets (Lantern, 160x90, frames 30-59: temporal error 3.9e-6, 2.1e-5 at 0) at a
-    /// quarter of the history's lag (level FLIP 0.0484, 0.0481 at 0). 0: the history as is.
+    /// A settled pixel shows the last image blended towards the history by this many times the
+    /// history's weight (at most 1), default 4 (0: the history): damps sub-pixel flicker (Lantern
+    /// temporal error 3.9e-6 against 2.1e-5) for a quarter of the history's lag.
     pub display_ratio: f32,
-    /// Share of a settled pixel's matte-light lag taken out: TAA shows its average of the matte
-    /// factor times the denoiser's current matte light (where the denoiser offers it and its
-    /// history continues) rather than averaging already averaged light (living room, 160x90,
-    /// 60 still frames, last frame FLIP 0.1358, 0.1403 at 0; costs where noise rather than lag
-    /// dominates: cornell_diffuse 0.0428 against 0.0407).
+    /// Share of a settled pixel's matte-light lag taken out by following the denoiser's current
+    /// light, [0, 1], default 1: living room FLIP 0.1358 against 0.1403 at 0; costs where noise
+    /// dominates (cornell_diffuse 0.0428 against 0.0407).
     pub current_light: f32,
-    /// As `current_light`, for the glossy light (living room 0.1414 against 0.1465 at 0).
+    /// As `current_light`, for the glossy light, default 1 (living room FLIP 0.1414, 0.1465 at 0).
     pub current_glossy: f32,
 }
 
