@@ -182,7 +182,7 @@ const FIELDS: &[Field] = &[
 ];
 
 /// What `--disable` may switch off: its history.
-const STAGES: &[Stage] = &[Stage::switch("accumulate_test.temporal")];
+const STAGES: &[Stage] = &[Stage::named("accumulate", "accumulate_test.temporal")];
 
 fn defaults() -> serde_json::Value {
     serde_json::json!({ "temporal": true, "max_frames": 32 })
@@ -294,9 +294,9 @@ fn a_registered_denoisers_settings_reach_presets_disable_and_the_frame() {
         assert!(format!("{e:#}").contains(needle), "{bad}: {e:#}");
     }
     assert!(hush_engine::denoise::fields().any(|f| f.path == "accumulate_test.max_frames"));
-    assert!(hush_engine::denoise::stage_names().contains(&"accumulate_test.temporal"));
+    assert!(hush_engine::denoise::stage_names().contains(&"accumulate"));
     let mut off = s.clone();
-    assert!(hush_engine::denoise::disable_stage(&mut off, "accumulate_test.temporal"));
+    assert!(hush_engine::denoise::disable_stage(&mut off, "accumulate"));
     assert_eq!(off.sections[SECTION], json!({ "temporal": false, "max_frames": 4 }));
     assert_eq!(FrameSettings::from_toml(&off.to_toml().unwrap()).unwrap(), off);
     let scene = hush_engine::scene::default_level();

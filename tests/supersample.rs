@@ -214,15 +214,15 @@ fn heaviest_frame_times_every_pass() {
         return; // no timestamp queries on this device
     }
     let times = r.pass_times(&gpu).unwrap();
-    let levels = spans.iter().filter(|s| s.label == "svgf/matte atrous").count();
+    let levels = spans.iter().filter(|s| s.label == "svgf/atrous_matte").count();
     assert_eq!(levels, 5, "{spans:?}");
-    let summed: f64 = spans.iter().filter(|s| s.label == "svgf/matte atrous").map(|s| s.ms).sum();
-    let merged = times.iter().find(|t| t.0 == "svgf/matte atrous").unwrap().1;
+    let summed: f64 = spans.iter().filter(|s| s.label == "svgf/atrous_matte").map(|s| s.ms).sum();
+    let merged = times.iter().find(|t| t.0 == "svgf/atrous_matte").unwrap().1;
     assert!((merged - summed).abs() < 1e-9, "{merged} vs {summed}");
     for p in [
         "trace",
         "supersample/samples",
-        "svgf/glossy atrous",
+        "svgf/atrous_glossy",
         "composite",
         "supersample/resolve",
         "taa",

@@ -19,7 +19,7 @@ use hush_engine::quality::{
     Image, compare, compare_with_flip_map, luminance, region_mean, save_flip_heatmap,
 };
 use hush_engine::scene::{CameraPath, Scene};
-use hush_engine::settings::{Denoiser, FrameSettings, stage_names};
+use hush_engine::settings::{Denoiser, FrameSettings};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -391,19 +391,10 @@ pub fn run(a: QualityArgs) -> Result<()> {
             Ok(())
         };
         row("nothing", &den)?;
-        // The stages of the denoiser under test, and TAA.
-        let prefix = format!("{}.", if denoiser == Denoiser::MARA { "" } else { denoiser.name() });
-        let own = |stage: &str| {
-            if denoiser == Denoiser::MARA {
-                stage.starts_with("matte.") || stage.starts_with("glossy.")
-            } else {
-                stage.starts_with(&prefix)
-            }
-        };
-        for stage in stage_names()
-            .into_iter()
-            .filter(|s| own(s) || *s == hush_engine::settings::TaaSettings::STAGE)
-        {
+        // The stages the denoiser under test declares, and TAA.
+        let own = hush_engine::settings::registry::denoiser(denoiser.name())?.stages;
+        let taa = hush_engine::settings::TaaSettings::STAGE;
+        for stage in own.iter().map(|s| s.name).chain([taa]) {
             let mut settings = base.clone();
             hush_engine::settings::disable_stage(&mut settings, stage);
             let (sc, _) = stream(&s, &settings, &references)?;

@@ -31,11 +31,13 @@ pub struct RenderArgs {
     /// --denoiser, --disable and --reflection-mv then override it.
     #[arg(long)]
     pub preset: Option<PathBuf>,
-    /// Real-time mode: denoiser stages to switch off, comma-separated (matte.temporal,
-    /// matte.history_bilateral, matte.disocclusion, matte.firefly, matte.bilateral, taa,
-    /// glossy.temporal, glossy.clipping, glossy.bilateral; svgf.temporal, svgf.glossy_temporal,
-    /// svgf.spatial_variance, svgf.atrous, svgf.accumulated_moments, svgf.bandwidth_boost,
-    /// svgf.firefly, svgf.reflection_reprojection, svgf.clipping, svgf.mirror_features).
+    /// Real-time mode: stages to switch off, comma-separated, by their names (matte/temporal,
+    /// matte/history_bilateral, matte/disocclusion, matte/firefly, matte/bilateral, taa,
+    /// glossy/temporal, glossy/bilateral; svgf/temporal, svgf/temporal_glossy, svgf/variance,
+    /// svgf/atrous; progressive/temporal, progressive/atrous), and switches that cover several
+    /// stages or part of one by their settings (glossy.clipping; svgf.accumulated_moments,
+    /// svgf.bandwidth_boost, svgf.firefly, svgf.reflection_reprojection, svgf.clipping,
+    /// svgf.mirror_features). An unknown name's error lists them all.
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
     /// Real-time mode: how the glossy chain reprojects reflections: diamond (Voorhuis's search),

@@ -135,7 +135,7 @@ fn bad_arguments_are_clear_errors() {
                 "--out",
                 "x.exr",
             ],
-            "glossy.bilateral",
+            "glossy/bilateral",
         ),
         (
             vec![

@@ -95,19 +95,19 @@ impl Signal {
     fn labels(self) -> [&'static str; 3] {
         match self {
             Signal::Matte => [
-                "progressive/matte temporal",
-                "progressive/matte variance",
-                "progressive/matte atrous",
+                "progressive/temporal_matte",
+                "progressive/variance_matte",
+                "progressive/atrous_matte",
             ],
             Signal::Glossy => [
-                "progressive/glossy temporal",
-                "progressive/glossy variance",
-                "progressive/glossy atrous",
+                "progressive/temporal_glossy",
+                "progressive/variance_glossy",
+                "progressive/atrous_glossy",
             ],
             Signal::Direct => [
-                "progressive/direct temporal",
-                "progressive/direct variance",
-                "progressive/direct atrous",
+                "progressive/temporal_direct",
+                "progressive/variance_direct",
+                "progressive/atrous_direct",
             ],
         }
     }

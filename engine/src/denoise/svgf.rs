@@ -232,17 +232,18 @@ struct SignalStages {
 
 impl SignalStages {
     fn new(gpu: &Gpu, glossy: bool, animated: bool, offered: &Bindings) -> Result<SignalStages> {
-        let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
+        let temporal =
+            if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
         // Labels are 'static: the profiler and the pass timings key on them.
         let labels: [&'static str; 4] = if glossy {
             [
-                "svgf/glossy temporal",
-                "svgf/glossy variance",
-                "svgf/glossy atrous",
-                "svgf/glossy final",
+                "svgf/temporal_glossy",
+                "svgf/variance_glossy",
+                "svgf/atrous_glossy",
+                "svgf/final_glossy",
             ]
         } else {
-            ["svgf/matte temporal", "svgf/matte variance", "svgf/matte atrous", "svgf/matte final"]
+            ["svgf/temporal_matte", "svgf/variance_matte", "svgf/atrous_matte", "svgf/final_matte"]
         };
         let stage = |label, file, b: &Bindings| {
             ChainStage::new(gpu, label, &modules(file, glossy, animated), "main", b)
@@ -496,19 +497,9 @@ fn motion_stages(
         ChainStage::new(gpu, label, &modules(file, animated), entry, &offered)
     };
     Ok(MotionStages {
-        motion: stage("svgf/glossy motion", "glossy/motion.wgsl", "main", None)?,
-        prefilter_h: stage(
-            "svgf/glossy prefilter_h",
-            "glossy/prefilter.wgsl",
-            "pre_h",
-            Some(false),
-        )?,
-        prefilter_v: stage(
-            "svgf/glossy prefilter_v",
-            "glossy/prefilter.wgsl",
-            "pre_v",
-            Some(true),
-        )?,
+        motion: stage("svgf/motion", "glossy/motion.wgsl", "main", None)?,
+        prefilter_h: stage("svgf/prefilter_h", "glossy/prefilter.wgsl", "pre_h", Some(false))?,
+        prefilter_v: stage("svgf/prefilter_v", "glossy/prefilter.wgsl", "pre_v", Some(true))?,
     })
 }
 

@@ -23,7 +23,14 @@ pub enum Off {
 }
 
 impl Stage {
-    /// A stage switched off by setting the boolean at `path` (its name) to false.
+    /// A stage `name` (`chain/stage`: its passes' label, settings group and WGSL file stem)
+    /// switched off by setting the boolean at `path` to false.
+    pub const fn named(name: &'static str, path: &'static str) -> Stage {
+        Stage { name, path, off: Off::False }
+    }
+
+    /// A switch that covers several stages or a part of one, named by its setting's `path`
+    /// and switched off by setting it to false.
     pub const fn switch(path: &'static str) -> Stage {
         Stage { name: path, path, off: Off::False }
     }

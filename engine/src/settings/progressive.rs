@@ -121,8 +121,8 @@ pub const INFO: DenoiserInfo = DenoiserInfo {
     fields: &[FIELDS],
     section: None,
     stages: &[
-        Stage::switch("progressive.temporal"),
-        Stage { name: "progressive.atrous", path: "progressive.levels", off: Off::Zero },
+        Stage::named("progressive/temporal", "progressive.temporal"),
+        Stage { name: "progressive/atrous", path: "progressive.levels", off: Off::Zero },
     ],
     views: VIEWS,
     fractions: true,

@@ -115,7 +115,8 @@ fn all_programs() -> Vec<Program> {
     }
     for animated in [false, true] {
         for glossy in [false, true] {
-            let temporal = if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal.wgsl" };
+            let temporal =
+                if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
             for stage in [temporal, "svgf/variance.wgsl", "svgf/atrous.wgsl", "svgf/final.wgsl"] {
                 v.push(
                     compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated))
