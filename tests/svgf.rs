@@ -127,7 +127,7 @@ fn svgf_history_resets_on_disocclusion() {
     let setup1 = r.camera_setup(&moved);
     let inv1 = setup1.jittered(halton_jitter(warm), SIZE).inverse();
     let read = |n: &str| r.read_texture(&gpu, n).unwrap().0;
-    // Frame `warm` (parity warm % 2) wrote moments[1 - parity].
+    // Frame `warm` wrote the moments slot that its parity (warm % 2) does not read.
     let written = 1 - warm as usize % 2;
     let (depth1, motion, normal, input) = (
         read("gbuffer/depth"),
