@@ -194,18 +194,30 @@ impl Panel {
         };
         let mut shown: Vec<&str> = vec![];
         let mut rows: Vec<(String, f64, Option<&'static str>)> = vec![];
+        // A stage's passes share one row: its name, then what tells them apart (`_h`/`_v`,
+        // `_matte`/`_glossy`), their times summed.
         for (pass, ms) in &self.pass_ms {
             match group_of(pass) {
-                Some(g) if shown.contains(&g) => {
-                    if let Some(row) = rows.iter_mut().find(|r| r.2 == Some(g)) {
-                        row.0 =
-                            format!("{g} ({})", pass.trim_start_matches(g).trim_start_matches('_'));
-                        row.1 += ms;
-                    }
-                }
                 Some(g) => {
-                    shown.push(g);
-                    rows.push((g.to_string(), *ms, Some(g)));
+                    let part = pass.trim_start_matches(g).trim_start_matches('_');
+                    match rows.iter_mut().find(|r| r.2 == Some(g)) {
+                        Some(row) => {
+                            row.0 = match row.0.strip_suffix(')') {
+                                Some(open) => format!("{open}, {part})"),
+                                None => format!("{g} ({part})"),
+                            };
+                            row.1 += ms;
+                        }
+                        None => {
+                            shown.push(g);
+                            let label = if part.is_empty() {
+                                g.to_string()
+                            } else {
+                                format!("{g} ({part})")
+                            };
+                            rows.push((label, *ms, Some(g)));
+                        }
+                    }
                 }
                 None => rows.push((pass.to_string(), *ms, None)),
             }
