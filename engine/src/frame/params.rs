@@ -26,7 +26,7 @@ pub struct FrameParams {
     pub representative_roughness: f32,
     /// Samples per pixel k (Voorhuis §5): the raster's guide and k - 1 traced ones.
     pub samples: u32,
-    /// Frames between two samples of a pixel, 1 / f (1: every pixel every frame; frame/schedule.rs).
+    /// Frames between two samples of a pixel, 1 / f (1: every pixel every frame; passes/schedule.rs).
     pub period: u32,
     /// Primary samples per pixel k of the traced primaries (realtime/primaries.wgsl), where a
     /// thin lens makes the primary hit random; 0: the raster's G-buffer.
