@@ -36,7 +36,7 @@ fn field_row(
     let mut changed = false;
     let hover = format!(
         "{}\n{}: default {}{}",
-        f.help,
+        f.help.trim(),
         f.path,
         show(default),
         if f.unit.is_empty() { String::new() } else { format!(" {}", f.unit) }

@@ -44,3 +44,40 @@ pub(super) const fn f(
 ) -> Field {
     Field { path, group, unit, kind, help }
 }
+
+/// Declares a technique's settings struct, its `Default` and its [`Field`] table from one text
+/// per setting: a field's doc comment is also its help in the viewer and in errors. Fields under
+/// `hidden` have no [`Field`] (they are not settings a user sets: test hooks).
+macro_rules! described {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident / $table:ident {
+            $(
+                $(#[doc = $doc:literal])+
+                $field:ident: $ty:ty = $default:expr,
+                    ($path:literal, $group:literal, $unit:literal, $kind:expr);
+            )*
+        }
+        hidden {
+            $( $(#[$hmeta:meta])* $hfield:ident: $hty:ty = $hdefault:expr; )*
+        }
+    ) => {
+        $(#[$meta])*
+        pub struct $name {
+            $( $(#[doc = $doc])+ pub $field: $ty, )*
+            $( $(#[$hmeta])* pub $hfield: $hty, )*
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                $name { $( $field: $default, )* $( $hfield: $hdefault, )* }
+            }
+        }
+
+        /// Its fields, in panel order; each one's help is its doc comment.
+        pub const $table: &[$crate::settings::Field] = &[
+            $( $crate::settings::field::f($path, $group, $unit, $kind, concat!($($doc),+)), )*
+        ];
+    };
+}
+pub(super) use described;

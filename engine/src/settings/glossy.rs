@@ -1,7 +1,7 @@
 //! The glossy chain's settings (Mara et al. 2017 §3.4 stages 8-10, Voorhuis §4) and their
 //! descriptions.
 
-use super::field::{Field, Kind::*, f};
+use super::field::{Kind::*, described};
 use serde::{Deserialize, Serialize};
 
 /// How the glossy chain finds where a reflection was in the previous frame.
@@ -35,102 +35,102 @@ impl ReflectionMv {
     }
 }
 
-/// The glossy chain: Mara et al. 2017 §3.4 stages 8-10 with the reflection reprojection and
-/// neighbourhood clipping of Voorhuis §4.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct GlossySettings {
-    /// Stage switches. Without `temporal` nothing is reprojected (Voorhuis's "NoSpecReproj").
-    pub temporal: bool,
-    /// Neighbourhood clipping of the reprojected history (Voorhuis §4.2.3), default off: at one
-    /// sample per pixel the box rarely holds the bright paths a converged history averages (level
-    /// FLIP 0.0738 on, 0.0694 off); ghosts are left to the confidence tests.
-    pub clipping: bool,
-    /// The separable bilateral (stages 9 and 10).
-    pub bilateral: bool,
-    pub reflection_mv: ReflectionMv,
-    /// Below this roughness reflections are reprojected with reflection motion vectors; above it
-    /// with the surface's (Voorhuis §4.2.1: 0.4).
-    pub roughness_threshold: f32,
-    /// At or below this roughness a surface is a mirror: its chain matches exact reflected hit
-    /// positions (eq. 1), filters with the reflected surface's normal and demodulates by its
-    /// reflectance (§4.1). Above it, the representative-ray distance of eq. (4)-(5).
-    pub mirror_roughness: f32,
-    /// Neighbourhood clipping applies below this roughness (§4.2.3: 0.9).
-    pub clip_roughness: f32,
-    /// Hysteresis h, as the matte temporal's (Mara: the same confidence and clamping).
-    pub hysteresis: f32,
-    /// The surface reprojection rejects a texel whose normal is more than this many degrees off,
-    /// [0, 180], default 10 (180: off): a crease's faces reflect different things under one
-    /// pixel (staircase FLIP 0.0645 at 10, 0.0726 off; the living room's shorter histories cost
-    /// 0.1632 against 0.1603).
-    pub reprojection_normal_degrees: f32,
-    /// First step of the diamond search's large pattern, pixels (Appendix A: 4; 1 = no LDSP
-    /// scaling).
-    pub initial_step: u32,
-    /// Most large-pattern iterations per pixel (bounds the search's cost).
-    pub max_search_steps: u32,
-    /// Eq. (11)'s d0, d1 for mirrors, in pixel footprints at the reflected distance.
-    pub d0_px: f32,
-    pub d1_px: f32,
-    /// Bilateral sigma = scale x roughness^exponent + epsilon pixels (Mara: 7, 0.1, epsilon).
-    /// Epsilon is 1 px so that mirrors (roughness 0) are still filtered, across the reflected
-    /// surface's features.
-    pub sigma_scale: f32,
-    pub sigma_exponent: f32,
-    pub sigma_epsilon_px: f32,
-    /// Frames of history past which the bilateral's sigma shrinks as 1 / n, default 1 (0: Mara's
-    /// fixed sigma): a converged history needs no spatial blur (level FLIP 0.0652, fixed 0.0994).
-    pub sigma_full_frames: f32,
-    /// The most frames a resampled glossy history counts as, default 1 (0: no cap): what a move
-    /// uncovered recovers like a fresh start (FLIP 10 frames after a strafe: 0.1071, uncapped
-    /// 0.1593) and reflections ghost less (ghost region 0.2111, 8 frames 0.2234).
-    pub resampled_history_frames: f32,
-    /// Voorhuis eq. (6)'s omega, with the ray differential at the secondary hit measured in
-    /// pixel footprints of the primary surface (scale-free, unlike the paper's world units):
-    /// sigma is multiplied by exp(-footprints / omega) below the roughness threshold.
-    pub ray_differential_omega: f32,
-    /// Bilateral weight on roughness differences: exp(-(dr / sigma)^2).
-    pub roughness_sigma: f32,
-    /// Trace each glossy pixel's representative (mirror) ray below the roughness threshold, and
-    /// search by eq. (1) on its real hit; off, eq. (4) extends the ray by the sample's depth and
-    /// the search uses eq. (5). On the `spheres` strafe (160x90, against a 65x65 brute-force
-    /// search) the glossy sphere's vectors were 8.05 px off on average (42.6% within 1 px) with
-    /// sampled depths, whose jumps between near and far geometry make eq. (5)'s minimum
-    /// ambiguous, and 0.31 px (92.6%) with traced ones, for one closest-hit ray per such pixel.
-    pub trace_representative_ray: bool,
-    /// Measurements only: also run a brute-force search over a window of this radius (pixels)
-    /// and report the diamond search's distance to it in the search view (0: off).
-    #[serde(skip)]
-    pub reference_search_radius: u32,
-}
-
-impl Default for GlossySettings {
-    fn default() -> Self {
-        GlossySettings {
-            temporal: true,
-            clipping: false,
-            bilateral: true,
-            reflection_mv: ReflectionMv::Diamond,
-            roughness_threshold: 0.4,
-            mirror_roughness: 0.01,
-            clip_roughness: 0.9,
-            hysteresis: 0.98,
-            reprojection_normal_degrees: 10.0,
-            initial_step: 4,
-            max_search_steps: 32,
-            d0_px: 2.0,
-            d1_px: 4.0,
-            sigma_scale: 7.0,
-            sigma_exponent: 0.1,
-            sigma_epsilon_px: 1.0,
-            sigma_full_frames: 1.0,
-            resampled_history_frames: 1.0,
-            ray_differential_omega: 16.0,
-            roughness_sigma: 0.1,
-            trace_representative_ray: true,
-            reference_search_radius: 0,
-        }
+described! {
+    /// The glossy chain: Mara et al. 2017 §3.4 stages 8-10 with the reflection reprojection and
+    /// neighbourhood clipping of Voorhuis §4.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    #[serde(default)]
+    pub struct GlossySettings / FIELDS {
+        /// Reflection motion: surface (primary), virtual position, or diamond search.
+        reflection_mv: ReflectionMv = ReflectionMv::Diamond,
+            ("glossy.reflection_mv", "glossy/motion", "", Choice(reflection_mvs));
+        /// Below this roughness reflections are reprojected with reflection motion vectors; above it
+        /// with the surface's (Voorhuis §4.2.1: 0.4).
+        roughness_threshold: f32 = 0.4,
+            ("glossy.roughness_threshold", "glossy/motion", "roughness", Float(0.0, 1.0, 0.005));
+        /// At or below this roughness a surface is a mirror: its chain matches exact reflected hit
+        /// positions (eq. 1), filters with the reflected surface's normal and demodulates by its
+        /// reflectance (§4.1). Above it, the representative-ray distance of eq. (4)-(5).
+        mirror_roughness: f32 = 0.01,
+            ("glossy.mirror_roughness", "glossy/motion", "roughness", Float(0.0, 1.0, 0.001));
+        /// First step of the diamond search's large pattern, pixels (Appendix A: 4; 1 = no LDSP
+        /// scaling).
+        initial_step: u32 = 4,
+            ("glossy.initial_step", "glossy/motion", "px", Int(1, 64));
+        /// Most large-pattern iterations per pixel (bounds the search's cost).
+        max_search_steps: u32 = 32,
+            ("glossy.max_search_steps", "glossy/motion", "steps", Int(1, 256));
+        /// Trace each glossy pixel's representative (mirror) ray below the roughness threshold, and
+        /// search by eq. (1) on its real hit; off, eq. (4) extends the ray by the sample's depth and
+        /// the search uses eq. (5). On the `spheres` strafe (160x90, against a 65x65 brute-force
+        /// search) the glossy sphere's vectors were 8.05 px off on average (42.6% within 1 px) with
+        /// sampled depths, whose jumps between near and far geometry make eq. (5)'s minimum
+        /// ambiguous, and 0.31 px (92.6%) with traced ones, for one closest-hit ray per such pixel.
+        trace_representative_ray: bool = true,
+            ("glossy.trace_representative_ray", "glossy/motion", "", Bool);
+        /// Stage switches. Without `temporal` nothing is reprojected (Voorhuis's "NoSpecReproj").
+        temporal: bool = true,
+            ("glossy.temporal", "glossy/temporal", "", Bool);
+        /// Hysteresis h, as the matte temporal's (Mara: the same confidence and clamping).
+        hysteresis: f32 = 0.98,
+            ("glossy.hysteresis", "glossy/temporal", "", Float(0.0, 1.0, 0.001));
+        /// The surface reprojection rejects a texel whose normal is more than this many degrees off,
+        /// [0, 180], default 10 (180: off): a crease's faces reflect different things under one
+        /// pixel (staircase FLIP 0.0645 at 10, 0.0726 off; the living room's shorter histories cost
+        /// 0.1632 against 0.1603).
+        reprojection_normal_degrees: f32 = 10.0,
+            ("glossy.reprojection_normal_degrees", "glossy/temporal", "degrees", Float(0.0, 180.0, 0.5));
+        /// Eq. (11)'s d0, d1 for mirrors, in pixel footprints at the reflected distance.
+        d0_px: f32 = 2.0,
+            ("glossy.d0_px", "glossy/temporal", "footprints", Float(0.0, 64.0, 0.05));
+        /// Eq. 11's d1 for mirrors, at the reflected distance.
+        d1_px: f32 = 4.0,
+            ("glossy.d1_px", "glossy/temporal", "footprints", Float(0.0, 64.0, 0.05));
+        /// Neighbourhood clipping of the reprojected history (Voorhuis §4.2.3), default off: at one
+        /// sample per pixel the box rarely holds the bright paths a converged history averages (level
+        /// FLIP 0.0738 on, 0.0694 off); ghosts are left to the confidence tests.
+        clipping: bool = false,
+            ("glossy.clipping", "glossy/temporal", "", Bool);
+        /// Neighbourhood clipping applies below this roughness (§4.2.3: 0.9).
+        clip_roughness: f32 = 0.9,
+            ("glossy.clip_roughness", "glossy/temporal", "roughness", Float(0.0, 1.0, 0.005));
+        /// The separable bilateral (stages 9 and 10).
+        bilateral: bool = true,
+            ("glossy.bilateral", "glossy/bilateral", "", Bool);
+        /// Bilateral sigma = scale x roughness^exponent + epsilon pixels (Mara: 7, 0.1, epsilon).
+        /// Epsilon is 1 px so that mirrors (roughness 0) are still filtered, across the reflected
+        /// surface's features.
+        sigma_scale: f32 = 7.0,
+            ("glossy.sigma_scale", "glossy/bilateral", "px", Float(0.0, 9.0, 0.05));
+        /// Roughness exponent of sigma (Mara 0.1).
+        sigma_exponent: f32 = 0.1,
+            ("glossy.sigma_exponent", "glossy/bilateral", "", Float(0.0, 4.0, 0.005));
+        /// Sigma at roughness 0.
+        sigma_epsilon_px: f32 = 1.0,
+            ("glossy.sigma_epsilon_px", "glossy/bilateral", "px", Float(0.0, 9.0, 0.05));
+        /// Frames of history past which the bilateral's sigma shrinks as 1 / n, default 1 (0: Mara's
+        /// fixed sigma): a converged history needs no spatial blur (level FLIP 0.0652, fixed 0.0994).
+        sigma_full_frames: f32 = 1.0,
+            ("glossy.sigma_full_frames", "glossy/bilateral", "frames", Float(0.0, 256.0, 0.1));
+        /// The most frames a resampled glossy history counts as, default 1 (0: no cap): what a move
+        /// uncovered recovers like a fresh start (FLIP 10 frames after a strafe: 0.1071, uncapped
+        /// 0.1593) and reflections ghost less (ghost region 0.2111, 8 frames 0.2234).
+        resampled_history_frames: f32 = 1.0,
+            ("glossy.resampled_history_frames", "glossy/temporal", "frames", Float(0.0, 1024.0, 1.0));
+        /// Voorhuis eq. (6)'s omega, with the ray differential at the secondary hit measured in
+        /// pixel footprints of the primary surface (scale-free, unlike the paper's world units):
+        /// sigma is multiplied by exp(-footprints / omega) below the roughness threshold.
+        ray_differential_omega: f32 = 16.0,
+            ("glossy.ray_differential_omega", "glossy/bilateral", "footprints", Float(0.001, 1024.0, 0.1));
+        /// Bilateral weight on roughness differences: exp(-(dr / sigma)^2).
+        roughness_sigma: f32 = 0.1,
+            ("glossy.roughness_sigma", "glossy/bilateral", "roughness", Float(0.0, 1.0, 0.001));
+    }
+    hidden {
+        /// Measurements only: also run a brute-force search over a window of this radius (pixels)
+        /// and report the diamond search's distance to it in the search view (0: off).
+        #[serde(skip)]
+        reference_search_radius: u32 = 0;
     }
 }
 
@@ -162,148 +162,3 @@ pub const MAX_GLOSSY_SIGMA_PX: f32 = 9.0;
 fn reflection_mvs() -> Vec<String> {
     super::field::names(&ReflectionMv::ALL)
 }
-
-/// Its fields, in panel order.
-pub const FIELDS: &[Field] = &[
-    f(
-        "glossy.reflection_mv",
-        "glossy/motion",
-        "",
-        Choice(reflection_mvs),
-        "Reflection motion: surface (primary), virtual position, or diamond search.",
-    ),
-    f(
-        "glossy.roughness_threshold",
-        "glossy/motion",
-        "roughness",
-        Float(0.0, 1.0, 0.005),
-        "Reflection motion below this roughness, surface motion above (Voorhuis 0.4).",
-    ),
-    f(
-        "glossy.mirror_roughness",
-        "glossy/motion",
-        "roughness",
-        Float(0.0, 1.0, 0.001),
-        "At or below this roughness a surface is a mirror (exact reflected hits).",
-    ),
-    f(
-        "glossy.initial_step",
-        "glossy/motion",
-        "px",
-        Int(1, 64),
-        "First step of the diamond search's large pattern (Appendix A: 4).",
-    ),
-    f(
-        "glossy.max_search_steps",
-        "glossy/motion",
-        "steps",
-        Int(1, 256),
-        "Most large-pattern iterations per pixel.",
-    ),
-    f(
-        "glossy.trace_representative_ray",
-        "glossy/motion",
-        "",
-        Bool,
-        "Trace the mirror ray of glossy surfaces under the threshold.",
-    ),
-    f(
-        "glossy.temporal",
-        "glossy/temporal",
-        "",
-        Bool,
-        "Stage 8: reprojection of glossy history (off: NoSpecReproj).",
-    ),
-    f(
-        "glossy.hysteresis",
-        "glossy/temporal",
-        "",
-        Float(0.0, 1.0, 0.001),
-        "h for the glossy history.",
-    ),
-    f(
-        "glossy.reprojection_normal_degrees",
-        "glossy/temporal",
-        "degrees",
-        Float(0.0, 180.0, 0.5),
-        "Surface reprojection rejects a previous texel whose normal differs by more (180: off).",
-    ),
-    f(
-        "glossy.d0_px",
-        "glossy/temporal",
-        "footprints",
-        Float(0.0, 64.0, 0.05),
-        "Eq. 11's d0 for mirrors, at the reflected distance.",
-    ),
-    f(
-        "glossy.d1_px",
-        "glossy/temporal",
-        "footprints",
-        Float(0.0, 64.0, 0.05),
-        "Eq. 11's d1 for mirrors, at the reflected distance.",
-    ),
-    f(
-        "glossy.clipping",
-        "glossy/temporal",
-        "",
-        Bool,
-        "Neighbourhood clipping of the reprojected history (Voorhuis 4.2.3).",
-    ),
-    f(
-        "glossy.clip_roughness",
-        "glossy/temporal",
-        "roughness",
-        Float(0.0, 1.0, 0.005),
-        "Clipping applies below this roughness (0.9).",
-    ),
-    f("glossy.bilateral", "glossy/bilateral", "", Bool, "Stages 9-10: separable bilateral."),
-    f(
-        "glossy.sigma_scale",
-        "glossy/bilateral",
-        "px",
-        Float(0.0, 9.0, 0.05),
-        "Sigma = scale x roughness^exponent + epsilon (Mara 7).",
-    ),
-    f(
-        "glossy.sigma_exponent",
-        "glossy/bilateral",
-        "",
-        Float(0.0, 4.0, 0.005),
-        "Roughness exponent of sigma (Mara 0.1).",
-    ),
-    f(
-        "glossy.sigma_epsilon_px",
-        "glossy/bilateral",
-        "px",
-        Float(0.0, 9.0, 0.05),
-        "Sigma at roughness 0.",
-    ),
-    f(
-        "glossy.sigma_full_frames",
-        "glossy/bilateral",
-        "frames",
-        Float(0.0, 256.0, 0.1),
-        "Past this history length sigma shrinks as 1/sqrt(length) (0: fixed).",
-    ),
-    f(
-        "glossy.resampled_history_frames",
-        "glossy/temporal",
-        "frames",
-        Float(0.0, 1024.0, 1.0),
-        "A bilinearly resampled history counts as at most this many frames (0: no cap).",
-    ),
-    f(
-        "glossy.ray_differential_omega",
-        "glossy/bilateral",
-        "footprints",
-        Float(0.001, 1024.0, 0.1),
-        "Voorhuis eq. 6's omega: sigma x exp(-ray differential / omega).",
-    ),
-    f(
-        "glossy.roughness_sigma",
-        "glossy/bilateral",
-        "roughness",
-        Float(0.0, 1.0, 0.001),
-        "Bilateral weight on roughness differences.",
-    ),
-];

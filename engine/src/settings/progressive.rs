@@ -3,7 +3,7 @@
 //! sample fractions below 1, which also runs at one sample per pixel.
 
 use super::denoiser_info::{DenoiserInfo, Off, Stage};
-use super::field::{Field, Kind::*, f};
+use super::field::{Kind::*, described};
 use super::view_spec::v;
 use super::{ViewMap, ViewSpec};
 use serde::{Deserialize, Serialize};
@@ -11,104 +11,41 @@ use serde::{Deserialize, Serialize};
 /// The most a-trous levels (steps 1 to 2^(levels - 1) pixels).
 pub const MAX_LEVELS: u32 = 6;
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct ProgressiveSettings {
-    /// Accumulation of light and luminance moments over samples (§4.2). Off, every frame starts
-    /// over from the samples it traced.
-    pub temporal: bool,
-    /// a of r = max(a, 1 / age) (§4.2): the smallest weight of a new sample (Dundr: 0.1).
-    pub alpha: f32,
-    /// In a still view a falls to 1 / this, so the light becomes a true mean of up to this many
-    /// samples; 0: `alpha` always (Dundr).
-    pub still_samples: f32,
-    /// A-trous levels of the 3x3 kernel, large scale first (§4.4; Dundr: 5, 61x61 pixels).
-    /// 0: no spatial filter (untraced pixels stay as they were).
-    pub levels: u32,
-    /// Normal weight exponent sigma_N (§4.4.1; Dundr: 64).
-    pub sigma_n: f32,
-    /// Depth weight sigma_D in depth gradients (§4.4.2; Dundr: 1).
-    pub sigma_d: f32,
-    /// Luminance weight sigma_L (§4.4.3, exp(-|L0 - L1| / (sigma_L var + epsilon)); Dundr: 4).
-    pub sigma_l: f32,
-    /// epsilon of the luminance weight (Dundr: 0.01 to 0.1).
-    pub epsilon_l: f32,
-}
-
-impl Default for ProgressiveSettings {
-    fn default() -> Self {
-        ProgressiveSettings {
-            temporal: true,
-            alpha: 0.1,
-            still_samples: 64.0,
-            levels: 5,
-            sigma_n: 64.0,
-            sigma_d: 1.0,
-            sigma_l: 4.0,
-            epsilon_l: 0.05,
-        }
+described! {
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    #[serde(default)]
+    pub struct ProgressiveSettings / FIELDS {
+        /// Accumulation of light and luminance moments over samples (§4.2). Off, every frame starts
+        /// over from the samples it traced.
+        temporal: bool = true,
+            ("progressive.temporal", "progressive/temporal", "", Bool);
+        /// a of r = max(a, 1 / age) (§4.2): the smallest weight of a new sample (Dundr: 0.1).
+        alpha: f32 = 0.1,
+            ("progressive.alpha", "progressive/temporal", "", Float(0.01, 1.0, 0.005));
+        /// In a still view a falls to 1 / this, so the light becomes a true mean of up to this many
+        /// samples; 0: `alpha` always (Dundr).
+        still_samples: f32 = 64.0,
+            ("progressive.still_samples", "progressive/temporal", "samples", Float(0.0, 1024.0, 1.0));
+        /// A-trous levels of the 3x3 kernel, large scale first (§4.4; Dundr: 5, 61x61 pixels).
+        /// 0: no spatial filter (untraced pixels stay as they were).
+        levels: u32 = 5,
+            ("progressive.levels", "progressive/atrous", "", Int(0, MAX_LEVELS as i64));
+        /// Normal weight exponent sigma_N (§4.4.1; Dundr: 64).
+        sigma_n: f32 = 64.0,
+            ("progressive.sigma_n", "progressive/atrous", "", Float(0.0, 256.0, 1.0));
+        /// Depth weight sigma_D in depth gradients (§4.4.2; Dundr: 1).
+        sigma_d: f32 = 1.0,
+            ("progressive.sigma_d", "progressive/atrous", "", Float(0.01, 16.0, 0.05));
+        /// Luminance weight sigma_L (§4.4.3, exp(-|L0 - L1| / (sigma_L var + epsilon)); Dundr: 4).
+        sigma_l: f32 = 4.0,
+            ("progressive.sigma_l", "progressive/atrous", "", Float(0.0, 64.0, 0.1));
+        /// epsilon of the luminance weight (Dundr: 0.01 to 0.1).
+        epsilon_l: f32 = 0.05,
+            ("progressive.epsilon_l", "progressive/atrous", "", Float(0.0, 1.0, 0.005));
+    }
+    hidden {
     }
 }
-
-/// Its fields, in panel order.
-pub const FIELDS: &[Field] = &[
-    f(
-        "progressive.temporal",
-        "progressive/temporal",
-        "",
-        Bool,
-        "Accumulate light and moments over samples (Dundr §4.2).",
-    ),
-    f(
-        "progressive.alpha",
-        "progressive/temporal",
-        "",
-        Float(0.01, 1.0, 0.005),
-        "Smallest weight of a new sample, r = max(a, 1/age).",
-    ),
-    f(
-        "progressive.still_samples",
-        "progressive/temporal",
-        "samples",
-        Float(0.0, 1024.0, 1.0),
-        "In a still view the light becomes a true mean of up to this many samples (0: alpha always).",
-    ),
-    f(
-        "progressive.levels",
-        "progressive/atrous",
-        "",
-        Int(0, MAX_LEVELS as i64),
-        "A-trous levels of the 3x3 kernel, large scale first (Dundr: 5).",
-    ),
-    f(
-        "progressive.sigma_n",
-        "progressive/atrous",
-        "",
-        Float(0.0, 256.0, 1.0),
-        "Normal weight exponent (Dundr: 64).",
-    ),
-    f(
-        "progressive.sigma_d",
-        "progressive/atrous",
-        "",
-        Float(0.01, 16.0, 0.05),
-        "Depth weight in depth gradients (Dundr: 1).",
-    ),
-    f(
-        "progressive.sigma_l",
-        "progressive/atrous",
-        "",
-        Float(0.0, 64.0, 0.1),
-        "Luminance weight: exp(-|dL| / (sigma_L var + epsilon)) (Dundr: 4).",
-    ),
-    f(
-        "progressive.epsilon_l",
-        "progressive/atrous",
-        "",
-        Float(0.0, 1.0, 0.005),
-        "epsilon of the luminance weight (Dundr: 0.01 to 0.1).",
-    ),
-];
 
 impl super::Denoiser {
     /// Dundr et al.'s progressive filter, then TAA.

@@ -3,115 +3,112 @@
 //! a switch, so that `hush-cli quality` can ablate each.
 
 use super::denoiser_info::{DenoiserInfo, Off, Stage};
-use super::field::{Field, Kind::*, f};
+use super::field::{Kind::*, described};
 use super::view_spec::v;
 use super::{ViewMap, ViewSpec};
 use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct SvgfSettings {
-    /// Temporal accumulation of the light and its luminance moments (SVGF §4.1). Off, every
-    /// frame starts over: variance comes from the spatial estimate alone.
-    pub temporal: bool,
-    /// Weight of the current frame in the light's exponential moving average (0.2 in SVGF).
-    pub alpha: f32,
-    /// Weight of the current frame in the moments' moving average (0.2 in SVGF).
-    pub alpha_moments: f32,
-    /// In a still view (no camera or object motion) the light's and the moments' weights fall
-    /// as 1 / h to 1 / this: a true mean of up to this many frames, where SVGF's 0.2 keeps
-    /// about 9. 0: `alpha` always (Schied et al.).
-    pub still_frames: f32,
-    /// The luminance edge-stop measures differences against the variance of the accumulated
-    /// light (the sample variance times the sum of the squared integration weights) rather
-    /// than of one sample (Schied et al.), so that edges sharpen as the history grows.
-    pub variance_of_mean: bool,
-    /// Next frame's history is the first a-trous level's output (Schied et al. §4.3); off, the
-    /// temporally integrated light before any spatial filter, so that a long history does not
-    /// compound the filter's blur.
-    pub filtered_history: bool,
-    /// The spatial variance estimate (7x7, SVGF §4.2) where fewer than 4 frames accumulated;
-    /// off, those pixels use the temporal moments as they are.
-    pub spatial_variance: bool,
-    /// Levels of the edge-avoiding a-trous wavelet filter (5x5 kernel, step 2^i; SVGF: 5).
-    /// The first level's output is the next frame's history. 0: no spatial filter.
-    pub levels: u32,
-    /// Where the light accumulated at least this many samples' worth (1 / the sum of the squared
-    /// integration weights: a still view's long mean, not a moving pixel's 0.2 average of about
-    /// 9), only the first `settled_levels` levels filter it: the wide levels' blur then costs
-    /// more (light pulled across corners and shadow edges) than their noise reduction gains.
-    /// 0: every level everywhere (Schied et al.).
-    pub settled_samples: f32,
-    /// Levels that still filter settled light (see `settled_samples`).
-    pub settled_levels: u32,
-    /// Luminance edge-stop sigma_l, in standard deviations of the variance (SVGF: 4).
-    pub sigma_l: f32,
-    /// Normal edge-stop exponent sigma_n (SVGF: 128).
-    pub sigma_n: f32,
-    /// Depth edge-stop sigma_z, in depth gradients (SVGF: 1).
-    pub sigma_z: f32,
-    /// Voorhuis §6: the spatial estimate averages the neighbours' accumulated moments (not this
-    /// frame's luminance), and the moments are true averages up to 4 reprojections.
-    pub accumulated_moments: bool,
-    /// Voorhuis §6 eq. (8): sigma_l x (8 - min(7, h)) for a history of h frames.
-    pub bandwidth_boost: bool,
-    /// SVGF's filtering of the variance at every a-trous level (var' = sum w^2 var / (sum w)^2).
-    /// Voorhuis §6 turns it off for indirect light (all Hush filters), trading some overblur
-    /// for smoother, steadier light.
-    pub variance_filtering: bool,
-    /// Voorhuis §6's firefly suppression after the a-trous, outside the history loop, on diffuse
-    /// light (the matte light, and the glossy light behind mirrors) that has not settled
-    /// (`settled_samples`): a pixel brighter than all its neighbours is brought down to the
-    /// brightest of them. Catches the fireflies of young histories; costs a 3x3 read per pixel
-    /// and signal.
-    pub firefly: bool,
-    /// Temporal accumulation of the glossy light; off (with `temporal` on), only the matte light
-    /// accumulates: Voorhuis's "NoSpecReproj" (§7.1), the glossy light filtered spatially alone.
-    pub glossy_temporal: bool,
-    /// Voorhuis §4: glossy light below `roughness_threshold` is reprojected with the reflection
-    /// motion vectors of the diamond search (the Mara glossy chain's `glossy/motion` stage);
-    /// off, with the surface's.
-    pub reflection_reprojection: bool,
-    /// Voorhuis §4.2.3: glossy history is clipped to the 5x5 box of the 7x7-blurred current
-    /// frame below `clip_roughness`, as the consistency tests are dropped there.
-    pub clipping: bool,
-    /// Voorhuis §4.1: behind mirrors the light is demodulated by the reflected surface's
-    /// reflectance and the a-trous edge-stops on the reflected surface's normal and distance.
-    pub mirror_features: bool,
-    /// Voorhuis §4.2.1: the roughness below which reflections are reprojected with reflection
-    /// motion vectors (0.4).
-    pub roughness_threshold: f32,
-    /// Voorhuis §4.2.3: the roughness below which the glossy history is clipped (0.9).
-    pub clip_roughness: f32,
-}
-
-impl Default for SvgfSettings {
-    fn default() -> Self {
-        SvgfSettings {
-            temporal: true,
-            alpha: 0.2,
-            alpha_moments: 0.2,
-            still_frames: 64.0,
-            variance_of_mean: true,
-            filtered_history: false,
-            spatial_variance: true,
-            levels: 5,
-            settled_samples: 16.0,
-            settled_levels: 2,
-            sigma_l: 4.0,
-            sigma_n: 128.0,
-            sigma_z: 1.0,
-            accumulated_moments: true,
-            bandwidth_boost: true,
-            variance_filtering: true,
-            firefly: true,
-            glossy_temporal: true,
-            reflection_reprojection: true,
-            clipping: false,
-            mirror_features: true,
-            roughness_threshold: 0.4,
-            clip_roughness: 0.9,
-        }
+described! {
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    #[serde(default)]
+    pub struct SvgfSettings / FIELDS {
+        /// Temporal accumulation of the light and its luminance moments (SVGF §4.1). Off, every
+        /// frame starts over: variance comes from the spatial estimate alone.
+        temporal: bool = true,
+            ("svgf.temporal", "svgf/temporal", "", Bool);
+        /// Weight of the current frame in the light's exponential moving average (0.2 in SVGF).
+        alpha: f32 = 0.2,
+            ("svgf.alpha", "svgf/temporal", "", Float(0.01, 1.0, 0.005));
+        /// Weight of the current frame in the moments' moving average (0.2 in SVGF).
+        alpha_moments: f32 = 0.2,
+            ("svgf.alpha_moments", "svgf/temporal", "", Float(0.01, 1.0, 0.005));
+        /// In a still view (no camera or object motion) the light's and the moments' weights fall
+        /// as 1 / h to 1 / this: a true mean of up to this many frames, where SVGF's 0.2 keeps
+        /// about 9. 0: `alpha` always (Schied et al.).
+        still_frames: f32 = 64.0,
+            ("svgf.still_frames", "svgf/temporal", "frames", Float(0.0, 1024.0, 1.0));
+        /// Next frame's history is the first a-trous level's output (Schied et al. §4.3); off, the
+        /// temporally integrated light before any spatial filter, so that a long history does not
+        /// compound the filter's blur.
+        filtered_history: bool = false,
+            ("svgf.filtered_history", "svgf/temporal", "", Bool);
+        /// The luminance edge-stop measures differences against the variance of the accumulated
+        /// light (the sample variance times the sum of the squared integration weights) rather
+        /// than of one sample (Schied et al.), so that edges sharpen as the history grows.
+        variance_of_mean: bool = true,
+            ("svgf.variance_of_mean", "svgf/atrous", "", Bool);
+        /// Voorhuis §6: the spatial estimate averages the neighbours' accumulated moments (not this
+        /// frame's luminance), and the moments are true averages up to 4 reprojections.
+        accumulated_moments: bool = true,
+            ("svgf.accumulated_moments", "svgf/temporal", "", Bool);
+        /// Temporal accumulation of the glossy light; off (with `temporal` on), only the matte light
+        /// accumulates: Voorhuis's "NoSpecReproj" (§7.1), the glossy light filtered spatially alone.
+        glossy_temporal: bool = true,
+            ("svgf.glossy_temporal", "svgf/temporal", "", Bool);
+        /// Voorhuis §4: glossy light below `roughness_threshold` is reprojected with the reflection
+        /// motion vectors of the diamond search (the Mara glossy chain's `glossy/motion` stage);
+        /// off, with the surface's.
+        reflection_reprojection: bool = true,
+            ("svgf.reflection_reprojection", "svgf/temporal", "", Bool);
+        /// Voorhuis §4.2.3: glossy history is clipped to the 5x5 box of the 7x7-blurred current
+        /// frame below `clip_roughness`, as the consistency tests are dropped there.
+        clipping: bool = false,
+            ("svgf.clipping", "svgf/temporal", "", Bool);
+        /// Voorhuis §4.2.1: the roughness below which reflections are reprojected with reflection
+        /// motion vectors (0.4).
+        roughness_threshold: f32 = 0.4,
+            ("svgf.roughness_threshold", "svgf/temporal", "", Float(0.0, 1.0, 0.01));
+        /// Voorhuis §4.2.3: the roughness below which the glossy history is clipped (0.9).
+        clip_roughness: f32 = 0.9,
+            ("svgf.clip_roughness", "svgf/temporal", "", Float(0.0, 1.0, 0.01));
+        /// The spatial variance estimate (7x7, SVGF §4.2) where fewer than 4 frames accumulated;
+        /// off, those pixels use the temporal moments as they are.
+        spatial_variance: bool = true,
+            ("svgf.spatial_variance", "svgf/variance", "", Bool);
+        /// Levels of the edge-avoiding a-trous wavelet filter (5x5 kernel, step 2^i; SVGF: 5).
+        /// The first level's output is the next frame's history. 0: no spatial filter.
+        levels: u32 = 5,
+            ("svgf.levels", "svgf/atrous", "levels", Int(0, MAX_LEVELS as i64));
+        /// Where the light accumulated at least this many samples' worth (1 / the sum of the squared
+        /// integration weights: a still view's long mean, not a moving pixel's 0.2 average of about
+        /// 9), only the first `settled_levels` levels filter it: the wide levels' blur then costs
+        /// more (light pulled across corners and shadow edges) than their noise reduction gains.
+        /// 0: every level everywhere (Schied et al.).
+        settled_samples: f32 = 16.0,
+            ("svgf.settled_samples", "svgf/atrous", "samples", Float(0.0, 1024.0, 1.0));
+        /// Levels that still filter settled light (see `settled_samples`).
+        settled_levels: u32 = 2,
+            ("svgf.settled_levels", "svgf/atrous", "levels", Int(0, MAX_LEVELS as i64));
+        /// Luminance edge-stop sigma_l, in standard deviations of the variance (SVGF: 4).
+        sigma_l: f32 = 4.0,
+            ("svgf.sigma_l", "svgf/atrous", "sigma", Float(0.0, 64.0, 0.1));
+        /// Normal edge-stop exponent sigma_n (SVGF: 128).
+        sigma_n: f32 = 128.0,
+            ("svgf.sigma_n", "svgf/atrous", "", Float(0.0, 512.0, 1.0));
+        /// Depth edge-stop sigma_z, in depth gradients (SVGF: 1).
+        sigma_z: f32 = 1.0,
+            ("svgf.sigma_z", "svgf/atrous", "gradients", Float(0.0, 64.0, 0.1));
+        /// Voorhuis §6 eq. (8): sigma_l x (8 - min(7, h)) for a history of h frames.
+        bandwidth_boost: bool = true,
+            ("svgf.bandwidth_boost", "svgf/atrous", "", Bool);
+        /// SVGF's filtering of the variance at every a-trous level (var' = sum w^2 var / (sum w)^2).
+        /// Voorhuis §6 turns it off for indirect light (all Hush filters), trading some overblur
+        /// for smoother, steadier light.
+        variance_filtering: bool = true,
+            ("svgf.variance_filtering", "svgf/atrous", "", Bool);
+        /// Voorhuis §4.1: behind mirrors the light is demodulated by the reflected surface's
+        /// reflectance and the a-trous edge-stops on the reflected surface's normal and distance.
+        mirror_features: bool = true,
+            ("svgf.mirror_features", "svgf/atrous", "", Bool);
+        /// Voorhuis §6's firefly suppression after the a-trous, outside the history loop, on diffuse
+        /// light (the matte light, and the glossy light behind mirrors) that has not settled
+        /// (`settled_samples`): a pixel brighter than all its neighbours is brought down to the
+        /// brightest of them. Catches the fireflies of young histories; costs a 3x3 read per pixel
+        /// and signal.
+        firefly: bool = true,
+            ("svgf.firefly", "svgf/final", "", Bool);
+    }
+    hidden {
     }
 }
 
@@ -166,165 +163,6 @@ impl SvgfSettings {
 
 /// The a-trous filter's deepest level (step 16 pixels, a 65-pixel footprint).
 pub const MAX_LEVELS: u32 = 5;
-
-/// Its fields, in panel order.
-pub const FIELDS: &[Field] = &[
-    f(
-        "svgf.temporal",
-        "svgf/temporal",
-        "",
-        Bool,
-        "Temporal accumulation of light and luminance moments (SVGF §4.1).",
-    ),
-    f(
-        "svgf.alpha",
-        "svgf/temporal",
-        "",
-        Float(0.01, 1.0, 0.005),
-        "Weight of the current frame in the light's moving average.",
-    ),
-    f(
-        "svgf.alpha_moments",
-        "svgf/temporal",
-        "",
-        Float(0.01, 1.0, 0.005),
-        "Weight of the current frame in the moments' moving average.",
-    ),
-    f(
-        "svgf.still_frames",
-        "svgf/temporal",
-        "frames",
-        Float(0.0, 1024.0, 1.0),
-        "In a still view the moving averages become true means of up to this many frames (0: alpha always).",
-    ),
-    f(
-        "svgf.filtered_history",
-        "svgf/temporal",
-        "",
-        Bool,
-        "History is the first a-trous level's output (Schied et al.); off, the unfiltered integrated light.",
-    ),
-    f(
-        "svgf.variance_of_mean",
-        "svgf/atrous",
-        "",
-        Bool,
-        "Edge-stop against the variance of the accumulated light, not of one sample.",
-    ),
-    f(
-        "svgf.accumulated_moments",
-        "svgf/temporal",
-        "",
-        Bool,
-        "Voorhuis §6: true moment averages up to 4 frames; the spatial estimate reads accumulated moments.",
-    ),
-    f(
-        "svgf.glossy_temporal",
-        "svgf/temporal",
-        "",
-        Bool,
-        "Accumulate the glossy light over time (off: Voorhuis's NoSpecReproj).",
-    ),
-    f(
-        "svgf.reflection_reprojection",
-        "svgf/temporal",
-        "",
-        Bool,
-        "Voorhuis §4: glossy light follows the reflection motion vectors (diamond search).",
-    ),
-    f(
-        "svgf.clipping",
-        "svgf/temporal",
-        "",
-        Bool,
-        "Voorhuis §4.2.3: glossy history clipped to the blurred current 5x5 neighbourhood.",
-    ),
-    f(
-        "svgf.roughness_threshold",
-        "svgf/temporal",
-        "",
-        Float(0.0, 1.0, 0.01),
-        "Below this roughness reflections use reflection motion vectors.",
-    ),
-    f(
-        "svgf.clip_roughness",
-        "svgf/temporal",
-        "",
-        Float(0.0, 1.0, 0.01),
-        "Below this roughness glossy history is clipped.",
-    ),
-    f(
-        "svgf.spatial_variance",
-        "svgf/variance",
-        "",
-        Bool,
-        "7x7 spatial variance estimate while fewer than 4 frames accumulated.",
-    ),
-    f(
-        "svgf.levels",
-        "svgf/atrous",
-        "levels",
-        Int(0, MAX_LEVELS as i64),
-        "Levels of the a-trous wavelet filter (0: no spatial filter).",
-    ),
-    f(
-        "svgf.settled_samples",
-        "svgf/atrous",
-        "samples",
-        Float(0.0, 1024.0, 1.0),
-        "Light accumulated from at least this many samples runs only settled_levels levels (0: all levels everywhere).",
-    ),
-    f(
-        "svgf.settled_levels",
-        "svgf/atrous",
-        "levels",
-        Int(0, MAX_LEVELS as i64),
-        "Levels that filter settled light.",
-    ),
-    f(
-        "svgf.sigma_l",
-        "svgf/atrous",
-        "sigma",
-        Float(0.0, 64.0, 0.1),
-        "Luminance edge-stop, in standard deviations.",
-    ),
-    f("svgf.sigma_n", "svgf/atrous", "", Float(0.0, 512.0, 1.0), "Normal edge-stop exponent."),
-    f(
-        "svgf.sigma_z",
-        "svgf/atrous",
-        "gradients",
-        Float(0.0, 64.0, 0.1),
-        "Depth edge-stop, in depth gradients.",
-    ),
-    f(
-        "svgf.bandwidth_boost",
-        "svgf/atrous",
-        "",
-        Bool,
-        "Voorhuis eq. (8): sigma_l x (8 - min(7, h)).",
-    ),
-    f(
-        "svgf.variance_filtering",
-        "svgf/atrous",
-        "",
-        Bool,
-        "Filter the variance at every level (off: Voorhuis §6 for indirect light).",
-    ),
-    f(
-        "svgf.mirror_features",
-        "svgf/atrous",
-        "",
-        Bool,
-        "Voorhuis §4.1: behind mirrors, demodulate by and edge-stop on the reflected surface.",
-    ),
-    f(
-        "svgf.firefly",
-        "svgf/final",
-        "",
-        Bool,
-        "Voorhuis §6: unsettled diffuse light (matte, glossy behind mirrors) brighter than all 8 neighbours is brought down to the brightest.",
-    ),
-];
 
 impl super::Denoiser {
     /// SVGF with Voorhuis's extensions, then TAA.
