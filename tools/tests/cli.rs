@@ -2,11 +2,7 @@
 
 mod support;
 
-use support::temp_dir;
-
-fn bin(_: &str) -> std::process::Command {
-    support::hush_cli()
-}
+use support::{hush_cli, temp_dir};
 
 #[test]
 fn render_then_compare_round_trips_through_files() {
@@ -14,7 +10,7 @@ fn render_then_compare_round_trips_through_files() {
     let exr = dir.join("a.exr");
     let png = dir.join("a.png");
     for out in [&exr, &png] {
-        let o = bin("hush-cli")
+        let o = hush_cli()
             .args([
                 "render",
                 "default",
@@ -33,7 +29,7 @@ fn render_then_compare_round_trips_through_files() {
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
-    let o = bin("hush-cli").args(["compare", "--json"]).arg(&exr).arg(&exr).output().unwrap();
+    let o = hush_cli().args(["compare", "--json"]).arg(&exr).arg(&exr).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(m["rmse"].as_f64(), Some(0.0));
@@ -274,7 +270,7 @@ fn bad_arguments_are_clear_errors() {
             "--mitsuba",
         ),
     ] {
-        let o = bin("hush-cli").args(&args).output().unwrap();
+        let o = hush_cli().args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success() && err.contains(needle), "{args:?}: {err}");
     }
@@ -282,7 +278,7 @@ fn bad_arguments_are_clear_errors() {
 
 #[test]
 fn bench_reports_json() {
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "bench", "default", "--json", "--width", "16", "--height", "16", "--spp", "2",
             "--rays", "4096",
@@ -304,12 +300,12 @@ fn bench_reports_json() {
 fn terrain_is_generated_and_written() {
     let dir = temp_dir("terrain");
     let out = dir.join("t.gltf");
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args(["level", "--scene", "terrain:5000", "--out", out.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "bench",
             out.to_str().unwrap(),

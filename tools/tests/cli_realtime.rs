@@ -3,11 +3,7 @@
 
 mod support;
 
-use support::temp_dir;
-
-fn bin(_: &str) -> std::process::Command {
-    support::hush_cli()
-}
+use support::{hush_cli, temp_dir};
 
 #[test]
 fn realtime_sequences_are_deterministic_and_ordered() {
@@ -21,7 +17,7 @@ fn realtime_sequences_are_deterministic_and_ordered() {
     let mut runs = vec![];
     for run in ["a", "b"] {
         let out = dir.join(run);
-        let o = bin("hush-cli")
+        let o = hush_cli()
             .args([
                 "render",
                 "level",
@@ -66,7 +62,7 @@ fn realtime_sequences_are_deterministic_and_ordered() {
 #[test]
 fn realtime_bench_reports_every_pass() {
     let profile = temp_dir("bench-profile").join("bench.puffin");
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "bench",
             "level",
@@ -137,7 +133,7 @@ fn realtime_bench_reports_every_pass() {
 #[test]
 fn quality_writes_scores_and_a_plot() {
     let dir = temp_dir("quality");
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "quality",
             "level",
@@ -186,7 +182,7 @@ fn quality_reuses_a_cached_reference() {
     let dir = temp_dir("quality-cache");
     let cache = dir.join("references");
     let run = |out: &str| {
-        let o = bin("hush-cli")
+        let o = hush_cli()
             .args([
                 "quality",
                 "level",
@@ -231,7 +227,7 @@ fn image_size(p: &std::path::Path) -> (u32, u32) {
 #[test]
 fn sweep_marks_a_pareto_front() {
     let dir = temp_dir("sweep");
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "sweep",
             "level",
@@ -263,7 +259,7 @@ fn sweep_marks_a_pareto_front() {
 #[test]
 fn reflections_measures_every_reprojection() {
     let dir = temp_dir("reflections");
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "reflections",
             "reflections",
@@ -303,7 +299,7 @@ fn a_preset_sets_the_frame() {
     std::fs::write(&preset, "max_depth = 2\n").unwrap();
     let mean = |extra: &[&str], name: &str| {
         let out = dir.join(name);
-        let o = bin("hush-cli")
+        let o = hush_cli()
             .args(["render", "level", "--mode", "realtime", "--width", "32", "--height", "18"])
             .args(extra)
             .arg("--out")
@@ -325,7 +321,7 @@ fn a_preset_sets_the_frame() {
 #[test]
 fn governed_render_writes_frames_csv() {
     let dir = temp_dir("governed");
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "render",
             "level",
@@ -367,7 +363,7 @@ fn governed_render_writes_frames_csv() {
 #[test]
 fn time_to_quality_follows_each_run_past_the_last_time() {
     let dir = temp_dir("time-to-quality");
-    let o = bin("hush-cli")
+    let o = hush_cli()
         .args([
             "time-to-quality",
             "level",

@@ -53,7 +53,7 @@ pub struct FrameContext<'a> {
     pub settings: &'a FrameSettings,
     /// Changes whenever a resource the frame offers may have been replaced (resize, a scene
     /// buffer reallocated): bind groups keyed on it stay valid while it stays.
-    pub key: crate::gpu::BindKey,
+    pub key: BindKey,
 }
 
 /// The denoised light for the composite (None: the trace's raw light passes through).

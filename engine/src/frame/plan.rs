@@ -67,8 +67,8 @@ impl Renderer {
         let (traced, primary_samples, prefilter) = self.primaries(gpu, input, settings, samples)?;
         let cam = self.camera_setup(&input.camera);
         let h = &self.history;
-        // Samples per pixel: the raster's guide jittered for TAA, a random position for the
-        // accumulate mode's box filter, the pixel centre otherwise.
+        // The raster's position in the pixel: Halton for TAA, uniformly random for the
+        // accumulate mode's box filter, the centre otherwise.
         let jitter = if settings.accumulate {
             super::random_jitter(h.frame_index, settings.seed)
         } else if denoiser.is_some() && settings.taa.enabled {

@@ -10,11 +10,9 @@
 
 use super::chain::ChainStage;
 use super::primaries::{FEATURE_WORDS, PrimaryTargets};
-use crate::gpu::{Bindings, GpuMemory, Recorder};
+use crate::gpu::{Bindings, GpuMemory, Recorder, Tex};
 use crate::shader::Reload;
 use anyhow::Result;
-
-type Tex = (wgpu::Texture, wgpu::TextureView);
 
 pub const COVARIANCE: &str = "prefilter/covariance";
 pub const SURE: &str = "prefilter/sure";
