@@ -6,7 +6,10 @@
 use std::path::Path;
 
 fn main() {
-    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared");
+    // Read when the script runs, not when it is compiled: a build script compiled for one
+    // checkout may be reused for another (cargo hashes workspace paths relative to the root).
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
+    let shared = Path::new(&manifest).join("../../shared");
     for (cfg, dir) in [("hush_shared_scenes", "scenes"), ("hush_shared_oracle", "oracle")] {
         let path = shared.join(dir);
         println!("cargo::rustc-check-cfg=cfg({cfg})");
