@@ -14,7 +14,7 @@ var moments: texture_2d<f32>;
 // surface), one record per pixel.
 var<storage, read> taps: array<vec4u>;
 var dst: texture_storage_2d<rgba16float, write>;
-var out_history: texture_storage_2d<rgba16float, write>;
+var out_history: texture_storage_2d<rgba32float, write>;
 var<uniform> level: Level;
 
 const KERNEL = array<f32, 3>(0.375, 0.25, 0.0625);

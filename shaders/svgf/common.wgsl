@@ -17,6 +17,12 @@ struct SvgfParams {
     // Light of at least this many samples' worth runs only the first settled_levels levels.
     settled_samples: f32,
     settled_levels: u32,
+    // The final regression (svgf/regression.wgsl): window radius (pixels), residual stop (standard
+    // deviations), and the samples' worth below which it passes the a-trous output on.
+    regression_radius: f32,
+    regression_k: f32,
+    regression_samples: f32,
+    regression_order: f32,
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
@@ -44,6 +50,7 @@ const SV_MIRROR_FEATURES: u32 = 256u;
 const SV_VARIANCE_OF_MEAN: u32 = 512u;
 const SV_FILTERED_HISTORY: u32 = 1024u;
 const SV_GLOSSY_TEMPORAL: u32 = 2048u;
+const SV_REGRESSION: u32 = 4096u;
 
 fn sv_on(bit: u32) -> bool {
     return (sv.bits & bit) != 0u;
@@ -86,7 +93,8 @@ fn integrate(current: vec3f, history: vec3f, moments: vec4f, reprojected: bool) 
     if !reprojected {
         return Integrated(current, vec4f(now, 1.0, 1.0));
     }
-    let h = min(moments.z + 1.0, 1024.0);
+    // 2^24: frames stay whole numbers in f32 (77 hours at 60 frames per second).
+    let h = min(moments.z + 1.0, 16777216.0);
     var floor_alpha = sv.alpha;
     var floor_moments = sv.alpha_moments;
     if dn.static_view != 0u && sv.still_frames > 0.0 {

@@ -13,7 +13,7 @@ var history: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var motion: texture_2d<f32>;
 var neighbourhood: texture_2d<f32>;
-var out_integrated: texture_storage_2d<rgba16float, write>;
+var out_integrated: texture_storage_2d<rgba32float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
 
 @compute @workgroup_size(8, 8)

@@ -9,7 +9,7 @@ var prev_depth: texture_depth_2d;
 var prev_normal: texture_2d<f32>;
 var history: texture_2d<f32>;
 var moments: texture_2d<f32>;
-var out_integrated: texture_storage_2d<rgba16float, write>;
+var out_integrated: texture_storage_2d<rgba32float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
 var out_features: texture_storage_2d<rg32float, write>;
 

@@ -17,7 +17,8 @@ use crate::passes::chain::ChainStage;
 use crate::passes::glossy::GlossyParams;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
-use crate::settings::{FrameSettings, SvgfSettings};
+use crate::passes::taa::TaaFollow;
+use crate::settings::{FrameSettings, SvgfSettings, svgf::STILL_FRAMES_MAX};
 use anyhow::{Context, Result};
 use bytemuck::{Pod, Zeroable};
 
@@ -50,6 +51,10 @@ pub struct SvgfParams {
     pub still_frames: f32,
     pub settled_samples: f32,
     pub settled_levels: u32,
+    pub regression_radius: f32,
+    pub regression_k: f32,
+    pub regression_samples: f32,
+    pub regression_order: f32,
     pub _pad: [u32; 3],
 }
 
@@ -62,9 +67,13 @@ impl SvgfParams {
             sigma_l: s.sigma_l.max(0.0),
             sigma_n: s.sigma_n.max(0.0),
             sigma_z: s.sigma_z.max(1e-3),
-            still_frames: s.still_frames.clamp(0.0, 1024.0),
+            still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
             settled_samples: s.settled_samples.max(0.0),
             settled_levels: s.settled_levels,
+            regression_radius: s.regression_radius as f32,
+            regression_k: s.regression_k.max(0.1),
+            regression_samples: s.regression_samples.max(1.0),
+            regression_order: s.regression_order.min(2) as f32,
             _pad: [0; 3],
         }
     }
@@ -109,13 +118,16 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     Ok(Box::new(Svgf { scene: *scene, res, matte: None, glossy: None, motion: None }))
 }
 
-/// One signal's textures: 104 bytes per pixel.
+/// One signal's textures: 140 bytes per pixel.
 pub struct SignalTargets {
-    /// The first a-trous level's output, by parity: what the next frame reprojects.
+    /// What the next frame reprojects, by parity: the integrated light, or the first a-trous
+    /// level's output (`filtered_history`). 32-bit floats: a still view's mean of 1 / h steps
+    /// would stall in 16-bit halves after about a thousand frames.
     pub history: PingPong<Tex>,
     /// Luminance moments and history length (m1, m2, h), by parity.
     pub moments: PingPong<Tex>,
-    /// This frame's temporally integrated light (rgb, raw luminance).
+    /// This frame's temporally integrated light (rgb, raw luminance), 32-bit as the history it
+    /// is copied to.
     pub integrated: Tex,
     /// The variance stage's output (rgb, variance): the first a-trous level's input.
     pub variance: Tex,
@@ -125,8 +137,12 @@ pub struct SignalTargets {
     /// The a-trous levels' ping-pong (rgb, variance).
     pub ping: Tex,
     pub pong: Tex,
+    /// The final regression's output (settled light fitted, the rest the a-trous output).
+    pub regressed: Tex,
     /// The light for the composite.
     pub out: Tex,
+    /// What TAA follows of the light (matte/reason's format: flags, history length).
+    pub state: Tex,
 }
 
 impl SignalTargets {
@@ -144,13 +160,15 @@ impl SignalTargets {
         let mut t = |label: &str, f| mem.texture(d, &format!("svgf/{name} {label}"), size, f, rw);
         SignalTargets {
             taps,
-            history: PingPong::new(|i| t(&format!("history {i}"), RGBA16F)),
+            history: PingPong::new(|i| t(&format!("history {i}"), RGBA32F)),
             moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
-            integrated: t("integrated", RGBA16F),
+            integrated: t("integrated", RGBA32F),
             variance: t("variance", RGBA16F),
             ping: t("ping", RGBA16F),
             pong: t("pong", RGBA16F),
+            regressed: t("regressed", RGBA16F),
             out: t("out", RGBA16F),
+            state: t("state", wgpu::TextureFormat::R32Uint),
         }
     }
 }
@@ -227,6 +245,9 @@ struct SignalStages {
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
+    /// The matte light's alone: lavapipe (Mesa 22.3, LLVM 15) aborts compiling the glossy
+    /// variant ("stack smashing detected"), so the glossy light shows the a-trous output.
+    regression: Option<ChainStage>,
     last: ChainStage,
 }
 
@@ -235,15 +256,22 @@ impl SignalStages {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
         // Labels are 'static: the profiler and the pass timings key on them.
-        let labels: [&'static str; 4] = if glossy {
+        let labels: [&'static str; 5] = if glossy {
             [
                 "svgf/temporal_glossy",
                 "svgf/variance_glossy",
                 "svgf/atrous_glossy",
+                "svgf/regression_glossy",
                 "svgf/final_glossy",
             ]
         } else {
-            ["svgf/temporal_matte", "svgf/variance_matte", "svgf/atrous_matte", "svgf/final_matte"]
+            [
+                "svgf/temporal_matte",
+                "svgf/variance_matte",
+                "svgf/atrous_matte",
+                "svgf/regression_matte",
+                "svgf/final_matte",
+            ]
         };
         let stage = |label, file, b: &Bindings| {
             ChainStage::new(gpu, label, &modules(file, glossy, animated), "main", b)
@@ -252,13 +280,19 @@ impl SignalStages {
             temporal: stage(labels[0], temporal, offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
-            last: stage(labels[3], "svgf/final.wgsl", offered)?,
+            regression: if glossy {
+                None
+            } else {
+                Some(stage(labels[3], "svgf/regression.wgsl", offered)?)
+            },
+            last: stage(labels[4], "svgf/final.wgsl", offered)?,
         })
     }
 
     fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
         [&mut self.temporal, &mut self.variance, &mut self.atrous, &mut self.last]
             .into_iter()
+            .chain(self.regression.as_mut())
             .map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 }
@@ -296,6 +330,8 @@ enum Pass {
     /// Level i: reads the variance stage's output (level 0), then pong and ping in turn.
     Atrous(usize),
     /// Reads the last level's output: 0 the variance stage's (no level ran), 1 ping, 2 pong.
+    Regression(usize),
+    /// Reads the variance stage's output (0), ping (1), pong (2) or the regression's (3).
     Final(usize),
 }
 
@@ -366,10 +402,17 @@ impl Resources {
                     .texture("out_history", &s.history.output(parity).1)
                     .buffer("level", &self.levels[level])
             }
-            Pass::Final(last) => b
+            Pass::Regression(last) => b
                 .texture("src", &[&s.variance, &s.ping, &s.pong][last].1)
+                .texture("light", &s.variance.1)
+                .buffer("taps", &s.taps)
                 .texture("moments", &s.moments.output(parity).1)
-                .texture("dst", &s.out.1),
+                .texture("dst", &s.regressed.1),
+            Pass::Final(src) => b
+                .texture("src", &[&s.variance, &s.ping, &s.pong, &s.regressed][src].1)
+                .texture("moments", &s.moments.output(parity).1)
+                .texture("dst", &s.out.1)
+                .texture("out_state", &s.state.1),
         }
     }
 
@@ -415,7 +458,7 @@ impl Resources {
     /// layout is checked against them).
     fn offered<'a>(&'a self, io: &FrameIo<'a>, t: &'a SvgfTargets, s: Signal<'a>) -> Bindings<'a> {
         let p = Parity::default();
-        [Pass::Variance, Pass::Atrous(0), Pass::Final(0)]
+        [Pass::Variance, Pass::Atrous(0), Pass::Regression(0), Pass::Final(0)]
             .into_iter()
             .fold(self.bindings(io, t, s, Pass::Temporal, p), |b, pass| {
                 b.with(&self.bindings(io, t, s, pass, p))
@@ -459,6 +502,16 @@ impl Resources {
         // The last level wrote pong when its index was even; bind groups by (last, parity).
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
         let variant = (6, 2 * last + parity.index());
+        let shown = match st.regression.as_mut() {
+            Some(regression) => {
+                regression.record_variant(rec, key, variant, size, |v| {
+                    b(Pass::Regression(v / 2), Parity::BOTH[v % 2])
+                })?;
+                3
+            }
+            None => last,
+        };
+        let variant = (8, 2 * shown + parity.index());
         st.last
             .record_variant(rec, key, variant, size, |v| b(Pass::Final(v / 2), Parity::BOTH[v % 2]))
     }
@@ -536,6 +589,14 @@ impl Denoiser for Svgf {
             res.record_stages(rec, io, cx, s, st)?;
         }
         Ok(())
+    }
+
+    /// TAA follows the matte light SVGF shows (the composite's), so that a still view shows the
+    /// latest converged light under TAA's averaged material rather than TAA's mean of every
+    /// frame SVGF showed (whose first frames are the least converged).
+    fn taa_follow(&self, _parity: Parity) -> TaaFollow<'_> {
+        let Some(t) = &self.res.targets else { return TaaFollow::default() };
+        TaaFollow { matte: Some((&t.matte.out.1, &t.matte.state.1)), glossy: None }
     }
 
     fn output(&self, _parity: Parity) -> Denoised<'_> {

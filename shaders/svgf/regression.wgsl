@@ -1,0 +1,203 @@
+// The final filter of settled light: a mean over the pixel's surface whose reach is chosen per
+// pixel by the intersection of confidence intervals (the ICI rule, Katkovnik 1999; Goldenshluger
+// and Nemirovski 1997). Nested windows of radius 0 (the pixel), 1, 2, 4, 8 and 16 pixels each
+// give an estimate of the light, the weighted mean of its taps (SVGF's depth and normal
+// edge-stops, eq. (3)-(4); the glossy light's reach Gaussian), with its standard deviation from
+// the taps' accumulated variance:
+//
+//   mu_k = sum w L / sum w,   sigma_k^2 = sum w^2 var / (sum w)^2.
+//
+// The filter keeps widening while the interval [mu_k - gamma sigma_k, mu_k + gamma sigma_k] still
+// meets every smaller window's, and shows the last estimate that did. Where the light is flat the
+// widest window averages about 70 taps; where a window starts to reach across a gradient no
+// feature separates (a contact shadow, a room's corner, a penumbra) its mean leaves the smaller
+// windows' intervals and the reach stops there. The intervals narrow as the history's variance
+// falls, so the reach falls with it and a still view converges to its accumulated mean: the
+// bias is bounded by gamma sigma of the chosen window. No weight depends on the light itself,
+// so Monte Carlo noise's skew (rare bright samples) biases nothing, where a luminance edge-stop
+// drops bright taps more often than dark ones. Light that has not settled (fewer than
+// `regression_samples`' worth) passes the a-trous output on.
+
+var src: texture_2d<f32>;
+// The variance stage's output: rgb the accumulated light, a its variance (of the mean with
+// variance_of_mean).
+var light: texture_2d<f32>;
+var moments: texture_2d<f32>;
+var<storage, read> taps: array<vec4u>;
+var dst: texture_storage_2d<rgba16float, write>;
+
+fn tap_features(t: vec4u) -> Features {
+    return Features(bitcast<f32>(t.x), bitcast<f32>(t.y), oct_decode(unpack2x16snorm(t.z)));
+}
+
+// Windows 1..5: radius 2^(k-1); a window's new taps lie on a grid of its radius / 2 pixels
+// (every pixel for radii 1 and 2), outside the previous window.
+const WINDOWS: i32 = 6;
+
+// Normal equations of the weighted fit of L(q) over the basis phi(u, v), (u, v) = (q - p) / 32:
+// (1), (1, u, v) or (1, u, v, u^2, uv, v^2) for regression_order 0, 1, 2, summed window by
+// window: a (6x6, row-major; only the first n x n used), the right-hand sides b (rgb each), and
+// sum w^2 and sum w var for the estimate's variance.
+struct Sums {
+    a: array<f32, 36>,
+    b: array<vec3f, 6>,
+    w2: f32,
+    wvar: f32,
+}
+
+fn basis(u: f32, v: f32) -> array<f32, 6> {
+    return array<f32, 6>(1.0, u, v, u * u, u * v, v * v);
+}
+
+fn unknowns() -> i32 {
+    return array<i32, 3>(1, 3, 6)[min(u32(sv.regression_order), 2u)];
+}
+
+fn add_tap(s: ptr<function, Sums>, w: f32, u: f32, v: f32, l: vec3f, variance: f32) {
+    let f = basis(u, v);
+    let n = unknowns();
+    for (var i = 0; i < n; i++) {
+        for (var j = 0; j < n; j++) {
+            (*s).a[i * 6 + j] += w * f[i] * f[j];
+        }
+        (*s).b[i] += w * f[i] * l;
+    }
+    (*s).w2 += w * w;
+    (*s).wvar += w * variance;
+}
+
+// The fit at the pixel (beta_0, rgb) and (A^-1)_00, by the Cholesky factors of the ridge-
+// regularised matrix: in a window symmetric about the pixel the first-order beta_0 is the
+// weighted mean; in one cut by an edge the slopes take out what the mean's off-centre centroid
+// would add, and the second order the curvature of a falloff.
+struct Fit {
+    beta0: vec3f,
+    inv00: f32,
+    ok: bool,
+}
+
+fn solve(s: Sums) -> Fit {
+    let n = unknowns();
+    var l: array<f32, 36>;
+    let ridge = 1e-3 * s.a[0];
+    for (var i = 0; i < n; i++) {
+        for (var j = 0; j <= i; j++) {
+            var sum = s.a[i * 6 + j];
+            if i == j && i > 0 {
+                sum += ridge;
+            }
+            for (var k = 0; k < j; k++) {
+                sum -= l[i * 6 + k] * l[j * 6 + k];
+            }
+            if i == j {
+                if !(sum > 1e-20) {
+                    return Fit(vec3f(0.0), 0.0, false);
+                }
+                l[i * 6 + i] = sqrt(sum);
+            } else {
+                l[i * 6 + j] = sum / l[j * 6 + j];
+            }
+        }
+    }
+    // Forward then back substitution, for the rgb right-hand side and for e_0.
+    var y: array<vec3f, 6>;
+    var e: array<f32, 6>;
+    for (var i = 0; i < n; i++) {
+        var sy = s.b[i];
+        var se = select(0.0, 1.0, i == 0);
+        for (var k = 0; k < i; k++) {
+            sy -= l[i * 6 + k] * y[k];
+            se -= l[i * 6 + k] * e[k];
+        }
+        y[i] = sy / l[i * 6 + i];
+        e[i] = se / l[i * 6 + i];
+    }
+    for (var i = n - 1; i >= 0; i--) {
+        var sy = y[i];
+        var se = e[i];
+        for (var k = i + 1; k < n; k++) {
+            sy -= l[k * 6 + i] * y[k];
+            se -= l[k * 6 + i] * e[k];
+        }
+        y[i] = sy / l[i * 6 + i];
+        e[i] = se / l[i * 6 + i];
+    }
+    return Fit(y[0], e[0], true);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let p = vec2i(gid.xy);
+    if !in_bounds(p) {
+        return;
+    }
+    let passed = textureLoad(src, p, 0);
+    let m = textureLoad(moments, p, 0);
+    let samples = 1.0 / max(m.w, 1e-6);
+    if !sv_on(SV_REGRESSION) || !has_surface(p) || samples < sv.regression_samples {
+        textureStore(dst, p, passed);
+        return;
+    }
+    let fc = signal_features(p);
+    let reach = signal_sigma(p);
+    let c = textureLoad(light, p, 0);
+    let gamma = sv.regression_k;
+    var s: Sums;
+    add_tap(&s, 1.0, 0.0, 0.0, c.rgb, max(c.a, 0.0));
+    var shown = c.rgb;
+    var lo = -1e30;
+    var hi = 1e30;
+    let widest = min(WINDOWS, i32(floor(log2(max(sv.regression_radius, 1.0)))) + 1);
+    for (var k = 1; k <= widest; k++) {
+        let r = 1 << u32(k - 1);
+        let inner = r / 2;
+        let step = max(r / 4, 1);
+        for (var dy = -r; dy <= r; dy += step) {
+            for (var dx = -r; dx <= r; dx += step) {
+                if max(abs(dx), abs(dy)) <= inner {
+                    continue;
+                }
+                let q = p + vec2i(dx, dy);
+                if !in_bounds(q) {
+                    continue;
+                }
+                let fq = tap_features(taps[tap_index(q)]);
+                if fq.dz < 0.0 {
+                    continue;
+                }
+                let offset = length(vec2f(f32(dx), f32(dy)));
+                let w = exp(-0.5 * offset * offset / (reach * reach)) * edge_weight(fc, fq, offset, 0.0, 0.0, 1.0);
+                if w > 1e-3 {
+                    let t = textureLoad(light, q, 0);
+                    add_tap(&s, w, f32(dx) / 32.0, f32(dy) / 32.0, t.rgb, max(t.a, 0.0));
+                }
+            }
+        }
+        // One variance for every tap, the window's mean: a pixel that missed the rare bright
+        // paths has a low mean and a low variance of its own, and would hold its interval shut.
+        let var_pool = s.wvar / s.a[0];
+        // The pixel alone and its 3x3 neighbourhood hold too few samples to judge the wider
+        // windows by: one whose light is a 2-sigma outlier (one pixel in twenty) would stop
+        // there and show its noise. The intersection starts at the 5x5 window.
+        if k < 2 {
+            continue;
+        }
+        let fit = solve(s);
+        if !fit.ok {
+            continue;
+        }
+        let lm = luminance(fit.beta0);
+        // Var(beta_0) = var (A^-1)_00 for equal weights; sum w^2 / sum w scales it for others.
+        let sd = sqrt(max(var_pool * fit.inv00 * s.w2 / s.a[0], 0.0));
+        lo = max(lo, lm - gamma * sd);
+        hi = min(hi, lm + gamma * sd);
+        if lo > hi {
+            break;
+        }
+        shown = fit.beta0;
+    }
+    if any(shown != shown) {
+        shown = c.rgb;
+    }
+    textureStore(dst, p, vec4f(half_safe(max(shown, vec3f(0.0))), passed.a));
+}
