@@ -34,6 +34,14 @@ fn tap_features(t: vec4u) -> Features {
 // (every pixel for radii 1 and 2), outside the previous window.
 const WINDOWS: i32 = 6;
 
+// The half-width of the pixel's own interval and the 3x3 window's, in standard deviations. They
+// hold too few samples to judge the wider windows by at `regression_k`: at 1 sigma a third of
+// all pixels, those whose mean lies over a sigma from their neighbours', would stop there and
+// show their noise. At 3 sigma one pixel in 370 does, and a window that blurs an edge (a shadow's,
+// a contact's) by more than 3 sigma of the accumulated light is still refused, so that the
+// smallest reach too falls with the variance and a still view converges.
+const NARROW_GAMMA: f32 = 3.0;
+
 // Normal equations of the weighted fit of L(q) over the basis phi(u, v), (u, v) = (q - p) / 32:
 // (1), (1, u, v) or (1, u, v, u^2, uv, v^2) for regression_order 0, 1, 2, summed window by
 // window: a (6x6, row-major; only the first n x n used), the right-hand sides b (rgb each), and
@@ -139,7 +147,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let fc = signal_features(p);
-    let reach = signal_sigma(p);
+    // The signal's reach bound, as the variance stage packed it: lavapipe (Mesa 22.3, LLVM 15)
+    // aborts compiling the glossy program when this stage calls signal_sigma itself.
+    let reach = bitcast<f32>(taps[tap_index(p)].w);
     let c = textureLoad(light, p, 0);
     let gamma = sv.regression_k;
     var s: Sums;
@@ -176,11 +186,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // One variance for every tap, the window's mean: a pixel that missed the rare bright
         // paths has a low mean and a low variance of its own, and would hold its interval shut.
         let var_pool = s.wvar / s.a[0];
-        // The pixel alone and its 3x3 neighbourhood hold too few samples to judge the wider
-        // windows by: one whose light is a 2-sigma outlier (one pixel in twenty) would stop
-        // there and show its noise. The intersection starts at the 5x5 window.
-        if k < 2 {
-            continue;
+        if k == 1 {
+            // The pixel alone, its standard deviation the 3x3 window's pooled one.
+            let l0 = luminance(c.rgb);
+            lo = l0 - NARROW_GAMMA * sqrt(var_pool);
+            hi = l0 + NARROW_GAMMA * sqrt(var_pool);
         }
         let fit = solve(s);
         if !fit.ok {
@@ -189,8 +199,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let lm = luminance(fit.beta0);
         // Var(beta_0) = var (A^-1)_00 for equal weights; sum w^2 / sum w scales it for others.
         let sd = sqrt(max(var_pool * fit.inv00 * s.w2 / s.a[0], 0.0));
-        lo = max(lo, lm - gamma * sd);
-        hi = min(hi, lm + gamma * sd);
+        let g = select(gamma, NARROW_GAMMA, k < 2);
+        lo = max(lo, lm - g * sd);
+        hi = min(hi, lm + g * sd);
         if lo > hi {
             break;
         }

@@ -245,9 +245,7 @@ struct SignalStages {
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
-    /// The matte light's alone: lavapipe (Mesa 22.3, LLVM 15) aborts compiling the glossy
-    /// variant ("stack smashing detected"), so the glossy light shows the a-trous output.
-    regression: Option<ChainStage>,
+    regression: ChainStage,
     last: ChainStage,
 }
 
@@ -280,20 +278,21 @@ impl SignalStages {
             temporal: stage(labels[0], temporal, offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
-            regression: if glossy {
-                None
-            } else {
-                Some(stage(labels[3], "svgf/regression.wgsl", offered)?)
-            },
+            regression: stage(labels[3], "svgf/regression.wgsl", offered)?,
             last: stage(labels[4], "svgf/final.wgsl", offered)?,
         })
     }
 
     fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
-        [&mut self.temporal, &mut self.variance, &mut self.atrous, &mut self.last]
-            .into_iter()
-            .chain(self.regression.as_mut())
-            .map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload)
+        [
+            &mut self.temporal,
+            &mut self.variance,
+            &mut self.atrous,
+            &mut self.regression,
+            &mut self.last,
+        ]
+        .into_iter()
+        .map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 }
 
@@ -331,8 +330,8 @@ enum Pass {
     Atrous(usize),
     /// Reads the last level's output: 0 the variance stage's (no level ran), 1 ping, 2 pong.
     Regression(usize),
-    /// Reads the variance stage's output (0), ping (1), pong (2) or the regression's (3).
-    Final(usize),
+    /// Reads the regression's output.
+    Final,
 }
 
 /// One signal's textures, and for the glossy signal the reflection motion's.
@@ -408,8 +407,9 @@ impl Resources {
                 .buffer("taps", &s.taps)
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.regressed.1),
-            Pass::Final(src) => b
-                .texture("src", &[&s.variance, &s.ping, &s.pong, &s.regressed][src].1)
+            Pass::Final => b
+                .texture("src", &s.regressed.1)
+                .texture("light", &s.variance.1)
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.out.1)
                 .texture("out_state", &s.state.1),
@@ -458,7 +458,7 @@ impl Resources {
     /// layout is checked against them).
     fn offered<'a>(&'a self, io: &FrameIo<'a>, t: &'a SvgfTargets, s: Signal<'a>) -> Bindings<'a> {
         let p = Parity::default();
-        [Pass::Variance, Pass::Atrous(0), Pass::Regression(0), Pass::Final(0)]
+        [Pass::Variance, Pass::Atrous(0), Pass::Regression(0), Pass::Final]
             .into_iter()
             .fold(self.bindings(io, t, s, Pass::Temporal, p), |b, pass| {
                 b.with(&self.bindings(io, t, s, pass, p))
@@ -502,18 +502,10 @@ impl Resources {
         // The last level wrote pong when its index was even; bind groups by (last, parity).
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
         let variant = (6, 2 * last + parity.index());
-        let shown = match st.regression.as_mut() {
-            Some(regression) => {
-                regression.record_variant(rec, key, variant, size, |v| {
-                    b(Pass::Regression(v / 2), Parity::BOTH[v % 2])
-                })?;
-                3
-            }
-            None => last,
-        };
-        let variant = (8, 2 * shown + parity.index());
-        st.last
-            .record_variant(rec, key, variant, size, |v| b(Pass::Final(v / 2), Parity::BOTH[v % 2]))
+        st.regression.record_variant(rec, key, variant, size, |v| {
+            b(Pass::Regression(v / 2), Parity::BOTH[v % 2])
+        })?;
+        st.last.record(rec, key, parity, size, |p| b(Pass::Final, p))
     }
 
     fn record_motion(

@@ -101,13 +101,13 @@ described! {
         /// reflectance and the a-trous edge-stops on the reflected surface's normal and distance.
         mirror_features: bool = true,
             ("svgf.mirror_features", "svgf/atrous", "", Bool);
-        /// The final filter of settled matte light (svgf/regression.wgsl): a fit of the accumulated
-        /// light over its surface's neighbours in windows of 1 to `regression_radius` pixels, each
-        /// window's reach chosen by the intersection of confidence intervals, so that the reach
-        /// falls as the history's variance falls and a still view converges to its mean without
-        /// blur bias. Off, settled light shows the a-trous output. Frame 60 of a still view (256²,
-        /// TAA after): cornell_diffuse FLIP 0.0272 against 0.0297 off, cornell_mirror 0.0586
-        /// against 0.0750; it costs a 192-tap pass over the matte light.
+        /// The final filter of settled light (svgf/regression.wgsl; both signals): a fit of the
+        /// accumulated light over its surface's neighbours in windows of 1 to `regression_radius`
+        /// pixels, each window accepted by the intersection of confidence intervals, so that the
+        /// reach falls as the history's variance falls and a still view converges to its mean
+        /// without blur bias. Off, settled light shows the a-trous output. Frame 60 of a still
+        /// view (256², TAA after): cornell_diffuse FLIP 0.0272 against 0.0297 off, cornell_mirror
+        /// 0.0561 against 0.0750; it costs a 192-tap pass per signal.
         regression: bool = true,
             ("svgf.regression", "svgf/regression", "", Bool);
         /// The regression's widest window radius (windows of 1, 2, 4 ... pixels up to it; 16: 0.0272,
