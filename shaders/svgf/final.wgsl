@@ -5,8 +5,6 @@
 // them, which keeps thin lit lines that the paper's 3x3 median erases (docs/decisions.md).
 
 var src: texture_2d<f32>;
-// The variance stage's output: the accumulated light and its variance (of the mean).
-var light: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
 // What TAA follows (taa/matte.wgsl, in matte/reason's format): REASON_DISOCCLUDED where the
@@ -15,32 +13,6 @@ var dst: texture_storage_2d<rgba16float, write>;
 // of the light (1 / the sum of the squared integration weights), so that TAA follows a still
 // view's mean but keeps averaging SVGF's 0.2 moving average (about 9 samples' worth).
 var out_state: texture_storage_2d<r32uint, write>;
-
-// The regression's fit y mixed with the pixel's own mean x by the weight that minimises their
-// mix's squared error, a = var(x) / E[(y - x)^2]: where the fit holds no bias E[(y - x)^2] is
-// about var(x) and the fit is shown; where it blurs a shadow's or a corner's gradient by b,
-// a = var(x) / (var(x) + b^2). E[(y - x)^2] is averaged over the 3x3 neighbourhood (one
-// pixel's own deviation would keep its noise). As the history grows var(x) falls and a fixed
-// bias b weighs ever less, so the image converges to the mean faster than the bias's own
-// interval (regression_k sigma) shrinks.
-const SHRINK_SIGMAS: f32 = 2.0;
-
-fn shrunk_to_mean(p: vec2i, fit: vec3f) -> vec3f {
-    let x = textureLoad(light, p, 0);
-    var d2 = 0.0;
-    var n = 0.0;
-    for (var k = 0; k < 9; k++) {
-        let q = p + neighbour_3x3(k);
-        if in_bounds(q) && has_surface(q) {
-            let d = luminance(textureLoad(src, q, 0).rgb - textureLoad(light, q, 0).rgb);
-            d2 += d * d;
-            n += 1.0;
-        }
-    }
-    let v = max(x.a, 0.0);
-    let a = clamp(SHRINK_SIGMAS * SHRINK_SIGMAS * v / max(d2 / max(n, 1.0), 1e-20), 0.0, 1.0);
-    return mix(x.rgb, fit, a);
-}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
@@ -58,9 +30,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         state = REASON_DISOCCLUDED;
     }
     textureStore(out_state, p, vec4u(state | (u32(clamp(worth + 0.5, 0.0, 16777215.0)) << 8u), 0u, 0u, 0u));
-    if sv_on(SV_REGRESSION) && has_surface(p) && worth >= sv.regression_samples {
-        c = shrunk_to_mean(p, c);
-    }
     // Settled light (SvgfSettings::settled_samples) has averaged its fireflies away.
     let settled = sv.settled_samples > 0.0 && worth >= sv.settled_samples;
     if sv_on(SV_FIREFLY) && signal_diffuse(p) && !settled {

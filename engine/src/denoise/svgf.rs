@@ -409,7 +409,6 @@ impl Resources {
                 .texture("dst", &s.regressed.1),
             Pass::Final => b
                 .texture("src", &s.regressed.1)
-                .texture("light", &s.variance.1)
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.out.1)
                 .texture("out_state", &s.state.1),

@@ -117,7 +117,13 @@ fn all_programs() -> Vec<Program> {
         for glossy in [false, true] {
             let temporal =
                 if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
-            for stage in [temporal, "svgf/variance.wgsl", "svgf/atrous.wgsl", "svgf/final.wgsl"] {
+            for stage in [
+                temporal,
+                "svgf/variance.wgsl",
+                "svgf/atrous.wgsl",
+                "svgf/regression.wgsl",
+                "svgf/final.wgsl",
+            ] {
                 v.push(
                     compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated))
                         .unwrap(),
@@ -383,6 +389,7 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     let (size, offs) = wgsl_layout(atrous, "SvgfParams");
     assert_eq!(size as usize, size_of::<SvgfParams>());
     assert_eq!(offs[8] as usize, offset_of!(SvgfParams, settled_levels));
+    assert_eq!(offs[12] as usize, offset_of!(SvgfParams, regression_order));
     assert_eq!(wgsl_layout(atrous, "Level").0, 16);
     // obvhs's CWBVH node is read as five vec4u.
     assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
