@@ -115,12 +115,13 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
 
 /// The denoiser the viewer starts with: on a software rasterizer the progressive filter, whose
 /// sample fractions below 1 let the governor hold its target at a larger scale than a filter
-/// that needs every pixel each frame; on a GPU Mara's chains.
+/// that needs every pixel each frame; on a GPU SVGF, which measures best in a still view
+/// (docs/decisions.md, "Default denoiser").
 fn default_denoiser(gpu: &Gpu) -> hush_engine::settings::Denoiser {
     if gpu.info.device_type == wgpu::DeviceType::Cpu {
         hush_engine::settings::Denoiser::PROGRESSIVE
     } else {
-        hush_engine::settings::Denoiser::MARA
+        hush_engine::settings::Denoiser::SVGF
     }
 }
 

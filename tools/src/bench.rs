@@ -19,7 +19,8 @@ pub struct BenchArgs {
     /// Real-time mode: frames measured (after two warm-up frames).
     #[arg(long, default_value_t = 32)]
     pub frames: u32,
-    /// Real-time mode: the denoiser (`none`, `mara` or `svgf`); default mara, or the preset's.
+    /// Real-time mode: the denoiser (`none`, `mara`, `svgf` or `progressive`); default mara, or
+    /// the preset's.
     #[arg(long)]
     pub denoiser: Option<String>,
     /// Real-time mode: measure the settings of this preset file (TOML, as the viewer saves).

@@ -34,7 +34,7 @@ pub struct QualityArgs {
     pub camera: Option<String>,
     #[arg(long, default_value_t = 60)]
     pub frames: u32,
-    /// `none`, `mara` or `svgf`; default mara, or the preset's.
+    /// `none`, `mara`, `svgf` or `progressive`; default mara, or the preset's.
     #[arg(long)]
     pub denoiser: Option<String>,
     /// Start from the settings of this preset file (TOML); --denoiser, --disable and

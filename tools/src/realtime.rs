@@ -37,12 +37,15 @@ fn frame_input(
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    let chains = preset_settings(
-        a.preset.as_deref(),
-        a.denoiser.as_deref(),
-        &a.disable,
-        a.reflection_mv.as_deref(),
-    )?;
+    // Without --denoiser or a preset, the denoiser that measures best in a still view
+    // (docs/decisions.md, "Default denoiser").
+    let default = hush_engine::settings::Denoiser::SVGF;
+    let denoiser = match (&a.denoiser, &a.preset) {
+        (None, None) => Some(default.name()),
+        (d, _) => d.as_deref(),
+    };
+    let chains =
+        preset_settings(a.preset.as_deref(), denoiser, &a.disable, a.reflection_mv.as_deref())?;
     let frames = a.frames.unwrap_or(1);
     if frames == 0 {
         bail!("--frames must be at least 1");

@@ -23,8 +23,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub camera_path: Option<PathBuf>,
     /// Real-time mode: the denoiser, `none`, `mara` (Mara et al. 2017: matte and glossy
-    /// chains) or `svgf` (SVGF with Voorhuis's extensions), each followed by TAA; default none,
-    /// or the preset's.
+    /// chains), `svgf` (SVGF with Voorhuis's extensions) or `progressive` (Dundr's filter, for
+    /// sample fractions below 1), each followed by TAA; default svgf, or the preset's.
     #[arg(long)]
     pub denoiser: Option<String>,
     /// Real-time mode: start from the settings of this preset file (TOML, as the viewer saves);

@@ -337,6 +337,9 @@ fn governed_render_writes_frames_csv() {
             "36",
             "--min-scale",
             "0.5",
+            // A denoiser that takes sample fractions (render's default, SVGF, does not).
+            "--denoiser",
+            "none",
             "--out-dir",
         ])
         .arg(&dir)

@@ -105,6 +105,10 @@ mod tests {
             assert_ne!(s, FrameSettings::default(), "{} changes nothing", p.display());
             n += 1;
         }
-        assert!(n >= 2);
+        assert!(n >= 5);
+        // Schied et al.'s SVGF is one configuration, in code and in the preset.
+        let schied = FrameSettings::load_preset(&dir.join("schied.toml")).unwrap();
+        assert_eq!(schied.svgf, crate::settings::SvgfSettings::schied());
+        assert_eq!(schied.denoiser, Denoiser::SVGF);
     }
 }
