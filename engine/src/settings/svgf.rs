@@ -106,8 +106,8 @@ described! {
         /// pixels, each window accepted by the intersection of confidence intervals, so that the
         /// reach falls as the history's variance falls and a still view converges to its mean
         /// without blur bias. Off, settled light shows the a-trous output. Frame 60 of a still
-        /// view (256², TAA after): cornell_diffuse FLIP 0.0272 against 0.0297 off, cornell_mirror
-        /// 0.0561 against 0.0750; it costs a 192-tap pass per signal.
+        /// view (256², TAA after): cornell_diffuse FLIP 0.0271 against 0.0297 off, cornell_mirror
+        /// 0.0571 against 0.0750; it costs a 192-tap pass per signal.
         regression: bool = true,
             ("svgf.regression", "svgf/regression", "", Bool);
         /// The regression's widest window radius (windows of 1, 2, 4 ... pixels up to it; 16: 0.0272,
