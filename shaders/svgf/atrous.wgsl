@@ -19,10 +19,6 @@ var<uniform> level: Level;
 
 const KERNEL = array<f32, 3>(0.375, 0.25, 0.0625);
 
-fn tap_features(t: vec4u) -> Features {
-    return Features(bitcast<f32>(t.x), bitcast<f32>(t.y), oct_decode(unpack2x16snorm(t.z)));
-}
-
 // The 3x3 Gaussian of the variance around p (SVGF's prefilter of eq. (5)).
 fn blurred_variance(p: vec2i) -> f32 {
     var sum = 0.0;

@@ -126,3 +126,13 @@ fn tap_index(p: vec2i) -> u32 {
     return u32(p.y) * frame.size.x + u32(p.x);
 }
 
+// A pixel's edge-stopping features as the variance stage packs them into its taps record
+// (variance.wgsl: pack_taps), and the signal's reach bound (signal_sigma) in its fourth word.
+fn tap_features(t: vec4u) -> Features {
+    return Features(bitcast<f32>(t.x), bitcast<f32>(t.y), oct_decode(unpack2x16snorm(t.z)));
+}
+
+fn tap_reach(t: vec4u) -> f32 {
+    return bitcast<f32>(t.w);
+}
+

@@ -1,22 +1,22 @@
-// The final filter of settled light: a mean over the pixel's surface whose reach is chosen per
-// pixel by the intersection of confidence intervals (the ICI rule, Katkovnik 1999; Goldenshluger
-// and Nemirovski 1997). Nested windows of radius 0 (the pixel), 1, 2, 4, 8 and 16 pixels each
-// give an estimate of the light, the weighted mean of its taps (SVGF's depth and normal
-// edge-stops, eq. (3)-(4); the glossy light's reach Gaussian), with its standard deviation from
-// the taps' accumulated variance:
+// The final filter of settled light: a local regression of the accumulated light (in the manner
+// of BMFR, Koskela et al. 2019, per pixel rather than per block) whose reach is chosen per pixel
+// by the intersection of confidence intervals (the ICI rule, Katkovnik 1999; Goldenshluger and
+// Nemirovski 1997). Nested windows of radius 1, 2, 4, 8 and 16 pixels each give an estimate of
+// the light at the pixel, beta_0 of a weighted least-squares fit over the window's taps
+// (regression_order: a mean, a plane or a quadric in screen space; SVGF's depth and normal
+// edge-stops, eq. (3)-(4); the signal's reach Gaussian), with its standard deviation from the
+// taps' pooled variance of the accumulated light.
 //
-//   mu_k = sum w L / sum w,   sigma_k^2 = sum w^2 var / (sum w)^2.
-//
-// The filter keeps widening while the interval [mu_k - gamma sigma_k, mu_k + gamma sigma_k] still
-// meets every smaller window's, and shows the last estimate that did. Where the light is flat the
-// widest window averages about 70 taps; where a window starts to reach across a gradient no
-// feature separates (a contact shadow, a room's corner, a penumbra) its mean leaves the smaller
-// windows' intervals and the reach stops there. The intervals narrow as the history's variance
-// falls, so the reach falls with it and a still view converges to its accumulated mean: the
-// bias is bounded by gamma sigma of the chosen window. No weight depends on the light itself,
-// so Monte Carlo noise's skew (rare bright samples) biases nothing, where a luminance edge-stop
-// drops bright taps more often than dark ones. Light that has not settled (fewer than
-// `regression_samples`' worth) passes the a-trous output on.
+// The filter keeps widening while a window's interval [beta_0 - gamma sigma, beta_0 + gamma
+// sigma] still meets every smaller window's and the pixel's own, and shows the last estimate that
+// did. Where the light is flat the widest window fits 192 taps; where a window starts to reach
+// across a gradient no feature separates (a contact shadow, a room's corner, a penumbra) its fit
+// leaves the smaller windows' intervals and the reach stops there. The intervals narrow as the
+// history's variance falls, so the reach falls with it and a still view converges to its
+// accumulated mean. No weight depends on the light itself, so Monte Carlo noise's skew (rare
+// bright samples) biases nothing, where a luminance edge-stop drops bright taps more often than
+// dark ones. Light that has not settled (fewer than `regression_samples`' worth) passes the
+// a-trous output on.
 
 var src: texture_2d<f32>;
 // The variance stage's output: rgb the accumulated light, a its variance (of the mean with
@@ -26,12 +26,8 @@ var moments: texture_2d<f32>;
 var<storage, read> taps: array<vec4u>;
 var dst: texture_storage_2d<rgba16float, write>;
 
-fn tap_features(t: vec4u) -> Features {
-    return Features(bitcast<f32>(t.x), bitcast<f32>(t.y), oct_decode(unpack2x16snorm(t.z)));
-}
-
-// Windows 1..5: radius 2^(k-1); a window's new taps lie on a grid of its radius / 2 pixels
-// (every pixel for radii 1 and 2), outside the previous window.
+// Windows 1..WINDOWS: radius 2^(k-1) (at most regression_radius); a window's new taps lie on a
+// grid of its radius / 4 pixels (every pixel up to radius 4), outside the previous window.
 const WINDOWS: i32 = 6;
 
 // The half-width of the pixel's own interval and the 3x3 window's, in standard deviations. They
@@ -149,7 +145,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let fc = signal_features(p);
     // The signal's reach bound, as the variance stage packed it: lavapipe (Mesa 22.3, LLVM 15)
     // aborts compiling the glossy program when this stage calls signal_sigma itself.
-    let reach = bitcast<f32>(taps[tap_index(p)].w);
+    let reach = tap_reach(taps[tap_index(p)]);
     let c = textureLoad(light, p, 0);
     let gamma = sv.regression_k;
     var s: Sums;
