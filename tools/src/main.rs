@@ -4,6 +4,7 @@ mod bench;
 mod bench_realtime;
 mod cli;
 mod compare;
+mod convergence;
 mod quality;
 mod realtime;
 mod reflections;

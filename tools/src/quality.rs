@@ -63,6 +63,18 @@ pub struct QualityArgs {
     /// Also run the stream with each denoiser stage off.
     #[arg(long)]
     pub ablations: bool,
+    /// Instead of the stream: run each of --denoisers and the plain accumulation of the same
+    /// frames over --frames frames of the still view, and write convergence.csv and
+    /// convergence.png (FLIP and relMSE against frames on log axes, 1 to --frames).
+    #[arg(long)]
+    pub convergence: bool,
+    /// The denoisers --convergence compares with the accumulation.
+    #[arg(long, value_delimiter = ',', default_value = "svgf,mara,progressive")]
+    pub denoisers: Vec<String>,
+    /// With --convergence: score against this image (an EXR, e.g. a Mitsuba render of the
+    /// scene) instead of the accumulated real-time frame.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
     #[arg(long)]
     pub out_dir: PathBuf,
     /// Keep each reference as an EXR in this folder, named by what it depends on (scene file,
@@ -262,6 +274,12 @@ pub fn run(a: QualityArgs) -> Result<()> {
         .collect();
     std::fs::create_dir_all(&a.out_dir)
         .with_context(|| format!("creating {}", a.out_dir.display()))?;
+    if a.convergence {
+        return crate::convergence::run(&a, scene, size, inputs[0]);
+    }
+    if a.reference.is_some() {
+        bail!("--reference is read by --convergence only");
+    }
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
     let s = Setup { gpu, scene, size, inputs };
