@@ -39,7 +39,8 @@ struct GlossyParams {
     reprojection_min_cos: f32,
     // A bilinearly resampled history counts as at most this many frames (0: no cap).
     resampled_history_frames: f32,
-    _pad1: u32,
+    // GlossySettings::still_frames, as DenoiseParams::still_frames for the matte chain.
+    still_frames: f32,
 }
 
 var<uniform> gp: GlossyParams;

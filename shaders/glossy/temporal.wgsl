@@ -1,7 +1,8 @@
 // Stage (8), glossy temporal (Mara et al. §3.4; Voorhuis §4.2.3): reproject the glossy history
 // with the reflection motion vectors of glossy/motion.wgsl, weigh it by a confidence, clip it to
 // the pre-blurred current neighbourhood and blend as the matte temporal does (history length n
-// in alpha; new sample weight max(1 - c, 1 / n)).
+// in alpha; new sample weight max(1 - c, 1 / n), in a still view 1 / n: matte/common.wgsl's
+// new_frame_weight).
 //
 // Confidence c, by how the pixel was reprojected:
 // - surface motion vectors (rough surfaces, --reflection-mv primary, or a static view): eq. (11)
@@ -101,7 +102,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var own = 0.0;
     if c > 0.0 {
         let texel = textureLoad(history, r.texel, 0);
-        n = min(max(texel.a, 1.0) + 1.0, 1024.0);
+        let still = gp.static_view != 0u && gp.still_frames > 0.0 && c >= gp.hysteresis;
+        n = min(max(texel.a, 1.0) + 1.0, select(MOVING_FRAMES_MAX, STILL_FRAMES_MAX, still));
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             hist = half_safe(load_bilinear(history, prev).rgb);
@@ -113,7 +115,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             clipped = clip_to_neighbourhood(neighbourhood, p, hist);
             clip = clamp(length(clipped - hist) / max(length(hist), 1e-4), 0.0, 1.0);
         }
-        result = mix(clipped, current, max(1.0 - c, 1.0 / n));
+        result = mix(clipped, current, new_frame_weight(c, n, gp.still_frames, still));
     }
     textureStore(dst, p, vec4f(half_safe(result), n));
     textureStore(out_info, p, vec4f(c, clip, n, own));

@@ -66,6 +66,9 @@ struct DenoiseParams {
     taa_current_light: f32,
     // The same for the glossy light (MatteSettings::taa_current_glossy).
     taa_current_glossy: f32,
+    // In a still view a history at full confidence weighs the new frame 1 / n down to
+    // 1 / this (0: the hysteresis always; MatteSettings::still_frames).
+    still_frames: f32,
 }
 
 var<uniform> dn: DenoiseParams;
@@ -279,6 +282,21 @@ fn confidence(h: f32, distance: f32) -> f32 {
         return 0.0;
     }
     return h * (1.0 - smoothstep(dn.d0_px, dn.d1_px, distance));
+}
+
+// History lengths: frames since the history restarted, at most 1024 while anything moves and
+// 2^24 in a still view (frame counts stay whole numbers in f32).
+const MOVING_FRAMES_MAX: f32 = 1024.0;
+const STILL_FRAMES_MAX: f32 = 16777216.0;
+
+// The new frame's weight in a temporal blend: max(1 - c, 1 / n), eq. (11)'s hysteresis with the
+// first frames averaged truly; in a still view at full confidence (`still`), 1 / n down to
+// 1 / still_frames, so that the history is the mean of every frame since the view settled.
+fn new_frame_weight(c: f32, n: f32, still_frames: f32, still: bool) -> f32 {
+    if still {
+        return max(1.0 / n, 1.0 / still_frames);
+    }
+    return max(1.0 - c, 1.0 / n);
 }
 
 // Tap i of n in a disk of radius r: a golden-angle spiral (uniform density), rotated per frame

@@ -8,7 +8,9 @@
 // its alpha), and the new sample's weight is max(1 - c, 1 / (n + 1)). A fresh history then
 // averages its first frames equally instead of keeping 0.98^k of its first, noisy sample (after
 // 60 frames that sample would still weigh 30%); once n passes 1 / (1 - h) it is the paper's
-// exponential blend. The reason texture carries n above its 8 flag bits. A history resampled
+// exponential blend. In a still view at full confidence the weight falls on as 1 / n (to
+// 1 / still_frames): the history is then a true mean and converges to the reference. The
+// reason texture carries n above its 8 flag bits. A history resampled
 // between texels (the surface moved on screen) is a little blurred each time, and counts as at
 // most resampled_history_frames, so that motion's blur fades within a few frames of a stop.
 
@@ -53,7 +55,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var n = 1.0;
     if c > 0.0 {
         let texel = textureLoad(history, r.texel, 0);
-        n = min(max(texel.a, 1.0) + 1.0, 1024.0);
+        let still = dn.static_view != 0u && dn.still_frames > 0.0 && c >= dn.hysteresis;
+        n = min(max(texel.a, 1.0) + 1.0, select(MOVING_FRAMES_MAX, STILL_FRAMES_MAX, still));
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             hist = half_safe(load_bilinear(history, prev).rgb);
@@ -84,7 +87,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 reason |= REASON_CLAMPED;
             }
         }
-        result = mix(clamped, current, max(1.0 - c, 1.0 / n));
+        result = mix(clamped, current, new_frame_weight(c, n, dn.still_frames, still));
     }
     textureStore(out_temporal, p, vec4f(half_safe(result), c));
     textureStore(out_reason, p, vec4u(reason | (u32(n) << 8u), 0u, 0u, 0u));

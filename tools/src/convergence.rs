@@ -126,6 +126,7 @@ fn curve(
     reference: &Image,
 ) -> Result<Curve> {
     let mut r = crate::quality::new_renderer(gpu, scene, size)?;
+    let start = std::time::Instant::now();
     let mut points = vec![];
     let last = marks.last().copied().unwrap_or(0);
     for frame in 1..=last {
@@ -135,6 +136,7 @@ fn curve(
             points.push((frame, m.flip, m.relmse, m.mean_rel_bias));
         }
     }
+    eprintln!("{name}: {last} frames in {:.1} s", start.elapsed().as_secs_f64());
     Ok(Curve { name: name.to_string(), points })
 }
 

@@ -8,7 +8,7 @@
 use super::chain::ChainStage;
 use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
-use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
+use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv, STILL_FRAMES_MAX};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 
@@ -44,7 +44,8 @@ pub struct GlossyParams {
     pub reprojection_min_cos: f32,
     /// [`GlossySettings::resampled_history_frames`].
     pub resampled_history_frames: f32,
-    pub _pad: u32,
+    /// [`GlossySettings::still_frames`].
+    pub still_frames: f32,
 }
 
 impl GlossyParams {
@@ -79,7 +80,7 @@ impl GlossyParams {
             static_view: static_view as u32,
             reprojection_min_cos: super::matte::normal_test_cos(s.reprojection_normal_degrees),
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
-            _pad: 0,
+            still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
         }
     }
 }

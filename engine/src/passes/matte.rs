@@ -6,7 +6,7 @@
 use super::chain::ChainStage;
 use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
-use crate::settings::{MatteSettings, TaaSettings};
+use crate::settings::{MatteSettings, STILL_FRAMES_MAX, TaaSettings};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 
@@ -65,8 +65,10 @@ pub struct DenoiseParams {
     pub taa_current_light: f32,
     /// [`TaaSettings::current_glossy`].
     pub taa_current_glossy: f32,
+    /// [`MatteSettings::still_frames`].
+    pub still_frames: f32,
     /// The uniform's size is a multiple of 16 bytes.
-    pub _pad: [f32; 2],
+    pub _pad: f32,
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -130,7 +132,8 @@ impl DenoiseParams {
             taa_display_ratio: taa.display_ratio.clamp(0.0, 1024.0),
             taa_current_light: taa.current_light.clamp(0.0, 1.0),
             taa_current_glossy: taa.current_glossy.clamp(0.0, 1.0),
-            _pad: [0.0; 2],
+            still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
+            _pad: 0.0,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The glossy chain's settings (Mara et al. 2017 §3.4 stages 8-10, Voorhuis §4) and their
 //! descriptions.
 
+use super::STILL_FRAMES_MAX;
 use super::field::{Kind::*, described};
 use serde::{Deserialize, Serialize};
 
@@ -74,6 +75,10 @@ described! {
         /// Hysteresis h, as the matte temporal's (Mara: the same confidence and clamping).
         hysteresis: f32 = 0.98,
             ("glossy.hysteresis", "glossy/temporal", "", Float(0.0, 1.0, 0.001));
+        /// As `matte.still_frames`, for the glossy history: in a still view the new frame weighs
+        /// 1 / n down to 1 / this (default 2^24, no cap; 0: the hysteresis always).
+        still_frames: f32 = STILL_FRAMES_MAX,
+            ("glossy.still_frames", "glossy/temporal", "frames", Float(0.0, STILL_FRAMES_MAX as f64, 1.0));
         /// The surface reprojection rejects a texel whose normal is more than this many degrees off,
         /// [0, 180], default 10 (180: off): a crease's faces reflect different things under one
         /// pixel (staircase FLIP 0.0645 at 10, 0.0726 off; the living room's shorter histories cost

@@ -23,7 +23,7 @@ pub use matte::MatteSettings;
 pub use progressive::{MAX_LEVELS as PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
 pub use registry::all_views;
 pub use registry::{DenoiserInfo, Off, Section, Stage};
-pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, SvgfSettings};
+pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, STILL_FRAMES_MAX, SvgfSettings};
 pub use taa::TaaSettings;
 pub use view::View;
 pub use view_spec::{FRAME_VIEWS, ViewMap, ViewSpec};

@@ -191,7 +191,7 @@ impl SvgfSettings {
     }
 }
 
-/// The longest still-view mean, in frames (frame counts stay exact in f32 up to 2^24).
+/// The longest still-view mean of any denoiser's history, in frames (frame counts stay exact in f32 up to 2^24).
 pub const STILL_FRAMES_MAX: f32 = 16_777_216.0;
 
 /// The a-trous filter's deepest level (step 16 pixels, a 65-pixel footprint).
