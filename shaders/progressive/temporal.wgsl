@@ -8,7 +8,7 @@ var prev_depth: texture_depth_2d;
 var prev_normal: texture_2d<f32>;
 var history: texture_2d<f32>;
 var moments: texture_2d<f32>;
-var out_integrated: texture_storage_2d<rgba16float, write>;
+var out_integrated: texture_storage_2d<rgba32float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
 
 @compute @workgroup_size(8, 8)
@@ -43,7 +43,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var light = hist;
     if sampled {
         let l = luma(current);
-        let age = select(1.0, min(mom.z + 1.0, 65536.0), found);
+        // 2^24: sample counts stay whole numbers in f32.
+        let age = select(1.0, min(mom.z + 1.0, 16777216.0), found);
         var a = pp.alpha;
         if dn.static_view != 0u && pp.still_samples > 0.0 {
             a = min(a, 1.0 / pp.still_samples);

@@ -5,14 +5,15 @@
 //! FLIP, relMSE and the mean bias per channel. A denoiser converges when its relMSE stays within
 //! a small factor of the accumulation's as the frames grow and its bias stays near zero; one
 //! whose spatial reach does not fall with the variance flattens out on the log-log plot.
-//! Writes convergence.csv and convergence.png (log frame axis, FLIP and relMSE).
+//! Writes convergence.csv, convergence.png (log frame axis, FLIP and relMSE) and each stream's
+//! last frame (`last_<stream>.exr`, and its FLIP heat map against the reference, `.png`).
 
 use crate::cli::preset_settings;
 use crate::quality::QualityArgs;
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::FrameInput;
 use hush_engine::gpu::Gpu;
-use hush_engine::quality::{Image, compare};
+use hush_engine::quality::{Image, compare, save_flip_heatmap};
 use hush_engine::scene::Scene;
 use hush_engine::settings::FrameSettings;
 use std::io::Write;
@@ -76,8 +77,17 @@ pub fn run(a: &QualityArgs, scene: Scene, size: (u32, u32), input: FrameInput) -
     let marks = checkpoints(a.frames);
     let accumulation =
         FrameSettings { accumulate: true, seed: a.seed, max_depth, ..Default::default() };
-    let mut curves =
-        vec![curve("accumulation", &gpu, &scene, size, &input, &accumulation, &marks, &reference)?];
+    let mut curves = vec![curve(
+        "accumulation",
+        &gpu,
+        &scene,
+        size,
+        &input,
+        &accumulation,
+        &marks,
+        &reference,
+        &a.out_dir,
+    )?];
     for name in names {
         let chains = preset_settings(
             a.preset.as_deref(),
@@ -86,7 +96,9 @@ pub fn run(a: &QualityArgs, scene: Scene, size: (u32, u32), input: FrameInput) -
             a.reflection_mv.as_deref(),
         )?;
         let settings = FrameSettings { seed: a.seed, max_depth, ..chains };
-        curves.push(curve(name, &gpu, &scene, size, &input, &settings, &marks, &reference)?);
+        curves.push(curve(
+            name, &gpu, &scene, size, &input, &settings, &marks, &reference, &a.out_dir,
+        )?);
     }
     write_csv(&a.out_dir.join("convergence.csv"), &curves)?;
     plot(&a.out_dir.join("convergence.png"), &curves, &a.scene)?;
@@ -124,6 +136,7 @@ fn curve(
     settings: &FrameSettings,
     marks: &[u32],
     reference: &Image,
+    out_dir: &Path,
 ) -> Result<Curve> {
     let mut r = crate::quality::new_renderer(gpu, scene, size)?;
     let start = std::time::Instant::now();
@@ -132,8 +145,13 @@ fn curve(
     for frame in 1..=last {
         r.render(gpu, input, settings, None).with_context(|| format!("{name}, frame {frame}"))?;
         if marks.contains(&frame) {
-            let m = compare(&r.read_hdr(gpu)?, reference)?;
+            let img = r.read_hdr(gpu)?;
+            let m = compare(&img, reference)?;
             points.push((frame, m.flip, m.relmse, m.mean_rel_bias));
+            if frame == last {
+                img.save(&out_dir.join(format!("last_{name}.exr")))?;
+                save_flip_heatmap(&img, reference, &out_dir.join(format!("last_{name}_flip.png")))?;
+            }
         }
     }
     eprintln!("{name}: {last} frames in {:.1} s", start.elapsed().as_secs_f64());

@@ -252,6 +252,10 @@ fn quality_convergence_scores_every_denoiser_beside_the_accumulation() {
     let relmse = |k: usize| rows[k][3].parse::<f64>().unwrap();
     assert!(relmse(0) > 3.0 * relmse(3), "{csv}");
     assert_eq!(image_size(&dir.join("convergence.png")), (960, 720));
+    for stream in ["accumulation", "svgf", "mara"] {
+        assert_eq!(image_size(&dir.join(format!("last_{stream}.exr"))), (32, 32));
+        assert_eq!(image_size(&dir.join(format!("last_{stream}_flip.png"))), (32, 32));
+    }
 }
 
 fn image_size(p: &std::path::Path) -> (u32, u32) {

@@ -17,7 +17,9 @@ use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
-use crate::settings::{FrameSettings, PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
+use crate::settings::{
+    FrameSettings, PROGRESSIVE_MAX_LEVELS, ProgressiveSettings, STILL_FRAMES_MAX,
+};
 use anyhow::{Context, Result};
 use bytemuck::{Pod, Zeroable};
 
@@ -43,7 +45,7 @@ impl ProgressiveParams {
     pub fn new(s: &ProgressiveSettings) -> ProgressiveParams {
         ProgressiveParams {
             alpha: s.alpha.clamp(1e-3, 1.0),
-            still_samples: s.still_samples.clamp(0.0, 1024.0),
+            still_samples: s.still_samples.clamp(0.0, STILL_FRAMES_MAX),
             sigma_n: s.sigma_n.max(0.0),
             sigma_d: s.sigma_d.max(1e-3),
             sigma_l: s.sigma_l.max(0.0),
@@ -143,7 +145,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
 }
 
-/// One signal's textures: 72 bytes per pixel.
+/// One signal's textures: 88 bytes per pixel.
 pub struct SignalTargets {
     /// The accumulated light (rgb) by parity: this frame's is next frame's history.
     pub history: PingPong<Tex>,
@@ -163,7 +165,8 @@ impl SignalTargets {
         let mut t =
             |label: &str, f| mem.texture(d, &format!("progressive/{name} {label}"), size, f, rw);
         SignalTargets {
-            history: PingPong::new(|i| t(&format!("history {i}"), RGBA16F)),
+            // 32-bit: a half float stalls a 1 / age mean after about a thousand samples.
+            history: PingPong::new(|i| t(&format!("history {i}"), RGBA32F)),
             moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
             variance: t("variance", RGBA16F),
             ping: t("ping", RGBA16F),

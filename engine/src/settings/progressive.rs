@@ -2,6 +2,7 @@
 //! filtering", §4-5; `denoise/progressive.rs`, shaders/progressive/*.wgsl): the denoiser for
 //! sample fractions below 1, which also runs at one sample per pixel.
 
+use super::STILL_FRAMES_MAX;
 use super::denoiser_info::{DenoiserInfo, Off, Stage};
 use super::field::{Kind::*, described};
 use super::view_spec::v;
@@ -23,9 +24,10 @@ described! {
         alpha: f32 = 0.1,
             ("progressive.alpha", "progressive/temporal", "", Float(0.01, 1.0, 0.005));
         /// In a still view a falls to 1 / this, so the light becomes a true mean of up to this many
-        /// samples; 0: `alpha` always (Dundr).
-        still_samples: f32 = 64.0,
-            ("progressive.still_samples", "progressive/temporal", "samples", Float(0.0, 1024.0, 1.0));
+        /// samples. The default, 2^24, is no cap: the mean of every sample since the view settled.
+        /// 0: `alpha` always (Dundr).
+        still_samples: f32 = STILL_FRAMES_MAX,
+            ("progressive.still_samples", "progressive/temporal", "samples", Float(0.0, STILL_FRAMES_MAX as f64, 1.0));
         /// A-trous levels of the 3x3 kernel, large scale first (§4.4; Dundr: 5, 61x61 pixels).
         /// 0: no spatial filter (untraced pixels stay as they were).
         levels: u32 = 5,
