@@ -6,6 +6,8 @@
 // sum w^2 var / (sum w)^2). The direct light's levels only fill missing pixels.
 
 var src: texture_2d<f32>;
+// The light's moments (m1, m2, age): the age sets the luminance weight's epsilon.
+var moments: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
 var<uniform> level: Level;
 
@@ -25,6 +27,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let nc = oct_decode(f.zw);
     let lc = select(luma(c.rgb), -1.0, missing);
+    let epsilon = luminance_epsilon(textureLoad(moments, p, 0).z);
     var sum = vec3f(0.0);
     var sum_var = 0.0;
     var wsum = 0.0;
@@ -48,7 +51,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             let nq = oct_decode(g.zw);
             let h = 0.25 * select(0.5, 1.0, dx == 0) * select(0.5, 1.0, dy == 0);
             let offset = f32(level.step) * length(vec2f(f32(dx), f32(dy)));
-            let w = h * dundr_weight(fc, nc, lc, max(c.a, 0.0), fq, nq, luma(t.rgb), offset);
+            let w = h * dundr_weight(fc, nc, lc, max(c.a, 0.0), epsilon, fq, nq, luma(t.rgb), offset);
             sum += w * t.rgb;
             sum_var += w * w * t.a;
             wsum += w;

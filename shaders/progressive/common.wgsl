@@ -13,7 +13,8 @@ struct ProgressiveParams {
     epsilon_l: f32,
     // 1: accumulate over samples (§4.2); 0: each frame alone.
     temporal: u32,
-    _pad: u32,
+    // In a still view epsilon_l falls as this / age past this many samples (0: never).
+    epsilon_full_samples: f32,
 }
 
 // Per dispatch: the a-trous step (large scale first) and whether the signal only fills pixels
@@ -42,7 +43,19 @@ fn luma(c: vec3f) -> f32 {
 
 // §4.4: w = w_N w_D w_L between pixel p (features fc, normal nc, luminance lc, variance;
 // lc < 0: no light there yet, no luminance weight) and tap q `offset` pixels away.
-fn dundr_weight(fc: vec2f, nc: vec3f, lc: f32, variance: f32, fq: vec2f, nq: vec3f, lq: f32, offset: f32) -> f32 {
+// The luminance weight's epsilon at a pixel whose light accumulated `age` samples: epsilon_l,
+// and in a still view past epsilon_full_samples epsilon_l x epsilon_full_samples / age. The
+// variance term beside it is the variance of the mean, which falls as 1 / age; a fixed epsilon
+// (Dundr's 0.01 to 0.1, in absolute luminance) outlasts it and keeps the 61-pixel filter
+// blurring a converged view's shading.
+fn luminance_epsilon(age: f32) -> f32 {
+    if dn.static_view == 0u || pp.epsilon_full_samples <= 0.0 {
+        return pp.epsilon_l;
+    }
+    return pp.epsilon_l * min(1.0, pp.epsilon_full_samples / max(age, 1.0));
+}
+
+fn dundr_weight(fc: vec2f, nc: vec3f, lc: f32, variance: f32, epsilon: f32, fq: vec2f, nq: vec3f, lq: f32, offset: f32) -> f32 {
     // §4.4.1
     let w_n = pow(max(dot(nc, nq), 0.0), pp.sigma_n);
     // §4.4.2: deviation from the local slope; epsilon 0.5% of the depth (Dundr's 0.005 of a
@@ -55,7 +68,7 @@ fn dundr_weight(fc: vec2f, nc: vec3f, lc: f32, variance: f32, fq: vec2f, nq: vec
     // §4.4.3
     var w_l = 1.0;
     if lc >= 0.0 {
-        w_l = exp(-abs(lc - lq) / (pp.sigma_l * variance + pp.epsilon_l));
+        w_l = exp(-abs(lc - lq) / (pp.sigma_l * variance + epsilon));
     }
     return w_n * w_d * w_l;
 }

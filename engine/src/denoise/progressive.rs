@@ -38,7 +38,7 @@ pub struct ProgressiveParams {
     pub sigma_l: f32,
     pub epsilon_l: f32,
     pub temporal: u32,
-    pub _pad: u32,
+    pub epsilon_full_samples: f32,
 }
 
 impl ProgressiveParams {
@@ -51,7 +51,7 @@ impl ProgressiveParams {
             sigma_l: s.sigma_l.max(0.0),
             epsilon_l: s.epsilon_l.max(1e-6),
             temporal: s.temporal as u32,
-            _pad: 0,
+            epsilon_full_samples: s.epsilon_full_samples.clamp(0.0, STILL_FRAMES_MAX),
         }
     }
 }
@@ -278,6 +278,7 @@ impl Resources {
                 // Large scale first: level i of n steps 2^(n - 1 - i) pixels.
                 let step = levels.saturating_sub(1 + i).min(LEVELS - 1);
                 b.texture("src", &src.1)
+                    .texture("moments", &s.moments.output(parity).1)
                     .texture("dst", &dst.1)
                     .buffer("level", &self.levels[(signal == Signal::Direct) as usize][step])
             }
