@@ -69,6 +69,8 @@ struct DenoiseParams {
     // In a still view a history at full confidence weighs the new frame 1 / n down to
     // 1 / this (0: the hysteresis always; MatteSettings::still_frames).
     still_frames: f32,
+    // Past this history length stage 7's edge-stop narrows as sqrt(this / n) (0: never).
+    edge_stop_full_frames: f32,
 }
 
 var<uniform> dn: DenoiseParams;

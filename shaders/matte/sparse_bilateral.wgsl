@@ -38,8 +38,15 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
     let fc = footprint(xc);
     var sigma_l = 0.0;
     if edge_k > 0.0 {
-        // The guide averages up to 9 samples: a third of the mean's noise.
-        sigma_l = edge_k * history_noise(p, xc, nc, fc) / 3.0 + 1e-6;
+        // The guide averages up to 9 samples: a third of the mean's noise. Past
+        // edge_stop_full_frames the stop narrows faster than the noise, so that what it lets
+        // through falls faster than the history's own error and a still view ends at its mean.
+        var k = edge_k;
+        if dn.edge_stop_full_frames > 0.0 {
+            let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
+            k *= sqrt(min(1.0, dn.edge_stop_full_frames / n));
+        }
+        sigma_l = k * history_noise(p, xc, nc, fc) / 3.0 + 1e-6;
     }
     let lc = centre.a;
     var sum = c;

@@ -23,7 +23,8 @@ struct SvgfParams {
     regression_k: f32,
     regression_samples: f32,
     regression_order: f32,
-    _pad0: u32,
+    // Past this many samples' worth the intervals narrow as sqrt(this / samples) (0: never).
+    regression_full_samples: f32,
     _pad1: u32,
     _pad2: u32,
 }

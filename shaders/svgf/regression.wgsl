@@ -147,7 +147,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // aborts compiling the glossy program when this stage calls signal_sigma itself.
     let reach = tap_reach(taps[tap_index(p)]);
     let c = textureLoad(light, p, 0);
-    let gamma = sv.regression_k;
+    // Past regression_full_samples the intervals narrow as sqrt(full / samples): at a fixed width
+    // an accepted window's bias stays a fixed share of the noise, and relMSE a fixed multiple of
+    // the accumulation's; narrowing, the reach falls faster than the noise and the view ends at
+    // its own mean.
+    var narrowing = 1.0;
+    if sv.regression_full_samples > 0.0 {
+        narrowing = sqrt(min(1.0, sv.regression_full_samples / samples));
+    }
+    let gamma = sv.regression_k * narrowing;
+    let narrow_gamma = NARROW_GAMMA * narrowing;
     var s: Sums;
     add_tap(&s, 1.0, 0.0, 0.0, c.rgb, max(c.a, 0.0));
     var shown = c.rgb;
@@ -185,8 +194,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if k == 1 {
             // The pixel alone, its standard deviation the 3x3 window's pooled one.
             let l0 = luminance(c.rgb);
-            lo = l0 - NARROW_GAMMA * sqrt(var_pool);
-            hi = l0 + NARROW_GAMMA * sqrt(var_pool);
+            lo = l0 - narrow_gamma * sqrt(var_pool);
+            hi = l0 + narrow_gamma * sqrt(var_pool);
         }
         let fit = solve(s);
         if !fit.ok {
@@ -195,7 +204,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let lm = luminance(fit.beta0);
         // Var(beta_0) = var (A^-1)_00 for equal weights; sum w^2 / sum w scales it for others.
         let sd = sqrt(max(var_pool * fit.inv00 * s.w2 / s.a[0], 0.0));
-        let g = select(gamma, NARROW_GAMMA, k < 2);
+        let g = select(gamma, narrow_gamma, k < 2);
         lo = max(lo, lm - g * sd);
         hi = min(hi, lm + g * sd);
         if lo > hi {

@@ -55,7 +55,8 @@ pub struct SvgfParams {
     pub regression_k: f32,
     pub regression_samples: f32,
     pub regression_order: f32,
-    pub _pad: [u32; 3],
+    pub regression_full_samples: f32,
+    pub _pad: [u32; 2],
 }
 
 impl SvgfParams {
@@ -74,7 +75,8 @@ impl SvgfParams {
             regression_k: s.regression_k.max(0.1),
             regression_samples: s.regression_samples.max(1.0),
             regression_order: s.regression_order.min(2) as f32,
-            _pad: [0; 3],
+            regression_full_samples: s.regression_full_samples.clamp(0.0, STILL_FRAMES_MAX),
+            _pad: [0; 2],
         }
     }
 }

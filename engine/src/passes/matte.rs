@@ -67,8 +67,8 @@ pub struct DenoiseParams {
     pub taa_current_glossy: f32,
     /// [`MatteSettings::still_frames`].
     pub still_frames: f32,
-    /// The uniform's size is a multiple of 16 bytes.
-    pub _pad: f32,
+    /// [`MatteSettings::edge_stop_full_frames`].
+    pub edge_stop_full_frames: f32,
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -133,7 +133,7 @@ impl DenoiseParams {
             taa_current_light: taa.current_light.clamp(0.0, 1.0),
             taa_current_glossy: taa.current_glossy.clamp(0.0, 1.0),
             still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
-            _pad: 0.0,
+            edge_stop_full_frames: s.edge_stop_full_frames.clamp(0.0, STILL_FRAMES_MAX),
         }
     }
 }

@@ -125,6 +125,14 @@ described! {
         /// 1 0.0293, 2 0.0304, 3 0.0310 with TAA's own mean).
         regression_k: f32 = 1.0,
             ("svgf.regression_k", "svgf/regression", "sigma", Float(0.1, 16.0, 0.1));
+        /// Past this many samples' worth the intervals (gamma and the first windows' 3 sigma) narrow
+        /// as sqrt(this / samples), so that a window's accepted bias falls faster than the noise of
+        /// its estimate and a still view ends at its own mean; at a fixed width the bias stays a
+        /// fixed share of the noise and relMSE stops at a fixed multiple of the accumulation's
+        /// (cornell_diffuse at 128², 1024 frames: relMSE 2.25x the accumulation's and FLIP
+        /// 0.0223; fixed, 2.51x and 0.0279; frame 60 the same). 0: fixed intervals.
+        regression_full_samples: f32 = 64.0,
+            ("svgf.regression_full_samples", "svgf/regression", "samples", Float(0.0, STILL_FRAMES_MAX as f64, 1.0));
         /// Light with fewer samples' worth than this shows the a-trous output.
         regression_samples: f32 = 16.0,
             ("svgf.regression_samples", "svgf/regression", "samples", Float(1.0, 1024.0, 1.0));

@@ -390,6 +390,7 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(size as usize, size_of::<SvgfParams>());
     assert_eq!(offs[8] as usize, offset_of!(SvgfParams, settled_levels));
     assert_eq!(offs[12] as usize, offset_of!(SvgfParams, regression_order));
+    assert_eq!(offs[13] as usize, offset_of!(SvgfParams, regression_full_samples));
     assert_eq!(wgsl_layout(atrous, "Level").0, 16);
     // obvhs's CWBVH node is read as five vec4u.
     assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
