@@ -458,9 +458,9 @@ fn disoccluded_region_recovers_like_a_fresh_start() {
 /// every frame (`MatteSettings::still_frames`) where the paper's hysteresis of 0.98 keeps about
 /// 50 frames' worth. After 256 frames the relMSE is within 1.2x of the plain accumulation of the
 /// same 256 frames, the mean within 0.5% of the reference per channel, and FLIP at frame 256
-/// below FLIP at frame 64. Measured: relMSE Mara 0.000611, plain 0.000802 (0.76x; with the
-/// hysteresis alone 0.001095, 1.36x); mean bias -0.15% / -0.15% / -0.09% (the plain
-/// accumulation's -0.72% / -0.75% / -0.78%); FLIP 0.0386 at 64, 0.0296 at 256.
+/// below FLIP at frame 64. Measured: relMSE Mara 0.000582, plain 0.000802 (0.73x; with the
+/// hysteresis alone 0.001095, 1.36x); mean bias -0.17% / -0.16% / -0.10% (the plain
+/// accumulation's -0.72% / -0.75% / -0.78%); FLIP 0.0386 at 64, 0.0276 at 256.
 #[test]
 fn mara_still_view_converges() {
     const SIZE: u32 = 128;

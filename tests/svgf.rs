@@ -313,9 +313,9 @@ fn svgf_nonfinite_input_never_reaches_history_or_screen() {
 /// accumulation of the same 256 frames (a filter whose blur bias did not fall with the history's
 /// variance would stay at its 64-frame error while the accumulation's halves twice), its mean
 /// within 0.5% of the reference's per channel, and FLIP at frame 256 below FLIP at frame 64 (the
-/// history keeps accumulating, no cap). Measured: relMSE SVGF 0.000864, plain 0.000802 (1.08x);
-/// mean bias -0.10% / -0.11% / -0.03% (the plain accumulation's -0.72% / -0.75% / -0.78%);
-/// FLIP 0.0374 at 64, 0.0329 at 256.
+/// history keeps accumulating, no cap). Measured: relMSE SVGF 0.000633, plain 0.000802 (0.79x);
+/// mean bias -0.07% / -0.08% / -0.00% (the plain accumulation's -0.72% / -0.75% / -0.78%);
+/// FLIP 0.0366 at 64, 0.0279 at 256.
 #[test]
 fn svgf_still_view_converges() {
     const SIZE: u32 = 128;
