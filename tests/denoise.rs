@@ -463,39 +463,5 @@ fn disoccluded_region_recovers_like_a_fresh_start() {
 /// accumulation's -0.72% / -0.75% / -0.78%); FLIP 0.0386 at 64, 0.0276 at 256.
 #[test]
 fn mara_still_view_converges() {
-    const SIZE: u32 = 128;
-    let dir = hush_tests::oracle("cornell_diffuse");
-    let scene = hush_engine::scene::load_gltf(&dir.join("cornell_diffuse.gltf")).unwrap();
-    let reference = Image::load(&dir.join("reference.exr")).unwrap().box_downsample(2).unwrap();
-    let cam = scene.camera_or_default();
-    let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (SIZE, SIZE)).unwrap();
-    let plain =
-        frames(&mut r, &gpu, &FrameSettings { accumulate: true, ..Default::default() }, cam, 256);
-    let at_64 = frames(&mut r, &gpu, &mara(), cam, 64);
-    let at_256 = frames(&mut r, &gpu, &mara(), cam, 192);
-    let (m_plain, m_64, m_256) = (
-        compare(&plain, &reference).unwrap(),
-        compare(&at_64, &reference).unwrap(),
-        compare(&at_256, &reference).unwrap(),
-    );
-    println!(
-        "relMSE plain {:.6} mara {:.6} ({:.2}x); bias {:?} (plain {:?}); FLIP at 64 {:.4}, at 256 {:.4}",
-        m_plain.relmse,
-        m_256.relmse,
-        m_256.relmse / m_plain.relmse,
-        m_256.mean_rel_bias,
-        m_plain.mean_rel_bias,
-        m_64.flip,
-        m_256.flip
-    );
-    assert!(
-        m_256.relmse <= 1.2 * m_plain.relmse,
-        "relMSE {} after 256 frames, plain accumulation {}",
-        m_256.relmse,
-        m_plain.relmse
-    );
-    for b in m_256.mean_rel_bias {
-        assert!(b.abs() < 0.005, "mean bias {b} against the reference");
-    }
-    assert!(m_256.flip < m_64.flip, "FLIP {} at 256 frames, {} at 64", m_256.flip, m_64.flip);
+    hush_tests::still_convergence(&mara()).check("mara");
 }

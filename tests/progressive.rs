@@ -361,45 +361,6 @@ fn progressive_nonfinite_input_never_reaches_history_or_screen() {
 /// epsilon 0.002194, 2.7x); mean bias -0.17% / -0.16% / -0.09%; FLIP 0.0740 at 64, 0.0441 at 256.
 #[test]
 fn progressive_still_view_converges() {
-    use hush_engine::quality::{Image, compare};
-    const FRAMES: u32 = 256;
-    let dir = hush_tests::oracle("cornell_diffuse");
-    let scene = hush_engine::scene::load_gltf(&dir.join("cornell_diffuse.gltf")).unwrap();
-    let reference = Image::load(&dir.join("reference.exr")).unwrap().box_downsample(2).unwrap();
-    let input = FrameInput { camera: scene.camera_or_default(), time: 0.0, shutter: None };
-    let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (128, 128)).unwrap();
-    let mut run = |s: &FrameSettings, n: u32| {
-        for _ in 0..n {
-            r.render(&gpu, &input, s, None).unwrap();
-        }
-        r.read_hdr(&gpu).unwrap()
-    };
-    let plain = run(&FrameSettings { accumulate: true, ..Default::default() }, FRAMES);
     let filtered = FrameSettings { denoiser: Denoiser::named("progressive"), ..Default::default() };
-    let at_64 = run(&filtered, 64);
-    let at_256 = run(&filtered, FRAMES - 64);
-    let (m_plain, m_64, m_256) = (
-        compare(&plain, &reference).unwrap(),
-        compare(&at_64, &reference).unwrap(),
-        compare(&at_256, &reference).unwrap(),
-    );
-    println!(
-        "relMSE plain {:.6} progressive {:.6} ({:.2}x); bias {:?}; FLIP at 64 {:.4}, at 256 {:.4}",
-        m_plain.relmse,
-        m_256.relmse,
-        m_256.relmse / m_plain.relmse,
-        m_256.mean_rel_bias,
-        m_64.flip,
-        m_256.flip
-    );
-    assert!(
-        m_256.relmse <= 1.2 * m_plain.relmse,
-        "relMSE {} against {}",
-        m_256.relmse,
-        m_plain.relmse
-    );
-    for b in m_256.mean_rel_bias {
-        assert!(b.abs() < 0.005, "mean bias {b} against the reference");
-    }
-    assert!(m_256.flip < m_64.flip, "FLIP {} at 256 frames, {} at 64", m_256.flip, m_64.flip);
+    hush_tests::still_convergence(&filtered).check("progressive");
 }

@@ -291,6 +291,11 @@ fn confidence(h: f32, distance: f32) -> f32 {
 const MOVING_FRAMES_MAX: f32 = 1024.0;
 const STILL_FRAMES_MAX: f32 = 16777216.0;
 
+// A history's length with this frame, from the length stored with it.
+fn next_length(stored: f32, still: bool) -> f32 {
+    return min(max(stored, 1.0) + 1.0, select(MOVING_FRAMES_MAX, STILL_FRAMES_MAX, still));
+}
+
 // The new frame's weight in a temporal blend: max(1 - c, 1 / n), eq. (11)'s hysteresis with the
 // first frames averaged truly; in a still view at full confidence (`still`), 1 / n down to
 // 1 / still_frames, so that the history is the mean of every frame since the view settled.

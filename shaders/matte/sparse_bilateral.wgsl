@@ -8,7 +8,7 @@
 // sqrt(n). The residual holds the noise without the shading's own variation: the input's
 // spread around its local mean counted a contact shadow's contrast as noise, and the edge-stop
 // then blurred the shadow it was there to keep.
-fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32) -> f32 {
+fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32, n: f32) -> f32 {
     var sum = residual_square(p);
     var count = 1.0;
     for (var i = 0u; i < 16u; i++) {
@@ -18,7 +18,6 @@ fn history_noise(p: vec2i, xc: vec3f, nc: vec3f, fc: f32) -> f32 {
             count += 1.0;
         }
     }
-    let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
     return sqrt(sum / count / n);
 }
 
@@ -41,12 +40,12 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         // The guide averages up to 9 samples: a third of the mean's noise. Past
         // edge_stop_full_frames the stop narrows faster than the noise, so that what it lets
         // through falls faster than the history's own error and a still view ends at its mean.
+        let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
         var k = edge_k;
         if dn.edge_stop_full_frames > 0.0 {
-            let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
             k *= sqrt(min(1.0, dn.edge_stop_full_frames / n));
         }
-        sigma_l = k * history_noise(p, xc, nc, fc) / 3.0 + 1e-6;
+        sigma_l = k * history_noise(p, xc, nc, fc, n) / 3.0 + 1e-6;
     }
     let lc = centre.a;
     var sum = c;

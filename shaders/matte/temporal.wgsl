@@ -56,7 +56,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if c > 0.0 {
         let texel = textureLoad(history, r.texel, 0);
         let still = dn.static_view != 0u && dn.still_frames > 0.0 && c >= dn.hysteresis;
-        n = min(max(texel.a, 1.0) + 1.0, select(MOVING_FRAMES_MAX, STILL_FRAMES_MAX, still));
+        n = next_length(texel.a, still);
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             hist = half_safe(load_bilinear(history, prev).rgb);

@@ -17,20 +17,25 @@ pub struct CompareArgs {
     pub flip_map: Option<PathBuf>,
 }
 
+/// A reference for a render of `size`: box-downsampled by the factor between them where the render
+/// is at an integer fraction of the reference's resolution (each pixel is the mean over its
+/// footprint), else as it is; and that factor (1: as it is).
+pub fn at_render_size(y: Image, size: (u32, u32)) -> Result<(Image, u32)> {
+    let (w, h) = size;
+    if y.width > w && w > 0 && y.width.is_multiple_of(w) && y.height == h * (y.width / w) {
+        let f = y.width / w;
+        return Ok((y.box_downsample(f)?, f));
+    }
+    Ok((y, 1))
+}
+
 pub fn run(a: CompareArgs) -> Result<()> {
     let x = Image::load(&a.test).with_context(|| format!("test image {}", a.test.display()))?;
-    let mut y = Image::load(&a.reference)
+    let y = Image::load(&a.reference)
         .with_context(|| format!("reference image {}", a.reference.display()))?;
-    // A render made at a fraction of the reference's resolution is compared with the
-    // reference box-downsampled by that factor (each pixel is the mean over its footprint).
-    if y.width > x.width
-        && x.width > 0
-        && y.width % x.width == 0
-        && y.height == x.height * (y.width / x.width)
-    {
-        let f = y.width / x.width;
+    let (y, f) = at_render_size(y, (x.width, x.height))?;
+    if f > 1 {
         eprintln!("reference box-downsampled by {f} to {}x{}", x.width, x.height);
-        y = y.box_downsample(f)?;
     }
     let m = compare(&x, &y)?;
     if let Some(path) = &a.flip_map {

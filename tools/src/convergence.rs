@@ -107,12 +107,10 @@ pub fn run(a: &QualityArgs, scene: Scene, size: (u32, u32), input: FrameInput) -
 }
 
 /// A reference image from a file (a Mitsuba render), box-downsampled when the run is at an
-/// integer fraction of its size (each pixel the mean over its footprint, as `compare` does).
+/// integer fraction of its size (`compare::at_render_size`).
 fn external_reference(path: &Path, size: (u32, u32)) -> Result<Image> {
-    let mut y = Image::load(path).with_context(|| format!("reference image {}", path.display()))?;
-    if y.width > size.0 && y.width % size.0 == 0 && y.height == size.1 * (y.width / size.0) {
-        y = y.box_downsample(y.width / size.0)?;
-    }
+    let y = Image::load(path).with_context(|| format!("reference image {}", path.display()))?;
+    let (y, _) = crate::compare::at_render_size(y, size)?;
     if (y.width, y.height) != size {
         bail!(
             "reference {} is {}x{}: render at its size or an integer fraction of it (asked {}x{})",
