@@ -40,7 +40,7 @@ fn scene(wrap_s: Wrap) -> Scene {
         vec![Vec2::new(-1.0, 1.0), Vec2::new(2.0, 1.0), Vec2::new(2.0, 0.0), Vec2::new(-1.0, 0.0)];
     let material = Material {
         emission: Vec3::ONE,
-        emissive_texture: Some(TextureRef { index: 0 }),
+        emissive_texture: Some(TextureRef::new(0)),
         base_color: Vec3::ZERO.extend(1.0),
         metallic: 0.0,
         specular_factor: 0.0,

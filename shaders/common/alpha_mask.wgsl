@@ -4,9 +4,10 @@ fn alpha_accept(slot: u32, b: vec2f) -> bool {
     if (m.flags & MAT_ALPHA_MASK) == 0u {
         return true;
     }
-    var a = m.base_color.a;
+    let t = tri_tex_coords(slot, b);
+    var a = m.base_color.a * t.color.a;
     if m.tex.x >= 0 {
-        a *= tex_sample(u32(m.tex.x), tri_uv(slot, b)).a;
+        a *= material_texture(m, 0u, t).a;
     }
     return a >= m.alpha_cutoff;
 }

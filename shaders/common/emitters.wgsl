@@ -43,7 +43,7 @@ fn sample_emitter(p: vec3f, u: vec3f) -> LightSample {
     }
     var le = m.emission;
     if m.tex.w >= 0 {
-        le *= tex_sample(u32(m.tex.w), tri_uv(slot, b)).rgb;
+        le *= material_texture(m, 3u, tri_tex_coords(slot, b)).rgb;
     }
     let pdf = emitter_pdf_area(m.emission) * d2 / cos_l;
     if pdf <= 0.0 {

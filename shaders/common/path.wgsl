@@ -138,7 +138,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         return;
     }
-    let ms = material_at(m, s.uv);
+    let ms = material_at(m, s.tc);
     let emission = ms.emission;
     let bsdf = material_bsdf(m, ms);
     if first {

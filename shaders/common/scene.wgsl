@@ -24,6 +24,8 @@ struct Material {
 
 const MAT_DOUBLE_SIDED: u32 = 1u;
 const MAT_ALPHA_MASK: u32 = 2u;
+// Bits 8 and up of the flags: the material's own index (common/texcoords.wgsl's table row).
+const MAT_INDEX_SHIFT: u32 = 8u;
 
 // Five texels per material (engine/src/gpu/prepare.rs, GpuMaterial).
 var material_texels: texture_2d<u32>;
@@ -47,6 +49,25 @@ fn tri_uv(slot: u32, b: vec2f) -> vec2f {
     return vec2f(dot(w, vec3f(s0.w, s1.w, s2.w)), dot(w, s3.xyz));
 }
 
+// The vertex attributes a material reads at a surface point: TEXCOORD_0, TEXCOORD_1 and COLOR_0
+// (common/attributes.wgsl, or TEXCOORD_0 and white in a scene without the other two).
+struct TexCoords {
+    uv0: vec2f,
+    uv1: vec2f,
+    color: vec4f,
+}
+
+fn tri_tex_coords(slot: u32, b: vec2f) -> TexCoords {
+    return TexCoords(tri_uv(slot, b), tri_uv1(slot, b), tri_color(slot, b));
+}
+
+// Texture slot k of material m (0 base colour, 1 metallic-roughness, 2 normal, 3 emissive; the
+// slot must hold a texture), read at the coordinates its texture info names
+// (common/texcoords.wgsl: TEXCOORD set and KHR_texture_transform).
+fn material_texture(m: Material, k: u32, t: TexCoords) -> vec4f {
+    return tex_sample(u32(m.tex[k]), texture_uv(m, k, t));
+}
+
 fn tri_normal(slot: u32, b: vec2f) -> vec3f {
     let w = vec3f(1.0 - b.x - b.y, b.x, b.y);
     return w.x * shading_at(slot * 4u).xyz + w.y * shading_at(slot * 4u + 1u).xyz + w.z * shading_at(slot * 4u + 2u).xyz;
@@ -58,7 +79,7 @@ struct Surface {
     // Geometric and shading normals, both turned to the side the ray came from.
     ng: vec3f,
     ns: vec3f,
-    uv: vec2f,
+    tc: TexCoords,
     // The ray hit the counter-clockwise (front) side.
     front: bool,
     material: u32,
@@ -82,9 +103,9 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
         ng = -ng;
         ns = -ns;
     }
-    s.uv = tri_uv(slot, hit.b);
+    s.tc = tri_tex_coords(slot, hit.b);
     s.ng = ng;
-    s.ns = apply_normal_map(slot, hit.b, ns, s.uv, material(s.material));
+    s.ns = apply_normal_map(slot, hit.b, ns, s.tc, material(s.material));
     if stored {
         // The stored normals (and tangents) are the close's: the mapped normal turns with the
         // triangle to the ray's time where objects move during the shutter.
@@ -102,22 +123,23 @@ struct MaterialSample {
     emission: vec3f,
 }
 
-fn material_at(m: Material, uv: vec2f) -> MaterialSample {
+// COLOR_0 multiplies the base colour (glTF 2.0 §3.7.2.1), alpha included.
+fn material_at(m: Material, t: TexCoords) -> MaterialSample {
     var r: MaterialSample;
-    r.base = m.base_color;
+    r.base = m.base_color * t.color;
     r.metallic = m.metallic;
     r.roughness = m.roughness;
     r.emission = m.emission;
     if m.tex.x >= 0 {
-        r.base *= tex_sample(u32(m.tex.x), uv);
+        r.base *= material_texture(m, 0u, t);
     }
     if m.tex.y >= 0 {
-        let mr = tex_sample(u32(m.tex.y), uv);
+        let mr = material_texture(m, 1u, t);
         r.roughness *= mr.g;
         r.metallic *= mr.b;
     }
     if m.tex.w >= 0 {
-        r.emission *= tex_sample(u32(m.tex.w), uv).rgb;
+        r.emission *= material_texture(m, 3u, t).rgb;
     }
     return r;
 }

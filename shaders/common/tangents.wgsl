@@ -1,7 +1,7 @@
 // Tangents (xyz, w = handedness), three vec4 per triangle, for tangent-space normal maps.
 var<storage, read> tangents: array<vec4f>;
 
-fn apply_normal_map(slot: u32, b: vec2f, ns: vec3f, uv: vec2f, m: Material) -> vec3f {
+fn apply_normal_map(slot: u32, b: vec2f, ns: vec3f, tc: TexCoords, m: Material) -> vec3f {
     if m.tex.z < 0 {
         return ns;
     }
@@ -14,7 +14,7 @@ fn apply_normal_map(slot: u32, b: vec2f, ns: vec3f, uv: vec2f, m: Material) -> v
     }
     let tn = normalize(t);
     let bn = cross(ns, tn) * select(1.0, -1.0, t4.w < 0.0);
-    var c = tex_sample(u32(m.tex.z), uv).xyz * 2.0 - 1.0;
+    var c = material_texture(m, 2u, tc).xyz * 2.0 - 1.0;
     c = vec3f(c.xy * m.normal_scale, c.z);
     let n = tn * c.x + bn * c.y + ns * c.z;
     let len = length(n);

@@ -50,7 +50,7 @@ fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
         discard;
     }
     let m = material(tri_material(slot));
-    let uv = tri_uv(slot, b);
+    let tc = tri_tex_coords(slot, b);
     let v0 = tris[slot * 3u].xyz;
     var ng = normalize(cross(tris[slot * 3u + 1u].xyz - v0, tris[slot * 3u + 2u].xyz - v0));
     var ns = tri_normal(slot, b);
@@ -59,8 +59,8 @@ fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     if !front {
         ns = -ns;
     }
-    ns = apply_normal_map(slot, b, ns, uv, m);
-    let ms = material_at(m, uv);
+    ns = apply_normal_map(slot, b, ns, tc, m);
+    let ms = material_at(m, tc);
     let bsdf = material_bsdf(m, ms);
     var o: GBufferOut;
     o.normal = oct_encode(ns);

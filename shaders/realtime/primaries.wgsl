@@ -64,7 +64,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         let s = surface_at(hit, ray.rd);
         let m = material(s.material);
-        let ms = material_at(m, s.uv);
+        let ms = material_at(m, s.tc);
         let bsdf = material_bsdf(m, ms);
         let object = bitcast<u32>(shading_at(hit.tri * 4u + 3u).w);
         if j == 0u {

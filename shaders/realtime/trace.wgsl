@@ -70,7 +70,7 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         return Shaded(vec3f(0.0), vec3f(0.0), vec3f(0.0), INF, vec3f(1.0), -rd, rd, INF, s.ns, true);
     }
-    let ms = material_at(m, s.uv);
+    let ms = material_at(m, s.tc);
     let bsdf = material_bsdf(m, ms);
     let basis = onb(s.ns);
     let wo = to_local(basis, -rd);

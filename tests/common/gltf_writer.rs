@@ -58,6 +58,33 @@ impl GltfWriter {
         self.accessors.len() - 1
     }
 
+    /// A float accessor of `ty` ("VEC2", "VEC4", ...) over `v`; returns its index.
+    pub fn floats(&mut self, v: &[f32], ty: &str) -> usize {
+        let n = match ty {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC3" => 3,
+            _ => 4,
+        };
+        let bytes: Vec<u8> = v.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let view = self.push_data(&bytes, 34962);
+        self.accessors.push(
+            json!({"bufferView": view, "componentType": 5126, "count": v.len() / n, "type": ty}),
+        );
+        self.accessors.len() - 1
+    }
+
+    /// A normalized UNSIGNED_BYTE accessor of `ty` over `v` (each element padded to 4 bytes,
+    /// as glTF aligns vertex attributes); returns its index.
+    pub fn unorm8(&mut self, v: &[u8], ty: &str) -> usize {
+        let n = if ty == "VEC3" { 3 } else { 4 };
+        let bytes: Vec<u8> = v.chunks(n).flat_map(|c| [c, &[0u8; 4][..4 - n]].concat()).collect();
+        let view = self.push_data(&bytes, 34962);
+        self.views[view]["byteStride"] = json!(4);
+        self.accessors.push(json!({"bufferView": view, "componentType": 5121, "normalized": true, "count": v.len() / n, "type": ty}));
+        self.accessors.len() - 1
+    }
+
     /// A mesh with one triangle primitive; returns the mesh index.
     pub fn mesh(&mut self, p: Prim) -> usize {
         let pos = self.vec3_accessor(p.positions);

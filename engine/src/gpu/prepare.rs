@@ -25,6 +25,11 @@ pub struct SceneFeatures {
     pub glossy: bool,
     /// Some object moves: the BVH is rebuilt each frame and object motion enters the motion vectors.
     pub animated: bool,
+    /// Some texture is read at TEXCOORD_1 or through a KHR_texture_transform: the per-material
+    /// coordinate table (`tex_uses`) exists.
+    pub texture_uses: bool,
+    /// Some mesh carries TEXCOORD_1 or COLOR_0: three more texels a triangle (`extras`).
+    pub vertex_extras: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,6 +82,11 @@ impl From<&crate::scene::Material> for GpuMaterial {
 }
 
 pub const MAT_DOUBLE_SIDED: u32 = 1;
+/// Bits 8 and up of [`GpuMaterial::flags`]: the material's index (shaders/common/texcoords.wgsl
+/// reads its row of [`PreparedScene::tex_uses`] by it).
+pub const MAT_INDEX_SHIFT: u32 = 8;
+/// As many materials as those bits count.
+pub const MAX_MATERIALS: usize = 1 << (32 - MAT_INDEX_SHIFT);
 pub const MAT_ALPHA_MASK: u32 = 2;
 
 /// Everything ready for upload, with no GPU involved (so limits can be computed before a device
@@ -99,7 +109,14 @@ pub struct PreparedScene {
     pub tris_open: Vec<Vec4>,
     pub shading: Vec<Vec4>,
     pub tangents: Vec<Vec4>,
+    /// [`SceneFeatures::vertex_extras`]: TEXCOORD_1 and COLOR_0, three texels (12 words) a
+    /// triangle in BVH order ([`pack_extras`]).
+    pub extras: Vec<[u32; 4]>,
     pub materials: Vec<GpuMaterial>,
+    /// [`SceneFeatures::texture_uses`]: per material and texture slot (base colour,
+    /// metallic-roughness, normal, emissive), two rows of the coordinates' affine map, the
+    /// first's w the TEXCOORD set ([`pack_texture_uses`]).
+    pub tex_uses: Vec<Vec4>,
     pub lights: Vec<GpuLight>,
     /// (cumulative probability bits, triangle slot).
     pub emitters: Vec<[u32; 2]>,
@@ -134,6 +151,7 @@ struct Flat {
     tris: Vec<Triangle>,
     attrs: Vec<[Vec4; 4]>,
     tans: Vec<[Vec4; 3]>,
+    extras: Vec<[[u32; 4]; 3]>,
     mats: Vec<u32>,
     dropped: usize,
 }
@@ -143,7 +161,7 @@ fn flatten(
     object: usize,
     transform: DMat4,
     origin: DVec3,
-    normal_maps: bool,
+    features: &SceneFeatures,
 ) -> Flat {
     let o = &scene.objects[object];
     let mesh = &scene.meshes[o.mesh];
@@ -191,7 +209,10 @@ fn flatten(
             n[2].extend(uv[2].x),
             Vec4::new(uv[0].y, uv[1].y, uv[2].y, f32::from_bits(object as u32)),
         ]);
-        if normal_maps {
+        if features.vertex_extras {
+            f.extras.push(pack_extras(mesh, idx));
+        }
+        if features.normal_maps {
             f.tans.push(idx.map(|i| {
                 let t =
                     mesh.tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
@@ -203,6 +224,43 @@ fn flatten(
         f.mats.push(mat);
     }
     f
+}
+
+/// A triangle's TEXCOORD_1 and COLOR_0 (shaders/common/attributes.wgsl): the three vertices'
+/// TEXCOORD_1 as f32 bits, then their colours as two unorm16x2 words each (RG, BA). A mesh
+/// without TEXCOORD_1 stores its TEXCOORD_0 there, one without COLOR_0 white.
+fn pack_extras(mesh: &crate::scene::Mesh, idx: [u32; 3]) -> [[u32; 4]; 3] {
+    let uv = idx.map(|i| {
+        let i = i as usize;
+        let uv = mesh.uvs1.get(i).or(mesh.uvs.get(i)).copied().unwrap_or_default();
+        if uv.is_finite() { uv } else { glam::Vec2::ZERO }
+    });
+    let unorm16 = |x: f32| (x.clamp(0.0, 1.0) * 65535.0).round() as u32;
+    let c = idx.map(|i| {
+        let c = mesh.colors.get(i as usize).copied().unwrap_or(Vec4::ONE);
+        [unorm16(c.x) | unorm16(c.y) << 16, unorm16(c.z) | unorm16(c.w) << 16]
+    });
+    let b = |x: f32| x.to_bits();
+    [
+        [b(uv[0].x), b(uv[0].y), b(uv[1].x), b(uv[1].y)],
+        [b(uv[2].x), b(uv[2].y), c[0][0], c[0][1]],
+        [c[1][0], c[1][1], c[2][0], c[2][1]],
+    ]
+}
+
+/// Per material and texture slot, the rows of the map from the mesh's coordinates to the
+/// texture's (shaders/common/texcoords.wgsl), the first row's w the TEXCOORD set.
+fn pack_texture_uses(materials: &[crate::scene::Material]) -> Vec<Vec4> {
+    let mut v = Vec::with_capacity(materials.len() * 8);
+    for m in materials {
+        for t in m.texture_refs() {
+            let t = t.unwrap_or(crate::scene::TextureRef::new(0));
+            let (a, o) = (t.transform.matrix2, t.transform.translation);
+            v.push(Vec4::new(a.x_axis.x, a.y_axis.x, o.x, t.set as f32));
+            v.push(Vec4::new(a.x_axis.y, a.y_axis.y, o.y, 0.0));
+        }
+    }
+    v
 }
 
 /// f32 matrix of a rebased world transform.
@@ -228,8 +286,29 @@ impl PreparedScene {
         let extent =
             scene.bounds().map(|(lo, hi)| (hi - lo).length()).filter(|e| *e > 0.0).unwrap_or(1.0);
         let normal_maps = scene.materials.iter().any(|m| m.normal_texture.is_some());
+        let texture_uses = scene
+            .materials
+            .iter()
+            .any(|m| m.texture_refs().into_iter().flatten().any(|t| !t.is_plain()));
+        let vertex_extras = scene.objects.iter().any(|o| {
+            let m = &scene.meshes[o.mesh];
+            !m.uvs1.is_empty() || !m.colors.is_empty()
+        });
+        let lights: Vec<GpuLight> = scene.lights.iter().map(|l| pack_light(l, origin)).collect();
+        let mut features = SceneFeatures {
+            punctual_lights: !lights.is_empty(),
+            emitters: false,
+            env: EnvKind::None,
+            textures: !scene.textures.is_empty(),
+            normal_maps,
+            alpha_mask: scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
+            glossy: Self::glossy_materials(scene),
+            animated: scene.is_animated(),
+            texture_uses,
+            vertex_extras,
+        };
         let flat: Vec<Flat> = (0..scene.objects.len())
-            .map(|i| flatten(scene, i, scene.objects[i].transform, origin, normal_maps))
+            .map(|i| flatten(scene, i, scene.objects[i].transform, origin, &features))
             .collect();
         let dropped: usize = flat.iter().map(|f| f.dropped).sum();
         if dropped > 0 {
@@ -240,8 +319,22 @@ impl PreparedScene {
             bail!("{} triangles: Hush handles at most {} per scene", count, MAX_TRIANGLES - 1);
         }
         let world: Vec<DMat4> = scene.objects.iter().map(|o| o.transform).collect();
-        let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
-        let lights: Vec<GpuLight> = scene.lights.iter().map(|l| pack_light(l, origin)).collect();
+        if scene.materials.len() > MAX_MATERIALS {
+            bail!(
+                "{} materials: Hush handles at most {MAX_MATERIALS} per scene",
+                scene.materials.len()
+            );
+        }
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let mut g = GpuMaterial::from(m);
+                g.flags |= (i as u32) << MAT_INDEX_SHIFT;
+                g
+            })
+            .collect();
 
         let mut env = EnvPack::default();
         let env_kind = match &scene.environment {
@@ -260,19 +353,10 @@ impl PreparedScene {
             }
         };
         let tex_data = pack_textures(scene);
-        let alpha_mask = scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_)));
-        let glossy = Self::glossy_materials(scene);
+        features.env = env_kind;
+        let tex_uses = if texture_uses { pack_texture_uses(&scene.materials) } else { vec![] };
         let mut p = PreparedScene {
-            features: SceneFeatures {
-                punctual_lights: !lights.is_empty(),
-                emitters: false,
-                env: env_kind,
-                textures: !scene.textures.is_empty(),
-                normal_maps,
-                alpha_mask,
-                glossy,
-                animated: scene.is_animated(),
-            },
+            features,
             accel: Accel::empty(kind),
             traversal_stack: kind.max_depth() as u32,
             origin,
@@ -281,7 +365,9 @@ impl PreparedScene {
             tris_open: vec![],
             shading: vec![],
             tangents: vec![],
+            extras: vec![],
             materials,
+            tex_uses,
             lights,
             emitters: vec![],
             emit_inv_total: 0.0,
@@ -338,7 +424,7 @@ impl PreparedScene {
                 glam::Mat4::IDENTITY
             };
             if o.animation.is_some() && now != before {
-                self.flat[i] = flatten(scene, i, now, self.origin, self.features.normal_maps);
+                self.flat[i] = flatten(scene, i, now, self.origin, &self.features);
                 self.world[i] = now;
                 moved = true;
             }
@@ -382,12 +468,14 @@ impl PreparedScene {
         let mut tris_in: Vec<Triangle> = vec![];
         let mut attrs: Vec<&[Vec4; 4]> = vec![];
         let mut tans: Vec<&[Vec4; 3]> = vec![];
+        let mut extras: Vec<&[[u32; 4]; 3]> = vec![];
         let mut mats: Vec<u32> = vec![];
         let mut open_in: Vec<Triangle> = vec![];
         for (i, f) in self.flat.iter().enumerate() {
             tris_in.extend_from_slice(&f.tris);
             attrs.extend(f.attrs.iter());
             tans.extend(f.tans.iter());
+            extras.extend(f.extras.iter());
             mats.extend_from_slice(&f.mats);
             if let Some(m) = self.open_from_close.get(i) {
                 let to = |v: Vec3A| Vec3A::from(m.transform_point3(v.into()));
@@ -426,6 +514,7 @@ impl PreparedScene {
         self.tris_open.clear();
         self.shading.clear();
         self.tangents.clear();
+        self.extras.clear();
         for &orig in &accel.order {
             let (t, i) = (&tris_in[orig as usize], orig as usize);
             let v = |a: Vec3A| Vec3::from(a);
@@ -443,6 +532,9 @@ impl PreparedScene {
             self.shading.extend_from_slice(attrs[i]);
             if self.features.normal_maps {
                 self.tangents.extend_from_slice(tans[i]);
+            }
+            if self.features.vertex_extras {
+                self.extras.extend_from_slice(extras[i]);
             }
         }
         // Emissive triangles by area x luminance (one-sided power up to a constant pi).

@@ -21,6 +21,9 @@ pub struct GpuScene {
     /// each), as texel rows like the nodes.
     pub shading: Texels,
     pub materials: Texels,
+    /// [`PreparedScene::extras`] and [`PreparedScene::tex_uses`], where the scene has them.
+    pub extras: Option<Texels>,
+    pub tex_uses: Option<Texels>,
     pub lights: Option<wgpu::Buffer>,
     pub emitters: Option<wgpu::Buffer>,
     pub env: Option<wgpu::Buffer>,
@@ -69,6 +72,8 @@ impl PreparedScene {
                 self.tex_data.len() * 4,
                 self.shading.len() * 16,
                 self.materials.len() * 80,
+                self.extras.len() * 16,
+                self.tex_uses.len() * 16,
             ]
             .into_iter()
             .map(texel_row_count)
@@ -130,6 +135,24 @@ impl PreparedScene {
             b(&self.materials),
             wgpu::TextureFormat::Rgba32Uint,
         );
+        let extras = f.vertex_extras.then(|| {
+            Texels::new(
+                gpu,
+                &mut mem,
+                "scene/vertex extras",
+                b(&self.extras),
+                wgpu::TextureFormat::Rgba32Uint,
+            )
+        });
+        let tex_uses = f.texture_uses.then(|| {
+            Texels::new(
+                gpu,
+                &mut mem,
+                "scene/texture uses",
+                b(&self.tex_uses),
+                wgpu::TextureFormat::Rgba32Float,
+            )
+        });
         let copy = s | wgpu::BufferUsages::COPY_DST;
         // Lights and environment are rewritten when the user moves the sun.
         let lights =
@@ -171,6 +194,8 @@ impl PreparedScene {
             tri_open_texels,
             shading,
             materials,
+            extras,
+            tex_uses,
             lights,
             emitters,
             env,
@@ -210,6 +235,9 @@ impl GpuScene {
                 replaced |= t.write(gpu, mem, b(&p.tris_open));
             }
             replaced |= self.shading.write(gpu, mem, b(&p.shading));
+            if let Some(t) = self.extras.as_mut() {
+                replaced |= t.write(gpu, mem, b(&p.extras));
+            }
         }
         let mut put = |buf: &mut wgpu::Buffer, label: &str, data: &[u8]| {
             if data.is_empty() {
@@ -256,6 +284,8 @@ impl GpuScene {
             .buffer("tris", &self.tris)
             .texture("shading_texels", &self.shading.view)
             .texture("material_texels", &self.materials.view)
+            .texture_opt("extra_texels", self.extras.as_ref().map(|t| &t.view))
+            .texture_opt("tex_use_texels", self.tex_uses.as_ref().map(|t| &t.view))
             .buffer_opt("lights", self.lights.as_ref())
             .buffer_opt("emitters", self.emitters.as_ref())
             .buffer_opt("env_data", self.env.as_ref())
@@ -291,9 +321,7 @@ impl GpuScene {
             "common/camera.wgsl",
             "common/path.wgsl",
         ];
-        m.push(if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" });
-        m.push(if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" });
-        m.push(if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" });
+        m.extend(self.material_modules());
         m.push(if f.punctual_lights { "common/lights.wgsl" } else { "common/lights_none.wgsl" });
         m.push(if f.emitters { "common/emitters.wgsl" } else { "common/emitters_none.wgsl" });
         m.push(match f.env {
@@ -302,6 +330,19 @@ impl GpuScene {
             EnvKind::Map => "common/env_map.wgsl",
         });
         m
+    }
+
+    /// The modules that read materials at a surface point: textures, normal maps, alpha masks,
+    /// texture coordinate maps and vertex attributes, each as the scene needs it.
+    pub fn material_modules(&self) -> [&'static str; 5] {
+        let f = &self.features;
+        [
+            if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" },
+            if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" },
+            if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" },
+            if f.texture_uses { "common/texcoords.wgsl" } else { "common/texcoords_none.wgsl" },
+            if f.vertex_extras { "common/attributes.wgsl" } else { "common/attributes_none.wgsl" },
+        ]
     }
 
     pub fn traversal_module(&self) -> &'static str {

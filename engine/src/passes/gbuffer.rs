@@ -176,19 +176,19 @@ fn bindings<'a>(scene: &'a GpuScene, frame: &'a wgpu::Buffer) -> Bindings<'a> {
 impl GBufferPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &wgpu::Buffer) -> Result<GBufferPass> {
         let f = &scene.features;
-        let modules = vec![
+        let mut modules = vec![
             "common/math.wgsl",
             "common/geometry.wgsl",
             "common/motion_none.wgsl",
             "common/scene.wgsl",
             "common/bsdf.wgsl",
-            if f.textures { "common/textures.wgsl" } else { "common/textures_none.wgsl" },
-            if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" },
-            if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" },
+        ];
+        modules.extend(scene.material_modules());
+        modules.extend([
             "realtime/frame.wgsl",
             if f.animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" },
             "realtime/gbuffer.wgsl",
-        ];
+        ]);
         let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         // Reversed Z: larger is nearer.
         let pipeline = Reloadable::new(

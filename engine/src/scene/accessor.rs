@@ -34,6 +34,10 @@ pub const NORMAL: Expect = Expect { ty: Type::Vec3, components: FLOAT };
 pub const TANGENT: Expect = Expect { ty: Type::Vec4, components: FLOAT };
 pub const TEXCOORD: Expect =
     Expect { ty: Type::Vec2, components: &[(F32, false), (U8, true), (U16, true)] };
+/// COLOR_0 is VEC3 or VEC4 (glTF 2.0 §3.7.2.1).
+pub const COLOR_RGB: Expect =
+    Expect { ty: Type::Vec3, components: &[(F32, false), (U8, true), (U16, true)] };
+pub const COLOR_RGBA: Expect = Expect { ty: Type::Vec4, ..COLOR_RGB };
 pub const INDICES: Expect =
     Expect { ty: Type::Scalar, components: &[(U8, false), (U16, false), (U32, false)] };
 pub const KEY_TIMES: Expect = Expect { ty: Type::Scalar, components: FLOAT };

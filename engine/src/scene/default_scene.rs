@@ -40,9 +40,9 @@ pub fn quad(center: Vec3, u: Vec3, v: Vec3, material: u32) -> Mesh {
             Vec2::new(1.0, 0.0),
             Vec2::new(0.0, 0.0),
         ],
-        tangents: vec![],
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
+        ..Default::default()
     }
 }
 

@@ -19,8 +19,12 @@ use std::path::Path;
 
 /// Extensions whose meaning Hush implements. Anything else is ignored with a warning when
 /// optional and refused when required.
-pub const SUPPORTED_EXTENSIONS: &[&str] =
-    &["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_specular"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_specular",
+    "KHR_texture_transform",
+];
 
 /// Largest texture side kept on load (larger ones are halved until they fit).
 pub const DEFAULT_MAX_TEXTURE_SIZE: u32 = 2048;

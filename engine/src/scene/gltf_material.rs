@@ -127,20 +127,36 @@ impl Importer<'_> {
         }
     }
 
+    /// A material's use of a texture: the texture (if it loaded), its TEXCOORD set and its
+    /// KHR_texture_transform (whose texCoord overrides the set).
     fn tex(
         &mut self,
         map: &HashMap<(usize, bool), u32>,
-        t: Option<(gltf::Texture, u32)>,
+        t: Option<(gltf::Texture, u32, Option<&serde_json::Value>)>,
         srgb: bool,
     ) -> Option<TextureRef> {
-        let (t, set) = t?;
-        if set != 0 {
+        let (t, mut set, ext) = t?;
+        let mut transform = glam::Affine2::IDENTITY;
+        if let Some(ext) = ext {
+            match texture_transform(ext) {
+                Ok((m, over)) => {
+                    transform = m;
+                    set = over.unwrap_or(set);
+                }
+                Err(e) => self.warn(format!(
+                    "textures[{}]: KHR_texture_transform {e}; the texture is read untransformed",
+                    t.index()
+                )),
+            }
+        }
+        if set > 1 {
             self.warn(format!(
-                "textures[{}] is used with TEXCOORD_{set}; only TEXCOORD_0 is supported",
+                "textures[{}] is read at TEXCOORD_{set}; Hush reads TEXCOORD_0 and TEXCOORD_1, and uses TEXCOORD_0",
                 t.index()
             ));
+            set = 0;
         }
-        map.get(&(t.index(), srgb)).map(|&index| TextureRef { index })
+        map.get(&(t.index(), srgb)).map(|&index| TextureRef { index, set, transform })
     }
 
     pub(super) fn material(
@@ -211,19 +227,25 @@ impl Importer<'_> {
             },
             base_color_texture: self.tex(
                 tex,
-                pbr.base_color_texture().map(|i| (i.texture(), i.tex_coord())),
+                pbr.base_color_texture()
+                    .as_ref()
+                    .map(|i| (i.texture(), i.tex_coord(), i.extension_value(TRANSFORM))),
                 true,
             ),
             metallic: clamp01(pbr.metallic_factor()),
             roughness: clamp01(pbr.roughness_factor()),
             metallic_roughness_texture: self.tex(
                 tex,
-                pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord())),
+                pbr.metallic_roughness_texture()
+                    .as_ref()
+                    .map(|i| (i.texture(), i.tex_coord(), i.extension_value(TRANSFORM))),
                 false,
             ),
             normal_texture: self.tex(
                 tex,
-                m.normal_texture().map(|i| (i.texture(), i.tex_coord())),
+                m.normal_texture()
+                    .as_ref()
+                    .map(|i| (i.texture(), i.tex_coord(), i.extension_value(TRANSFORM))),
                 false,
             ),
             normal_scale: m
@@ -234,13 +256,100 @@ impl Importer<'_> {
             emission: fin(emission),
             emissive_texture: self.tex(
                 tex,
-                m.emissive_texture().map(|i| (i.texture(), i.tex_coord())),
+                m.emissive_texture()
+                    .as_ref()
+                    .map(|i| (i.texture(), i.tex_coord(), i.extension_value(TRANSFORM))),
                 true,
             ),
             specular_factor: clamp01(specular_factor),
             specular_color: fin(specular_color),
             alpha_mode,
             double_sided: m.double_sided(),
+        }
+    }
+}
+
+const TRANSFORM: &str = "KHR_texture_transform";
+
+/// KHR_texture_transform's matrix and its texCoord override, from the extension's JSON.
+fn texture_transform(v: &serde_json::Value) -> Result<(glam::Affine2, Option<u32>), String> {
+    let pair = |key: &str, default: [f32; 2]| -> Result<glam::Vec2, String> {
+        match v.get(key) {
+            None => Ok(default.into()),
+            Some(a) => {
+                let xs: Vec<f32> = a
+                    .as_array()
+                    .filter(|a| a.len() == 2)
+                    .map(|a| a.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect())
+                    .unwrap_or_default();
+                match xs[..] {
+                    [x, y] if x.is_finite() && y.is_finite() => Ok(glam::Vec2::new(x, y)),
+                    _ => Err(format!("{key} is not two finite numbers")),
+                }
+            }
+        }
+    };
+    let rotation = match v.get("rotation") {
+        None => 0.0,
+        Some(r) => match r.as_f64().map(|r| r as f32) {
+            Some(r) if r.is_finite() => r,
+            _ => return Err("rotation is not a finite number".into()),
+        },
+    };
+    let set = match v.get("texCoord") {
+        None => None,
+        Some(s) => Some(
+            s.as_u64().and_then(|s| u32::try_from(s).ok()).ok_or("texCoord is not a set index")?,
+        ),
+    };
+    let m =
+        TextureRef::khr_transform(pair("offset", [0.0; 2])?, rotation, pair("scale", [1.0; 2])?);
+    Ok((m, set))
+}
+
+/// Whether a texture of `m` is read at TEXCOORD_1 (the mesh then keeps that set), and whether
+/// its normal map is (its tangents then follow TEXCOORD_1).
+pub(super) fn texcoord1_uses(m: &gltf::Material) -> (bool, bool) {
+    let set = |s: u32, ext: Option<&serde_json::Value>| {
+        ext.and_then(|e| e.get("texCoord")).and_then(|s| s.as_u64()).unwrap_or(s as u64) == 1
+    };
+    let pbr = m.pbr_metallic_roughness();
+    let normal =
+        m.normal_texture().is_some_and(|i| set(i.tex_coord(), i.extension_value(TRANSFORM)));
+    let any = normal
+        || [pbr.base_color_texture(), pbr.metallic_roughness_texture(), m.emissive_texture()]
+            .iter()
+            .flatten()
+            .any(|i| set(i.tex_coord(), i.extension_value(TRANSFORM)));
+    (any, normal)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::texture_transform;
+    use glam::Vec2;
+    use serde_json::json;
+
+    #[test]
+    fn texture_transforms_follow_the_extension_and_refuse_malformed_values() {
+        let half_turn = std::f32::consts::FRAC_PI_2;
+        let (m, set) = texture_transform(
+            &json!({"offset": [0.5, 0.0], "rotation": half_turn, "scale": [2.0, 1.0], "texCoord": 1}),
+        )
+        .unwrap();
+        // T R S (1, 0): scaled to (2, 0), turned to (0, -2) (R = [cos sin; -sin cos]), offset.
+        let p = m.transform_point2(Vec2::X);
+        assert!((p - Vec2::new(0.5, -2.0)).length() < 1e-6, "{p}");
+        assert_eq!(set, Some(1));
+        let (m, set) = texture_transform(&json!({})).unwrap();
+        assert_eq!((m, set), (glam::Affine2::IDENTITY, None));
+        for bad in [
+            json!({"offset": [1.0]}),
+            json!({"scale": "large"}),
+            json!({"rotation": [1.0]}),
+            json!({"texCoord": -1}),
+        ] {
+            assert!(texture_transform(&bad).is_err(), "{bad}");
         }
     }
 }

@@ -75,6 +75,40 @@ pub(super) fn primitive(
             Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
             None => vec![Vec2::ZERO; n],
         };
+    let (reads_uv1, normal_uv1) = super::gltf_material::texcoord1_uses(&prim.material());
+    let uvs1: Vec<Vec2> = match reads_uv1 {
+        false => vec![],
+        true => {
+            match same_count("TEXCOORD_1", gltf::Semantic::TexCoords(1), accessor::TEXCOORD, imp)? {
+                Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
+                None => {
+                    imp.warn(format!("{here}: its material reads TEXCOORD_1, which it lacks; TEXCOORD_0 is read instead"));
+                    uvs.clone()
+                }
+            }
+        }
+    };
+    let colors: Vec<Vec4> = match attribute(gltf::Semantic::Colors(0)) {
+        None => vec![],
+        Some(i) => {
+            let rgba = data.root.accessors.get(i).is_some_and(|a| {
+                a.type_ == gltf::json::validation::Checked::Valid(gltf::json::accessor::Type::Vec4)
+            });
+            let expect = if rgba { accessor::COLOR_RGBA } else { accessor::COLOR_RGB };
+            let c =
+                same_count("COLOR_0", gltf::Semantic::Colors(0), expect, imp)?.unwrap_or_default();
+            let clean = |x: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { 1.0 };
+            if rgba {
+                c.chunks_exact(4)
+                    .map(|c| Vec4::from_slice(c).to_array().map(clean).into())
+                    .collect()
+            } else {
+                c.chunks_exact(3)
+                    .map(|c| Vec4::new(clean(c[0]), clean(c[1]), clean(c[2]), 1.0))
+                    .collect()
+            }
+        }
+    };
     let tangents: Option<Vec<Vec4>> =
         same_count("TANGENT", gltf::Semantic::Tangents, accessor::TANGENT, imp)?
             .map(|t| t.chunks_exact(4).map(|c| Vec4::new(c[0], c[1], c[2], c[3])).collect());
@@ -83,6 +117,8 @@ pub(super) fn primitive(
         positions,
         normals: normals.unwrap_or_default(),
         uvs,
+        uvs1,
+        colors,
         tangents: vec![],
         indices,
         material,
@@ -94,7 +130,7 @@ pub(super) fn primitive(
     if prim.material().normal_texture().is_some() {
         match tangents {
             Some(t) if t.len() == m.positions.len() => m.tangents = t,
-            _ => generate_tangents(&mut m),
+            _ => generate_tangents(&mut m, normal_uv1),
         }
     }
     Ok(Some(m))
@@ -133,14 +169,21 @@ fn flatten_with_face_normals(m: &mut Mesh) {
             out.positions.push(p[k]);
             out.normals.push(n);
             out.uvs.push(m.uvs.get(t[k] as usize).copied().unwrap_or_default());
+            if let Some(uv) = m.uvs1.get(t[k] as usize) {
+                out.uvs1.push(*uv);
+            }
+            if let Some(c) = m.colors.get(t[k] as usize) {
+                out.colors.push(*c);
+            }
         }
     }
     *m = out;
 }
 
-/// MikkTSpace tangents (the glTF reference) for a mesh with a normal map but no TANGENT.
-fn generate_tangents(m: &mut Mesh) {
-    struct Geo<'a>(&'a mut Mesh);
+/// MikkTSpace tangents (the glTF reference) for a mesh with a normal map but no TANGENT, along
+/// the coordinates the normal map is read at (TEXCOORD_1 where `uv1`).
+fn generate_tangents(m: &mut Mesh, uv1: bool) {
+    struct Geo<'a>(&'a mut Mesh, bool);
     impl Geo<'_> {
         fn vertex(&self, f: usize, v: usize) -> usize {
             self.0.indices[f * 3 + v] as usize
@@ -163,7 +206,8 @@ fn generate_tangents(m: &mut Mesh) {
             finite3(self.0.normals.get(self.vertex(f, v)).copied().unwrap_or(Vec3::Z)).into()
         }
         fn tex_coord(&self, f: usize, v: usize) -> [f32; 2] {
-            let uv = self.0.uvs.get(self.vertex(f, v)).copied().unwrap_or_default();
+            let uvs = if self.1 { &self.0.uvs1 } else { &self.0.uvs };
+            let uv = uvs.get(self.vertex(f, v)).copied().unwrap_or_default();
             if uv.is_finite() { uv.into() } else { [0.0; 2] }
         }
         fn set_tangent_encoded(&mut self, t: [f32; 4], f: usize, v: usize) {
@@ -194,7 +238,7 @@ fn generate_tangents(m: &mut Mesh) {
     }
     // MikkTSpace writes per face-vertex; shared vertices get the last write, which matches for
     // the usual case of vertices split along UV seams.
-    let _ = mikktspace::generate_tangents(&mut Geo(m));
+    let _ = mikktspace::generate_tangents(&mut Geo(m, uv1));
 }
 
 /// Node index -> its animation (translation/rotation/scale channels of every glTF animation).
@@ -327,7 +371,7 @@ mod tests {
                 indices: vec![0, 1, 2],
                 ..Default::default()
             };
-            generate_tangents(&mut m);
+            generate_tangents(&mut m, false);
             assert_eq!(m.tangents.len(), 3);
         }
         let mut m = Mesh {
@@ -337,7 +381,7 @@ mod tests {
             indices: vec![0, 2, 1],
             ..Default::default()
         };
-        generate_tangents(&mut m);
+        generate_tangents(&mut m, false);
         assert!((m.tangents[0].truncate() - Vec3::X).length() < 1e-5, "{:?}", m.tangents);
     }
 }

@@ -66,14 +66,11 @@ pub(super) fn tiled(mut m: Mesh, s: Vec2) -> Mesh {
 pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
     let mut materials = vec![
         Material {
-            base_color_texture: Some(TextureRef { index: 0 }),
+            base_color_texture: Some(TextureRef::new(0)),
             roughness: 0.12,
             ..lambert("polished floor", Vec3::ONE)
         },
-        Material {
-            base_color_texture: Some(TextureRef { index: 1 }),
-            ..lambert("brick", Vec3::ONE)
-        },
+        Material { base_color_texture: Some(TextureRef::new(1)), ..lambert("brick", Vec3::ONE) },
         lambert("plaster", Vec3::new(0.78, 0.75, 0.7)),
         lambert("stone", Vec3::new(0.55, 0.52, 0.48)),
         metal("mirror", Vec3::ONE, 0.0),

@@ -47,6 +47,11 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// TEXCOORD_0, or zeros.
     pub uvs: Vec<Vec2>,
+    /// TEXCOORD_1, or empty where no texture of the mesh's material reads it.
+    pub uvs1: Vec<Vec2>,
+    /// COLOR_0 (RGBA, alpha 1 where the file stores RGB), multiplied into the base colour; empty
+    /// without one.
+    pub colors: Vec<Vec4>,
     /// xyz tangent, w handedness; only filled when the material has a normal map.
     pub tangents: Vec<Vec4>,
     pub indices: Vec<u32>,
@@ -124,6 +129,16 @@ impl Default for Material {
 }
 
 impl Material {
+    /// Its textures in the shaders' slot order: base colour, metallic-roughness, normal, emissive.
+    pub fn texture_refs(&self) -> [Option<TextureRef>; 4] {
+        [
+            self.base_color_texture,
+            self.metallic_roughness_texture,
+            self.normal_texture,
+            self.emissive_texture,
+        ]
+    }
+
     pub fn is_emissive(&self) -> bool {
         self.emission.max_element() > 0.0
     }

@@ -30,18 +30,12 @@ pub fn reflection_scene(mirror_floor: bool) -> Scene {
             metal("mirror floor", Vec3::splat(0.9), 0.0)
         } else {
             Material {
-                base_color_texture: Some(TextureRef { index: 0 }),
+                base_color_texture: Some(TextureRef::new(0)),
                 ..lambert("checker floor", Vec3::ONE)
             }
         },
-        Material {
-            base_color_texture: Some(TextureRef { index: 1 }),
-            ..lambert("brick", Vec3::ONE)
-        },
-        Material {
-            base_color_texture: Some(TextureRef { index: 0 }),
-            ..lambert("checker", Vec3::ONE)
-        },
+        Material { base_color_texture: Some(TextureRef::new(1)), ..lambert("brick", Vec3::ONE) },
+        Material { base_color_texture: Some(TextureRef::new(0)), ..lambert("checker", Vec3::ONE) },
         metal("glossy sphere r0.2", Vec3::new(0.95, 0.7, 0.45), 0.2),
         metal("mirror sphere", Vec3::splat(0.95), 0.0),
         lambert("red", Vec3::new(0.75, 0.1, 0.08)),

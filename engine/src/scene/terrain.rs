@@ -62,7 +62,7 @@ pub fn terrain(n: usize) -> Scene {
         }
     }
     let normals = normals.into_iter().map(|n| n.normalize_or(Vec3::Y)).collect();
-    let mesh = Mesh { positions, normals, uvs, tangents: vec![], indices, material: 0 };
+    let mesh = Mesh { positions, normals, uvs, indices, material: 0, ..Default::default() };
     let (sun, sky) = sky::sun_and_sky(Vec3::new(0.4, -0.6, 0.5).normalize());
     Scene {
         name: format!("terrain:{n}"),

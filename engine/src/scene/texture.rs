@@ -1,5 +1,6 @@
 use crate::limits::Budget;
 use anyhow::{Context, Result};
+use glam::{Affine2, Mat2, Vec2};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Wrap {
@@ -21,10 +22,42 @@ pub struct Texture {
     pub wrap_t: Wrap,
 }
 
-/// A material's use of a texture. Only TEXCOORD_0 is supported.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A material's use of a texture: which texture, read at which of the mesh's texture
+/// coordinate sets, through which affine map (glTF `textureInfo.texCoord` and
+/// `KHR_texture_transform`).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureRef {
     pub index: u32,
+    /// TEXCOORD_0 or TEXCOORD_1.
+    pub set: u32,
+    /// Applied to the coordinates before the lookup: KHR_texture_transform's
+    /// offset x rotation x scale, identity without it.
+    pub transform: Affine2,
+}
+
+impl TextureRef {
+    /// Texture `index` at TEXCOORD_0, untransformed.
+    pub fn new(index: u32) -> TextureRef {
+        TextureRef { index, set: 0, transform: Affine2::IDENTITY }
+    }
+
+    /// Read at TEXCOORD_0 as stored: the shaders need no per-texture coordinate table for it.
+    pub fn is_plain(&self) -> bool {
+        self.set == 0 && self.transform == Affine2::IDENTITY
+    }
+
+    /// KHR_texture_transform's matrix, T x R x S as the extension's specification writes it:
+    /// `rotation` radians counter-clockwise in UV space (the image turns clockwise).
+    pub fn khr_transform(offset: Vec2, rotation: f32, scale: Vec2) -> Affine2 {
+        let (s, c) = rotation.sin_cos();
+        Affine2::from_mat2_translation(
+            Mat2::from_cols(
+                Vec2::new(c * scale.x, -s * scale.x),
+                Vec2::new(s * scale.y, c * scale.y),
+            ),
+            offset,
+        )
+    }
 }
 
 impl Texture {

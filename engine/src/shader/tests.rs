@@ -1,6 +1,6 @@
 use super::*;
 
-const FEATURE_SETS: &[[&str; 6]] = &[
+const FEATURE_SETS: &[[&str; 8]] = &[
     [
         "common/alpha_none.wgsl",
         "common/textures_none.wgsl",
@@ -8,6 +8,8 @@ const FEATURE_SETS: &[[&str; 6]] = &[
         "common/lights_none.wgsl",
         "common/emitters_none.wgsl",
         "common/env_none.wgsl",
+        "common/texcoords_none.wgsl",
+        "common/attributes_none.wgsl",
     ],
     [
         "common/alpha_mask.wgsl",
@@ -16,6 +18,8 @@ const FEATURE_SETS: &[[&str; 6]] = &[
         "common/lights.wgsl",
         "common/emitters.wgsl",
         "common/env_map.wgsl",
+        "common/texcoords.wgsl",
+        "common/attributes.wgsl",
     ],
     [
         "common/alpha_none.wgsl",
@@ -24,6 +28,8 @@ const FEATURE_SETS: &[[&str; 6]] = &[
         "common/lights.wgsl",
         "common/emitters_none.wgsl",
         "common/env_constant.wgsl",
+        "common/texcoords.wgsl",
+        "common/attributes_none.wgsl",
     ],
     [
         "common/alpha_mask.wgsl",
@@ -32,6 +38,8 @@ const FEATURE_SETS: &[[&str; 6]] = &[
         "common/lights_none.wgsl",
         "common/emitters.wgsl",
         "common/env_none.wgsl",
+        "common/texcoords_none.wgsl",
+        "common/attributes.wgsl",
     ],
 ];
 
@@ -49,6 +57,8 @@ fn all_programs() -> Vec<Program> {
                 set[1],
                 set[2],
                 set[0],
+                set[6],
+                set[7],
                 "realtime/frame.wgsl",
                 motion,
                 "realtime/gbuffer.wgsl",
