@@ -34,6 +34,28 @@ pub const NORMAL: Expect = Expect { ty: Type::Vec3, components: FLOAT };
 pub const TANGENT: Expect = Expect { ty: Type::Vec4, components: FLOAT };
 pub const TEXCOORD: Expect =
     Expect { ty: Type::Vec2, components: &[(F32, false), (U8, true), (U16, true)] };
+/// What KHR_mesh_quantization adds to each (its table "Extending Mesh Attributes"): positions
+/// as any 8- or 16-bit integer, normalized or not; normals and tangents as normalized signed
+/// integers; texture coordinates as signed integers too.
+pub const Q_POSITION: Expect = Expect {
+    ty: Type::Vec3,
+    components: &[
+        (F32, false),
+        (I8, false),
+        (I8, true),
+        (U8, false),
+        (U8, true),
+        (I16, false),
+        (I16, true),
+        (U16, false),
+        (U16, true),
+    ],
+};
+pub const Q_NORMAL: Expect =
+    Expect { ty: Type::Vec3, components: &[(F32, false), (I8, true), (I16, true)] };
+pub const Q_TANGENT: Expect = Expect { ty: Type::Vec4, ..Q_NORMAL };
+pub const Q_TEXCOORD: Expect = Expect { ty: Type::Vec2, ..Q_POSITION };
+
 /// COLOR_0 is VEC3 or VEC4 (glTF 2.0 §3.7.2.1).
 pub const COLOR_RGB: Expect =
     Expect { ty: Type::Vec3, components: &[(F32, false), (U8, true), (U16, true)] };
@@ -96,6 +118,12 @@ pub fn read_f32(
             (I8, true) => (b[0] as i8 as f32 / 127.0).max(-1.0),
             (U16, true) => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
             (I16, true) => (i16::from_le_bytes([b[0], b[1]]) as f32 / 32767.0).max(-1.0),
+            // KHR_mesh_quantization's integers, taken as they are (the node's transform or the
+            // texture transform scales them).
+            (U8, false) => b[0] as f32,
+            (I8, false) => b[0] as i8 as f32,
+            (U16, false) => u16::from_le_bytes([b[0], b[1]]) as f32,
+            (I16, false) => i16::from_le_bytes([b[0], b[1]]) as f32,
             // Not allowed by any `Expect` that reads floats.
             _ => 0.0,
         })

@@ -24,6 +24,8 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_specular",
     "KHR_texture_transform",
+    "KHR_mesh_quantization",
+    super::meshopt::EXTENSION,
 ];
 
 /// Largest texture side kept on load (larger ones are halved until they fit).
@@ -132,6 +134,12 @@ fn parse(bytes: &[u8], limits: &Limits) -> Result<(gltf::Document, Option<Vec<u8
         let supported = SUPPORTED_EXTENSIONS.iter().map(|e| e.to_string()).collect();
         return Err(crate::Error::UnsupportedExtension { unsupported, supported }.into());
     }
+    // Every required extension is one Hush implements (checked above); the `gltf` crate would
+    // refuse those it has no feature for (KHR_mesh_quantization, EXT_meshopt_compression), so
+    // the list is not passed on.
+    if let Some(o) = v.as_object_mut() {
+        o.remove("extensionsRequired");
+    }
     // `scene.nodes` is optional in glTF 2.0, but the `gltf` crate's schema requires it.
     if let Some(scenes) = v.get_mut("scenes").and_then(|s| s.as_array_mut()) {
         for s in scenes.iter_mut().filter_map(|s| s.as_object_mut()) {
@@ -167,7 +175,10 @@ impl Importer<'_> {
                 ));
             }
         }
-        let buffers = self.load_buffers(doc, blob)?;
+        let mut buffers = self.load_buffers(doc, blob)?;
+        for w in super::meshopt::decompress(doc.as_json(), &mut buffers, &mut self.budget)? {
+            self.warn(w);
+        }
         let (textures, tex_map) = self.load_textures(doc, &buffers)?;
         let materials: Vec<Material> =
             doc.materials().map(|m| self.material(&m, &tex_map)).collect();
@@ -320,6 +331,12 @@ impl Importer<'_> {
         let limit = self.budget.limits.file_bytes;
         let mut out = vec![];
         for b in doc.buffers() {
+            if super::meshopt::is_fallback(&b) {
+                // Space for compressed views to decode into (super::meshopt), charged first.
+                self.budget.decode(b.length() as u64, format_args!("buffers[{}]", b.index()))?;
+                out.push(vec![0u8; b.length()]);
+                continue;
+            }
             let data = match b.source() {
                 gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
                     anyhow!(

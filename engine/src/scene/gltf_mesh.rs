@@ -22,6 +22,9 @@ pub(super) fn primitive(
         return Ok(None);
     }
     let attribute = |s: gltf::Semantic| prim.get(&s).map(|a| a.index());
+    // KHR_mesh_quantization widens the component types of the geometry attributes.
+    let quantized = data.root.extensions_used.iter().any(|e| e == "KHR_mesh_quantization");
+    let q = |plain: Expect, widened: Expect| if quantized { widened } else { plain };
     let Some(pos) = attribute(gltf::Semantic::Positions) else {
         imp.warn(format!("{here} has no POSITION; skipped"));
         return Ok(None);
@@ -29,7 +32,7 @@ pub(super) fn primitive(
     let positions: Vec<Vec3> = vec3s(accessor::read_f32(
         data,
         pos,
-        accessor::POSITION,
+        q(accessor::POSITION, accessor::Q_POSITION),
         &mut imp.budget,
         &format!("{here}.attributes.POSITION"),
     )?);
@@ -69,17 +72,32 @@ pub(super) fn primitive(
         }
         Ok(Some(v))
     };
-    let normals = same_count("NORMAL", gltf::Semantic::Normals, accessor::NORMAL, imp)?.map(vec3s);
-    let uvs: Vec<Vec2> =
-        match same_count("TEXCOORD_0", gltf::Semantic::TexCoords(0), accessor::TEXCOORD, imp)? {
-            Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
-            None => vec![Vec2::ZERO; n],
-        };
+    let normals = same_count(
+        "NORMAL",
+        gltf::Semantic::Normals,
+        q(accessor::NORMAL, accessor::Q_NORMAL),
+        imp,
+    )?
+    .map(vec3s);
+    let uvs: Vec<Vec2> = match same_count(
+        "TEXCOORD_0",
+        gltf::Semantic::TexCoords(0),
+        q(accessor::TEXCOORD, accessor::Q_TEXCOORD),
+        imp,
+    )? {
+        Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
+        None => vec![Vec2::ZERO; n],
+    };
     let (reads_uv1, normal_uv1) = super::gltf_material::texcoord1_uses(&prim.material());
     let uvs1: Vec<Vec2> = match reads_uv1 {
         false => vec![],
         true => {
-            match same_count("TEXCOORD_1", gltf::Semantic::TexCoords(1), accessor::TEXCOORD, imp)? {
+            match same_count(
+                "TEXCOORD_1",
+                gltf::Semantic::TexCoords(1),
+                q(accessor::TEXCOORD, accessor::Q_TEXCOORD),
+                imp,
+            )? {
                 Some(t) => t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect(),
                 None => {
                     imp.warn(format!("{here}: its material reads TEXCOORD_1, which it lacks; TEXCOORD_0 is read instead"));
@@ -109,9 +127,13 @@ pub(super) fn primitive(
             }
         }
     };
-    let tangents: Option<Vec<Vec4>> =
-        same_count("TANGENT", gltf::Semantic::Tangents, accessor::TANGENT, imp)?
-            .map(|t| t.chunks_exact(4).map(|c| Vec4::new(c[0], c[1], c[2], c[3])).collect());
+    let tangents: Option<Vec<Vec4>> = same_count(
+        "TANGENT",
+        gltf::Semantic::Tangents,
+        q(accessor::TANGENT, accessor::Q_TANGENT),
+        imp,
+    )?
+    .map(|t| t.chunks_exact(4).map(|c| Vec4::new(c[0], c[1], c[2], c[3])).collect());
     let material = prim.material().index().map(|i| i as u32).unwrap_or(default_material);
     let mut m = Mesh {
         positions,

@@ -15,6 +15,7 @@ mod gltf_importer;
 mod gltf_material;
 mod gltf_mesh;
 mod level;
+mod meshopt;
 mod reflections;
 mod sky;
 mod terrain;

@@ -1,0 +1,322 @@
+//! Compressed geometry: a mesh stored with KHR_mesh_quantization's integer attributes, and one
+//! stored in EXT_meshopt_compression's compressed buffer views (vertex and index codecs, the
+//! octahedral and exponential filters), load as the float mesh they encode, within the
+//! precision of the encoding; a damaged stream is refused with an error that names it.
+
+use base64::Engine;
+use glam::{DVec3, Vec2, Vec3};
+use hush_engine::scene::{Scene, load_gltf};
+use hush_tests::gltf_writer::write_json;
+use serde_json::{Value, json};
+
+/// A 5 x 5 grid over a paraboloid cap: positions, unit normals, UVs and triangle indices.
+struct Grid {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    uvs: Vec<[f32; 2]>,
+    indices: Vec<u32>,
+}
+
+fn grid() -> Grid {
+    let n = 5;
+    let mut g = Grid { positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (i as f32 / 2.0 - 1.0, j as f32 / 2.0 - 1.0);
+            g.positions.push([x, y, 0.2 * (x * x + y * y)]);
+            g.normals.push(Vec3::new(-0.4 * x, -0.4 * y, 1.0).normalize().to_array());
+            g.uvs.push([(x + 1.0) / 2.0, (1.0 - y) / 2.0]);
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = (j * n + i) as u32;
+            g.indices.extend([a, a + 1, a + n as u32 + 1, a, a + n as u32 + 1, a + n as u32]);
+        }
+    }
+    g
+}
+
+/// Buffers, views and accessors of a hand-written file.
+#[derive(Clone, Default)]
+struct File {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl File {
+    fn view(&mut self, bytes: &[u8], stride: Option<usize>) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(s) = stride {
+            v["byteStride"] = json!(s);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(v);
+        self.views.len() - 1
+    }
+
+    fn accessor(
+        &mut self,
+        view: usize,
+        component: u32,
+        normalized: bool,
+        count: usize,
+        ty: &str,
+    ) -> usize {
+        self.accessors.push(json!({"bufferView": view, "componentType": component, "normalized": normalized, "count": count, "type": ty}));
+        self.accessors.len() - 1
+    }
+
+    /// The file: one node (with `node` merged in) holding one primitive of `attributes`.
+    fn scene(
+        self,
+        name: &str,
+        attributes: Value,
+        indices: usize,
+        node: Value,
+        extensions: &[&str],
+        extra_buffers: Vec<Value>,
+    ) -> Result<Scene, String> {
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&self.bin)
+        );
+        let mut n = json!({"mesh": 0});
+        for (k, v) in node.as_object().unwrap() {
+            n[k] = v.clone();
+        }
+        let mut buffers = vec![json!({"byteLength": self.bin.len(), "uri": uri})];
+        buffers.extend(extra_buffers);
+        let j = json!({
+            "asset": {"version": "2.0"},
+            "scene": 0,
+            "scenes": [{"nodes": [0]}],
+            "nodes": [n],
+            "meshes": [{"primitives": [{"attributes": attributes, "indices": indices}]}],
+            "accessors": self.accessors,
+            "bufferViews": self.views,
+            "buffers": buffers,
+            "extensionsUsed": extensions,
+            "extensionsRequired": extensions,
+        });
+        load_gltf(&write_json(name, &j)).map_err(|e| format!("{e:#}"))
+    }
+}
+
+fn floats(v: &[impl AsRef<[f32]>]) -> Vec<u8> {
+    v.iter()
+        .flat_map(|x| x.as_ref().iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<_>>())
+        .collect()
+}
+
+fn float_file(g: &Grid, name: &str) -> Scene {
+    let mut f = File::default();
+    let p = f.view(&floats(&g.positions), None);
+    let n = f.view(&floats(&g.normals), None);
+    let t = f.view(&floats(&g.uvs), None);
+    let i = f.view(&g.indices.iter().flat_map(|i| i.to_le_bytes()).collect::<Vec<_>>(), None);
+    let count = g.positions.len();
+    let attrs = json!({
+        "POSITION": f.accessor(p, 5126, false, count, "VEC3"),
+        "NORMAL": f.accessor(n, 5126, false, count, "VEC3"),
+        "TEXCOORD_0": f.accessor(t, 5126, false, count, "VEC2"),
+    });
+    let idx = f.accessor(i, 5125, false, g.indices.len(), "SCALAR");
+    f.accessors[0]["min"] = json!([-1.0, -1.0, 0.0]);
+    f.accessors[0]["max"] = json!([1.0, 1.0, 0.4]);
+    f.scene(name, attrs, idx, json!({}), &[], vec![]).unwrap()
+}
+
+/// Positions, normals and UVs of a loaded scene's first mesh, positions placed by its node.
+fn geometry(s: &Scene) -> (Vec<DVec3>, Vec<Vec3>, Vec<Vec2>, Vec<u32>) {
+    let m = &s.meshes[s.objects[0].mesh];
+    let t = s.objects[0].transform;
+    let p = m.positions.iter().map(|p| t.transform_point3(p.as_dvec3())).collect();
+    let n = m.normals.iter().map(|n| n.normalize()).collect();
+    (p, n, m.uvs.clone(), m.indices.clone())
+}
+
+/// Each triangle turned to start at its smallest index: the index codec may rotate a
+/// triangle's vertices (the winding stays).
+fn triangles(i: &[u32]) -> Vec<[u32; 3]> {
+    i.chunks_exact(3)
+        .map(|t| {
+            let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        })
+        .collect()
+}
+
+/// Largest differences (positions, normals, UVs) of `test` from `reference`; the same triangles.
+fn differences(test: &Scene, reference: &Scene) -> (f64, f32, f32) {
+    let (p, n, t, i) = geometry(test);
+    let (rp, rn, rt, ri) = geometry(reference);
+    assert_eq!(triangles(&i), triangles(&ri), "triangles");
+    let dp = p.iter().zip(&rp).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f64::max);
+    let dn = n.iter().zip(&rn).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max);
+    let dt = t.iter().zip(&rt).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max);
+    (dp, dn, dt)
+}
+
+#[test]
+fn quantized_attributes_load_as_the_floats_they_encode() {
+    let g = grid();
+    let reference = float_file(&g, "float-grid-q");
+    // gltfpack's layout: positions as 16-bit integers with the scale in the node, normals as
+    // normalized bytes (padded to 4), UVs as normalized 16-bit.
+    let scale = 1024.0;
+    let mut f = File::default();
+    let pos: Vec<u8> = g
+        .positions
+        .iter()
+        .flat_map(|p| {
+            let q = p.map(|x| (x * scale).round() as i16);
+            [q[0].to_le_bytes(), q[1].to_le_bytes(), q[2].to_le_bytes(), [0, 0]].concat()
+        })
+        .collect();
+    let nor: Vec<u8> = g
+        .normals
+        .iter()
+        .flat_map(|n| {
+            let q = n.map(|x| (x * 127.0).round() as i8 as u8);
+            [q[0], q[1], q[2], 0]
+        })
+        .collect();
+    let uv: Vec<u8> = g
+        .uvs
+        .iter()
+        .flat_map(|t| t.map(|x| ((x * 65535.0).round() as u16).to_le_bytes()).concat())
+        .collect();
+    let p = f.view(&pos, Some(8));
+    let n = f.view(&nor, Some(4));
+    let t = f.view(&uv, None);
+    let i = f.view(
+        &g.indices.iter().map(|&i| i as u16).flat_map(u16::to_le_bytes).collect::<Vec<_>>(),
+        None,
+    );
+    let count = g.positions.len();
+    let attrs = json!({
+        "POSITION": f.accessor(p, 5122, false, count, "VEC3"),
+        "NORMAL": f.accessor(n, 5120, true, count, "VEC3"),
+        "TEXCOORD_0": f.accessor(t, 5123, true, count, "VEC2"),
+    });
+    let idx = f.accessor(i, 5123, false, g.indices.len(), "SCALAR");
+    f.accessors[0]["min"] = json!([-1024, -1024, 0]);
+    f.accessors[0]["max"] = json!([1024, 1024, 410]);
+    let node = json!({"scale": [1.0 / scale, 1.0 / scale, 1.0 / scale]});
+    let s = f
+        .clone()
+        .scene(
+            "quantized-grid",
+            attrs.clone(),
+            idx,
+            node.clone(),
+            &["KHR_mesh_quantization"],
+            vec![],
+        )
+        .unwrap();
+    let (dp, dn, dt) = differences(&s, &reference);
+    println!("quantized: positions within {dp}, normals {dn}, UVs {dt}");
+    // Half a quantization step of each encoding (normals: a step of 1/127 in each component
+    // before renormalizing).
+    assert!(dp <= 0.5 / scale as f64 + 1e-6, "positions {dp}");
+    assert!(dn < 1.5 / 127.0, "normals {dn}");
+    assert!(dt <= 0.5 / 65535.0 + 1e-6, "UVs {dt}");
+    // Without the extension the same integers are not valid glTF: refused, naming the accessor.
+    let e = f.scene("quantized-undeclared", attrs, idx, node, &[], vec![]).unwrap_err();
+    assert!(e.contains("POSITION") && e.contains("SHORT"), "{e}");
+}
+
+/// The extension's octahedral encoding of a unit vector in 8-bit components (X, Y, 1.0 = 127).
+fn octahedral8(n: [f32; 3]) -> [u8; 4] {
+    let l = n[0].abs() + n[1].abs() + n[2].abs();
+    let (mut x, mut y) = (n[0] / l, n[1] / l);
+    if n[2] < 0.0 {
+        let (ox, oy) = (x, y);
+        x = (1.0 - oy.abs()) * ox.signum();
+        y = (1.0 - ox.abs()) * oy.signum();
+    }
+    [(x * 127.0).round() as i8 as u8, (y * 127.0).round() as i8 as u8, 127, 0]
+}
+
+/// The meshopt file of `g`; `damage` truncates the compressed positions.
+fn meshopt_file(g: &Grid, name: &str, damage: bool) -> Result<Scene, String> {
+    let count = g.positions.len();
+    let mut f = File::default();
+    let positions = meshopt::encode_vertex_buffer(&g.positions).unwrap();
+    let normals: Vec<[u8; 4]> = g.normals.iter().map(|&n| octahedral8(n)).collect();
+    let normals = meshopt::encode_vertex_buffer(&normals).unwrap();
+    // Exponential filter: mantissa x 2^-16 with the exponent in the top byte.
+    let uvs: Vec<[i32; 2]> = g
+        .uvs
+        .iter()
+        .map(|t| t.map(|x| (-16i32 << 24) | (((x * 65536.0).round() as i32) & 0xff_ffff)))
+        .collect();
+    let uvs = meshopt::encode_vertex_buffer(&uvs).unwrap();
+    let indices = meshopt::encode_index_buffer(&g.indices, count).unwrap();
+    // Compressed streams in buffer 0; the views they decode into in buffer 1 (the fallback).
+    let mut views = vec![];
+    let mut at = 0usize;
+    for (data, stride, n, mode, filter) in [
+        (&positions, 12, count, "ATTRIBUTES", "NONE"),
+        (&normals, 4, count, "ATTRIBUTES", "OCTAHEDRAL"),
+        (&uvs, 8, count, "ATTRIBUTES", "EXPONENTIAL"),
+        (&indices, 4, g.indices.len(), "TRIANGLES", "NONE"),
+    ] {
+        let mut data = data.clone();
+        if damage && views.is_empty() {
+            data.truncate(data.len() / 2);
+        }
+        let src = f.view(&data, None);
+        let source = f.views[src].clone();
+        let mut v = json!({"buffer": 1, "byteOffset": at, "byteLength": n * stride, "extensions": {
+            "EXT_meshopt_compression": {"buffer": 0, "byteOffset": source["byteOffset"], "byteLength": source["byteLength"],
+                "byteStride": stride, "count": n, "mode": mode, "filter": filter}}});
+        if mode == "ATTRIBUTES" {
+            v["byteStride"] = json!(stride);
+        }
+        views.push(v);
+        at += n * stride;
+    }
+    let first = f.views.len();
+    f.views.extend(views);
+    let attrs = json!({
+        "POSITION": f.accessor(first, 5126, false, count, "VEC3"),
+        "NORMAL": f.accessor(first + 1, 5120, true, count, "VEC3"),
+        "TEXCOORD_0": f.accessor(first + 2, 5126, false, count, "VEC2"),
+    });
+    let idx = f.accessor(first + 3, 5125, false, g.indices.len(), "SCALAR");
+    f.accessors[0]["min"] = json!([-1.0, -1.0, 0.0]);
+    f.accessors[0]["max"] = json!([1.0, 1.0, 0.4]);
+    let fallback =
+        json!({"byteLength": at, "extensions": {"EXT_meshopt_compression": {"fallback": true}}});
+    f.scene(
+        name,
+        attrs,
+        idx,
+        json!({}),
+        &["EXT_meshopt_compression", "KHR_mesh_quantization"],
+        vec![fallback],
+    )
+}
+
+#[test]
+fn meshopt_compressed_views_load_as_the_mesh_they_encode() {
+    let g = grid();
+    let reference = float_file(&g, "float-grid-m");
+    let s = meshopt_file(&g, "meshopt-grid", false).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let (dp, dn, dt) = differences(&s, &reference);
+    println!("meshopt: positions within {dp}, normals {dn}, UVs {dt}");
+    // The vertex and index codecs are lossless; the octahedral filter keeps 8 bits a component
+    // (about 1/127 of the unit sphere's octant edge), the exponential one a mantissa of 2^-16.
+    assert_eq!(dp, 0.0, "positions");
+    assert!(dn < 0.03, "normals {dn}");
+    assert!(dt <= 0.5 / 65536.0 + 1e-7, "UVs {dt}");
+    let e = meshopt_file(&g, "meshopt-damaged", true).unwrap_err();
+    assert!(e.contains("EXT_meshopt_compression") && e.contains("does not decode"), "{e}");
+}
