@@ -1,7 +1,11 @@
-// Alpha-masked materials cut their triangles out where base colour alpha < cutoff.
-fn alpha_accept(slot: u32, b: vec2f) -> bool {
+// Alpha-masked materials cut their triangles out where base colour alpha < cutoff; blended ones
+// (stochastic transparency) are seen with probability alpha: a hit is accepted where a number
+// uniform in [0, 1), hashed from the ray (or the raster's pixel and frame) and the triangle, is
+// below alpha. Every ray and frame draws anew, so each mean converges to glTF's "over" blend;
+// one ray meets a triangle with one draw, so a path and its shadow rays agree with themselves.
+fn alpha_accept(slot: u32, b: vec2f, ray: u32) -> bool {
     let m = material(tri_material(slot));
-    if (m.flags & MAT_ALPHA_MASK) == 0u {
+    if (m.flags & (MAT_ALPHA_MASK | MAT_ALPHA_BLEND)) == 0u {
         return true;
     }
     let t = tri_tex_coords(slot, b);
@@ -9,5 +13,28 @@ fn alpha_accept(slot: u32, b: vec2f) -> bool {
     if m.tex.x >= 0 {
         a *= material_texture(m, 0u, t).a;
     }
+    if (m.flags & MAT_ALPHA_BLEND) != 0u {
+        return f32(alpha_hash(ray ^ alpha_hash(slot)) >> 8u) * (1.0 / 16777216.0) < a;
+    }
     return a >= m.alpha_cutoff;
+}
+
+// PCG's output permutation (O'Neill 2014), as common/rng.wgsl's pcg_hash; this module is also
+// composed into the raster program, which has no random numbers otherwise.
+fn alpha_hash(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336963u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// A ray's draw: its origin and direction bits hashed (different for every sample and bounce).
+fn alpha_ray(o: vec3f, d: vec3f) -> u32 {
+    let a = bitcast<vec3u>(o);
+    let b = bitcast<vec3u>(d);
+    return alpha_hash(a.x ^ alpha_hash(a.y ^ alpha_hash(a.z ^ alpha_hash(b.x ^ alpha_hash(b.y ^ alpha_hash(b.z))))));
+}
+
+// The raster's draw for a pixel in a frame.
+fn alpha_raster(pixel: vec2u, frame_index: u32) -> u32 {
+    return alpha_hash(pixel.x ^ alpha_hash(pixel.y ^ alpha_hash(frame_index)));
 }

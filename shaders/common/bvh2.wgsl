@@ -27,6 +27,8 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
     var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
+    // Stochastic transparency's draw for this ray (common/alpha_mask.wgsl).
+    let ray = alpha_ray(o, d);
     // TRAVERSAL_STACK comes from the scene (engine/src/accel, traversal_stack).
     var stack: array<u32, TRAVERSAL_STACK>;
     var sp = 0u;
@@ -39,7 +41,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
             for (var i = 0u; i < count; i++) {
                 let slot = item + i;
                 let r = intersect_triangle(o, d, slot, tmax);
-                if r.x < tmax && alpha_accept(slot, r.yz) {
+                if r.x < tmax && alpha_accept(slot, r.yz, ray) {
                     tmax = r.x;
                     hit = Hit(r.x, slot, r.yz);
                     if any_hit {

@@ -66,6 +66,8 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
     var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
+    // Stochastic transparency's draw for this ray (common/alpha_mask.wgsl).
+    let ray = alpha_ray(o, d);
     let oct_inv4 = select(0x04040404u, 0u, d.x < 0.0) | select(0x02020202u, 0u, d.y < 0.0)
         | select(0x01010101u, 0u, d.z < 0.0);
     var stack: array<vec2u, TRAVERSAL_STACK>;
@@ -79,7 +81,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
             prim.y &= ~(1u << k);
             let slot = prim.x + k;
             let r = intersect_triangle(o, d, slot, tmax);
-            if r.x < tmax && alpha_accept(slot, r.yz) {
+            if r.x < tmax && alpha_accept(slot, r.yz, ray) {
                 tmax = r.x;
                 hit = Hit(r.x, slot, r.yz);
                 if any_hit {

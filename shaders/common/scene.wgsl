@@ -24,6 +24,7 @@ struct Material {
 
 const MAT_DOUBLE_SIDED: u32 = 1u;
 const MAT_ALPHA_MASK: u32 = 2u;
+const MAT_ALPHA_BLEND: u32 = 4u;
 // Bits 8 and up of the flags: the material's own index (common/texcoords.wgsl's table row).
 const MAT_INDEX_SHIFT: u32 = 8u;
 

@@ -46,7 +46,8 @@ struct GBufferOut {
 fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     let slot = v.slot;
     let b = v.bary;
-    if !alpha_accept(slot, b) {
+    // Blended surfaces draw per pixel and frame (the jittered frames then average them).
+    if !alpha_accept(slot, b, alpha_raster(vec2u(v.clip.xy), frame.index)) {
         discard;
     }
     let m = material(tri_material(slot));

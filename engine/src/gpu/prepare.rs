@@ -60,6 +60,7 @@ impl From<&crate::scene::Material> for GpuMaterial {
         let (mask, cutoff) = match m.alpha_mode {
             AlphaMode::Opaque => (0, 0.0),
             AlphaMode::Mask(c) => (MAT_ALPHA_MASK, c),
+            AlphaMode::Blend => (MAT_ALPHA_BLEND, 0.0),
         };
         GpuMaterial {
             base_color: m.base_color.to_array(),
@@ -88,6 +89,7 @@ pub const MAT_INDEX_SHIFT: u32 = 8;
 /// As many materials as those bits count.
 pub const MAX_MATERIALS: usize = 1 << (32 - MAT_INDEX_SHIFT);
 pub const MAT_ALPHA_MASK: u32 = 2;
+pub const MAT_ALPHA_BLEND: u32 = 4;
 
 /// Everything ready for upload, with no GPU involved (so limits can be computed before a device
 /// is requested, and so tests can inspect it).
@@ -301,7 +303,7 @@ impl PreparedScene {
             env: EnvKind::None,
             textures: !scene.textures.is_empty(),
             normal_maps,
-            alpha_mask: scene.materials.iter().any(|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
+            alpha_mask: scene.materials.iter().any(|m| m.alpha_mode != AlphaMode::Opaque),
             glossy: Self::glossy_materials(scene),
             animated: scene.is_animated(),
             texture_uses,

@@ -145,6 +145,9 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
             if let Some(t) = tex(m.normal_texture) {
                 v["normalTexture"] = json!({"index": t["index"], "scale": m.normal_scale});
             }
+            if m.alpha_mode == AlphaMode::Blend {
+                v["alphaMode"] = json!("BLEND");
+            }
             if let AlphaMode::Mask(c) = m.alpha_mode {
                 v["alphaMode"] = json!("MASK");
                 v["alphaCutoff"] = json!(c);

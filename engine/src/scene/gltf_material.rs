@@ -182,11 +182,7 @@ impl Importer<'_> {
             gltf::material::AlphaMode::Mask => {
                 super::AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5))
             }
-            gltf::material::AlphaMode::Blend => {
-                // A path tracer has no draw order; blending is rendered as a 50% cut-out.
-                self.warn(format!("material {:?}: alpha BLEND is rendered as MASK 0.5", m.name()));
-                super::AlphaMode::Mask(0.5)
-            }
+            gltf::material::AlphaMode::Blend => super::AlphaMode::Blend,
         };
         let strength = m.emissive_strength().unwrap_or(1.0);
         let clamp01 = |x: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 };

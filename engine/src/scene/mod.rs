@@ -83,6 +83,10 @@ pub enum AlphaMode {
     Opaque,
     /// Cut out where base colour alpha < cutoff.
     Mask(f32),
+    /// Seen with probability alpha (stochastic transparency): each ray, and each real-time
+    /// frame's raster, passes through with probability 1 - alpha, so that every mean converges
+    /// to alpha x this surface + (1 - alpha) x what lies behind it, as glTF's "over" blend.
+    Blend,
 }
 
 /// glTF metallic-roughness material (+ KHR_materials_specular, KHR_materials_emissive_strength).
