@@ -4,6 +4,7 @@ mod bench;
 mod bench_realtime;
 mod cli;
 mod compare;
+mod conformance;
 mod convergence;
 mod quality;
 mod realtime;
@@ -28,6 +29,9 @@ enum Command {
     Render(render::RenderArgs),
     /// Compare an image with a reference: RMSE, relMSE, SSIM, FLIP, non-finite pixels.
     Compare(compare::CompareArgs),
+    /// Load and render every glTF file under a folder (e.g. the Khronos sample models) in both
+    /// modes: which load, which are refused and why, which render wrong; CSV and images.
+    Conformance(conformance::ConformanceArgs),
     /// Score a denoised stream against per-frame references: CSV, plot, ablations.
     Quality(quality::QualityArgs),
     /// Time to quality: FLIP on screen against wall-clock seconds since the camera stopped
@@ -85,6 +89,7 @@ fn main() {
         Command::Render(a) if a.mode == "realtime" => realtime::run(a),
         Command::Render(a) => render::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Conformance(a) => conformance::run(a),
         Command::Bench(a) if a.mode == "realtime" => bench_realtime::run(&a),
         Command::Bench(a) => bench::run(a),
         Command::Level(a) => level(a),

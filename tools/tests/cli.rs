@@ -328,3 +328,44 @@ fn terrain_is_generated_and_written() {
     let t = v["triangles"].as_u64().unwrap();
     assert!((4900..=5100).contains(&t), "{t} triangles");
 }
+
+#[test]
+fn conformance_reports_loaded_refused_and_why() {
+    let dir = temp_dir("conformance-in");
+    let good = dir.join("Room/glTF/room.gltf");
+    let o = hush_cli().args(["level", "--scene", "default", "--out"]).arg(&good).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::create_dir_all(dir.join("Draco/glTF")).unwrap();
+    std::fs::write(
+        dir.join("Draco/glTF/draco.gltf"),
+        r#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"]}"#,
+    )
+    .unwrap();
+    std::fs::write(dir.join("broken.glb"), b"glTF\x02\x00\x00\x00\x08\x00\x00\x00").unwrap();
+    std::fs::write(dir.join("notes.txt"), "not a scene").unwrap();
+    let out = temp_dir("conformance-out");
+    let o = hush_cli()
+        .args(["conformance"])
+        .arg(&dir)
+        .args(["--width", "16", "--height", "16", "--spp", "2", "--frames", "2", "--out-dir"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("conformance.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    let row = |name: &str| {
+        rows.iter().find(|r| r[0].ends_with(name)).unwrap_or_else(|| panic!("{name}: {csv}"))
+    };
+    assert_eq!(row("room.gltf")[1], "loaded", "{csv}");
+    assert!(
+        row("draco.gltf")[1] == "refused"
+            && row("draco.gltf")[2].contains("KHR_draco_mesh_compression"),
+        "{csv}"
+    );
+    assert!(row("broken.glb")[1] == "refused" && row("broken.glb")[2].contains("GLB"), "{csv}");
+    assert!(out.join("Room_glTF_room.gltf.reference.png").exists());
+    assert!(out.join("Room_glTF_room.gltf.realtime.png").exists());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("3 files: 1 loaded, 2 refused, 0 wrong"));
+}
