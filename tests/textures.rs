@@ -33,6 +33,7 @@ fn scene(wrap_s: Wrap) -> Scene {
         srgb: false,
         wrap_s,
         wrap_t: Wrap::Clamp,
+        nearest: false,
     };
     // A 6 x 2 quad facing +Z that the camera sees edge to edge; u from -1 (left) to 2.
     let mut mesh = quad(Vec3::ZERO, Vec3::new(3.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 0);
@@ -135,4 +136,67 @@ fn wrap_modes_tile_mirror_and_clamp() {
             );
         }
     }
+}
+
+/// A sampler whose magFilter is NEAREST reads whole texels: away from texel borders every pixel
+/// is one texel's colour; the same texture filtered bilinearly blends neighbours there. The
+/// scene goes through Hush's glTF export and import, so the sampler's filter is what the file
+/// says.
+#[test]
+fn nearest_samplers_read_whole_texels() {
+    let (w, h) = (W, H);
+    let mut fractions = vec![];
+    for nearest in [true, false] {
+        let mut s = scene(Wrap::Repeat);
+        s.textures[0].nearest = nearest;
+        // u from 0 to 1 across the width: four texel columns of 24 pixels, two rows of 16.
+        s.meshes[0].uvs = vec![
+            Vec2::new(0.0, 1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.0, 0.0),
+        ];
+        let dir =
+            std::env::temp_dir().join(format!("hush-nearest-{}-{nearest}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("tiles.gltf");
+        hush_engine::scene::save_gltf(&s, &path).unwrap();
+        let loaded = hush_engine::scene::load_gltf(&path).unwrap();
+        assert_eq!(loaded.textures[0].nearest, nearest);
+        let acc = hush_tests::render(&loaded, w, h, 64, 2).unwrap();
+        let texel_colours: Vec<Vec3> = (0..8)
+            .map(|i| {
+                // An emissive texture is sRGB in glTF: the loaded one decodes its texels.
+                let c = &s.textures[0].rgba8[i * 4..i * 4 + 3];
+                let srgb = |b: u8| {
+                    let c = b as f32 / 255.0;
+                    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+                };
+                assert!(loaded.textures[0].srgb);
+                Vec3::new(srgb(c[0]), srgb(c[1]), srgb(c[2]))
+            })
+            .collect();
+        // Pixels whose footprint lies inside one texel: 2 pixels and more from texel borders.
+        let (mut whole, mut count) = (0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let (cx, cy) = (x % 24, y % 16);
+                if !(2..22).contains(&cx) || !(2..14).contains(&cy) {
+                    continue;
+                }
+                count += 1;
+                let c = acc.mean.at(x, y);
+                if texel_colours.iter().any(|t| (*t - c).abs().max_element() < 0.01) {
+                    whole += 1;
+                }
+            }
+        }
+        fractions.push(whole as f64 / count as f64);
+    }
+    println!(
+        "pixels showing one texel's colour: nearest {:.3}, bilinear {:.3}",
+        fractions[0], fractions[1]
+    );
+    assert_eq!(fractions[0], 1.0, "nearest");
+    assert!(fractions[1] < 0.5, "bilinear");
 }

@@ -1,5 +1,6 @@
 // All textures in one array of words: four u32 of header per texture (texel offset, width,
-// height, flags: bit 0 sRGB, bits 1-2 wrap S, bits 3-4 wrap T with 0 repeat, 1 clamp, 2 mirror),
+// height, flags: bit 0 sRGB, bits 1-2 wrap S, bits 3-4 wrap T with 0 repeat, 1 clamp, 2 mirror,
+// bit 5 nearest),
 // then RGBA8 texels. One binding serves any number of textures on every backend. The words are
 // read four to a texel of a texel-row texture (see tri_texels in geometry.wgsl).
 var tex_words: texture_2d<u32>;
@@ -41,7 +42,8 @@ fn texel(off: u32, w: u32, x: u32, y: u32, srgb: bool) -> vec4f {
     return select(c, vec4f(srgb_decode(c.rgb), c.a), srgb);
 }
 
-// Bilinear, without mip-maps: the reference tracer's many samples per pixel filter minification.
+// Bilinear (nearest where the sampler says so), without mip-maps: the reference tracer's many
+// samples per pixel filter minification.
 fn tex_sample(index: u32, uv_in: vec2f) -> vec4f {
     let off = tex_word(index * 4u);
     let w = tex_word(index * 4u + 1u);
@@ -54,7 +56,13 @@ fn tex_sample(index: u32, uv_in: vec2f) -> vec4f {
     }
     let ws = (flags >> 1u) & 3u;
     let wt = (flags >> 3u) & 3u;
-    let f = vec2f(wrap_unit(uv.x, ws), wrap_unit(uv.y, wt)) * vec2f(f32(w), f32(h)) - 0.5;
+    let unit = vec2f(wrap_unit(uv.x, ws), wrap_unit(uv.y, wt));
+    if (flags & 32u) != 0u {
+        // The texel the coordinate falls in (u = 1 exactly: the last one).
+        let t = min(vec2u(unit * vec2f(f32(w), f32(h))), vec2u(w, h) - 1u);
+        return texel(off, w, t.x, t.y, srgb);
+    }
+    let f = unit * vec2f(f32(w), f32(h)) - 0.5;
     let i = floor(f);
     let t = f - i;
     let x = wrap_pair(i32(i.x), i32(w), ws);

@@ -139,7 +139,10 @@ pub(super) fn pack_textures(scene: &Scene) -> Vec<u32> {
         data[i * 4] = data.len() as u32;
         data[i * 4 + 1] = t.width;
         data[i * 4 + 2] = t.height;
-        data[i * 4 + 3] = (t.srgb as u32) | (wrap(t.wrap_s) << 1) | (wrap(t.wrap_t) << 3);
+        data[i * 4 + 3] = (t.srgb as u32)
+            | (wrap(t.wrap_s) << 1)
+            | (wrap(t.wrap_t) << 3)
+            | ((t.nearest as u32) << 5);
         data.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
     }
     data
@@ -161,6 +164,7 @@ mod tests {
             srgb: true,
             wrap_s: Wrap::Repeat,
             wrap_t: Wrap::Repeat,
+            nearest: false,
         };
         let small = Texture {
             name: "small".into(),

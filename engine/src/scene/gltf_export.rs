@@ -111,7 +111,11 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
             .context("texture size")?;
         img.save(dir.join(&file)).with_context(|| format!("writing {file}"))?;
         images.push(json!({"uri": file, "name": t.name}));
-        samplers.push(json!({"wrapS": wrap(t.wrap_s), "wrapT": wrap(t.wrap_t)}));
+        let mut sampler = json!({"wrapS": wrap(t.wrap_s), "wrapT": wrap(t.wrap_t)});
+        if t.nearest {
+            sampler["magFilter"] = json!(9728);
+        }
+        samplers.push(sampler);
         textures.push(json!({"source": i, "sampler": i}));
     }
     let tex = |r: Option<super::TextureRef>| r.map(|r| json!({"index": r.index}));

@@ -40,7 +40,7 @@ impl Importer<'_> {
         // (image, sRGB) -> its first texture: an image shared by textures is decoded once, and
         // copied only for a texture that samples it with other wrap modes.
         let mut first: HashMap<(usize, bool), Option<usize>> = HashMap::new();
-        let mut placed: HashMap<(usize, bool, Wrap, Wrap), usize> = HashMap::new();
+        let mut placed: HashMap<(usize, bool, Wrap, Wrap, bool), usize> = HashMap::new();
         let wrap = |w: gltf::texture::WrappingMode| match w {
             gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
             gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
@@ -64,21 +64,24 @@ impl Importer<'_> {
             };
             let Some(decoded) = decoded else { continue };
             let (ws, wt) = (wrap(t.sampler().wrap_s()), wrap(t.sampler().wrap_t()));
-            let index = match placed.get(&(key.0, key.1, ws, wt)) {
+            let nearest = t.sampler().mag_filter() == Some(gltf::texture::MagFilter::Nearest);
+            let index = match placed.get(&(key.0, key.1, ws, wt, nearest)) {
                 Some(&i) => i,
                 None if !placed.keys().any(|k| (k.0, k.1) == key) => {
                     textures[decoded].wrap_s = ws;
                     textures[decoded].wrap_t = wt;
+                    textures[decoded].nearest = nearest;
                     decoded
                 }
                 None => {
-                    let copy = Texture { wrap_s: ws, wrap_t: wt, ..textures[decoded].clone() };
+                    let copy =
+                        Texture { wrap_s: ws, wrap_t: wt, nearest, ..textures[decoded].clone() };
                     self.budget.decode(copy.rgba8.len() as u64, format_args!("textures[{ti}]"))?;
                     textures.push(copy);
                     textures.len() - 1
                 }
             };
-            placed.insert((key.0, key.1, ws, wt), index);
+            placed.insert((key.0, key.1, ws, wt, nearest), index);
             map.insert((ti, srgb), index as u32);
         }
         Ok((textures, map))

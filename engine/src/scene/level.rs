@@ -32,6 +32,7 @@ pub(super) fn texture(
         srgb,
         wrap_s: Wrap::Repeat,
         wrap_t: Wrap::Repeat,
+        nearest: false,
     }
 }
 

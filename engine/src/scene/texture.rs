@@ -20,6 +20,9 @@ pub struct Texture {
     pub srgb: bool,
     pub wrap_s: Wrap,
     pub wrap_t: Wrap,
+    /// The sampler's magFilter is NEAREST: texels are read unfiltered (pixel art, lookup
+    /// tables); otherwise bilinear.
+    pub nearest: bool,
 }
 
 /// A material's use of a texture: which texture, read at which of the mesh's texture
@@ -101,6 +104,7 @@ impl Texture {
             srgb,
             wrap_s: Wrap::Repeat,
             wrap_t: Wrap::Repeat,
+            nearest: false,
         })
     }
 }
