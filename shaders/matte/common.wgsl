@@ -71,6 +71,10 @@ struct DenoiseParams {
     still_frames: f32,
     // Past this history length stage 7's edge-stop narrows as sqrt(this / n) (0: never).
     edge_stop_full_frames: f32,
+    // In a still view, a history longer than edge_stop_full_frames is read only from a previous
+    // texel whose normal is within this cosine of the surface's (-2: any normal;
+    // MatteSettings::still_normal_degrees).
+    still_normal_min_cos: f32,
 }
 
 var<uniform> dn: DenoiseParams;

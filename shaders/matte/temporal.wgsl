@@ -41,7 +41,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var c = 0.0;
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     if dn.history_valid != 0u {
-        r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
+        // A long still-view history tests normals too (MatteSettings::still_normal_degrees).
+        var min_cos = dn.reprojection_min_cos;
+        let own = clamp(vec2i(floor(prev)), vec2i(0), vec2i(frame.size) - 1);
+        if dn.static_view != 0u && dn.edge_stop_full_frames > 0.0 && textureLoad(history, own, 0).a > dn.edge_stop_full_frames {
+            min_cos = max(min_cos, dn.still_normal_min_cos);
+        }
+        r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), min_cos);
     }
     if r.distance < 0.0 {
         reason = REASON_DISOCCLUDED;

@@ -69,6 +69,9 @@ pub struct DenoiseParams {
     pub still_frames: f32,
     /// [`MatteSettings::edge_stop_full_frames`].
     pub edge_stop_full_frames: f32,
+    /// [`MatteSettings::still_normal_degrees`] as a cosine (-2: off).
+    pub still_normal_min_cos: f32,
+    pub _pad: [f32; 3],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -134,6 +137,8 @@ impl DenoiseParams {
             taa_current_glossy: taa.current_glossy.clamp(0.0, 1.0),
             still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
             edge_stop_full_frames: s.edge_stop_full_frames.clamp(0.0, STILL_FRAMES_MAX),
+            still_normal_min_cos: normal_test_cos(s.still_normal_degrees),
+            _pad: [0.0; 3],
         }
     }
 }
