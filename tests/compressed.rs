@@ -243,8 +243,18 @@ fn octahedral8(n: [f32; 3]) -> [u8; 4] {
     [(x * 127.0).round() as i8 as u8, (y * 127.0).round() as i8 as u8, 127, 0]
 }
 
-/// The meshopt file of `g`; `damage` truncates the compressed positions.
+/// The meshopt file of `g`; `damage` truncates the compressed positions, `edit` changes the
+/// JSON of the first compressed view and of the fallback buffer before writing.
 fn meshopt_file(g: &Grid, name: &str, damage: bool) -> Result<Scene, String> {
+    meshopt_file_with(g, name, damage, |_, _| {})
+}
+
+fn meshopt_file_with(
+    g: &Grid,
+    name: &str,
+    damage: bool,
+    edit: impl FnOnce(&mut Value, &mut Value),
+) -> Result<Scene, String> {
     let count = g.positions.len();
     let mut f = File::default();
     let positions = meshopt::encode_vertex_buffer(&g.positions).unwrap();
@@ -282,6 +292,9 @@ fn meshopt_file(g: &Grid, name: &str, damage: bool) -> Result<Scene, String> {
         views.push(v);
         at += n * stride;
     }
+    let mut fallback =
+        json!({"byteLength": at, "extensions": {"EXT_meshopt_compression": {"fallback": true}}});
+    edit(&mut views[0], &mut fallback);
     let first = f.views.len();
     f.views.extend(views);
     let attrs = json!({
@@ -292,8 +305,6 @@ fn meshopt_file(g: &Grid, name: &str, damage: bool) -> Result<Scene, String> {
     let idx = f.accessor(first + 3, 5125, false, g.indices.len(), "SCALAR");
     f.accessors[0]["min"] = json!([-1.0, -1.0, 0.0]);
     f.accessors[0]["max"] = json!([1.0, 1.0, 0.4]);
-    let fallback =
-        json!({"byteLength": at, "extensions": {"EXT_meshopt_compression": {"fallback": true}}});
     f.scene(
         name,
         attrs,
@@ -319,4 +330,66 @@ fn meshopt_compressed_views_load_as_the_mesh_they_encode() {
     assert!(dt <= 0.5 / 65536.0 + 1e-7, "UVs {dt}");
     let e = meshopt_file(&g, "meshopt-damaged", true).unwrap_err();
     assert!(e.contains("EXT_meshopt_compression") && e.contains("does not decode"), "{e}");
+}
+
+/// Hostile compressed views are refused with errors that name what is wrong, before anything
+/// large is allocated: a fallback buffer past the decoded-bytes budget, a count whose size
+/// overflows, a size that disagrees with the view, a stream outside its buffer, an unknown mode
+/// and a stride the filter cannot take.
+#[test]
+fn hostile_compressed_views_are_refused_by_name() {
+    let g = grid();
+    let ext = |v: &mut Value| v["extensions"]["EXT_meshopt_compression"].take();
+    let cases: Vec<(&str, Box<dyn FnOnce(&mut Value, &mut Value)>, &str)> = vec![
+        ("huge-fallback", Box::new(|_, b| b["byteLength"] = json!(1u64 << 40)), "decoded-bytes"),
+        (
+            "overflow",
+            Box::new(move |v, _| {
+                let mut e = ext(v);
+                e["count"] = json!(u64::MAX / 4);
+                v["extensions"]["EXT_meshopt_compression"] = e;
+            }),
+            "overflows",
+        ),
+        (
+            "size",
+            Box::new(move |v, _| {
+                let mut e = ext(v);
+                e["count"] = json!(7);
+                v["extensions"]["EXT_meshopt_compression"] = e;
+            }),
+            "the view holds",
+        ),
+        (
+            "outside",
+            Box::new(move |v, _| {
+                let mut e = ext(v);
+                e["byteOffset"] = json!(1u64 << 33);
+                v["extensions"]["EXT_meshopt_compression"] = e;
+            }),
+            "outside buffers[0]",
+        ),
+        (
+            "mode",
+            Box::new(move |v, _| {
+                let mut e = ext(v);
+                e["mode"] = json!("POINTS");
+                v["extensions"]["EXT_meshopt_compression"] = e;
+            }),
+            "mode",
+        ),
+        (
+            "filter-stride",
+            Box::new(move |v, _| {
+                let mut e = ext(v);
+                e["filter"] = json!("QUATERNION");
+                v["extensions"]["EXT_meshopt_compression"] = e;
+            }),
+            "byteStride 12",
+        ),
+    ];
+    for (name, edit, needle) in cases {
+        let e = meshopt_file_with(&g, &format!("meshopt-{name}"), false, edit).unwrap_err();
+        assert!(e.contains(needle), "{name}: {e}");
+    }
 }
