@@ -340,7 +340,8 @@ fn meshopt_compressed_views_load_as_the_mesh_they_encode() {
 fn hostile_compressed_views_are_refused_by_name() {
     let g = grid();
     let ext = |v: &mut Value| v["extensions"]["EXT_meshopt_compression"].take();
-    let cases: Vec<(&str, Box<dyn FnOnce(&mut Value, &mut Value)>, &str)> = vec![
+    type Edit = Box<dyn FnOnce(&mut Value, &mut Value)>;
+    let cases: Vec<(&str, Edit, &str)> = vec![
         ("huge-fallback", Box::new(|_, b| b["byteLength"] = json!(1u64 << 40)), "decoded-bytes"),
         (
             "overflow",
