@@ -66,7 +66,10 @@ impl From<&crate::scene::Material> for GpuMaterial {
             base_color: m.base_color.to_array(),
             emission: m.emission.to_array(),
             metallic: m.metallic,
-            specular_color: m.specular_color.to_array(),
+            // The shaders' dielectric F0 is 0.04 x the specular colour (the F0 of ior 1.5);
+            // another ior scales the colour by its F0 over that (KHR_materials_ior, with the
+            // specular extension's min(F0 x colour, 1) applied in make_bsdf as before).
+            specular_color: (m.specular_color * dielectric_f0(m.ior) / 0.04).to_array(),
             roughness: m.roughness,
             specular_factor: m.specular_factor,
             alpha_cutoff: cutoff,
@@ -80,6 +83,11 @@ impl From<&crate::scene::Material> for GpuMaterial {
             ],
         }
     }
+}
+
+/// Normal-incidence reflectance of a dielectric of index `ior` in air.
+pub fn dielectric_f0(ior: f32) -> f32 {
+    ((ior - 1.0) / (ior + 1.0)).powi(2)
 }
 
 pub const MAT_DOUBLE_SIDED: u32 = 1;

@@ -157,6 +157,9 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
                 v["alphaCutoff"] = json!(c);
             }
             ext.insert("KHR_materials_specular".into(), json!({"specularFactor": m.specular_factor, "specularColorFactor": m.specular_color.to_array()}));
+            if m.ior != 1.5 {
+                ext.insert("KHR_materials_ior".into(), json!({"ior": m.ior}));
+            }
             v["extensions"] = Value::Object(ext);
             v
         })
@@ -293,6 +296,9 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     }
     if !lights.is_empty() {
         used.push("KHR_lights_punctual");
+    }
+    if scene.materials.iter().any(|m| m.ior != 1.5) {
+        used.push("KHR_materials_ior");
     }
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": "Hush"},

@@ -25,6 +25,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_specular",
     "KHR_texture_transform",
     "KHR_mesh_quantization",
+    "KHR_materials_ior",
     super::meshopt::EXTENSION,
 ];
 

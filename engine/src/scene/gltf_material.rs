@@ -187,6 +187,23 @@ impl Importer<'_> {
             }
             gltf::material::AlphaMode::Blend => super::AlphaMode::Blend,
         };
+        // KHR_materials_ior: 1 or more (glTF's 0, "infinite", and anything else out of range is
+        // read as the default 1.5, with a warning).
+        let ior = match m
+            .extension_value("KHR_materials_ior")
+            .map(|e| e.get("ior").and_then(|v| v.as_f64()))
+        {
+            None | Some(None) => 1.5,
+            Some(Some(v)) if v.is_finite() && v >= 1.0 => v as f32,
+            Some(Some(v)) => {
+                self.warn(format!(
+                    "materials[{}] ({:?}): KHR_materials_ior {v} is not an index of 1 or more; 1.5 is used",
+                    m.index().unwrap_or(0),
+                    m.name().unwrap_or("")
+                ));
+                1.5
+            }
+        };
         let strength = m.emissive_strength().unwrap_or(1.0);
         let clamp01 = |x: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 };
         let fin = |v: Vec3| if v.is_finite() { v.max(Vec3::ZERO) } else { Vec3::ZERO };
@@ -262,6 +279,7 @@ impl Importer<'_> {
             ),
             specular_factor: clamp01(specular_factor),
             specular_color: fin(specular_color),
+            ior,
             alpha_mode,
             double_sided: m.double_sided(),
         }

@@ -107,6 +107,9 @@ pub struct Material {
     /// KHR_materials_specular: 0 makes a dielectric purely Lambertian.
     pub specular_factor: f32,
     pub specular_color: Vec3,
+    /// KHR_materials_ior: a dielectric's F0 is ((ior - 1) / (ior + 1))^2 (0.04 at the default
+    /// 1.5), times the specular colour.
+    pub ior: f32,
     pub alpha_mode: AlphaMode,
     pub double_sided: bool,
 }
@@ -127,6 +130,7 @@ impl Default for Material {
             emissive_texture: None,
             specular_factor: 1.0,
             specular_color: Vec3::ONE,
+            ior: 1.5,
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
         }
