@@ -102,6 +102,32 @@ d = doc(); d['materials'][0].update({"alphaMode": "MASK", "alphaCutoff": 0.3, "d
 d['meshes'][0]['primitives'].append({"attributes": {"POSITION": 0}, "material": 1})
 scenes['ok-alpha'] = pack(d, F)
 scenes['ok-empty'] = pack({"asset": {"version": "2.0"}, "scenes": [{}]}, {})
+# Texture coordinates and materials: TEXCOORD_1 through KHR_texture_transform's override, COLOR_0,
+# a NEAREST sampler, alpha blend and KHR_materials_ior.
+d = doc(images=[{"uri": "c.png"}], textures=[{"source": 0, "sampler": 0}], samplers=[{"magFilter": 9728, "wrapS": 33648}],
+        extensionsUsed=["KHR_texture_transform", "KHR_materials_ior"])
+d['meshes'][0]['primitives'][0]['attributes'].update({"TEXCOORD_1": 2, "COLOR_0": 1})
+m = d['materials'][0]; m.update({"alphaMode": "BLEND", "extensions": {"KHR_materials_ior": {"ior": 1.33}}})
+m['pbrMetallicRoughness']['baseColorTexture'] = {"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "rotation": 0.3, "scale": [2, 2], "texCoord": 1}}}
+scenes['ok-texcoords'] = pack(d, {**F, "c.png": PNG})
+# KHR_mesh_quantization: the quad's positions as SHORT (padded to 8 bytes), normals as normalized BYTE.
+QQ = b''.join(struct.pack('<4h', x, y, z, 0) for x, y, z in [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)]) + struct.pack('<4b', 0, 127, 0, 0) * 4
+d = doc(extensionsUsed=["KHR_mesh_quantization"], extensionsRequired=["KHR_mesh_quantization"])
+d['buffers'].append({"uri": "qq.bin", "byteLength": len(QQ)})
+d['bufferViews'] += [{"buffer": 1, "byteOffset": 0, "byteLength": 32, "byteStride": 8}, {"buffer": 1, "byteOffset": 32, "byteLength": 16, "byteStride": 4}]
+d['accessors'][0] = {"bufferView": 9, "componentType": 5122, "count": 4, "type": "VEC3", "min": [-1, 0, -1], "max": [1, 0, 1]}
+d['accessors'][1] = {"bufferView": 10, "componentType": 5120, "normalized": True, "count": 4, "type": "VEC3"}
+scenes['ok-quantized'] = pack(d, {**F, "qq.bin": QQ})
+# EXT_meshopt_compression: the positions' view decoded from bytes that are no meshopt stream, and
+# a fallback buffer past the decoded-bytes budget.
+def meshopt(fallback_length):
+    d = doc(extensionsUsed=["EXT_meshopt_compression"], extensionsRequired=["EXT_meshopt_compression"])
+    d['buffers'].append({"byteLength": fallback_length, "extensions": {"EXT_meshopt_compression": {"fallback": True}}})
+    d['bufferViews'][0] = {"buffer": 1, "byteOffset": 0, "byteLength": 48, "byteStride": 12, "extensions": {"EXT_meshopt_compression": {
+        "buffer": 0, "byteOffset": 0, "byteLength": 48, "byteStride": 12, "count": 4, "mode": "ATTRIBUTES"}}}
+    return d
+scenes['bad-meshopt-not-a-stream'] = pack(meshopt(48), F)
+scenes['bad-meshopt-huge-fallback'] = pack(meshopt(1 << 40), F)
 # Refused
 def bad(name, mutate, files=F):
     d = doc(); mutate(d); scenes['bad-' + name] = pack(d, files)
