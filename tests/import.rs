@@ -198,18 +198,8 @@ fn index_of_refraction_sets_the_reflectance() {
         let got = render(&scene, 4, 4, 4, 0).unwrap().mean.mean();
         println!("ior {ior}: reflected {got}, F0 {f0}");
         assert!((got - Vec3::splat(f0)).abs().max_element() < 1e-4, "ior {ior}: {got} vs {f0}");
-        let (gpu, mut r) = hush_engine::frame::Renderer::headless(
-            scene.clone(),
-            hush_engine::accel::BvhKind::DEFAULT,
-            (4, 4),
-        )
-        .unwrap();
-        let input = hush_engine::frame::FrameInput {
-            camera: scene.camera_or_default(),
-            time: 0.0,
-            shutter: None,
-        };
-        r.render(&gpu, &input, &Default::default(), None).unwrap();
+        let (gpu, r) =
+            hush_tests::realtime_renderer(&scene, (4, 4), &Default::default(), 1).unwrap();
         let (spec, _) = r.read_texture(&gpu, "gbuffer/specular").unwrap();
         let g_f0 = spec[0] as f32 / 255.0;
         assert!((g_f0 - f0).abs() <= 1.0 / 255.0, "ior {ior}: G-buffer F0 {g_f0} vs {f0}");

@@ -6,7 +6,7 @@
 
 use base64::Engine;
 use glam::Vec3;
-use hush_engine::quality::Image;
+use hush_engine::quality::{Image, srgb_to_linear};
 use hush_engine::scene::{Environment, Scene, load_gltf};
 use hush_tests::gltf_writer::{GltfWriter, Prim};
 use serde_json::{Value, json};
@@ -33,17 +33,8 @@ fn transformed(uv: [f32; 2]) -> [f32; 2] {
 
 /// A 4 x 2 texture, every texel a different colour, as a PNG data URI.
 fn texture_uri() -> String {
-    let colours: [[u8; 3]; 8] = [
-        [255, 0, 0],
-        [0, 255, 0],
-        [0, 0, 255],
-        [255, 255, 0],
-        [0, 255, 255],
-        [255, 0, 255],
-        [40, 40, 40],
-        [200, 120, 60],
-    ];
-    let rgba: Vec<u8> = colours.iter().flat_map(|c| [c[0], c[1], c[2], 255]).collect();
+    let rgba: Vec<u8> =
+        hush_tests::TILE_COLOURS.iter().flat_map(|c| [c[0], c[1], c[2], 255]).collect();
     let img = image::RgbaImage::from_raw(4, 2, rgba).unwrap();
     let mut png = vec![];
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
@@ -236,24 +227,11 @@ fn vertex_colours_multiply_the_base_colour_in_both_modes() {
         let scene = Scene { environment: Environment::Constant(Vec3::ONE), ..scene };
         let acc = hush_tests::render(&scene, W, H, 64, 1).unwrap();
         let (mut worst_ref, mut worst_gb) = (0f32, 0f32);
-        let (gpu, mut r) = hush_engine::frame::Renderer::headless(
-            scene.clone(),
-            hush_engine::accel::BvhKind::DEFAULT,
-            (W, H),
-        )
-        .unwrap();
-        let input = hush_engine::frame::FrameInput {
-            camera: scene.camera_or_default(),
-            time: 0.0,
-            shutter: None,
-        };
-        r.render(&gpu, &input, &Default::default(), None).unwrap();
+        let (gpu, r) =
+            hush_tests::realtime_renderer(&scene, (W, H), &Default::default(), 1).unwrap();
         let (albedo, format) = r.read_texture(&gpu, "gbuffer/base_color").unwrap();
         assert_eq!(format, wgpu::TextureFormat::Rgba8UnormSrgb);
-        let srgb = |b: u8| {
-            let c = b as f32 / 255.0;
-            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-        };
+        let srgb = |b: u8| srgb_to_linear(b as f32 / 255.0);
         for y in 0..H {
             for x in 0..W {
                 let want = base

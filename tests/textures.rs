@@ -3,7 +3,7 @@
 //! hold the edge as glTF's samplers do (repeat, mirrored repeat, clamp to edge).
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
-use hush_engine::quality::Image;
+use hush_engine::quality::{Image, srgb_to_linear};
 use hush_engine::scene::{
     Camera, Environment, Material, Object, Scene, Texture, TextureRef, Wrap, quad,
 };
@@ -14,17 +14,7 @@ const TILE: u32 = W / 3;
 
 fn scene(wrap_s: Wrap) -> Scene {
     // 4 x 2 texels, every one a different colour.
-    let colours: [[u8; 3]; 8] = [
-        [255, 0, 0],
-        [0, 255, 0],
-        [0, 0, 255],
-        [255, 255, 0],
-        [0, 255, 255],
-        [255, 0, 255],
-        [40, 40, 40],
-        [200, 120, 60],
-    ];
-    let rgba8 = colours.iter().flat_map(|c| [c[0], c[1], c[2], 255]).collect();
+    let rgba8 = hush_tests::TILE_COLOURS.iter().flat_map(|c| [c[0], c[1], c[2], 255]).collect();
     let texture = Texture {
         name: "tiles".into(),
         width: 4,
@@ -167,13 +157,9 @@ fn nearest_samplers_read_whole_texels() {
         let texel_colours: Vec<Vec3> = (0..8)
             .map(|i| {
                 // An emissive texture is sRGB in glTF: the loaded one decodes its texels.
-                let c = &s.textures[0].rgba8[i * 4..i * 4 + 3];
-                let srgb = |b: u8| {
-                    let c = b as f32 / 255.0;
-                    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-                };
                 assert!(loaded.textures[0].srgb);
-                Vec3::new(srgb(c[0]), srgb(c[1]), srgb(c[2]))
+                let c = hush_tests::TILE_COLOURS[i].map(|b| srgb_to_linear(b as f32 / 255.0));
+                Vec3::from_array(c)
             })
             .collect();
         // Pixels whose footprint lies inside one texel: 2 pixels and more from texel borders.

@@ -68,6 +68,16 @@ impl Error {
     }
 }
 
+/// The message of a caught panic (`std::panic::catch_unwind`'s payload), or "panic" where it
+/// carries none.
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "panic".into())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

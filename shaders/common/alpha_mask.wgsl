@@ -14,27 +14,19 @@ fn alpha_accept(slot: u32, b: vec2f, ray: u32) -> bool {
         a *= material_texture(m, 0u, t).a;
     }
     if (m.flags & MAT_ALPHA_BLEND) != 0u {
-        return f32(alpha_hash(ray ^ alpha_hash(slot)) >> 8u) * (1.0 / 16777216.0) < a;
+        return f32(pcg_hash(ray ^ pcg_hash(slot)) >> 8u) * (1.0 / 16777216.0) < a;
     }
     return a >= m.alpha_cutoff;
-}
-
-// PCG's output permutation (O'Neill 2014), as common/rng.wgsl's pcg_hash; this module is also
-// composed into the raster program, which has no random numbers otherwise.
-fn alpha_hash(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336963u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
 }
 
 // A ray's draw: its origin and direction bits hashed (different for every sample and bounce).
 fn alpha_ray(o: vec3f, d: vec3f) -> u32 {
     let a = bitcast<vec3u>(o);
     let b = bitcast<vec3u>(d);
-    return alpha_hash(a.x ^ alpha_hash(a.y ^ alpha_hash(a.z ^ alpha_hash(b.x ^ alpha_hash(b.y ^ alpha_hash(b.z))))));
+    return pcg_hash(a.x ^ pcg_hash(a.y ^ pcg_hash(a.z ^ pcg_hash(b.x ^ pcg_hash(b.y ^ pcg_hash(b.z))))));
 }
 
 // The raster's draw for a pixel in a frame.
 fn alpha_raster(pixel: vec2u, frame_index: u32) -> u32 {
-    return alpha_hash(pixel.x ^ alpha_hash(pixel.y ^ alpha_hash(frame_index)));
+    return pcg_hash(pixel.x ^ pcg_hash(pixel.y ^ pcg_hash(frame_index)));
 }

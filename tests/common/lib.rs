@@ -86,14 +86,38 @@ pub fn realtime_frames(
     settings: &hush_engine::settings::FrameSettings,
     frames: u32,
 ) -> Result<hush_engine::quality::Image> {
+    let (gpu, r) = realtime_renderer(scene, size, settings, frames)?;
+    r.read_hdr(&gpu)
+}
+
+/// A real-time renderer of `scene` that has rendered `frames` frames from the scene's camera
+/// with `settings`, for a test to read its textures.
+pub fn realtime_renderer(
+    scene: &Scene,
+    size: (u32, u32),
+    settings: &hush_engine::settings::FrameSettings,
+    frames: u32,
+) -> Result<(Gpu, hush_engine::frame::Renderer)> {
     use hush_engine::frame::{FrameInput, Renderer};
     let (gpu, mut r) = Renderer::headless(scene.clone(), BvhKind::DEFAULT, size)?;
     let input = FrameInput { camera: scene.camera_or_default(), time: 0.0, shutter: None };
     for _ in 0..frames {
         r.render(&gpu, &input, settings, None)?;
     }
-    r.read_hdr(&gpu)
+    Ok((gpu, r))
 }
+
+/// The texture tests' 4 x 2 texels, each a different colour (8-bit RGB, top row first).
+pub const TILE_COLOURS: [[u8; 3]; 8] = [
+    [255, 0, 0],
+    [0, 255, 0],
+    [0, 0, 255],
+    [255, 255, 0],
+    [0, 255, 255],
+    [255, 0, 255],
+    [40, 40, 40],
+    [200, 120, 60],
+];
 
 /// Per-channel relative mean bias of `test` against `reference` after leaving out the 0.1% of
 /// pixels whose luminances differ most (caustic and highlight pixels whose means a few rare

@@ -163,14 +163,10 @@ fn check(path: &Path, name: &str, a: &ConformanceArgs) -> Row {
     row.outcome = match rendered {
         Ok(Ok(o)) => o,
         Ok(Err(e)) => Outcome::Wrong(format!("render failed: {}", first_line(&e))),
-        Err(p) => {
-            let msg = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Outcome::Wrong(format!("render panicked: {msg}"))
-        }
+        Err(p) => Outcome::Wrong(format!(
+            "render panicked: {}",
+            hush_engine::error::panic_message(p.as_ref())
+        )),
     };
     row.seconds = start.elapsed().as_secs_f64();
     row

@@ -178,6 +178,8 @@ impl GBufferPass {
         let f = &scene.features;
         let mut modules = vec![
             "common/math.wgsl",
+            // pcg_hash, for the stochastic transparency of blended materials (alpha_mask.wgsl).
+            "common/rng.wgsl",
             "common/geometry.wgsl",
             "common/motion_none.wgsl",
             "common/scene.wgsl",

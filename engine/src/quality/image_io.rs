@@ -192,7 +192,8 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
 }
 
-fn srgb_to_linear(c: f32) -> f32 {
+/// The sRGB transfer function's inverse (IEC 61966-2-1): an encoded value in [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 

@@ -86,11 +86,7 @@ pub fn load_gltf_from(
         .import(&document, blob, name.to_string())
     });
     std::panic::catch_unwind(run).unwrap_or_else(|p| {
-        let msg = p
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| p.downcast_ref::<String>().cloned());
-        Err(crate::Error::ImportPanic(msg.unwrap_or_else(|| "panic".into())).into())
+        Err(crate::Error::ImportPanic(crate::error::panic_message(p.as_ref())).into())
     })
 }
 

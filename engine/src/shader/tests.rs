@@ -50,6 +50,7 @@ fn all_programs() -> Vec<Program> {
         for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
             let m = [
                 "common/math.wgsl",
+                "common/rng.wgsl",
                 "common/geometry.wgsl",
                 "common/motion_none.wgsl",
                 "common/scene.wgsl",
