@@ -6,6 +6,8 @@
 // Schlick's F at the half vector; roughness 0 makes g a delta mirror. F0 = base colour for
 // metals, KHR_materials_specular's 0.04 x specular colour x specular factor for dielectrics.
 // All directions are in the local shading frame (z = shading normal).
+// A transmissive material (KHR_materials_transmission) replaces the reflection and matte lobes
+// with common/transmission.wgsl's dielectric (bsdf_eval and bsdf_sample hand it over).
 
 struct Bsdf {
     // (1 - metallic) x base colour.
@@ -14,6 +16,15 @@ struct Bsdf {
     f90: vec3f,
     alpha: f32,
     delta: bool,
+    // KHR_materials_transmission x (1 - metallic); 0 for an opaque material (with_glass sets
+    // these four).
+    transmission: f32,
+    // Index ratio across the surface, beyond over this side (ior entering, 1 / ior leaving).
+    eta: f32,
+    // The transmitted light's tint (the base colour).
+    tint: vec3f,
+    // KHR_materials_volume's thickness 0: light passes straight through.
+    thin: bool,
 }
 
 // Mitsuba clamps GGX alpha to >= 1e-4; below that Hush uses the delta mirror.
@@ -27,6 +38,10 @@ fn make_bsdf(base: vec3f, metallic: f32, roughness: f32, spec_factor: f32, spec_
     b.f90 = mix(vec3f(spec_factor), vec3f(1.0), metallic);
     b.alpha = roughness * roughness;
     b.delta = b.alpha < MIN_ALPHA;
+    b.transmission = 0.0;
+    b.eta = 1.0;
+    b.tint = vec3f(0.0);
+    b.thin = false;
     return b;
 }
 
@@ -97,6 +112,13 @@ fn glossy_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
 }
 
 fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
+    if b.transmission > 0.0 {
+        return glass_eval(b, wo, wi);
+    }
+    return opaque_eval(b, wo, wi);
+}
+
+fn opaque_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> BsdfEval {
     var r: BsdfEval;
     r.f_cos = vec3f(0.0);
     r.pdf = 0.0;
@@ -142,6 +164,13 @@ fn cosine_hemisphere(u: vec2f) -> vec3f {
 
 // One-sample choice between the lobes, then the full mixture pdf for MIS.
 fn bsdf_sample(b: Bsdf, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSample {
+    if b.transmission > 0.0 {
+        return glass_sample(b, wo, u_lobe, u);
+    }
+    return opaque_sample(b, wo, u_lobe, u);
+}
+
+fn opaque_sample(b: Bsdf, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSample {
     var s: BsdfSample;
     s.weight = vec3f(0.0);
     s.pdf = 0.0;
@@ -163,7 +192,7 @@ fn bsdf_sample(b: Bsdf, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSample {
     } else {
         s.wi = cosine_hemisphere(u);
     }
-    let e = bsdf_eval(b, wo, s.wi);
+    let e = opaque_eval(b, wo, s.wi);
     if e.pdf <= 0.0 {
         return s;
     }

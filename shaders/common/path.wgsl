@@ -107,7 +107,6 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     let segments = (*st).segments;
     let ro = (*st).ro;
     let rd = (*st).rd;
-    let beta = (*st).beta;
     let prev_delta = (*st).prev_delta;
     let prev_pdf = (*st).prev_pdf;
     let prev_select = (*st).prev_select;
@@ -128,7 +127,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
             if !prev_delta {
                 w = power_heuristic(prev_pdf, prev_select * env_pdf(rd));
             }
-            (*st).radiance += beta * le * w;
+            (*st).radiance += (*st).beta * le * w;
         }
         return;
     }
@@ -138,9 +137,11 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         return;
     }
+    // A segment that ends on the inside of glass crossed its volume.
+    let beta = (*st).beta * glass_absorption(m, s.front, hit.t);
     let ms = material_at(m, s.tc);
     let emission = ms.emission;
-    let bsdf = material_bsdf(m, ms);
+    let bsdf = with_glass(material_bsdf(m, ms), m, ms, s.front);
     if first {
         (*st).first_reflectance = min(bsdf.albedo + bsdf.f0, vec3f(1.0));
         (*st).first_normal = s.ns;
@@ -161,6 +162,9 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     let frame = onb(s.ns);
     let wo = to_local(frame, -rd);
     let origin = offset_ray(s.p, s.ng, eps);
+    // Rays that go through (glass) start on the surface's far side.
+    let origin_through = offset_ray(s.p, -s.ng, eps);
+    let transmits = bsdf.transmission > 0.0;
 
     // Next-event estimation (skipped when the glossy lobe is a pure mirror and there is no
     // matte lobe: no light sample can land in a delta lobe).
@@ -168,11 +172,12 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     if light_groups() > 0u && (matte_present || !bsdf.delta) {
         let ls = sample_light(s.p, rng);
         let wi_l = to_local(frame, ls.wi);
-        if max3(ls.li) > 0.0 && wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
+        let through = transmits && wi_l.z < 0.0 && dot(ls.wi, s.ng) < 0.0;
+        if max3(ls.li) > 0.0 && ((wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0) || through) {
             let e = bsdf_eval(bsdf, wo, wi_l);
             if max3(e.f_cos) > 0.0 {
                 let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-                let blocked = traverse(origin, ls.wi, tmax, true).tri != NO_HIT;
+                let blocked = traverse(select(origin, origin_through, through), ls.wi, tmax, true).tri != NO_HIT;
                 if !blocked {
                     var w = 1.0;
                     if ls.pdf > 0.0 {
@@ -191,8 +196,10 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
         return;
     }
     let wi = frame * bs.wi;
-    // A direction below the geometric surface would start inside the object.
-    if dot(wi, s.ng) <= 0.0 {
+    // A direction below the geometric surface would start inside the object, unless the BSDF
+    // chose to go through (and then it must leave by the far side).
+    let through = transmits && bs.wi.z < 0.0;
+    if select(dot(wi, s.ng) <= 0.0, dot(wi, s.ng) >= 0.0, through) {
         return;
     }
     var next_beta = beta * bs.weight;
@@ -208,7 +215,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     (*st).prev_pdf = bs.pdf;
     (*st).prev_delta = bs.delta;
     (*st).prev_select = select_p;
-    (*st).ro = origin;
+    (*st).ro = select(origin, origin_through, through);
     (*st).rd = normalize(wi);
     (*st).segments = segments + 1;
     (*st).done = false;

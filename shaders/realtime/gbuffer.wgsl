@@ -62,7 +62,7 @@ fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     }
     ns = apply_normal_map(slot, b, ns, tc, m);
     let ms = material_at(m, tc);
-    let bsdf = material_bsdf(m, ms);
+    let bsdf = with_glass(material_bsdf(m, ms), m, ms, front);
     var o: GBufferOut;
     o.normal = oct_encode(ns);
     o.motion = to_pixels(v.prev) - to_pixels(v.cur);
@@ -79,5 +79,12 @@ fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     // Emitters emit from the front face only.
     let e = select(vec3f(0.0), ms.emission, front);
     o.emission = vec4f(half_safe(e), clamp(max3(bsdf.f90), 0.0, 1.0));
+    if bsdf.transmission > 0.0 {
+        // Glass: the trace puts all its light in the glossy signal (realtime/trace.wgsl,
+        // shade_glass); F = 1 and no matte base composite it unchanged.
+        o.base_color = vec4f(0.0);
+        o.specular = vec4f(1.0, 1.0, 1.0, clamp(ms.roughness, 0.0, 1.0));
+        o.emission.w = 1.0;
+    }
     return o;
 }

@@ -65,7 +65,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let s = surface_at(hit, ray.rd);
         let m = material(s.material);
         let ms = material_at(m, s.tc);
-        let bsdf = material_bsdf(m, ms);
+        let bsdf = with_glass(material_bsdf(m, ms), m, ms, s.front);
         let object = bitcast<u32>(shading_at(hit.tri * 4u + 3u).w);
         if j == 0u {
             ids = vec2u(object, hit.tri);
@@ -76,7 +76,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         n += 1.0;
         normal += s.ns;
-        if s.front || (m.flags & MAT_DOUBLE_SIDED) != 0u {
+        if bsdf.transmission > 0.0 {
+            // Glass, as the raster writes it (realtime/gbuffer.wgsl).
+            spec += vec4f(1.0, 1.0, 1.0, clamp(ms.roughness, 0.0, 1.0));
+            emission += vec4f(half_safe(select(vec3f(0.0), ms.emission, s.front)), 1.0);
+        } else if s.front || (m.flags & MAT_DOUBLE_SIDED) != 0u {
             base += vec4f(clamp(ms.base.rgb, vec3f(0.0), vec3f(1.0)), clamp(ms.metallic, 0.0, 1.0));
             spec += vec4f(clamp(bsdf.f0, vec3f(0.0), vec3f(1.0)), clamp(ms.roughness, 0.0, 1.0));
             emission += vec4f(half_safe(select(vec3f(0.0), ms.emission, s.front)), clamp(max3(bsdf.f90), 0.0, 1.0));

@@ -71,7 +71,10 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
         return Shaded(vec3f(0.0), vec3f(0.0), vec3f(0.0), INF, vec3f(1.0), -rd, rd, INF, s.ns, true);
     }
     let ms = material_at(m, s.tc);
-    let bsdf = material_bsdf(m, ms);
+    let bsdf = with_glass(material_bsdf(m, ms), m, ms, s.front);
+    if bsdf.transmission > 0.0 {
+        return shade_glass(rd, hit, s, ms, rng);
+    }
     let basis = onb(s.ns);
     let wo = to_local(basis, -rd);
     let origin = offset_ray(s.p, s.ng, eps);
@@ -178,6 +181,26 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
         representative_t = traverse(origin, mirror, INF, false).t;
     }
     return Shaded(matte, direct, glossy, glossy_t, hit_reflectance, hit_normal, mirror, representative_t, s.ns, false);
+}
+
+// Glass (common/transmission.wgsl) at the primary hit: reflection and refraction together are
+// the glossy signal, which the G-buffer's glass marker (F = 1, no matte) composites unchanged.
+// Each sample is the reference tracer's path from the camera (one more primary traversal, on
+// glass pixels only), so next-event estimation and MIS at the glass are those of the reference
+// mode. A pixel has one motion vector: the refracted image is reprojected with the glass
+// surface (virtual distance 0), which is exact for a still camera and thin glass, and lags for
+// thick glass under motion.
+fn shade_glass(rd: vec3f, hit: Hit, s: Surface, ms: MaterialSample, rng: ptr<function, u32>) -> Shaded {
+    let ro = s.p - rd * hit.t;
+    let paths = max(frame.paths, 1u);
+    var glossy = vec3f(0.0);
+    for (var k = 0u; k < paths; k++) {
+        glossy += trace_path(camera_path(ro, rd), rng).radiance;
+    }
+    // The composite adds the surface's own emission.
+    glossy = max(glossy / f32(paths) - select(vec3f(0.0), ms.emission, s.front), vec3f(0.0));
+    let mirror = reflect(rd, s.ns);
+    return Shaded(vec3f(0.0), vec3f(0.0), glossy, 0.0, vec3f(1.0), s.ns, mirror, 0.0, s.ns, false);
 }
 
 // The raster's hit of pixel px's camera ray rd: its triangle (slot), with exact barycentrics of

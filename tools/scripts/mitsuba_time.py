@@ -3,10 +3,10 @@
 `hush-cli bench --mitsuba` runs this beside its own tracer so both rates come from one run on
 one machine. The scene must follow the conventions of the oracle scenes (shared/oracle/README.md):
 one triangle primitive per mesh with float32 POSITION and NORMAL and uint32 indices, materials
-Lambertian / mirror / rough metal, area emission, point and directional lights, a constant
+Lambertian / mirror / rough metal / glass (smooth or rough dielectric), area emission, point and directional lights, a constant
 environment, a perspective or thin-lens camera. Anything else is refused with an error.
 
-Usage: mitsuba_time.py SCENE.gltf --width W --height H --spp N [--out image.exr]
+Usage: mitsuba_time.py SCENE.gltf --width W --height H --spp N [--seed S] [--out image.exr]
 Prints one JSON line: {"seconds": render seconds, "samples_per_second": ..., "mean_rgb": [...]}.
 """
 import argparse, json, math, os, sys, time
@@ -46,6 +46,7 @@ def main():
     ap.add_argument("--width", type=int, required=True)
     ap.add_argument("--height", type=int, required=True)
     ap.add_argument("--spp", type=int, required=True)
+    ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out")
     a = ap.parse_args()
     g = json.load(open(a.scene))
@@ -124,7 +125,18 @@ def main():
         c = pbr.get("baseColorFactor", [1, 1, 1, 1])[:3]
         metallic, rough = pbr.get("metallicFactor", 1.0), pbr.get("roughnessFactor", 1.0)
         ext = mat.get("extensions", {})
-        if metallic == 0.0 and ext.get("KHR_materials_specular", {}).get("specularFactor", 1.0) == 0.0:
+        glass = ext.get("KHR_materials_transmission", {}).get("transmissionFactor", 0.0)
+        if glass > 0.0:
+            # Contract (d): a closed volume of exact dielectric, white, no attenuation.
+            ior = ext.get("KHR_materials_ior", {}).get("ior", 1.5)
+            thick = ext.get("KHR_materials_volume", {}).get("thicknessFactor", 0.0)
+            if glass != 1.0 or metallic != 0.0 or c != [1, 1, 1] or thick <= 0.0 or not mat.get("doubleSided"):
+                fail(f"glass {mat.get('name')!r} is out of contract")
+            if rough == 0.0:
+                bsdf = {"type": "dielectric", "int_ior": ior, "ext_ior": 1.0}
+            else:
+                bsdf = {"type": "roughdielectric", "distribution": "ggx", "alpha": max(rough * rough, 1e-4), "int_ior": ior, "ext_ior": 1.0}
+        elif metallic == 0.0 and ext.get("KHR_materials_specular", {}).get("specularFactor", 1.0) == 0.0:
             bsdf = {"type": "diffuse", "reflectance": {"type": "rgb", "value": c}}
         elif metallic == 1.0 and rough == 0.0:
             bsdf = {"type": "conductor", "material": "none", "specular_reflectance": {"type": "rgb", "value": c}}
@@ -132,7 +144,7 @@ def main():
             bsdf = {"type": "roughconductor", "distribution": "ggx", "alpha": max(rough * rough, 1e-4), "material": "none", "specular_reflectance": {"type": "rgb", "value": c}}
         else:
             fail(f"material {mat.get('name')!r} is out of contract")
-        if mat.get("doubleSided"):
+        if mat.get("doubleSided") and glass == 0.0:
             bsdf = {"type": "twosided", "bsdf": bsdf}
         props = mi.Properties()
         props["bsdf"] = mi.load_dict(bsdf)
@@ -153,7 +165,7 @@ def main():
     sc = mi.load_dict(scene)
     load_s = time.perf_counter() - t0
     t0 = time.perf_counter()
-    img = mi.render(sc, spp=a.spp)
+    img = mi.render(sc, spp=a.spp, seed=a.seed)
     img = np.array(img)
     secs = time.perf_counter() - t0
     if a.out:

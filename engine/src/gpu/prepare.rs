@@ -30,6 +30,9 @@ pub struct SceneFeatures {
     pub texture_uses: bool,
     /// Some mesh carries TEXCOORD_1 or COLOR_0: three more texels a triangle (`extras`).
     pub vertex_extras: bool,
+    /// Some material transmits light (KHR_materials_transmission): the per-material glass table
+    /// (`glass`) and the refraction code exist (shaders/common/transmission.wgsl).
+    pub transmission: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,7 +77,9 @@ impl From<&crate::scene::Material> for GpuMaterial {
             specular_factor: m.specular_factor,
             alpha_cutoff: cutoff,
             normal_scale: m.normal_scale,
-            flags: mask | if m.double_sided { MAT_DOUBLE_SIDED } else { 0 },
+            // An interface between two media has two sides, whatever doubleSided says.
+            flags: mask
+                | if m.double_sided || m.transmission > 0.0 { MAT_DOUBLE_SIDED } else { 0 },
             tex: [
                 t(m.base_color_texture),
                 t(m.metallic_roughness_texture),
@@ -127,6 +132,9 @@ pub struct PreparedScene {
     /// metallic-roughness, normal, emissive), two rows of the coordinates' affine map, the
     /// first's w the TEXCOORD set ([`pack_texture_uses`]).
     pub tex_uses: Vec<Vec4>,
+    /// [`SceneFeatures::transmission`]: per material two rows, (transmission, ior, 1 if
+    /// thin-walled, 0) and (absorption per metre rgb, 0) ([`pack_glass`]).
+    pub glass: Vec<Vec4>,
     pub lights: Vec<GpuLight>,
     /// (cumulative probability bits, triangle slot).
     pub emitters: Vec<[u32; 2]>,
@@ -273,6 +281,18 @@ fn pack_texture_uses(materials: &[crate::scene::Material]) -> Vec<Vec4> {
     v
 }
 
+/// Per material the two rows of shaders/common/transmission.wgsl's glass table.
+fn pack_glass(materials: &[crate::scene::Material]) -> Vec<Vec4> {
+    let mut v = Vec::with_capacity(materials.len() * 2);
+    for m in materials {
+        let thin = if m.thickness > 0.0 { 0.0 } else { 1.0 };
+        v.push(Vec4::new(m.transmission, m.ior, thin, 0.0));
+        let sigma = if m.transmission > 0.0 { m.absorption() } else { Vec3::ZERO };
+        v.push(sigma.extend(0.0));
+    }
+    v
+}
+
 /// f32 matrix of a rebased world transform.
 fn rebased(m: DMat4, origin: DVec3) -> glam::Mat4 {
     (DMat4::from_translation(-origin) * m).as_mat4()
@@ -287,6 +307,7 @@ impl PreparedScene {
         scene.materials.iter().enumerate().filter(|(i, _)| used.contains(i)).any(|(_, m)| {
             let g = GpuMaterial::from(m);
             g.metallic > 0.0
+                || m.transmission > 0.0
                 || (g.specular_factor > 0.0 && g.specular_color.iter().any(|c| *c > 0.0))
         })
     }
@@ -316,6 +337,7 @@ impl PreparedScene {
             animated: scene.is_animated(),
             texture_uses,
             vertex_extras,
+            transmission: scene.materials.iter().any(|m| m.transmission > 0.0),
         };
         let flat: Vec<Flat> = (0..scene.objects.len())
             .map(|i| flatten(scene, i, scene.objects[i].transform, origin, &features))
@@ -365,6 +387,8 @@ impl PreparedScene {
         let tex_data = pack_textures(scene);
         features.env = env_kind;
         let tex_uses = if texture_uses { pack_texture_uses(&scene.materials) } else { vec![] };
+        let glass =
+            if features.transmission { pack_glass(&scene.materials) } else { vec![] };
         let mut p = PreparedScene {
             features,
             accel: Accel::empty(kind),
@@ -378,6 +402,7 @@ impl PreparedScene {
             extras: vec![],
             materials,
             tex_uses,
+            glass,
             lights,
             emitters: vec![],
             emit_inv_total: 0.0,

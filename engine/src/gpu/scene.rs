@@ -24,6 +24,8 @@ pub struct GpuScene {
     /// [`PreparedScene::extras`] and [`PreparedScene::tex_uses`], where the scene has them.
     pub extras: Option<Texels>,
     pub tex_uses: Option<Texels>,
+    /// [`PreparedScene::glass`], where some material transmits.
+    pub glass: Option<Texels>,
     pub lights: Option<wgpu::Buffer>,
     pub emitters: Option<wgpu::Buffer>,
     pub env: Option<wgpu::Buffer>,
@@ -74,6 +76,7 @@ impl PreparedScene {
                 self.materials.len() * 80,
                 self.extras.len() * 16,
                 self.tex_uses.len() * 16,
+                self.glass.len() * 16,
             ]
             .into_iter()
             .map(texel_row_count)
@@ -153,6 +156,15 @@ impl PreparedScene {
                 wgpu::TextureFormat::Rgba32Float,
             )
         });
+        let glass = f.transmission.then(|| {
+            Texels::new(
+                gpu,
+                &mut mem,
+                "scene/glass",
+                b(&self.glass),
+                wgpu::TextureFormat::Rgba32Float,
+            )
+        });
         let copy = s | wgpu::BufferUsages::COPY_DST;
         // Lights and environment are rewritten when the user moves the sun.
         let lights =
@@ -196,6 +208,7 @@ impl PreparedScene {
             materials,
             extras,
             tex_uses,
+            glass,
             lights,
             emitters,
             env,
@@ -286,6 +299,7 @@ impl GpuScene {
             .texture("material_texels", &self.materials.view)
             .texture_opt("extra_texels", self.extras.as_ref().map(|t| &t.view))
             .texture_opt("tex_use_texels", self.tex_uses.as_ref().map(|t| &t.view))
+            .texture_opt("glass_texels", self.glass.as_ref().map(|t| &t.view))
             .buffer_opt("lights", self.lights.as_ref())
             .buffer_opt("emitters", self.emitters.as_ref())
             .buffer_opt("env_data", self.env.as_ref())
@@ -334,7 +348,7 @@ impl GpuScene {
 
     /// The modules that read materials at a surface point: textures, normal maps, alpha masks,
     /// texture coordinate maps and vertex attributes, each as the scene needs it.
-    pub fn material_modules(&self) -> [&'static str; 5] {
+    pub fn material_modules(&self) -> [&'static str; 6] {
         let f = &self.features;
         [
             if f.alpha_mask { "common/alpha_mask.wgsl" } else { "common/alpha_none.wgsl" },
@@ -342,6 +356,11 @@ impl GpuScene {
             if f.normal_maps { "common/tangents.wgsl" } else { "common/tangents_none.wgsl" },
             if f.texture_uses { "common/texcoords.wgsl" } else { "common/texcoords_none.wgsl" },
             if f.vertex_extras { "common/attributes.wgsl" } else { "common/attributes_none.wgsl" },
+            if f.transmission {
+                "common/transmission.wgsl"
+            } else {
+                "common/transmission_none.wgsl"
+            },
         ]
     }
 

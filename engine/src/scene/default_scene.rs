@@ -70,7 +70,7 @@ pub fn cuboid(center: Vec3, half: Vec3, material: u32) -> Mesh {
     m
 }
 
-pub(super) fn uv_sphere(center: Vec3, r: f32, material: u32, seg: u32, rings: u32) -> Mesh {
+pub fn uv_sphere(center: Vec3, r: f32, material: u32, seg: u32, rings: u32) -> Mesh {
     let mut m = Mesh { material, ..Default::default() };
     for j in 0..=rings {
         let th = std::f32::consts::PI * j as f32 / rings as f32;

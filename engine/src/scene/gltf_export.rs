@@ -160,6 +160,17 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
             if m.ior != 1.5 {
                 ext.insert("KHR_materials_ior".into(), json!({"ior": m.ior}));
             }
+            if m.transmission > 0.0 {
+                ext.insert("KHR_materials_transmission".into(), json!({"transmissionFactor": m.transmission}));
+            }
+            if m.thickness > 0.0 {
+                let mut vol = json!({"thicknessFactor": m.thickness});
+                if m.attenuation_distance.is_finite() {
+                    vol["attenuationDistance"] = json!(m.attenuation_distance);
+                    vol["attenuationColor"] = json!(m.attenuation_color.to_array());
+                }
+                ext.insert("KHR_materials_volume".into(), vol);
+            }
             v["extensions"] = Value::Object(ext);
             v
         })
@@ -296,6 +307,12 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     }
     if !lights.is_empty() {
         used.push("KHR_lights_punctual");
+    }
+    if scene.materials.iter().any(|m| m.transmission > 0.0) {
+        used.push("KHR_materials_transmission");
+    }
+    if scene.materials.iter().any(|m| m.thickness > 0.0) {
+        used.push("KHR_materials_volume");
     }
     if scene.materials.iter().any(|m| m.ior != 1.5) {
         used.push("KHR_materials_ior");

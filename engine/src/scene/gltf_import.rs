@@ -26,6 +26,8 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_texture_transform",
     "KHR_mesh_quantization",
     "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
     super::meshopt::EXTENSION,
 ];
 

@@ -204,6 +204,7 @@ impl Importer<'_> {
                 1.5
             }
         };
+        let glass = self.glass(m);
         let strength = m.emissive_strength().unwrap_or(1.0);
         let clamp01 = |x: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 };
         let fin = |v: Vec3| if v.is_finite() { v.max(Vec3::ZERO) } else { Vec3::ZERO };
@@ -280,9 +281,80 @@ impl Importer<'_> {
             specular_factor: clamp01(specular_factor),
             specular_color: fin(specular_color),
             ior,
+            transmission: glass.transmission,
+            thickness: glass.thickness,
+            attenuation_color: glass.attenuation_color,
+            attenuation_distance: glass.attenuation_distance,
             alpha_mode,
             double_sided: m.double_sided(),
         }
+    }
+}
+
+/// What KHR_materials_transmission and KHR_materials_volume say of a material.
+struct Glass {
+    transmission: f32,
+    thickness: f32,
+    attenuation_color: Vec3,
+    attenuation_distance: f32,
+}
+
+impl Importer<'_> {
+    /// KHR_materials_transmission and KHR_materials_volume. Values out of the extensions' range
+    /// are clamped with a warning; their textures are not read (the factors apply alone).
+    fn glass(&mut self, m: &gltf::Material) -> Glass {
+        let mut g = Glass {
+            transmission: 0.0,
+            thickness: 0.0,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: f32::INFINITY,
+        };
+        let number = |e: &serde_json::Value, key: &str| e.get(key).and_then(|v| v.as_f64());
+        let mut problems = vec![];
+        if let Some(e) = m.extension_value("KHR_materials_transmission") {
+            let t = number(e, "transmissionFactor").unwrap_or(0.0);
+            if !(0.0..=1.0).contains(&t) {
+                problems.push("transmissionFactor out of [0, 1]");
+            }
+            g.transmission = if t.is_finite() { t.clamp(0.0, 1.0) as f32 } else { 0.0 };
+            if e.get("transmissionTexture").is_some() {
+                problems.push("transmissionTexture is not read");
+            }
+        }
+        if let Some(e) = m.extension_value("KHR_materials_volume") {
+            let t = number(e, "thicknessFactor").unwrap_or(0.0);
+            if !(t.is_finite() && t >= 0.0) {
+                problems.push("thicknessFactor below 0");
+            }
+            g.thickness = if t.is_finite() { t.max(0.0) as f32 } else { 0.0 };
+            if let Some(d) = number(e, "attenuationDistance") {
+                if d.is_finite() && d > 0.0 {
+                    g.attenuation_distance = d as f32;
+                } else {
+                    problems.push("attenuationDistance not above 0");
+                }
+            }
+            if let Some(c) = e.get("attenuationColor").and_then(|v| v.as_array()) {
+                let c: Vec<f32> = c.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect();
+                if c.len() == 3 && c.iter().all(|x| (0.0..=1.0).contains(x)) {
+                    g.attenuation_color = Vec3::new(c[0], c[1], c[2]);
+                } else {
+                    problems.push("attenuationColor not 3 numbers in [0, 1]");
+                }
+            }
+            if e.get("thicknessTexture").is_some() {
+                problems.push("thicknessTexture is not read");
+            }
+        }
+        if !problems.is_empty() {
+            self.warn(format!(
+                "materials[{}] ({:?}): {}",
+                m.index().unwrap_or(0),
+                m.name().unwrap_or(""),
+                problems.join("; ")
+            ));
+        }
+        g
     }
 }
 

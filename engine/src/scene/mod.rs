@@ -23,7 +23,7 @@ mod texture;
 
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
-pub use default_scene::{cuboid, default_scene, quad};
+pub use default_scene::{cuboid, default_scene, quad, uv_sphere};
 pub use environment::{EnvMap, Environment};
 pub use files::{MemoryFiles, SceneFiles, SceneFolder};
 pub use gltf_export::save_gltf;
@@ -110,6 +110,17 @@ pub struct Material {
     /// KHR_materials_ior: a dielectric's F0 is ((ior - 1) / (ior + 1))^2 (0.04 at the default
     /// 1.5), times the specular colour.
     pub ior: f32,
+    /// KHR_materials_transmission: the share of the dielectric base that lets light through
+    /// (tinted by the base colour) instead of scattering it diffusely. 0 is opaque. A
+    /// transmissive material is two-sided whatever `double_sided` says: an interface has two.
+    pub transmission: f32,
+    /// KHR_materials_volume: 0 is thin-walled (light passes straight through, unrefracted);
+    /// more means the mesh closes a volume that refracts by `ior` on the way in and out.
+    pub thickness: f32,
+    /// KHR_materials_volume: inside the volume, light keeps `attenuation_color` of itself per
+    /// `attenuation_distance` metres travelled (Beer-Lambert); infinite distance absorbs nothing.
+    pub attenuation_color: Vec3,
+    pub attenuation_distance: f32,
     pub alpha_mode: AlphaMode,
     pub double_sided: bool,
 }
@@ -131,6 +142,10 @@ impl Default for Material {
             specular_factor: 1.0,
             specular_color: Vec3::ONE,
             ior: 1.5,
+            transmission: 0.0,
+            thickness: 0.0,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: f32::INFINITY,
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
         }
@@ -146,6 +161,16 @@ impl Material {
             self.normal_texture,
             self.emissive_texture,
         ]
+    }
+
+    /// Absorption coefficient per metre inside a volume (KHR_materials_volume):
+    /// -ln(attenuation colour) / attenuation distance, 0 where nothing is absorbed.
+    pub fn absorption(&self) -> Vec3 {
+        if self.thickness <= 0.0 || !self.attenuation_distance.is_finite() {
+            return Vec3::ZERO;
+        }
+        let c = self.attenuation_color.clamp(Vec3::splat(1e-6), Vec3::ONE);
+        Vec3::new(-c.x.ln(), -c.y.ln(), -c.z.ln()) / self.attenuation_distance
     }
 
     pub fn is_emissive(&self) -> bool {

@@ -1,6 +1,6 @@
 use super::*;
 
-const FEATURE_SETS: &[[&str; 8]] = &[
+const FEATURE_SETS: &[[&str; 9]] = &[
     [
         "common/alpha_none.wgsl",
         "common/textures_none.wgsl",
@@ -10,6 +10,7 @@ const FEATURE_SETS: &[[&str; 8]] = &[
         "common/env_none.wgsl",
         "common/texcoords_none.wgsl",
         "common/attributes_none.wgsl",
+        "common/transmission.wgsl",
     ],
     [
         "common/alpha_mask.wgsl",
@@ -20,6 +21,7 @@ const FEATURE_SETS: &[[&str; 8]] = &[
         "common/env_map.wgsl",
         "common/texcoords.wgsl",
         "common/attributes.wgsl",
+        "common/transmission_none.wgsl",
     ],
     [
         "common/alpha_none.wgsl",
@@ -30,6 +32,7 @@ const FEATURE_SETS: &[[&str; 8]] = &[
         "common/env_constant.wgsl",
         "common/texcoords.wgsl",
         "common/attributes_none.wgsl",
+        "common/transmission.wgsl",
     ],
     [
         "common/alpha_mask.wgsl",
@@ -40,6 +43,7 @@ const FEATURE_SETS: &[[&str; 8]] = &[
         "common/env_none.wgsl",
         "common/texcoords_none.wgsl",
         "common/attributes.wgsl",
+        "common/transmission_none.wgsl",
     ],
 ];
 
@@ -60,6 +64,7 @@ fn all_programs() -> Vec<Program> {
                 set[0],
                 set[6],
                 set[7],
+                set[8],
                 "realtime/frame.wgsl",
                 motion,
                 "realtime/gbuffer.wgsl",
