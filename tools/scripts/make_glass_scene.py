@@ -1,19 +1,21 @@
-"""Write the glass oracle scene, tests/oracle/cornell_glass, and render its Mitsuba reference.
+"""Write the glass parity scene, tests/mitsuba/cornell_glass, and render its Mitsuba reference.
 
 The scene is cornell_mirror's geometry with its two objects turned to glass under the oracle
 contract's material (d) (shared/oracle/README.md): the sphere a smooth dielectric, the block a
 rough one (GGX roughness 0.3), both ior 1.5, closed, double-sided, without attenuation. Paths get
 8 segments (the other scenes have 6) so that light crosses both glass surfaces and still reaches
-a wall. The reference and an independent peer (another seed) are rendered by mitsuba_time.py,
-the same converter `hush-cli bench --mitsuba` uses.
+a wall. The reference and an independent peer (another seed, written to the system's temp
+folder: it measures the reference's own noise and is not committed) are rendered by
+mitsuba_time.py, the same converter `hush-cli bench --mitsuba` uses. The oracle scenes in
+tests/oracle are copies of ../shared/oracle; this one is Hush's own, so it lives apart.
 
 Usage (from the repository root): python3 tools/scripts/make_glass_scene.py [--spp 4096]
 """
-import argparse, json, os, shutil, subprocess, sys
+import argparse, json, os, shutil, subprocess, sys, tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SRC = os.path.join(ROOT, "tests", "oracle", "cornell_mirror")
-DST = os.path.join(ROOT, "tests", "oracle", "cornell_glass")
+DST = os.path.join(ROOT, "tests", "mitsuba", "cornell_glass")
 
 
 def glass(name, roughness):
@@ -62,9 +64,11 @@ def main():
         return
     script = os.path.join(ROOT, "tools", "scripts", "mitsuba_time.py")
     info = {}
-    for file, spp, seed in (("reference.exr", a.spp, 0), ("peer.exr", a.peer_spp, 1)):
+    peer = os.path.join(tempfile.gettempdir(), "cornell_glass_peer.exr")
+    for file, path, spp, seed in (("reference.exr", os.path.join(DST, "reference.exr"), a.spp, 0),
+                                  ("peer.exr", peer, a.peer_spp, 1)):
         out = subprocess.run([sys.executable, script, gltf, "--width", "256", "--height", "256",
-                              "--spp", str(spp), "--seed", str(seed), "--out", os.path.join(DST, file)],
+                              "--spp", str(spp), "--seed", str(seed), "--out", path],
                              check=True, capture_output=True, text=True).stdout
         r = json.loads(out.strip().splitlines()[-1])
         info[file] = {"scene": "cornell_glass", "spp": spp, "seed": seed, "seconds": round(r["seconds"], 2),
