@@ -201,6 +201,7 @@ fn unusable_input_is_a_clear_error() {
             max_depth: 6,
             seed: 0,
             shutter_camera: None,
+            texture_lod: true,
         };
         let e = ReferenceTracer::new(&gpu, &prepared, &gs, &view)
             .err()

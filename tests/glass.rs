@@ -96,7 +96,9 @@ fn absorption_follows_beer_lambert_through_the_centre() {
         centre.iter().map(|&(x, y)| img.at(x, y).element_sum() as f64 / 3.0).sum::<f64>() / 4.0
     };
     let (got, got_rt) = (mean(&acc.mean), mean(&rt));
-    println!("absorbing glass, centre: closed form {want:.4}, reference {got:.4}, real-time {got_rt:.4}");
+    println!(
+        "absorbing glass, centre: closed form {want:.4}, reference {got:.4}, real-time {got_rt:.4}"
+    );
     // The centre pixels' rays pass within 1.5 degrees of the axis: their chords are shorter
     // than the diameter by under 0.3%. A sample's standard deviation is 0.17 (measured at 16384
     // spp, where the four pixels average 0.5109): the mean's standard error is 0.25% of it
@@ -155,5 +157,7 @@ fn glass_costs_nothing_where_absent_and_round_trips() {
     assert_eq!((a.transmission, a.ior, a.thickness), (1.0, 1.5, 0.5));
     assert_eq!((b.transmission, b.ior, b.thickness), (a.transmission, a.ior, a.thickness));
     assert_eq!((b.attenuation_color, b.attenuation_distance), (a.attenuation_color, 3.0));
-    assert!((a.absorption() - Vec3::new(0.9f32.ln(), 0.5f32.ln(), 0.25f32.ln()) / -3.0).length() < 1e-6);
+    assert!(
+        (a.absorption() - Vec3::new(0.9f32.ln(), 0.5f32.ln(), 0.25f32.ln()) / -3.0).length() < 1e-6
+    );
 }

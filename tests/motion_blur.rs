@@ -29,7 +29,15 @@ fn camera_at(s: f64) -> Camera {
 }
 
 fn view(camera: Camera, shutter_camera: Option<Camera>, seed: u32) -> TraceView {
-    TraceView { camera, width: SIZE.0, height: SIZE.1, max_depth: MAX_DEPTH, seed, shutter_camera }
+    TraceView {
+        camera,
+        width: SIZE.0,
+        height: SIZE.1,
+        max_depth: MAX_DEPTH,
+        seed,
+        shutter_camera,
+        texture_lod: true,
+    }
 }
 
 /// The reference tracer over the whole shutter, `spp` samples per pixel.

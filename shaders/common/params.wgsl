@@ -33,6 +33,8 @@ struct Params {
     cam_open_fwd: vec4f,
     // x: 1 where each path sees the scene at a random time in the shutter, 0: all at the close.
     shutter: vec4f,
+    // x: 1 where ray cones choose texture mip levels after the primary hit, 0: the finest.
+    texture_lod: vec4f,
 }
 
 var<uniform> params: Params;

@@ -43,11 +43,19 @@ struct PathStart {
     // Probability with which the vertex that chose rd picked the light group its own next-event
     // estimate sampled (the MIS weight of an emitter hit by rd needs it).
     nee_select: f32,
+    // The ray cone (common/scene.wgsl, cone_lod): its width at ro and its spread angle.
+    cone: vec2f,
+}
+
+// The angle between neighbouring pixels' rays at the image centre: a camera ray's cone spread
+// (Akenine-Moller et al. 2019, eq. (20.30)).
+fn pixel_spread() -> f32 {
+    return 2.0 * length(params.cam_up.xyz) / (length(params.cam_fwd.xyz) * f32(params.height));
 }
 
 // A camera ray: nothing to weigh against.
 fn camera_path(ro: vec3f, rd: vec3f) -> PathStart {
-    return PathStart(ro, rd, vec3f(1.0), 1, 0.0, true, 1.0);
+    return PathStart(ro, rd, vec3f(1.0), 1, 0.0, true, 1.0, vec2f(0.0, pixel_spread()));
 }
 
 // What a path contributes and where its first segment ended (INF for a miss).
@@ -79,10 +87,15 @@ struct PathState {
     first_reflectance: vec3f,
     first_normal: vec3f,
     done: bool,
+    cone: vec2f,
+    // The square of the index ratios crossed so far (Mitsuba's eta^2): Russian roulette weighs
+    // the throughput by it, so that refraction's radiance scaling 1 / eta^2 does not end paths
+    // inside glass that will regain it on the way out.
+    eta2: f32,
 }
 
 fn path_begin(start: PathStart) -> PathState {
-    return PathState(start.ro, start.rd, start.beta, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false);
+    return PathState(start.ro, start.rd, start.beta, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false, start.cone, 1.0);
 }
 
 fn path_result(st: PathState) -> PathResult {
@@ -131,8 +144,15 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
         }
         return;
     }
-    let s = surface_at(hit, rd);
+    var s = surface_at(hit, rd);
     let m = material(s.material);
+    // The cone's width where it meets the surface; after the primary hit its footprint picks
+    // the mip level of every texture read.
+    let cone_width = (*st).cone.x + (*st).cone.y * hit.t;
+    if HAS_TEXTURES && segments > 1 && params.texture_lod.x > 0.0 {
+        s.tc.lod = cone_lod(hit.tri, cone_width, dot(s.ng, rd));
+        s.tc.xi = f32(pcg_hash(bitcast<u32>(hit.b.x) ^ pcg_hash(bitcast<u32>(hit.t)))) * (1.0 / 4294967296.0);
+    }
     // The back of a single-sided surface is a black absorber, as in Mitsuba.
     if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         return;
@@ -203,9 +223,12 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
         return;
     }
     var next_beta = beta * bs.weight;
+    if through && !bsdf.thin {
+        (*st).eta2 *= bsdf.eta * bsdf.eta;
+    }
     // Russian roulette from the fifth segment on, as Mitsuba (unbiased).
     if segments + 1 > params.rr_depth {
-        let q = min(max3(next_beta), 0.95);
+        let q = min(max3(next_beta) * (*st).eta2, 0.95);
         if rand(rng) >= q {
             return;
         }
@@ -217,6 +240,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     (*st).prev_select = select_p;
     (*st).ro = select(origin, origin_through, through);
     (*st).rd = normalize(wi);
+    (*st).cone = vec2f(cone_width, cone_spread_after((*st).cone.y, bs.pdf));
     (*st).segments = segments + 1;
     (*st).done = false;
 }

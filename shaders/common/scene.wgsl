@@ -52,21 +52,56 @@ fn tri_uv(slot: u32, b: vec2f) -> vec2f {
 
 // The vertex attributes a material reads at a surface point: TEXCOORD_0, TEXCOORD_1 and COLOR_0
 // (common/attributes.wgsl, or TEXCOORD_0 and white in a scene without the other two).
+// lod and xi choose the mip level of every texture read there (common/textures.wgsl): a ray
+// cone's footprint after the primary hit (cone_lod), the finest level before it.
 struct TexCoords {
     uv0: vec2f,
     uv1: vec2f,
     color: vec4f,
+    lod: f32,
+    xi: f32,
 }
 
+const FINEST_LOD: f32 = -1e30;
+
 fn tri_tex_coords(slot: u32, b: vec2f) -> TexCoords {
-    return TexCoords(tri_uv(slot, b), tri_uv1(slot, b), tri_color(slot, b));
+    return TexCoords(tri_uv(slot, b), tri_uv1(slot, b), tri_color(slot, b), FINEST_LOD, 0.0);
+}
+
+// Ray cones (Akenine-Moller et al. 2019, "Texture Level of Detail Strategies for Real-Time Ray
+// Tracing", §20.3.4, eq. (20.39)): a cone of width w meeting triangle slot at cos_i covers a
+// footprint whose side in TEXCOORD_0 units is w / |cos_i| x sqrt(uv area / world area);
+// returned as its log2 (textures add log2 of their size in texels). A TEXCOORD_1 read or a
+// KHR_texture_transform's scale uses the same footprint.
+fn cone_lod(slot: u32, width: f32, cos_i: f32) -> f32 {
+    let v0 = tri_vertex(slot * 3u);
+    let world = length(cross(tri_vertex(slot * 3u + 1u) - v0, tri_vertex(slot * 3u + 2u) - v0));
+    let s0 = shading_at(slot * 4u).w;
+    let s1 = shading_at(slot * 4u + 1u).w;
+    let s2 = shading_at(slot * 4u + 2u).w;
+    let t = shading_at(slot * 4u + 3u).xyz;
+    let a = vec2f(s1 - s0, t.y - t.x);
+    let b = vec2f(s2 - s0, t.z - t.x);
+    let uv_area = abs(a.x * b.y - a.y * b.x);
+    return 0.5 * log2(max(uv_area, 1e-30) / max(world, 1e-30)) + log2(max(width, 1e-30) / max(abs(cos_i), 1e-3));
+}
+
+// A cone's spread after scattering into a direction of solid-angle pdf `pdf`: the sample
+// stands for about 1 / pdf steradians, a cone of apex angle 2 sqrt(1 / (pi pdf)) (the
+// footprint a path differential gives a sampled direction, Suykens & Willems 2001), capped at
+// one radian; a delta direction (pdf 0 here) keeps the spread it had.
+fn cone_spread_after(spread: f32, pdf: f32) -> f32 {
+    if pdf <= 0.0 {
+        return spread;
+    }
+    return spread + min(2.0 * sqrt(1.0 / (PI * pdf)), 1.0);
 }
 
 // Texture slot k of material m (0 base colour, 1 metallic-roughness, 2 normal, 3 emissive; the
 // slot must hold a texture), read at the coordinates its texture info names
 // (common/texcoords.wgsl: TEXCOORD set and KHR_texture_transform).
 fn material_texture(m: Material, k: u32, t: TexCoords) -> vec4f {
-    return tex_sample(u32(m.tex[k]), texture_uv(m, k, t));
+    return tex_sample(u32(m.tex[k]), texture_uv(m, k, t), t.lod, t.xi);
 }
 
 fn tri_normal(slot: u32, b: vec2f) -> vec3f {

@@ -1,7 +1,7 @@
 // All textures in one array of words: four u32 of header per texture (texel offset, width,
 // height, flags: bit 0 sRGB, bits 1-2 wrap S, bits 3-4 wrap T with 0 repeat, 1 clamp, 2 mirror,
-// bit 5 nearest),
-// then RGBA8 texels. One binding serves any number of textures on every backend. The words are
+// bit 5 nearest, bits 6-10 the number of mip levels below the base),
+// then RGBA8 texels, the base level's followed by each mip level's (engine/src/gpu/pack.rs). One binding serves any number of textures on every backend. The words are
 // read four to a texel of a texel-row texture (see tri_texels in geometry.wgsl).
 var tex_words: texture_2d<u32>;
 
@@ -42,13 +42,38 @@ fn texel(off: u32, w: u32, x: u32, y: u32, srgb: bool) -> vec4f {
     return select(c, vec4f(srgb_decode(c.rgb), c.a), srgb);
 }
 
-// Bilinear (nearest where the sampler says so), without mip-maps: the reference tracer's many
-// samples per pixel filter minification.
-fn tex_sample(index: u32, uv_in: vec2f) -> vec4f {
-    let off = tex_word(index * 4u);
-    let w = tex_word(index * 4u + 1u);
-    let h = tex_word(index * 4u + 2u);
+const HAS_TEXTURES: bool = true;
+
+// Mip level l: its texel offset, width and height (each level half the one above, at least one
+// texel a side).
+fn tex_level(off: u32, w: u32, h: u32, l: u32) -> vec3u {
+    var r = vec3u(off, w, h);
+    for (var k = 0u; k < l; k++) {
+        r = vec3u(r.x + r.y * r.z, max(r.y >> 1u, 1u), max(r.z >> 1u, 1u));
+    }
+    return r;
+}
+
+// Bilinear (nearest where the sampler says so) in the mip level a footprint calls for. lod:
+// log2 of the footprint's side in texture coordinates (TexCoords.lod; very negative at a primary
+// hit, whose minification the pixel's samples filter). The level is log2 of the side in texels,
+// chosen between the two levels around it with probability by xi, so one bilinear lookup has
+// trilinear filtering's mean.
+fn tex_sample(index: u32, uv_in: vec2f, lod: f32, xi: f32) -> vec4f {
+    let off0 = tex_word(index * 4u);
+    let w0 = tex_word(index * 4u + 1u);
+    let h0 = tex_word(index * 4u + 2u);
     let flags = tex_word(index * 4u + 3u);
+    let texels = lod + 0.5 * log2(f32(w0) * f32(h0));
+    var level = 0u;
+    if texels > 0.0 {
+        let fl = floor(texels);
+        level = u32(min(fl + select(0.0, 1.0, xi < texels - fl), f32((flags >> 6u) & 31u)));
+    }
+    let lv = tex_level(off0, w0, h0, level);
+    let off = lv.x;
+    let w = lv.y;
+    let h = lv.z;
     let srgb = (flags & 1u) != 0u;
     var uv = uv_in;
     if !all(abs(uv) < vec2f(1e6)) {

@@ -83,6 +83,8 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
     let has_matte = max3(bsdf.albedo) > 0.0;
     let has_glossy = HAS_GLOSSY && max3(f_s) > 0.0;
     let mirror = reflect(rd, s.ns);
+    // The camera ray's cone where it meets the surface (secondary hits filter their textures).
+    let cone_width = pixel_spread() * hit.t;
     var matte = vec3f(0.0);
     var glossy = vec3f(0.0);
     var direct = vec3f(0.0);
@@ -137,7 +139,8 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
             let wl = cosine_hemisphere(rand2(rng));
             let wi = basis * wl;
             if dot(wi, s.ng) > 0.0 {
-                let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select), rng);
+                let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), wl.z * INV_PI));
+                let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone), rng);
                 matte += r.radiance;
             }
         } else {
@@ -151,7 +154,7 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
             if bsdf.delta {
                 // A mirror: F(h) = F(w_s) exactly, so the demodulated weight is 1.
                 wl = vec3f(-wo.xy, wo.z);
-                start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select);
+                start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select, vec2f(cone_width, pixel_spread()));
             } else {
                 wl = reflect(-wo, sample_vndf(bsdf.alpha, wo, rand2(rng)));
                 let g = glossy_eval(bsdf, wo, wl);
@@ -159,7 +162,8 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
                 if g.pdf > 0.0 {
                     weight = g.f_cos / (g.pdf * f_s);
                 }
-                start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select);
+                let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), g.pdf));
+                start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select, cone);
             }
             if wl.z > 0.0 && dot(start.rd, s.ng) > 0.0 && max3(start.beta) > 0.0 {
                 let r = trace_path(start, rng);

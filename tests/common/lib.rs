@@ -25,6 +25,12 @@ pub fn oracle(scene: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("oracle").join(scene)
 }
 
+/// A scene of Hush's own with a Mitsuba reference (`tests/mitsuba`, written and rendered by
+/// `tools/scripts/make_*_scene.py` under the oracle's conventions).
+pub fn mitsuba_scene(scene: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("mitsuba").join(scene)
+}
+
 /// Render `scene` with the reference tracer: `spp` samples per pixel at `w` x `h`.
 pub fn render(scene: &Scene, w: u32, h: u32, spp: u32, seed: u32) -> Result<Accumulation> {
     render_with(scene, w, h, spp, seed, BvhKind::DEFAULT)
@@ -38,6 +44,18 @@ pub fn render_with(
     seed: u32,
     kind: BvhKind,
 ) -> Result<Accumulation> {
+    render_lod(scene, (w, h), spp, seed, kind, true)
+}
+
+/// [`render_with`], with ray cones choosing texture mip levels after the primary hit or not.
+pub fn render_lod(
+    scene: &Scene,
+    (w, h): (u32, u32),
+    spp: u32,
+    seed: u32,
+    kind: BvhKind,
+    texture_lod: bool,
+) -> Result<Accumulation> {
     let prepared = PreparedScene::new(scene, kind)?;
     let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
@@ -48,6 +66,7 @@ pub fn render_with(
         max_depth: scene.max_depth,
         seed,
         shutter_camera: None,
+        texture_lod,
     };
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     let mut done = 0;

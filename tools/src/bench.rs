@@ -200,6 +200,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
             max_depth: scene.max_depth,
             seed: 0,
             shutter_camera: None,
+            texture_lod: true,
         };
         let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
         tracer.dispatch(&gpu, 1);

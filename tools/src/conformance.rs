@@ -102,6 +102,7 @@ fn reference(scene: &Scene, a: &ConformanceArgs) -> Result<Image> {
         max_depth: scene.max_depth,
         seed: 0,
         shutter_camera: None,
+        texture_lod: true,
     };
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     tracer.dispatch(&gpu, a.spp.max(1));

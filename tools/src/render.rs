@@ -184,6 +184,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         max_depth: a.max_depth.unwrap_or(scene.max_depth),
         seed: a.seed,
         shutter_camera: None,
+        texture_lod: true,
     };
     let mut prepared = PreparedScene::new(&scene, kind)?;
     let time = a.time.unwrap_or(0.0);

@@ -285,6 +285,7 @@ impl Renderer {
             max_depth: settings.max_depth,
             seed: settings.seed,
             shutter_camera: input.shutter.map(|s| s.camera),
+            texture_lod: settings.texture_lod,
         };
         let tp = make_params(&self.prepared, &trace_view);
         gpu.queue.write_buffer(&self.uniforms.params, 0, bytemuck::bytes_of(&tp));

@@ -1,7 +1,7 @@
 //! Packing lights, the environment map's sampling tables and textures into the layouts the
 //! shaders read (`shaders/common/lights.wgsl`, `env_map.wgsl`, `textures.wgsl`).
 
-use crate::scene::{Light, Scene, Wrap};
+use crate::scene::{Light, Scene, Wrap, mip_chain_texels};
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3};
 
@@ -103,12 +103,17 @@ impl EnvPack {
 /// offers. Over that budget the largest textures are halved until the set fits.
 pub const TEXTURE_BUDGET_BYTES: usize = 128 << 20;
 
+/// Bits of a texture header's flags word (shaders/common/textures.wgsl) from which the number
+/// of mip levels below the base is stored; the levels follow the base level's texels.
+pub const TEX_MIPS_SHIFT: u32 = 6;
+
 pub(super) fn pack_textures(scene: &Scene) -> Vec<u32> {
     let n = scene.textures.len();
     let mut textures: Vec<std::borrow::Cow<crate::scene::Texture>> =
         scene.textures.iter().map(std::borrow::Cow::Borrowed).collect();
+    // Each texture with its mip chain (a third more).
     let bytes = |t: &[std::borrow::Cow<crate::scene::Texture>]| {
-        n * 16 + t.iter().map(|t| t.rgba8.len()).sum::<usize>()
+        n * 16 + t.iter().map(|t| mip_chain_texels(t.width, t.height) * 4).sum::<usize>()
     };
     let before = bytes(&textures);
     while bytes(&textures) > TEXTURE_BUDGET_BYTES {
@@ -139,11 +144,21 @@ pub(super) fn pack_textures(scene: &Scene) -> Vec<u32> {
         data[i * 4] = data.len() as u32;
         data[i * 4 + 1] = t.width;
         data[i * 4 + 2] = t.height;
+        let mips = t.mips();
         data[i * 4 + 3] = (t.srgb as u32)
             | (wrap(t.wrap_s) << 1)
             | (wrap(t.wrap_t) << 3)
-            | ((t.nearest as u32) << 5);
-        data.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
+            | ((t.nearest as u32) << 5)
+            | ((mips.len() as u32) << TEX_MIPS_SHIFT);
+        let words = |b: &[u8]| {
+            b.chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect::<Vec<_>>()
+        };
+        data.extend(words(&t.rgba8));
+        for (_, _, level) in &mips {
+            data.extend(words(level));
+        }
     }
     data
 }
@@ -179,7 +194,7 @@ mod tests {
         // The large one was halved, the small one kept; headers point at the texels.
         assert_eq!((data[1], data[2]), (side / 2, side / 2));
         assert_eq!((data[5], data[6]), (4, 2));
-        assert_eq!(data[4] as usize, 8 + (side / 2 * side / 2) as usize);
+        assert_eq!(data[4] as usize, 8 + mip_chain_texels(side / 2, side / 2));
         assert_eq!(data[data[4] as usize], u32::from_le_bytes([7; 4]));
     }
 }

@@ -78,8 +78,7 @@ impl From<&crate::scene::Material> for GpuMaterial {
             alpha_cutoff: cutoff,
             normal_scale: m.normal_scale,
             // An interface between two media has two sides, whatever doubleSided says.
-            flags: mask
-                | if m.double_sided || m.transmission > 0.0 { MAT_DOUBLE_SIDED } else { 0 },
+            flags: mask | if m.double_sided || m.transmission > 0.0 { MAT_DOUBLE_SIDED } else { 0 },
             tex: [
                 t(m.base_color_texture),
                 t(m.metallic_roughness_texture),
@@ -387,8 +386,7 @@ impl PreparedScene {
         let tex_data = pack_textures(scene);
         features.env = env_kind;
         let tex_uses = if texture_uses { pack_texture_uses(&scene.materials) } else { vec![] };
-        let glass =
-            if features.transmission { pack_glass(&scene.materials) } else { vec![] };
+        let glass = if features.transmission { pack_glass(&scene.materials) } else { vec![] };
         let mut p = PreparedScene {
             features,
             accel: Accel::empty(kind),

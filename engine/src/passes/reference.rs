@@ -43,6 +43,8 @@ pub struct TraceParams {
     /// x: 1 where the shutter is open for a while (each path a random time in it), 0 for an
     /// instant exposure (every ray at the close).
     pub shutter: [f32; 4],
+    /// x: 1 where ray cones choose texture mip levels after the primary hit, 0: the finest.
+    pub texture_lod: [f32; 4],
 }
 
 /// What to render: the camera, image size and path settings.
@@ -57,6 +59,9 @@ pub struct TraceView {
     /// Motion blur: the camera at the shutter's open (`camera` is at its close); objects move
     /// as [`PreparedScene::expose`] set them up.
     pub shutter_camera: Option<Camera>,
+    /// Ray cones choose texture mip levels after the primary hit
+    /// ([`crate::settings::FrameSettings::texture_lod`]).
+    pub texture_lod: bool,
 }
 
 /// Russian roulette starts after this many segments (Mitsuba's rr_depth).
@@ -260,6 +265,7 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
         cam_open_up: open.2.extend(0.0).to_array(),
         cam_open_fwd: open.3.extend(0.0).to_array(),
         shutter: [moving as u32 as f32, 0.0, 0.0, 0.0],
+        texture_lod: [view.texture_lod as u32 as f32, 0.0, 0.0, 0.0],
     }
 }
 

@@ -34,7 +34,7 @@ pub use gltf_import::{
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
 pub use terrain::{MAX_TERRAIN_TRIANGLES, terrain};
-pub use texture::{Texture, TextureRef, Wrap, decode_image};
+pub use texture::{Texture, TextureRef, Wrap, decode_image, mip_chain_texels};
 
 use anyhow::Result;
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};

@@ -91,6 +91,13 @@ const FRAME_FIELDS: &[Field] = &[
         "With a thin lens: Moon et al. 2017's pre-filter of the traced G-buffer (world-position weights, bandwidth by SURE).",
     ),
     f(
+        "texture_lod",
+        "trace",
+        "texture mips",
+        Bool,
+        "Ray cones choose each texture's mip level after the primary hit: an indirect ray reads the mean of its footprint, not one texel (less noise, same converged image).",
+    ),
+    f(
         "sample_fraction",
         "trace",
         "",
