@@ -382,9 +382,11 @@ fn camera_stop_recovers_like_a_fresh_start() {
 /// after 10 frames at the end view, over the same pixels. Glossy histories resampled while
 /// moving carry the reflections of the way there; counted as at most 8 frames they still
 /// weighed 8 / 18 ten frames after the stop (GlossySettings::resampled_history_frames).
-/// Measured at 96x54 over 144 pixels: a fresh start 0.1282; the stop 0.1345 with the glossy
-/// cap at 1 frame (the default), 0.1354 at 2, 0.1562 at 8, 0.1736 uncapped. The bound leaves
-/// 5% for a different driver's rounding and fails at 8 frames. The margin is thin: TAA's
+/// Measured at 96x54 over 144 pixels: a fresh start 0.1254; the stop 0.1326 with the glossy
+/// cap at 1 frame (the default, 1.06x), 0.1336 at 2, 0.1552 at 8 (1.24x). Before ray cones
+/// filtered the level's textures at secondary hits (FrameSettings::texture_lod), 0.1282 and
+/// 0.1345, 0.1354, 0.1562, 0.1736 uncapped: the cones helped a fresh start more than the stop.
+/// The bound, 1.1x, leaves 4% for a different driver's rounding and fails at 8 frames. TAA's
 /// following of the glossy light (TaaSettings::current_glossy) shows the glossy
 /// temporal's running mean, in which the history blurred while moving still weighs 1 / 11 ten
 /// frames after the stop, where TAA's own average lets a restarted history fade as 1 / n²;
@@ -448,7 +450,7 @@ fn disoccluded_region_recovers_like_a_fresh_start() {
         "the move uncovered too little to measure"
     );
     assert!(
-        after <= 1.05 * fresh,
+        after <= 1.1 * fresh,
         "10 frames after the stop the uncovered region's FLIP is {after}, a fresh start's {fresh}"
     );
 }
