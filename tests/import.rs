@@ -53,11 +53,7 @@ fn bitterli_scenes_load_with_their_extras() {
     // Its windows are Mitsuba's dielectric: glass, read without a warning.
     let glass = lr.materials.iter().find(|m| m.name == "Glass").expect("the Glass material");
     assert_eq!((glass.transmission, glass.ior, glass.thickness), (1.0, 1.5, 0.01));
-    assert!(
-        !lr.warnings.iter().any(|w| w.contains("KHR_materials")),
-        "{:?}",
-        lr.warnings
-    );
+    assert!(!lr.warnings.iter().any(|w| w.contains("KHR_materials")), "{:?}", lr.warnings);
     assert!(lr.camera.is_some());
     let st = load_gltf_with(&shared().join("scenes/staircase/staircase.gltf"), 16).unwrap();
     assert_eq!(st.resolution, Some((720, 1280)));

@@ -20,7 +20,7 @@ const SIDE: u32 = 256;
 fn scene() -> Scene {
     let rgba8 = (0..SIDE * SIDE)
         .flat_map(|i| {
-            let v = if ((i % SIDE) / 4 + i / SIDE / 4) % 2 == 0 { 255 } else { 0 };
+            let v = if ((i % SIDE) / 4 + i / SIDE / 4).is_multiple_of(2) { 255 } else { 0 };
             [v, v, v, 255]
         })
         .collect();
