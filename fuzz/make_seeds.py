@@ -110,6 +110,15 @@ d['meshes'][0]['primitives'][0]['attributes'].update({"TEXCOORD_1": 2, "COLOR_0"
 m = d['materials'][0]; m.update({"alphaMode": "BLEND", "extensions": {"KHR_materials_ior": {"ior": 1.33}}})
 m['pbrMetallicRoughness']['baseColorTexture'] = {"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "rotation": 0.3, "scale": [2, 2], "texCoord": 1}}}
 scenes['ok-texcoords'] = pack(d, {**F, "c.png": PNG})
+# Glass: KHR_materials_transmission + KHR_materials_volume on the quad, and a second material
+# whose values are all out of range (clamped, with warnings).
+d = doc(extensionsUsed=["KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_ior"])
+d['materials'][0]['extensions'] = {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.33},
+                                   "KHR_materials_volume": {"thicknessFactor": 0.5, "attenuationColor": [0.9, 0.5, 0.2], "attenuationDistance": 2.0}}
+d['materials'].append({"extensions": {"KHR_materials_transmission": {"transmissionFactor": 7, "transmissionTexture": {"index": 9}},
+                                      "KHR_materials_volume": {"thicknessFactor": -1, "attenuationColor": [2, "x"], "attenuationDistance": -1}}})
+d['meshes'][0]['primitives'].append({"attributes": {"POSITION": 0}, "material": 1})
+scenes['ok-glass'] = pack(d, F)
 # KHR_mesh_quantization: the quad's positions as SHORT (padded to 8 bytes), normals as normalized BYTE.
 QQ = b''.join(struct.pack('<4h', x, y, z, 0) for x, y, z in [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)]) + struct.pack('<4b', 0, 127, 0, 0) * 4
 d = doc(extensionsUsed=["KHR_mesh_quantization"], extensionsRequired=["KHR_mesh_quantization"])
