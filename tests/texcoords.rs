@@ -256,3 +256,66 @@ fn vertex_colours_multiply_the_base_colour_in_both_modes() {
         assert!(worst_gb < 0.5 / W as f32 + 8e-3, "{name}: G-buffer {worst_gb}");
     }
 }
+
+/// A normal map read through KHR_texture_transform tilts the normal along the transformed
+/// coordinates: the G-buffer's normals equal those of the same quad with the transform baked
+/// into TEXCOORD_0 (whose tangents the importer derives from the baked coordinates), and differ
+/// from the normal map read untransformed. The map is the tiles' texture (every texel a
+/// different colour, so a different tilt).
+#[test]
+fn transformed_normal_maps_turn_their_tangent_frame() {
+    let lambert = |info: Value| {
+        json!({
+            "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
+            "normalTexture": info,
+        })
+    };
+    let baked = quad_file(
+        "normals-baked",
+        |g| vec![("TEXCOORD_0", g.floats(&uvs(transformed), "VEC2"))],
+        lambert(json!({"index": 0})),
+        2,
+    );
+    let transform = quad_file(
+        "normals-transform",
+        |g| vec![("TEXCOORD_0", g.floats(&uvs(|uv| uv), "VEC2"))],
+        lambert(json!({"index": 0, "extensions": khr(json!({}))})),
+        2,
+    );
+    let normals = |scene: &Scene| -> Vec<Vec3> {
+        let (gpu, r) =
+            hush_tests::realtime_renderer(scene, (W, H), &Default::default(), 1).unwrap();
+        let (bytes, _) = r.read_texture(&gpu, "gbuffer/normal").unwrap();
+        (0..(W * H) as usize).map(|i| hush_tests::oct_normal(&bytes[i * 4..])).collect()
+    };
+    let (want, got) = (normals(&baked), normals(&transform));
+    // The same texels read without the transform's rotation of the frame.
+    let unturned: Vec<Vec3> = {
+        let mut s = transform.clone();
+        let t = s.materials[0].normal_texture.as_mut().unwrap();
+        let uv_only = t.transform;
+        t.transform = glam::Affine2::IDENTITY;
+        // Keep the coordinates: bake them into the mesh's TEXCOORD_0 instead.
+        for uv in &mut s.meshes[0].uvs {
+            *uv = uv_only.transform_point2(*uv);
+        }
+        s.meshes[0].tangents = transform.meshes[0].tangents.clone();
+        normals(&s)
+    };
+    let worst = |a: &[Vec3]| {
+        a.iter().zip(&want).map(|(x, y)| x.angle_between(*y).to_degrees()).fold(0f32, f32::max)
+    };
+    let (turned, plain) = (worst(&got), worst(&unturned));
+    let tilt = want.iter().map(|n| n.angle_between(Vec3::Z).to_degrees()).fold(0f32, f32::max);
+    println!(
+        "normal maps: worst angle to the baked quad's normals {turned:.3} degrees with the frame turned, {plain:.2} without (tilts up to {tilt:.1})"
+    );
+    // Oct-encoded snorm16 normals: 0.01 degrees; a jittered sample may fall on the
+    // neighbouring texel at a texel border in one image and not the other, so compare the
+    // bulk: at most 10% of pixels beyond 0.5 degrees.
+    let far = |a: &[Vec3]| {
+        a.iter().zip(&want).filter(|(x, y)| x.angle_between(**y).to_degrees() > 0.5).count()
+    };
+    assert!(far(&got) * 10 <= want.len(), "{} of {} pixels turned wrong", far(&got), want.len());
+    assert!(far(&unturned) * 2 > want.len(), "the check compares something: {plain}");
+}

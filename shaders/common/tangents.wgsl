@@ -15,7 +15,8 @@ fn apply_normal_map(slot: u32, b: vec2f, ns: vec3f, tc: TexCoords, m: Material) 
     let tn = normalize(t);
     let bn = cross(ns, tn) * select(1.0, -1.0, t4.w < 0.0);
     var c = material_texture(m, 2u, tc).xyz * 2.0 - 1.0;
-    c = vec3f(c.xy * m.normal_scale, c.z);
+    // Under KHR_texture_transform the map's x and y run along the transformed coordinates.
+    c = vec3f(texture_frame(m, 2u, c.xy * m.normal_scale), c.z);
     let n = tn * c.x + bn * c.y + ns * c.z;
     let len = length(n);
     return select(ns, n / len, len > 1e-12 && len < 1e30);
