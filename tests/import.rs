@@ -205,3 +205,61 @@ fn index_of_refraction_sets_the_reflectance() {
         assert!((g_f0 - f0).abs() <= 1.0 / 255.0, "ior {ior}: G-buffer F0 {g_f0} vs {f0}");
     }
 }
+
+/// A CUBICSPLINE translation channel moves its node along glTF 2.0 Appendix C's Hermite
+/// spline (not linearly between the keys), without a warning; Hush's export writes it back as
+/// CUBICSPLINE and the re-import moves the same way.
+#[test]
+fn cubic_spline_channels_follow_their_tangents_and_round_trip() {
+    let mut g = GltfWriter::default();
+    let m = g.lambert([0.5, 0.5, 0.5]);
+    let mesh = g.mesh(Prim {
+        positions: &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        normals: None,
+        indices: None,
+        material: m,
+    });
+    let node = g.node(json!({"mesh": mesh}));
+    g.camera([0.0, 0.0, 5.0], [0.0, 0.0, 0.0], 0.8);
+    let times = g.floats(&[0.0, 2.0], "SCALAR");
+    // Key 0: in (9, 9, 9), value (0, 0, 0), out (1, 0, 0); key 1: in (0, 3, 0), value (2, 0, 0),
+    // out (9, 9, 9).
+    let out = g.floats(
+        &[9.0, 9.0, 9.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 3.0, 0.0, 2.0, 0.0, 0.0, 9.0, 9.0, 9.0],
+        "VEC3",
+    );
+    let mut j = g.to_json();
+    j["accessors"][times]["min"] = json!([0.0]);
+    j["accessors"][times]["max"] = json!([2.0]);
+    j["animations"] = json!([{
+        "samplers": [{"input": times, "output": out, "interpolation": "CUBICSPLINE"}],
+        "channels": [{"sampler": 0, "target": {"node": node, "path": "translation"}}]
+    }]);
+    let want = |t: f64| {
+        let (s, dt) = (t / 2.0, 2.0);
+        let (p0, b0, p1, a1) = (
+            DVec3::ZERO,
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(0.0, 3.0, 0.0),
+        );
+        p0 * (2.0 * s * s * s - 3.0 * s * s + 1.0)
+            + b0 * dt * (s * s * s - 2.0 * s * s + s)
+            + p1 * (-2.0 * s * s * s + 3.0 * s * s)
+            + a1 * dt * (s * s * s - s * s)
+    };
+    let scene = load_gltf(&hush_tests::gltf_writer::write_json("cubic-spline", &j)).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let dir = hush_tests::gltf_writer::temp_dir("cubic-spline-export");
+    hush_engine::scene::save_gltf(&scene, &dir.join("exported.gltf")).unwrap();
+    let back = load_gltf(&dir.join("exported.gltf")).unwrap();
+    for s in [&scene, &back] {
+        let o = s.objects.iter().find(|o| o.animation.is_some()).expect("an animated object");
+        for t in [0.25, 1.0, 1.5] {
+            let p = o.transform_at(t).transform_point3(DVec3::ZERO);
+            assert!((p - want(t)).length() < 1e-5, "t = {t}: {p} against {}", want(t));
+        }
+    }
+    // At t = 1 the spline stands at (1.25, -0.75, 0): the linear path would be at (1, 0, 0).
+    assert!((want(1.0) - DVec3::new(1.25, -0.75, 0.0)).length() < 1e-12);
+}

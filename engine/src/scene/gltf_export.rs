@@ -70,8 +70,24 @@ impl Writer {
 
     fn track3(&mut self, t: &Track<DVec3>) -> (usize, usize) {
         let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
-        let values: Vec<f32> = t.values.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+        let values: Vec<f32> = keyed(t).iter().flat_map(|v| v.as_vec3().to_array()).collect();
         (self.floats(&times, 1, "SCALAR", None, true), self.floats(&values, 3, "VEC3", None, false))
+    }
+}
+
+/// A sampler's output: the values, or for CUBICSPLINE (in-tangent, value, out-tangent) per key.
+fn keyed<T: Copy>(t: &Track<T>) -> Vec<T> {
+    if t.tangents.len() != t.values.len() {
+        return t.values.clone();
+    }
+    t.values.iter().zip(&t.tangents).flat_map(|(v, [a, b])| [*a, *v, *b]).collect()
+}
+
+fn interpolation<T>(t: &Track<T>) -> &'static str {
+    match (t.step, t.tangents.len() == t.values.len() && !t.values.is_empty()) {
+        (true, _) => "STEP",
+        (false, true) => "CUBICSPLINE",
+        (false, false) => "LINEAR",
     }
 }
 
@@ -206,27 +222,29 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
                 let target = nodes.len();
                 let mut samplers = vec![];
                 let mut channels = vec![];
-                let step = |s: bool| if s { "STEP" } else { "LINEAR" };
                 if let Some(t) = &a.translation_track {
                     let (i, o) = w.track3(t);
                     channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "translation"}}));
-                    samplers.push(json!({"input": i, "output": o, "interpolation": step(t.step)}));
+                    samplers
+                        .push(json!({"input": i, "output": o, "interpolation": interpolation(t)}));
                 }
                 if let Some(t) = &a.scale_track {
                     let (i, o) = w.track3(t);
                     channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "scale"}}));
-                    samplers.push(json!({"input": i, "output": o, "interpolation": step(t.step)}));
+                    samplers
+                        .push(json!({"input": i, "output": o, "interpolation": interpolation(t)}));
                 }
                 if let Some(t) = &a.rotation_track {
                     let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
                     let values: Vec<f32> =
-                        t.values.iter().flat_map(|q| q.as_quat().to_array()).collect();
+                        keyed(t).iter().flat_map(|q| q.as_quat().to_array()).collect();
                     let (i, o) = (
                         w.floats(&times, 1, "SCALAR", None, true),
                         w.floats(&values, 4, "VEC4", None, false),
                     );
                     channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "rotation"}}));
-                    samplers.push(json!({"input": i, "output": o, "interpolation": step(t.step)}));
+                    samplers
+                        .push(json!({"input": i, "output": o, "interpolation": interpolation(t)}));
                 }
                 animations
                     .push(json!({"name": o.name, "samplers": samplers, "channels": channels}));

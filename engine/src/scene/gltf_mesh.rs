@@ -307,10 +307,15 @@ pub(super) fn animations(
                 &format!("{here} output"),
             )?;
             let k = expect.ty.multiplicity();
-            // CUBICSPLINE stores (in-tangent, value, out-tangent) per key: keep the values.
+            // CUBICSPLINE stores (in-tangent, value, out-tangent) per key.
             let per_key = if interp == Interpolation::CubicSpline { 3 } else { 1 };
             let keys: Vec<&[f32]> =
                 values.chunks_exact(k).skip(per_key / 2).step_by(per_key).collect();
+            let tangents: Vec<[&[f32]; 2]> = if per_key == 3 {
+                values.chunks_exact(3 * k).map(|c| [&c[..k], &c[2 * k..]]).collect()
+            } else {
+                vec![]
+            };
             if keys.len() != times.len() || values.len() != times.len() * k * per_key {
                 imp.warn(format!(
                     "{here}: {} keys but {} values; ignored",
@@ -321,12 +326,9 @@ pub(super) fn animations(
             }
             let sorted =
                 times.windows(2).all(|w| w[0] <= w[1]) && times.iter().all(|t| t.is_finite());
-            if !sorted || !keys.iter().all(|v| v.iter().all(|x| x.is_finite())) {
+            if !sorted || !values.iter().all(|x| x.is_finite()) {
                 imp.warn(format!("{here} has unsorted or non-finite keys; ignored"));
                 continue;
-            }
-            if interp == Interpolation::CubicSpline {
-                imp.warn(format!("{here}: CUBICSPLINE is sampled linearly between keys"));
             }
             let (t, r, s) = node.transform().decomposed();
             let a = map.entry(node.index()).or_insert_with(|| Animation {
@@ -339,26 +341,27 @@ pub(super) fn animations(
                 scale_track: None,
             });
             let step = interp == Interpolation::Step;
-            let v3 = || {
-                keys.iter()
-                    .map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
-                    .collect::<Vec<_>>()
-            };
+            let d3 = |v: &[f32]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+            let dq =
+                |v: &[f32]| DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64);
+            let v3 = || keys.iter().map(|v| d3(v)).collect::<Vec<_>>();
+            let t3 = || tangents.iter().map(|[a, b]| [d3(a), d3(b)]).collect::<Vec<_>>();
             match property {
                 Property::Translation => {
-                    a.translation_track = Some(Track { times, values: v3(), step })
+                    a.translation_track = Some(Track { times, values: v3(), step, tangents: t3() })
                 }
-                Property::Scale => a.scale_track = Some(Track { times, values: v3(), step }),
+                Property::Scale => {
+                    a.scale_track = Some(Track { times, values: v3(), step, tangents: t3() })
+                }
                 _ => {
                     let values = keys
                         .iter()
-                        .map(|v| {
-                            DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64)
-                                .normalize()
-                        })
+                        .map(|v| dq(v).normalize())
                         .map(|q| if q.is_finite() { q } else { DQuat::IDENTITY })
                         .collect();
-                    a.rotation_track = Some(Track { times, values, step });
+                    // Tangents are not unit quaternions: kept as they are.
+                    let tangents = tangents.iter().map(|[a, b]| [dq(a), dq(b)]).collect();
+                    a.rotation_track = Some(Track { times, values, step, tangents });
                 }
             }
         }

@@ -203,11 +203,13 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
                 DVec3::new(0.0, 1.3, 0.0),
             ],
             step: false,
+            tangents: vec![],
         }),
         rotation_track: Some(Track {
             times: vec![0.0, 1.0, 2.0, 3.0, 4.0],
             values: turn,
             step: false,
+            tangents: vec![],
         }),
         scale_track: None,
     };

@@ -87,6 +87,7 @@ pub fn reflection_scene(mirror_floor: bool) -> Scene {
                 DVec3::new(-1.5, 0.4, -3.2),
             ],
             step: false,
+            tangents: vec![],
         }),
         rotation_track: None,
         scale_track: None,
