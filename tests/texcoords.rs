@@ -319,3 +319,79 @@ fn transformed_normal_maps_turn_their_tangent_frame() {
     assert!(far(&got) * 10 <= want.len(), "{} of {} pixels turned wrong", far(&got), want.len());
     assert!(far(&unturned) * 2 > want.len(), "the check compares something: {plain}");
 }
+
+/// NormalTangentMirrorTest's point, on a file of our own: two quads mirror images of each other
+/// about x = 0, the right one's TEXCOORD_0 running right to left (a mirrored UV island, which
+/// flips its tangents' handedness), both normal-mapped with the tiles' texture. The G-buffer's
+/// normals must be mirror images too: n(x) = (-n.x, n.y, n.z) at -x. With the handedness
+/// ignored (tangents' w forced to +1) the right half's tilt in y turns the wrong way.
+#[test]
+fn mirrored_uv_islands_mirror_their_normal_maps() {
+    let mut g = GltfWriter::default();
+    g.materials.push(json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
+        "normalTexture": {"index": 0},
+    }));
+    let mesh = g.mesh(Prim {
+        positions: &[
+            [-1.0, -1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ],
+        normals: Some(&[[0.0, 0.0, 1.0]; 8]),
+        indices: Some(&[0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7]),
+        material: 0,
+    });
+    let uv = g.floats(
+        &[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0],
+        "VEC2",
+    );
+    g.meshes[mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+    g.node(json!({"mesh": mesh}));
+    g.camera([0.0, 0.0, 2.0], [0.0, 0.0, 0.0], 2.0 * 0.5f32.atan());
+    g.extras = json!({"max_depth": 2});
+    let mut j = g.to_json();
+    j["images"] = json!([{"uri": texture_uri()}]);
+    j["textures"] = json!([{"source": 0, "sampler": 0}]);
+    j["samplers"] = json!([{"magFilter": 9728}]);
+    let scene = load_gltf(&hush_tests::gltf_writer::write_json("mirrored-uvs", &j)).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let tangents = &scene.meshes[0].tangents;
+    // glTF's v runs down the image: the plain island is left-handed (w = -1), its mirror not.
+    assert!(tangents[..4].iter().all(|t| t.w < 0.0) && tangents[4..].iter().all(|t| t.w > 0.0));
+    // Mirror pairs that disagree by more than 2 degrees (a jittered sample near a texel border
+    // may read the neighbouring texel on one side only: NEAREST keeps that to the borders).
+    let asymmetric = |scene: &Scene| {
+        let (gpu, r) =
+            hush_tests::realtime_renderer(scene, (W, H), &Default::default(), 1).unwrap();
+        let (bytes, _) = r.read_texture(&gpu, "gbuffer/normal").unwrap();
+        let n = |x: u32, y: u32| hush_tests::oct_normal(&bytes[((y * W + x) * 4) as usize..]);
+        let mut bad = 0;
+        for y in 0..H {
+            for x in 0..W / 2 {
+                let (l, r) = (n(x, y), n(W - 1 - x, y));
+                if Vec3::new(-l.x, l.y, l.z).angle_between(r).to_degrees() > 2.0 {
+                    bad += 1;
+                }
+            }
+        }
+        bad
+    };
+    let with = asymmetric(&scene);
+    let mut unsigned = scene.clone();
+    for t in &mut unsigned.meshes[0].tangents {
+        t.w = 1.0;
+    }
+    let without = asymmetric(&unsigned);
+    let pairs = (W * H / 2) as usize;
+    println!(
+        "mirrored UVs: {with} of {pairs} mirror pairs disagree; {without} with the handedness ignored"
+    );
+    assert!(with * 10 <= pairs, "{with} of {pairs} pairs are not mirror images");
+    assert!(without * 2 > pairs, "the check compares something: {without}");
+}
