@@ -395,3 +395,53 @@ fn mirrored_uv_islands_mirror_their_normal_maps() {
     assert!(with * 10 <= pairs, "{with} of {pairs} pairs are not mirror images");
     assert!(without * 2 > pairs, "the check compares something: {without}");
 }
+
+/// Hush's export keeps what these files say: each texture's TEXCOORD set and transform (a
+/// mirrored one too), TEXCOORD_1 and COLOR_0.
+#[test]
+fn export_keeps_texture_transforms_sets_and_vertex_colours() {
+    let mut scenes: Vec<(&str, Scene)> = variants();
+    let colours: Vec<f32> = CORNERS.iter().flat_map(|c| [c[0], c[1], 0.5, 1.0]).collect();
+    scenes.push((
+        "colours and a mirrored transform",
+        quad_file(
+            "export-colours",
+            |g| {
+                vec![
+                    ("COLOR_0", g.floats(&colours, "VEC4")),
+                    ("TEXCOORD_0", g.floats(&uvs(|uv| uv), "VEC2")),
+                ]
+            },
+            emissive(json!({"index": 0, "extensions": khr(json!({"scale": [-1.5, 0.8]}))})),
+            1,
+        ),
+    ));
+    for (name, scene) in scenes {
+        let dir = hush_tests::gltf_writer::temp_dir("texcoords-export");
+        let path = dir.join("exported.gltf");
+        hush_engine::scene::save_gltf(&scene, &path).unwrap();
+        let back = load_gltf(&path).unwrap();
+        assert!(back.warnings.is_empty(), "{name}: {:?}", back.warnings);
+        for (a, b) in scene.materials.iter().zip(&back.materials) {
+            for (ta, tb) in a.texture_refs().into_iter().zip(b.texture_refs()) {
+                match (ta, tb) {
+                    (None, None) => {}
+                    (Some(ta), Some(tb)) => {
+                        assert_eq!(ta.set, tb.set, "{name}");
+                        assert!(
+                            ta.transform.abs_diff_eq(tb.transform, 1e-5),
+                            "{name}: {:?} against {:?}",
+                            ta.transform,
+                            tb.transform
+                        );
+                    }
+                    _ => panic!("{name}: a texture lost or gained"),
+                }
+            }
+        }
+        let (ma, mb) = (&scene.meshes[0], &back.meshes[0]);
+        assert_eq!(ma.uvs1, mb.uvs1, "{name}");
+        assert_eq!(ma.colors, mb.colors, "{name}");
+        println!("{name}: {} TEXCOORD_1, {} COLOR_0 kept", mb.uvs1.len(), mb.colors.len());
+    }
+}

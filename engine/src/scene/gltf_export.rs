@@ -91,6 +91,28 @@ fn interpolation<T>(t: &Track<T>) -> &'static str {
     }
 }
 
+/// A material's textureInfo: the texture, its TEXCOORD set, and its KHR_texture_transform
+/// (the affine map taken apart into offset, rotation and scale as the extension composes them,
+/// TextureRef::khr_transform).
+fn texture_info(r: super::TextureRef) -> Value {
+    let mut v = json!({"index": r.index});
+    if r.set != 0 {
+        v["texCoord"] = json!(r.set);
+    }
+    if r.transform != glam::Affine2::IDENTITY {
+        let (c0, c1) = (r.transform.matrix2.x_axis, r.transform.matrix2.y_axis);
+        // Columns sx (cos, -sin) and sy (sin, cos); a mirror (negative determinant) in sy.
+        let (sx, sy) = (c0.length(), c1.length() * r.transform.matrix2.determinant().signum());
+        let rotation = (-c0.y).atan2(c0.x);
+        v["extensions"] = json!({"KHR_texture_transform": {
+            "offset": r.transform.translation.to_array(),
+            "rotation": rotation,
+            "scale": [sx, sy],
+        }});
+    }
+    v
+}
+
 fn wrap(w: Wrap) -> u32 {
     match w {
         Wrap::Repeat => 10497,
@@ -134,7 +156,7 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
         samplers.push(sampler);
         textures.push(json!({"source": i, "sampler": i}));
     }
-    let tex = |r: Option<super::TextureRef>| r.map(|r| json!({"index": r.index}));
+    let tex = |r: Option<super::TextureRef>| r.map(texture_info);
 
     let mut uses_strength = false;
     let materials: Vec<Value> = scene
@@ -163,7 +185,9 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
                 v["emissiveTexture"] = t;
             }
             if let Some(t) = tex(m.normal_texture) {
-                v["normalTexture"] = json!({"index": t["index"], "scale": m.normal_scale});
+                let mut t = t;
+                t["scale"] = json!(m.normal_scale);
+                v["normalTexture"] = t;
             }
             if m.alpha_mode == AlphaMode::Blend {
                 v["alphaMode"] = json!("BLEND");
@@ -203,6 +227,14 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
         if m.uvs.len() == m.positions.len() {
             let uv: Vec<f32> = m.uvs.iter().flat_map(|p| p.to_array()).collect();
             attrs["TEXCOORD_0"] = json!(w.floats(&uv, 2, "VEC2", Some(34962), false));
+        }
+        if m.uvs1.len() == m.positions.len() {
+            let uv: Vec<f32> = m.uvs1.iter().flat_map(|p| p.to_array()).collect();
+            attrs["TEXCOORD_1"] = json!(w.floats(&uv, 2, "VEC2", Some(34962), false));
+        }
+        if m.colors.len() == m.positions.len() {
+            let c: Vec<f32> = m.colors.iter().flat_map(|p| p.to_array()).collect();
+            attrs["COLOR_0"] = json!(w.floats(&c, 4, "VEC4", Some(34962), false));
         }
         let indices = w.indices(&m.indices);
         meshes.push(json!({"primitives": [{"attributes": attrs, "indices": indices, "material": m.material, "mode": 4}]}));
@@ -320,6 +352,12 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
 
     let bin_name = format!("{stem}.bin");
     let mut used = vec!["KHR_materials_specular"];
+    let transformed = |m: &super::Material| {
+        m.texture_refs().into_iter().flatten().any(|t| t.transform != glam::Affine2::IDENTITY)
+    };
+    if scene.materials.iter().any(transformed) {
+        used.push("KHR_texture_transform");
+    }
     if uses_strength {
         used.push("KHR_materials_emissive_strength");
     }
