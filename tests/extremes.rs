@@ -194,15 +194,7 @@ fn unusable_input_is_a_clear_error() {
     let gpu = Gpu::headless(&prepared.requirements(0, 0)).unwrap();
     let gs = prepared.upload(&gpu);
     for (w, h) in [(0, 10), (10, 0), (20000, 10)] {
-        let view = TraceView {
-            camera: scene.camera_or_default(),
-            width: w,
-            height: h,
-            max_depth: 6,
-            seed: 0,
-            shutter_camera: None,
-            texture_lod: true,
-        };
+        let view = TraceView::new(scene.camera_or_default(), (w, h), 6, 0);
         let e = ReferenceTracer::new(&gpu, &prepared, &gs, &view)
             .err()
             .map(|e| e.to_string())

@@ -192,11 +192,16 @@ fn opaque_sample(b: Bsdf, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSample {
     } else {
         s.wi = cosine_hemisphere(u);
     }
-    let e = opaque_eval(b, wo, s.wi);
-    if e.pdf <= 0.0 {
-        return s;
+    return evaluated(s, opaque_eval(b, wo, s.wi));
+}
+
+// Sample s (its direction chosen, nothing else set) completed by the evaluation of its
+// direction: the mixture pdf and f cos / pdf; a direction of pdf 0 carries nothing.
+fn evaluated(s: BsdfSample, e: BsdfEval) -> BsdfSample {
+    var r = s;
+    if e.pdf > 0.0 {
+        r.pdf = e.pdf;
+        r.weight = e.f_cos / e.pdf;
     }
-    s.pdf = e.pdf;
-    s.weight = e.f_cos / e.pdf;
-    return s;
+    return r;
 }

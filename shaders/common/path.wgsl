@@ -87,6 +87,7 @@ struct PathState {
     first_reflectance: vec3f,
     first_normal: vec3f,
     done: bool,
+    // The ray cone at ro (PathStart::cone).
     cone: vec2f,
     // The square of the index ratios crossed so far (Mitsuba's eta^2): Russian roulette weighs
     // the throughput by it, so that refraction's radiance scaling 1 / eta^2 does not end paths
@@ -146,16 +147,16 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     }
     var s = surface_at(hit, rd);
     let m = material(s.material);
+    // The back of a single-sided surface is a black absorber, as in Mitsuba.
+    if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
+        return;
+    }
     // The cone's width where it meets the surface; after the primary hit its footprint picks
     // the mip level of every texture read.
     let cone_width = (*st).cone.x + (*st).cone.y * hit.t;
     if HAS_TEXTURES && segments > 1 && params.texture_lod.x > 0.0 && any(m.tex >= vec4i(0)) {
         s.tc.lod = cone_lod(hit.tri, cone_width, dot(s.ng, rd));
         s.tc.xi = f32(pcg_hash(bitcast<u32>(hit.b.x) ^ pcg_hash(bitcast<u32>(hit.t)))) * (1.0 / 4294967296.0);
-    }
-    // The back of a single-sided surface is a black absorber, as in Mitsuba.
-    if !s.front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
-        return;
     }
     // A segment that ends on the inside of glass crossed its volume.
     let beta = (*st).beta * glass_absorption(m, s.front, hit.t);

@@ -1,8 +1,9 @@
 // All textures in one array of words: four u32 of header per texture (texel offset, width,
 // height, flags: bit 0 sRGB, bits 1-2 wrap S, bits 3-4 wrap T with 0 repeat, 1 clamp, 2 mirror,
-// bit 5 nearest, bits 6-10 the number of mip levels below the base),
-// then RGBA8 texels, the base level's followed by each mip level's (engine/src/gpu/pack.rs). One binding serves any number of textures on every backend. The words are
-// read four to a texel of a texel-row texture (see tri_texels in geometry.wgsl).
+// bit 5 nearest, bits 6-10 the number of mip levels below the base), then RGBA8 texels, the
+// base level's followed by each mip level's (engine/src/gpu/pack.rs). One binding serves any
+// number of textures on every backend. The words are read four to a texel of a texel-row
+// texture (see tri_texels in geometry.wgsl).
 var tex_words: texture_2d<u32>;
 
 fn tex_word(i: u32) -> u32 {

@@ -171,11 +171,5 @@ fn glass_sample(b: Bsdf, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSample {
             }
         }
     }
-    let e = glass_eval(b, wo, s.wi);
-    if e.pdf <= 0.0 {
-        return s;
-    }
-    s.pdf = e.pdf;
-    s.weight = e.f_cos / e.pdf;
-    return s;
+    return evaluated(s, glass_eval(b, wo, s.wi));
 }

@@ -60,13 +60,8 @@ pub fn render_lod(
     let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
     let view = TraceView {
-        camera: scene.camera_or_default(),
-        width: w,
-        height: h,
-        max_depth: scene.max_depth,
-        seed,
-        shutter_camera: None,
         texture_lod,
+        ..TraceView::new(scene.camera_or_default(), (w, h), scene.max_depth, seed)
     };
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     let mut done = 0;

@@ -193,15 +193,8 @@ pub fn run(a: BenchArgs) -> Result<()> {
         caster.cast(&gpu, &gscene, &rays[..rays.len().min(4096)], false)?; // warm-up (pipeline compile)
         let (_, t) = caster.cast(&gpu, &gscene, &rays, false)?;
         let rays_per_second = a.rays as f64 / t.as_secs_f64();
-        let view = TraceView {
-            camera: scene.camera_or_default(),
-            width: a.width,
-            height: a.height,
-            max_depth: scene.max_depth,
-            seed: 0,
-            shutter_camera: None,
-            texture_lod: true,
-        };
+        let view =
+            TraceView::new(scene.camera_or_default(), (a.width, a.height), scene.max_depth, 0);
         let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
         tracer.dispatch(&gpu, 1);
         gpu.wait()?;

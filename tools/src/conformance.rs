@@ -95,15 +95,7 @@ fn reference(scene: &Scene, a: &ConformanceArgs) -> Result<Image> {
     let prepared = PreparedScene::new(scene, BvhKind::DEFAULT)?;
     let gpu = Gpu::headless(&prepared.requirements(a.width as u64 * a.height as u64, 32))?;
     let gscene = prepared.upload(&gpu);
-    let view = TraceView {
-        camera: scene.camera_or_default(),
-        width: a.width,
-        height: a.height,
-        max_depth: scene.max_depth,
-        seed: 0,
-        shutter_camera: None,
-        texture_lod: true,
-    };
+    let view = TraceView::new(scene.camera_or_default(), (a.width, a.height), scene.max_depth, 0);
     let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
     tracer.dispatch(&gpu, a.spp.max(1));
     gpu.wait()?;

@@ -177,15 +177,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let scene = load_scene(&a.scene, &a.load)?;
     let (w, h) = image_size(&scene, a.width, a.height);
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
-    let view = TraceView {
-        camera,
-        width: w,
-        height: h,
-        max_depth: a.max_depth.unwrap_or(scene.max_depth),
-        seed: a.seed,
-        shutter_camera: None,
-        texture_lod: true,
-    };
+    let view = TraceView::new(camera, (w, h), a.max_depth.unwrap_or(scene.max_depth), a.seed);
     let mut prepared = PreparedScene::new(&scene, kind)?;
     let time = a.time.unwrap_or(0.0);
     let open = time - shutter(&a)? / fps(&a)?;

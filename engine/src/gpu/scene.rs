@@ -138,33 +138,14 @@ impl PreparedScene {
             b(&self.materials),
             wgpu::TextureFormat::Rgba32Uint,
         );
-        let extras = f.vertex_extras.then(|| {
-            Texels::new(
-                gpu,
-                &mut mem,
-                "scene/vertex extras",
-                b(&self.extras),
-                wgpu::TextureFormat::Rgba32Uint,
-            )
-        });
-        let tex_uses = f.texture_uses.then(|| {
-            Texels::new(
-                gpu,
-                &mut mem,
-                "scene/texture uses",
-                b(&self.tex_uses),
-                wgpu::TextureFormat::Rgba32Float,
-            )
-        });
-        let glass = f.transmission.then(|| {
-            Texels::new(
-                gpu,
-                &mut mem,
-                "scene/glass",
-                b(&self.glass),
-                wgpu::TextureFormat::Rgba32Float,
-            )
-        });
+        // Tables only some scenes have (SceneFeatures): none is allocated where it is off.
+        let mut table = |on: bool, name: &str, data: &[u8], format| {
+            on.then(|| Texels::new(gpu, &mut mem, name, data, format))
+        };
+        use wgpu::TextureFormat::{Rgba32Float, Rgba32Uint};
+        let extras = table(f.vertex_extras, "scene/vertex extras", b(&self.extras), Rgba32Uint);
+        let tex_uses = table(f.texture_uses, "scene/texture uses", b(&self.tex_uses), Rgba32Float);
+        let glass = table(f.transmission, "scene/glass", b(&self.glass), Rgba32Float);
         let copy = s | wgpu::BufferUsages::COPY_DST;
         // Lights and environment are rewritten when the user moves the sun.
         let lights =

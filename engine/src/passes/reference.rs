@@ -64,6 +64,22 @@ pub struct TraceView {
     pub texture_lod: bool,
 }
 
+impl TraceView {
+    /// A still view (no shutter) of `size` pixels through `camera`, ray cones on: the renders
+    /// that do not animate start here.
+    pub fn new(camera: Camera, (width, height): (u32, u32), max_depth: i32, seed: u32) -> Self {
+        TraceView {
+            camera,
+            width,
+            height,
+            max_depth,
+            seed,
+            shutter_camera: None,
+            texture_lod: true,
+        }
+    }
+}
+
 /// Russian roulette starts after this many segments (Mitsuba's rr_depth).
 pub const RR_DEPTH: i32 = 5;
 

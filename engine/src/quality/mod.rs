@@ -5,7 +5,9 @@ mod metrics;
 mod ssim;
 mod timeline;
 
-pub use image_io::{Image, decode_exr, srgb_to_linear, tonemap_srgb8, write_exr, write_png};
+pub use image_io::{
+    Image, decode_exr, linear_to_srgb, srgb_to_linear, tonemap_srgb8, write_exr, write_png,
+};
 pub use metrics::{
     Metrics, compare, compare_with_flip_map, flip_ldr, flip_map, flip_over, luminance, region_mean,
     relmse, rmse, save_flip_heatmap,

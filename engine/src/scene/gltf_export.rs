@@ -68,10 +68,20 @@ impl Writer {
         self.accessors.len() - 1
     }
 
+    /// A track's input (times) and output (values, or CUBICSPLINE's triples) accessors.
     fn track3(&mut self, t: &Track<DVec3>) -> (usize, usize) {
-        let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
         let values: Vec<f32> = keyed(t).iter().flat_map(|v| v.as_vec3().to_array()).collect();
-        (self.floats(&times, 1, "SCALAR", None, true), self.floats(&values, 3, "VEC3", None, false))
+        (self.times(t), self.floats(&values, 3, "VEC3", None, false))
+    }
+
+    fn track_quat(&mut self, t: &Track<DQuat>) -> (usize, usize) {
+        let values: Vec<f32> = keyed(t).iter().flat_map(|q| q.as_quat().to_array()).collect();
+        (self.times(t), self.floats(&values, 4, "VEC4", None, false))
+    }
+
+    fn times<T>(&mut self, t: &Track<T>) -> usize {
+        let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
+        self.floats(&times, 1, "SCALAR", None, true)
     }
 }
 
@@ -220,21 +230,30 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     for m in &scene.meshes {
         let pos: Vec<f32> = m.positions.iter().flat_map(|p| p.to_array()).collect();
         let mut attrs = json!({"POSITION": w.floats(&pos, 3, "VEC3", Some(34962), true)});
-        if m.normals.len() == m.positions.len() {
-            let n: Vec<f32> = m.normals.iter().flat_map(|p| p.to_array()).collect();
-            attrs["NORMAL"] = json!(w.floats(&n, 3, "VEC3", Some(34962), false));
-        }
-        if m.uvs.len() == m.positions.len() {
-            let uv: Vec<f32> = m.uvs.iter().flat_map(|p| p.to_array()).collect();
-            attrs["TEXCOORD_0"] = json!(w.floats(&uv, 2, "VEC2", Some(34962), false));
-        }
-        if m.uvs1.len() == m.positions.len() {
-            let uv: Vec<f32> = m.uvs1.iter().flat_map(|p| p.to_array()).collect();
-            attrs["TEXCOORD_1"] = json!(w.floats(&uv, 2, "VEC2", Some(34962), false));
-        }
-        if m.colors.len() == m.positions.len() {
-            let c: Vec<f32> = m.colors.iter().flat_map(|p| p.to_array()).collect();
-            attrs["COLOR_0"] = json!(w.floats(&c, 4, "VEC4", Some(34962), false));
+        // Per-vertex attributes the mesh has: (name, vertices, components, accessor type, data).
+        let flat2 = |v: &[glam::Vec2]| v.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>();
+        let attributes = [
+            (
+                "NORMAL",
+                m.normals.len(),
+                3,
+                "VEC3",
+                m.normals.iter().flat_map(|p| p.to_array()).collect(),
+            ),
+            ("TEXCOORD_0", m.uvs.len(), 2, "VEC2", flat2(&m.uvs)),
+            ("TEXCOORD_1", m.uvs1.len(), 2, "VEC2", flat2(&m.uvs1)),
+            (
+                "COLOR_0",
+                m.colors.len(),
+                4,
+                "VEC4",
+                m.colors.iter().flat_map(|p| p.to_array()).collect(),
+            ),
+        ];
+        for (name, n, k, ty, data) in attributes {
+            if n == m.positions.len() {
+                attrs[name] = json!(w.floats(&data, k, ty, Some(34962), false));
+            }
         }
         let indices = w.indices(&m.indices);
         meshes.push(json!({"primitives": [{"attributes": attrs, "indices": indices, "material": m.material, "mode": 4}]}));
@@ -254,29 +273,18 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
                 let target = nodes.len();
                 let mut samplers = vec![];
                 let mut channels = vec![];
+                let mut channel = |path: &str, (i, o): (usize, usize), interpolation: &str| {
+                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": path}}));
+                    samplers.push(json!({"input": i, "output": o, "interpolation": interpolation}));
+                };
                 if let Some(t) = &a.translation_track {
-                    let (i, o) = w.track3(t);
-                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "translation"}}));
-                    samplers
-                        .push(json!({"input": i, "output": o, "interpolation": interpolation(t)}));
+                    channel("translation", w.track3(t), interpolation(t));
                 }
                 if let Some(t) = &a.scale_track {
-                    let (i, o) = w.track3(t);
-                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "scale"}}));
-                    samplers
-                        .push(json!({"input": i, "output": o, "interpolation": interpolation(t)}));
+                    channel("scale", w.track3(t), interpolation(t));
                 }
                 if let Some(t) = &a.rotation_track {
-                    let times: Vec<f32> = t.times.iter().map(|x| *x as f32).collect();
-                    let values: Vec<f32> =
-                        keyed(t).iter().flat_map(|q| q.as_quat().to_array()).collect();
-                    let (i, o) = (
-                        w.floats(&times, 1, "SCALAR", None, true),
-                        w.floats(&values, 4, "VEC4", None, false),
-                    );
-                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": "rotation"}}));
-                    samplers
-                        .push(json!({"input": i, "output": o, "interpolation": interpolation(t)}));
+                    channel("rotation", w.track_quat(t), interpolation(t));
                 }
                 animations
                     .push(json!({"name": o.name, "samplers": samplers, "channels": channels}));

@@ -1,4 +1,5 @@
 use crate::limits::Budget;
+use crate::quality::{linear_to_srgb, srgb_to_linear};
 use anyhow::{Context, Result};
 use glam::{Affine2, Mat2, Vec2};
 
@@ -75,16 +76,6 @@ pub fn mip_chain_texels(w: u32, h: u32) -> usize {
     }
 }
 
-/// sRGB-encoded byte to linear light.
-fn srgb_to_linear(v: u8) -> f32 {
-    let c = v as f32 / 255.0;
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-}
-
-fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
-}
-
 impl Texture {
     /// The mip levels below this one, each half the one above (at least one texel a side) down
     /// to 1 x 1: every texel the mean of the 2 x 2 texels it covers (the last row or column of
@@ -97,7 +88,8 @@ impl Texture {
             return levels;
         }
         let decode: Vec<f32> = (0..=255u8)
-            .map(|v| if self.srgb { srgb_to_linear(v) } else { v as f32 / 255.0 })
+            .map(|v| v as f32 / 255.0)
+            .map(|c| if self.srgb { srgb_to_linear(c) } else { c })
             .collect();
         let mut w = self.width as usize;
         let mut h = self.height as usize;
