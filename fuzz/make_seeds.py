@@ -137,6 +137,27 @@ def meshopt(fallback_length):
     return d
 scenes['bad-meshopt-not-a-stream'] = pack(meshopt(48), F)
 scenes['bad-meshopt-huge-fallback'] = pack(meshopt(1 << 40), F)
+# EXT_meshopt_compression's INDICES mode: the strip's u16 indices (view 4) as an index sequence
+# (header 0xd1, one varint a delta from baseline 0, a 4-byte tail), and the same cut short.
+def sequence(indices):
+    out, last = bytearray([0xd1]), 0
+    for i in indices:
+        d = i - last; last = i
+        v = (((d << 1) ^ (d >> 31)) & 0xffffffff) << 1
+        while v >= 0x80:
+            out.append(v & 0x7f | 0x80); v >>= 7
+        out.append(v)
+    return bytes(out) + bytes(4)
+SEQ = sequence([0, 1, 2, 3])
+def meshopt_strip(stream):
+    d = doc(extensionsUsed=["EXT_meshopt_compression"], extensionsRequired=["EXT_meshopt_compression"])
+    d['buffers'] += [{"uri": "seq.bin", "byteLength": len(stream)}, {"byteLength": 8, "extensions": {"EXT_meshopt_compression": {"fallback": True}}}]
+    d['bufferViews'][4] = {"buffer": 2, "byteOffset": 0, "byteLength": 8, "extensions": {"EXT_meshopt_compression": {
+        "buffer": 1, "byteOffset": 0, "byteLength": len(stream), "byteStride": 2, "count": 4, "mode": "INDICES"}}}
+    d['meshes'][0]['primitives'] = [{"attributes": {"POSITION": 0}, "indices": 4, "mode": 5}]
+    return pack(d, {**F, "seq.bin": stream})
+scenes['ok-meshopt-strip'] = meshopt_strip(SEQ)
+scenes['bad-meshopt-strip-cut'] = meshopt_strip(SEQ[:6])
 # Refused
 def bad(name, mutate, files=F):
     d = doc(); mutate(d); scenes['bad-' + name] = pack(d, files)

@@ -43,6 +43,8 @@ struct File {
     bin: Vec<u8>,
     views: Vec<Value>,
     accessors: Vec<Value>,
+    /// The primitive's topology (glTF's mode; triangles when `None`).
+    mode: Option<u32>,
 }
 
 impl File {
@@ -91,12 +93,16 @@ impl File {
         }
         let mut buffers = vec![json!({"byteLength": self.bin.len(), "uri": uri})];
         buffers.extend(extra_buffers);
+        let mut primitive = json!({"attributes": attributes, "indices": indices});
+        if let Some(m) = self.mode {
+            primitive["mode"] = json!(m);
+        }
         let j = json!({
             "asset": {"version": "2.0"},
             "scene": 0,
             "scenes": [{"nodes": [0]}],
             "nodes": [n],
-            "meshes": [{"primitives": [{"attributes": attributes, "indices": indices}]}],
+            "meshes": [{"primitives": [primitive]}],
             "accessors": self.accessors,
             "bufferViews": self.views,
             "buffers": buffers,
@@ -113,19 +119,47 @@ fn floats(v: &[impl AsRef<[f32]>]) -> Vec<u8> {
         .collect()
 }
 
+/// The grid as one triangle strip (rows joined by degenerate triangles), glTF mode 5.
+const STRIP: u32 = 5;
+fn strip() -> Vec<u32> {
+    let n = 5u32;
+    let mut s: Vec<u32> = vec![];
+    for j in 0..n - 1 {
+        if j > 0 {
+            s.extend([*s.last().unwrap(), (j + 1) * n]);
+        }
+        for i in 0..n {
+            s.extend([(j + 1) * n + i, j * n + i]);
+        }
+    }
+    s
+}
+
+/// meshoptimizer 0.22's `meshopt_encodeIndexSequence` of `strip()` (the crate binds the
+/// encoder only as an unsafe call, so the stream is stored here).
+const STRIP_ENCODED: [u8; 51] = [
+    209, 20, 18, 24, 18, 24, 18, 24, 18, 24, 18, 0, 24, 0, 18, 24, 18, 24, 18, 24, 18, 24, 18, 0,
+    24, 0, 18, 24, 18, 24, 18, 24, 18, 24, 18, 0, 24, 0, 18, 24, 18, 24, 18, 24, 18, 24, 18, 0, 0,
+    0, 0,
+];
+
 fn float_file(g: &Grid, name: &str) -> Scene {
-    let mut f = File::default();
+    float_file_with(g, name, &g.indices, None)
+}
+
+fn float_file_with(g: &Grid, name: &str, indices: &[u32], mode: Option<u32>) -> Scene {
+    let mut f = File { mode, ..Default::default() };
     let p = f.view(&floats(&g.positions), None);
     let n = f.view(&floats(&g.normals), None);
     let t = f.view(&floats(&g.uvs), None);
-    let i = f.view(&g.indices.iter().flat_map(|i| i.to_le_bytes()).collect::<Vec<_>>(), None);
+    let i = f.view(&indices.iter().flat_map(|i| i.to_le_bytes()).collect::<Vec<_>>(), None);
     let count = g.positions.len();
     let attrs = json!({
         "POSITION": f.accessor(p, 5126, false, count, "VEC3"),
         "NORMAL": f.accessor(n, 5126, false, count, "VEC3"),
         "TEXCOORD_0": f.accessor(t, 5126, false, count, "VEC2"),
     });
-    let idx = f.accessor(i, 5125, false, g.indices.len(), "SCALAR");
+    let idx = f.accessor(i, 5125, false, indices.len(), "SCALAR");
     f.accessors[0]["min"] = json!([-1.0, -1.0, 0.0]);
     f.accessors[0]["max"] = json!([1.0, 1.0, 0.4]);
     f.scene(name, attrs, idx, json!({}), &[], vec![]).unwrap()
@@ -246,17 +280,20 @@ fn octahedral8(n: [f32; 3]) -> [u8; 4] {
 /// The meshopt file of `g`; `damage` truncates the compressed positions, `edit` changes the
 /// JSON of the first compressed view and of the fallback buffer before writing.
 fn meshopt_file(g: &Grid, name: &str, damage: bool) -> Result<Scene, String> {
-    meshopt_file_with(g, name, damage, |_, _| {})
+    meshopt_file_with(g, name, damage, false, |_, _| {})
 }
 
+/// `strip`: the grid as `strip()`, its 16-bit indices in an INDICES (index sequence) view,
+/// instead of a triangle list in a TRIANGLES view.
 fn meshopt_file_with(
     g: &Grid,
     name: &str,
     damage: bool,
+    strip: bool,
     edit: impl FnOnce(&mut Value, &mut Value),
 ) -> Result<Scene, String> {
     let count = g.positions.len();
-    let mut f = File::default();
+    let mut f = File { mode: strip.then_some(STRIP), ..Default::default() };
     let positions = meshopt::encode_vertex_buffer(&g.positions).unwrap();
     let normals: Vec<[u8; 4]> = g.normals.iter().map(|&n| octahedral8(n)).collect();
     let normals = meshopt::encode_vertex_buffer(&normals).unwrap();
@@ -267,7 +304,11 @@ fn meshopt_file_with(
         .map(|t| t.map(|x| (-16i32 << 24) | (((x * 65536.0).round() as i32) & 0xff_ffff)))
         .collect();
     let uvs = meshopt::encode_vertex_buffer(&uvs).unwrap();
-    let indices = meshopt::encode_index_buffer(&g.indices, count).unwrap();
+    let (indices, index_count, index_stride, index_mode) = if strip {
+        (STRIP_ENCODED.to_vec(), self::strip().len(), 2, "INDICES")
+    } else {
+        (meshopt::encode_index_buffer(&g.indices, count).unwrap(), g.indices.len(), 4, "TRIANGLES")
+    };
     // Compressed streams in buffer 0; the views they decode into in buffer 1 (the fallback).
     let mut views = vec![];
     let mut at = 0usize;
@@ -275,7 +316,7 @@ fn meshopt_file_with(
         (&positions, 12, count, "ATTRIBUTES", "NONE"),
         (&normals, 4, count, "ATTRIBUTES", "OCTAHEDRAL"),
         (&uvs, 8, count, "ATTRIBUTES", "EXPONENTIAL"),
-        (&indices, 4, g.indices.len(), "TRIANGLES", "NONE"),
+        (&indices, index_stride, index_count, index_mode, "NONE"),
     ] {
         let mut data = data.clone();
         if damage && views.is_empty() {
@@ -302,7 +343,13 @@ fn meshopt_file_with(
         "NORMAL": f.accessor(first + 1, 5120, true, count, "VEC3"),
         "TEXCOORD_0": f.accessor(first + 2, 5126, false, count, "VEC2"),
     });
-    let idx = f.accessor(first + 3, 5125, false, g.indices.len(), "SCALAR");
+    let idx = f.accessor(
+        first + 3,
+        if index_stride == 2 { 5123 } else { 5125 },
+        false,
+        index_count,
+        "SCALAR",
+    );
     f.accessors[0]["min"] = json!([-1.0, -1.0, 0.0]);
     f.accessors[0]["max"] = json!([1.0, 1.0, 0.4]);
     f.scene(
@@ -330,6 +377,21 @@ fn meshopt_compressed_views_load_as_the_mesh_they_encode() {
     assert!(dt <= 0.5 / 65536.0 + 1e-7, "UVs {dt}");
     let e = meshopt_file(&g, "meshopt-damaged", true).unwrap_err();
     assert!(e.contains("EXT_meshopt_compression") && e.contains("does not decode"), "{e}");
+}
+
+/// A triangle strip whose indices are an INDICES view (the index-sequence codec, which
+/// gltfpack writes for strips, fans, lines and points) loads as the same strip uncompressed.
+/// Broken streams are the decoder's unit tests (engine/src/scene/meshopt.rs).
+#[test]
+fn meshopt_index_sequences_load_as_the_strip_they_encode() {
+    let g = grid();
+    let reference = float_file_with(&g, "float-strip", &strip(), Some(STRIP));
+    let s = meshopt_file_with(&g, "meshopt-strip", false, true, |_, _| {}).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let (dp, _, _) = differences(&s, &reference);
+    assert_eq!(dp, 0.0, "positions");
+    // The strip's 36 triangles, 8 of them the degenerate joins, reach the mesh.
+    assert_eq!(geometry(&s).3.len(), 3 * (strip().len() - 2));
 }
 
 /// Hostile compressed views are refused with errors that name what is wrong, before anything
@@ -390,7 +452,7 @@ fn hostile_compressed_views_are_refused_by_name() {
         ),
     ];
     for (name, edit, needle) in cases {
-        let e = meshopt_file_with(&g, &format!("meshopt-{name}"), false, edit).unwrap_err();
+        let e = meshopt_file_with(&g, &format!("meshopt-{name}"), false, false, edit).unwrap_err();
         assert!(e.contains(needle), "{name}: {e}");
     }
 }

@@ -175,9 +175,7 @@ impl Importer<'_> {
             }
         }
         let mut buffers = self.load_buffers(doc, blob)?;
-        for w in super::meshopt::decompress(doc.as_json(), &mut buffers, &mut self.budget)? {
-            self.warn(w);
-        }
+        super::meshopt::decompress(doc.as_json(), &mut buffers, &mut self.budget)?;
         let (textures, tex_map) = self.load_textures(doc, &buffers)?;
         let materials: Vec<Material> =
             doc.materials().map(|m| self.material(&m, &tex_map)).collect();

@@ -2,11 +2,12 @@
 //! meshoptimizer's vertex and index codecs, decoded at load into the bytes the view describes,
 //! so that the accessors read them as they read any view.
 //!
-//! The vertex and index codecs are meshoptimizer's own (the `meshopt` crate builds its C++
+//! The vertex and triangle codecs are meshoptimizer's own (the `meshopt` crate builds its C++
 //! source): the format is defined by that implementation, and its decoders check every read
 //! against the input's length (a malformed stream is an error code, not a read past the end).
-//! The filters (octahedral, quaternion, exponential) are written here from the extension's
-//! Appendix B, because the crate binds them only as unsafe calls. Each view's decoded size is
+//! The index-sequence codec (mode INDICES) and the filters (octahedral, quaternion,
+//! exponential) are written here from the extension's specification, because the crate binds
+//! them only as unsafe calls and the workspace forbids unsafe code. Each view's decoded size is
 //! charged to the decoded-bytes budget before anything is allocated.
 
 use crate::limits::Budget;
@@ -112,26 +113,13 @@ fn parse(e: &Value, here: &str) -> Result<Compressed> {
 /// names (its buffer, byteOffset and byteLength: a fallback buffer's space, or uncompressed
 /// data that the decoded bytes equal).
 /// Returns warnings for views it leaves as they are.
-pub fn decompress(
-    root: &Root,
-    buffers: &mut [Vec<u8>],
-    budget: &mut Budget,
-) -> Result<Vec<String>> {
-    let mut warnings = vec![];
+pub fn decompress(root: &Root, buffers: &mut [Vec<u8>], budget: &mut Budget) -> Result<()> {
     for (i, view) in root.buffer_views.iter().enumerate() {
         let Some(e) = view.extensions.as_ref().and_then(|x| x.others.get(EXTENSION)) else {
             continue;
         };
         let here = format!("bufferViews[{i}].extensions.{EXTENSION}");
         let c = parse(e, &here)?;
-        if c.mode == Mode::Indices {
-            // The index-sequence codec has no safe binding; it holds the indices of points,
-            // lines and strips, which gltfpack writes for non-triangle primitives.
-            warnings.push(format!(
-                "{here}: INDICES (index sequence) data is not decoded; primitives reading it render nothing"
-            ));
-            continue;
-        }
         let size = c
             .count
             .checked_mul(c.stride)
@@ -171,17 +159,20 @@ pub fn decompress(
             })?;
         target.copy_from_slice(&out);
     }
-    Ok(warnings)
+    Ok(())
 }
 
 fn decode(c: &Compressed, src: &[u8], out: &mut [u8]) -> Result<(), String> {
+    let codec = |e: meshopt::Error| e.to_string();
     let decoded = match c.mode {
-        Mode::Attributes => vertex_bytes(src, c.count, c.stride),
+        Mode::Attributes => vertex_bytes(src, c.count, c.stride).map_err(codec),
         Mode::Triangles if c.stride == 2 => meshopt::decode_index_buffer::<u16>(src, c.count)
-            .map(|v| v.iter().flat_map(|i| i.to_le_bytes()).collect()),
+            .map(|v| v.iter().flat_map(|i| i.to_le_bytes()).collect())
+            .map_err(codec),
         Mode::Triangles => meshopt::decode_index_buffer::<u32>(src, c.count)
-            .map(|v| v.iter().flat_map(|i| i.to_le_bytes()).collect()),
-        Mode::Indices => unreachable!("INDICES views are skipped before decoding"),
+            .map(|v| v.iter().flat_map(|i| i.to_le_bytes()).collect())
+            .map_err(codec),
+        Mode::Indices => index_sequence(src, c.count, c.stride),
     }
     .map_err(|e| format!("the compressed data does not decode ({e})"))?;
     if decoded.len() != out.len() {
@@ -196,6 +187,53 @@ fn decode(c: &Compressed, src: &[u8], out: &mut [u8]) -> Result<(), String> {
         Filter::Exponential => out.chunks_exact_mut(4).for_each(exponential),
     }
     Ok(())
+}
+
+/// Mode INDICES, the index-sequence codec ("Mode 2: indices" of the extension's specification):
+/// a header byte 0xd1, then per index a varint whose low bit picks one of two baselines and
+/// whose other bits are the zigzag delta from it, then a 4-byte tail. Used for the indices of
+/// strips, fans, lines and points. Little-endian indices of `stride` bytes out.
+fn index_sequence(src: &[u8], count: usize, stride: usize) -> Result<Vec<u8>, String> {
+    const TAIL: usize = 4;
+    // A stream at least as long as its shortest valid encoding, one byte per index, so that a
+    // count far beyond the data is refused before the output is filled.
+    if src.len() < 1 + count + TAIL {
+        return Err(format!("{} bytes cannot hold {count} indices", src.len()));
+    }
+    // Version 1 is what the specification requires; version 0 streams of older encoders
+    // decode the same way.
+    if src[0] != 0xd1 && src[0] != 0xd0 {
+        return Err(format!("header {:#04x} is not an index sequence's 0xd1", src[0]));
+    }
+    let end = src.len() - TAIL;
+    let mut at = 1;
+    let mut last = [0u32; 2];
+    let mut out = Vec::with_capacity(count * stride);
+    for _ in 0..count {
+        if at >= end {
+            return Err(format!("the stream ends before index {}", out.len() / stride));
+        }
+        // Seven bits a byte, low group first, at most five bytes.
+        let mut v = 0u32;
+        for k in 0..5 {
+            let byte = *src.get(at).ok_or("a varint runs past the end")?;
+            at += 1;
+            v |= u32::from(byte & 0x7f).wrapping_shl(7 * k);
+            if byte < 0x80 {
+                break;
+            }
+        }
+        let baseline = (v & 1) as usize;
+        let delta = (v >> 2) ^ (v >> 1 & 1).wrapping_neg();
+        let index = last[baseline].wrapping_add(delta);
+        last[baseline] = index;
+        if stride == 2 {
+            out.extend_from_slice(&(index as u16).to_le_bytes());
+        } else {
+            out.extend_from_slice(&index.to_le_bytes());
+        }
+    }
+    Ok(out)
 }
 
 /// One vertex of N bytes, for the vertex codec (which decodes elements of a type's size).
@@ -337,4 +375,41 @@ fn exponential(e: &mut [u8]) {
     let (exp, mantissa) = (v >> 24, (v << 8) >> 8);
     let f = 2f32.powi(exp) * mantissa as f32;
     e.copy_from_slice(&f.to_le_bytes());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::index_sequence;
+
+    /// meshoptimizer 0.22's `meshopt_encodeIndexSequence` of these indices: one-byte and
+    /// multi-byte varints, both baselines, deltas of either sign.
+    const INDICES: [u32; 9] = [0, 300, 70000, 5, 70001, 100000000, 1, 16777219, 16777218];
+    const ENCODED: [u8; 28] = [
+        209, 0, 177, 9, 192, 139, 17, 155, 9, 4, 237, 135, 222, 190, 1, 190, 139, 17, 243, 135,
+        222, 158, 1, 3, 0, 0, 0, 0,
+    ];
+
+    #[test]
+    fn index_sequences_decode_as_meshoptimizer_encoded_them() {
+        let out = index_sequence(&ENCODED, INDICES.len(), 4).unwrap();
+        let got: Vec<u32> =
+            out.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().unwrap())).collect();
+        assert_eq!(got, INDICES);
+        // The 16-bit form keeps the low half, as the reference decoder does.
+        let out = index_sequence(&ENCODED, INDICES.len(), 2).unwrap();
+        assert_eq!(u16::from_le_bytes([out[2], out[3]]), 300);
+    }
+
+    #[test]
+    fn broken_index_sequences_are_errors() {
+        // Cut short, a count past the data, a wrong header, long varints running into the tail.
+        assert!(index_sequence(&ENCODED[..20], INDICES.len(), 4).is_err());
+        assert!(index_sequence(&ENCODED, 30, 4).is_err());
+        let mut bad = ENCODED;
+        bad[0] = 0xa1;
+        assert!(index_sequence(&bad, INDICES.len(), 4).is_err());
+        let mut run = [0xffu8; 12];
+        run[0] = 0xd1;
+        assert!(index_sequence(&run, 3, 4).is_err());
+    }
 }
