@@ -154,6 +154,92 @@ fn mirrored_transforms_keep_front_faces_counter_clockwise() {
     assert!((acc.mean.mean() - Vec3::ONE).abs().max_element() < 1e-4, "{}", acc.mean.mean());
 }
 
+/// The point of the Khronos OrientationTest, on a file of Hush's own: six arrows built along +Y,
+/// turned by node quaternions, node matrices and nested nodes (mixing both) to point along +X,
+/// -X, +Y, -Y, +Z and -Z, each a colour of its own. Where each arrow's middle projects (the
+/// camera's pinhole projection of the intended direction, computed here), both modes show that
+/// arrow's colour. Swapped quaternion components, a transposed matrix or nested transforms
+/// composed in the wrong order move arrows off their spots (the nested -Z arrow lands on +X).
+#[test]
+fn node_rotations_point_every_arrow_where_it_should() {
+    use std::f32::consts::FRAC_1_SQRT_2 as H;
+    let colours: [[f32; 3]; 6] = [
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 1.0],
+        [1.0, 0.0, 1.0],
+    ];
+    let directions = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
+    let mut g = GltfWriter::default();
+    let arrows: Vec<usize> = colours
+        .iter()
+        .map(|c| {
+            g.materials.push(json!({
+                "pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0},
+                "emissiveFactor": c, "doubleSided": true,
+            }));
+            let m = g.materials.len() as u32 - 1;
+            let b = hush_engine::scene::cuboid(Vec3::new(0.0, 1.5, 0.0), Vec3::new(0.25, 1.0, 0.25), m);
+            g.engine_mesh(&b, m as usize)
+        })
+        .collect();
+    // +X: a quaternion, 90 degrees about -Z. -X: a matrix, 90 degrees about +Z (column-major).
+    g.node(json!({"mesh": arrows[0], "rotation": [0.0, 0.0, -H, H]}));
+    g.node(json!({"mesh": arrows[1], "matrix": [0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]}));
+    // +Y: a parent's matrix (90 degrees about +X) undone by its child's quaternion.
+    let child = g.node(json!({"mesh": arrows[2], "rotation": [-H, 0.0, 0.0, H]}));
+    g.node(
+        json!({"children": [child], "matrix": [1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1]}),
+    );
+    // -Y: half a turn about Z. +Z: a matrix, 90 degrees about +X.
+    g.node(json!({"mesh": arrows[3], "rotation": [0.0, 0.0, 1.0, 0.0]}));
+    g.node(json!({"mesh": arrows[4], "matrix": [1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1]}));
+    // -Z: the child turns +Y to +X, then its parent turns +X to -Z (90 degrees about +Y).
+    let child = g.node(json!({"mesh": arrows[5], "rotation": [0.0, 0.0, -H, H]}));
+    g.node(json!({"children": [child], "rotation": [0.0, H, 0.0, H]}));
+    let (eye, target, yfov) = (Vec3::new(7.0, 5.5, 9.0), Vec3::new(0.0, 0.3, 0.0), 0.6f32);
+    g.camera(eye.to_array(), target.to_array(), yfov);
+    g.extras = json!({"max_depth": 1});
+    let scene = load_gltf(&g.write("orientation")).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+
+    const N: u32 = 64;
+    // The pinhole projection of the camera written above (square image).
+    let z = (eye - target).normalize();
+    let x = Vec3::Y.cross(z).normalize();
+    let y = z.cross(x);
+    let pixel = |p: Vec3| {
+        let d = p - eye;
+        let s = (yfov / 2.0).tan() * -d.dot(z);
+        let (u, v) = (d.dot(x) / s, d.dot(y) / s);
+        (((u + 1.0) / 2.0 * N as f32) as u32, ((1.0 - v) / 2.0 * N as f32) as u32)
+    };
+    let reference = render(&scene, N, N, 16, 3).unwrap().mean;
+    let realtime = hush_tests::realtime_accumulate(&scene, N, N, 8, 3).unwrap();
+    for (mode, img) in [("reference", &reference), ("real time", &realtime)] {
+        for (k, d) in directions.iter().enumerate() {
+            let (px, py) = pixel(1.5 * *d);
+            let seen = img.at(px, py);
+            // The nearest of the six colours and black: an arrow 3.5 pixels wide leaves its
+            // middle pixel that arrow's colour, within the few pixels' jitter at its edges.
+            let nearest = colours
+                .iter()
+                .chain(std::iter::once(&[0.0; 3]))
+                .map(|c| (Vec3::from(*c) - seen).length())
+                .enumerate()
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap();
+            println!("{mode}: arrow {d} at ({px}, {py}) shows {seen}");
+            assert!(
+                nearest.0 == k && nearest.1 < 0.35,
+                "{mode}: the pixel where the {d} arrow should be shows {seen}"
+            );
+        }
+    }
+}
+
 /// A thin-lens camera survives Hush's own glTF export.
 #[test]
 fn a_thin_lens_round_trips_through_export() {

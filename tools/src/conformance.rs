@@ -5,7 +5,7 @@
 //! light at all in a scene that has some. Writes conformance.csv and, per loaded file, the two
 //! images (PNG) for a person to look over; prints the counts. What each sample model is built to
 //! show is checked by the tests of the feature it exercises (tests/texcoords.rs,
-//! tests/transparency.rs, tests/compressed.rs, tests/textures.rs).
+//! tests/transparency.rs, tests/compressed.rs, tests/textures.rs, tests/import.rs).
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
