@@ -52,6 +52,7 @@ fn scene() -> Scene {
         mesh,
         transform: DMat4::IDENTITY,
         animation: None,
+        deform: None,
     };
     Scene {
         name: "checker floor".into(),

@@ -46,6 +46,7 @@ fn scene(wrap_s: Wrap) -> Scene {
             mesh: 0,
             transform: DMat4::IDENTITY,
             animation: None,
+            deform: None,
         }],
         materials: vec![material],
         textures: vec![texture],

@@ -29,7 +29,7 @@ without a window use the command-line tool, e.g.\n    hush-cli render level --mo
 
 const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-path PATH.json]
             [--preset SETTINGS.toml] [--shaders DIR] [--profiler] [--puffin-http [PORT]]
-            [--limit NAME=VALUE[,NAME=VALUE...]]
+            [--limit NAME=VALUE[,NAME=VALUE...]] [--animation INDEX]
   no scene: the default level. Keys: WASD move, Q/E down/up, right-drag look, wheel speed,
   shift run, middle-click focus the depth of field there, F12 screenshot (PNG + EXR),
   R record a camera path, P play it, F9 profiler,
@@ -38,7 +38,8 @@ const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-
   release builds embed them unless --shaders DIR or $HUSH_SHADERS names a folder.
   --profiler opens the profiler window at start; --puffin-http serves profiles to puffin_viewer on 127.0.0.1 (default port 8585).
   --limit sets a budget on what a scene file may make Hush read and build (file-bytes, json-bytes,
-  image-pixels, decoded-bytes, nodes, hierarchy-depth, triangles); a file over one is refused.";
+  image-pixels, decoded-bytes, nodes, hierarchy-depth, triangles); a file over one is refused.
+  --animation plays only that one of the file's animations (by index); without it all play.";
 
 struct Args {
     scene: String,
@@ -287,6 +288,12 @@ fn parse_args() -> Result<Option<Args>> {
             }
             "--profiler" => profiler = true,
             "--limit" => load.limits.apply(&it.next().context("--limit needs NAME=VALUE")?)?,
+            "--animation" => {
+                let i = it.next().context("--animation needs an index")?;
+                load.animation = Some(i.parse().with_context(|| {
+                    format!("--animation {i}: an animation's index (0, 1, ...)")
+                })?);
+            }
             "--puffin-http" => {
                 let port = match it.peek().and_then(|p| p.parse::<u16>().ok()) {
                     Some(p) => {

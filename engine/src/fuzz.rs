@@ -75,7 +75,7 @@ fn split<'a>(data: &'a [u8], mark: &'a [u8]) -> impl Iterator<Item = &'a [u8]> +
 /// device. Any error is fine; a panic, a hang or a runaway allocation is the bug.
 pub fn scene(data: &[u8]) -> Result<Scene> {
     let (bytes, files) = unpack(data);
-    let opts = LoadOptions { max_texture_size: 64, limits: FUZZ_LIMITS };
+    let opts = LoadOptions { max_texture_size: 64, limits: FUZZ_LIMITS, animation: None };
     let mut scene = match load_gltf_from(bytes, "fuzz", &files, &opts) {
         // The fuzzer records panics: an import panic caught at the boundary is re-raised so
         // that it counts as the bug it is.

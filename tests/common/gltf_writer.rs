@@ -64,6 +64,7 @@ impl GltfWriter {
             "SCALAR" => 1,
             "VEC2" => 2,
             "VEC3" => 3,
+            "MAT4" => 16,
             _ => 4,
         };
         let bytes: Vec<u8> = v.iter().flat_map(|f| f.to_le_bytes()).collect();

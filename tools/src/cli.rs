@@ -21,6 +21,10 @@ pub struct LoadArgs {
     /// nodes (1,000,000), hierarchy-depth (1024), triangles (after instancing, 16,777,215).
     #[arg(long, value_name = "NAME=VALUE")]
     pub limit: Vec<String>,
+    /// Play only this one of the file's animations (its index in the file); without it every
+    /// animation plays at once (a node several drive takes the last one's channel).
+    #[arg(long, value_name = "INDEX")]
+    pub animation: Option<usize>,
 }
 
 impl LoadArgs {
@@ -29,7 +33,11 @@ impl LoadArgs {
         for l in &self.limit {
             limits.apply(l)?;
         }
-        Ok(LoadOptions { max_texture_size: self.max_texture_size, limits })
+        Ok(LoadOptions {
+            max_texture_size: self.max_texture_size,
+            limits,
+            animation: self.animation,
+        })
     }
 }
 

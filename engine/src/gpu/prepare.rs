@@ -155,6 +155,8 @@ pub struct PreparedScene {
     pub prev_from_current: Vec<glam::Mat4>,
     flat: Vec<Flat>,
     pub time: f64,
+    /// The time deforming objects (skins, morph targets) are posed at; None: their rest pose.
+    pose_time: Option<f64>,
     /// Per object, the rebased transform from where a point is at the shutter's close (`time`)
     /// to where it is at its open; empty while no object moves during the shutter.
     open_from_close: Vec<glam::Mat4>,
@@ -173,15 +175,18 @@ struct Flat {
     dropped: usize,
 }
 
+/// `time`: the time a deforming object's mesh is posed at (None: its rest pose).
 fn flatten(
     scene: &Scene,
     object: usize,
     transform: DMat4,
     origin: DVec3,
     features: &SceneFeatures,
+    time: Option<f64>,
 ) -> Flat {
     let o = &scene.objects[object];
-    let mesh = &scene.meshes[o.mesh];
+    let mesh = o.mesh_at(&scene.meshes[o.mesh], time);
+    let mesh = mesh.as_ref();
     let m3 = DMat3::from_mat4(transform);
     let flip = m3.determinant() < 0.0;
     let nmat = m3.inverse().transpose();
@@ -339,7 +344,7 @@ impl PreparedScene {
             transmission: scene.materials.iter().any(|m| m.transmission > 0.0),
         };
         let flat: Vec<Flat> = (0..scene.objects.len())
-            .map(|i| flatten(scene, i, scene.objects[i].transform, origin, &features))
+            .map(|i| flatten(scene, i, scene.objects[i].transform, origin, &features, None))
             .collect();
         let dropped: usize = flat.iter().map(|f| f.dropped).sum();
         if dropped > 0 {
@@ -415,6 +420,7 @@ impl PreparedScene {
             world,
             flat,
             time: 0.0,
+            pose_time: None,
             open_from_close: vec![],
         };
         p.assemble();
@@ -448,6 +454,7 @@ impl PreparedScene {
 
     fn move_objects(&mut self, scene: &Scene, time: f64) -> bool {
         let mut moved = false;
+        let repose = self.pose_time != Some(time);
         for (i, o) in scene.objects.iter().enumerate().take(self.world.len()) {
             let now = o.transform_at(time);
             let before = self.world[i];
@@ -456,13 +463,15 @@ impl PreparedScene {
             } else {
                 glam::Mat4::IDENTITY
             };
-            if o.animation.is_some() && now != before {
-                self.flat[i] = flatten(scene, i, now, self.origin, &self.features);
+            let deforms = repose && o.deform.as_ref().is_some_and(|d| d.moves());
+            if (o.animation.is_some() && now != before) || deforms {
+                self.flat[i] = flatten(scene, i, now, self.origin, &self.features, Some(time));
                 self.world[i] = now;
                 moved = true;
             }
         }
         self.time = time;
+        self.pose_time = Some(time);
         moved
     }
 

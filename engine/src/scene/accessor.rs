@@ -62,6 +62,25 @@ pub const COLOR_RGB: Expect =
 pub const COLOR_RGBA: Expect = Expect { ty: Type::Vec4, ..COLOR_RGB };
 pub const INDICES: Expect =
     Expect { ty: Type::Scalar, components: &[(U8, false), (U16, false), (U32, false)] };
+/// Skins (glTF 2.0 §3.7.3.1): JOINTS_n as unsigned integers, WEIGHTS_n as floats or
+/// normalized unsigned integers, inverse bind matrices as float MAT4.
+pub const JOINTS: Expect = Expect { ty: Type::Vec4, components: &[(U8, false), (U16, false)] };
+pub const WEIGHTS: Expect =
+    Expect { ty: Type::Vec4, components: &[(F32, false), (U8, true), (U16, true)] };
+pub const MATRICES: Expect = Expect { ty: Type::Mat4, components: FLOAT };
+/// Morph target displacements (§3.7.2.2), and what KHR_mesh_quantization adds: signed
+/// integers, normalized or not, for positions; normalized signed ones for normals and tangents.
+pub const TARGET: Expect = Expect { ty: Type::Vec3, components: FLOAT };
+pub const Q_TARGET_POSITION: Expect = Expect {
+    ty: Type::Vec3,
+    components: &[(F32, false), (I8, false), (I8, true), (I16, false), (I16, true)],
+};
+pub const Q_TARGET_DIRECTION: Expect = Q_NORMAL;
+/// A weights channel's output (§3.11's sampler table).
+pub const WEIGHTS_KEYS: Expect = Expect {
+    ty: Type::Scalar,
+    components: &[(F32, false), (I8, true), (U8, true), (I16, true), (U16, true)],
+};
 pub const KEY_TIMES: Expect = Expect { ty: Type::Scalar, components: FLOAT };
 pub const TRANSLATION: Expect = Expect { ty: Type::Vec3, components: FLOAT };
 pub const SCALE: Expect = Expect { ty: Type::Vec3, components: FLOAT };

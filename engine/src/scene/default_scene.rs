@@ -150,6 +150,7 @@ pub fn default_scene() -> Scene {
             mesh: i,
             transform: DMat4::IDENTITY,
             animation: None,
+            deform: None,
         })
         .collect();
     Scene {

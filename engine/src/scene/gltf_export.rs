@@ -2,7 +2,9 @@
 //! map as EXR beside it, following the same conventions the importer reads (lights as
 //! KHR_lights_punctual with color x intensity = irradiance or W/sr; emission beyond 1 through
 //! KHR_materials_emissive_strength; KHR_materials_specular; `scenes[0].extras`). The `gltf`
-//! crate only reads, so the JSON is written here with serde_json.
+//! crate only reads, so the JSON is written here with serde_json. Animated nodes keep their
+//! channels and their animated ancestors (as nested nodes); a skinned or morphed object is
+//! written as a static mesh in its rest pose (its skin, targets and weights channels are not).
 
 use super::{AlphaMode, Environment, Light, Scene, Track, Wrap};
 use crate::quality::Image;
@@ -226,8 +228,19 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
         })
         .collect();
 
+    // Deforming objects' meshes posed at rest, after the scene's own.
+    let mut posed = vec![];
+    let mut mesh_of = vec![];
+    for o in &scene.objects {
+        if o.deforms() {
+            mesh_of.push(scene.meshes.len() + posed.len());
+            posed.push(o.mesh_at(&scene.meshes[o.mesh], None).into_owned());
+        } else {
+            mesh_of.push(o.mesh);
+        }
+    }
     let mut meshes = vec![];
-    for m in &scene.meshes {
+    for m in scene.meshes.iter().chain(&posed) {
         let pos: Vec<f32> = m.positions.iter().flat_map(|p| p.to_array()).collect();
         let mut attrs = json!({"POSITION": w.floats(&pos, 3, "VEC3", Some(34962), true)});
         // Per-vertex attributes the mesh has: (name, vertices, components, accessor type, data).
@@ -262,43 +275,23 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     let mut nodes = vec![];
     let mut roots = vec![];
     let mut animations = vec![];
-    for o in &scene.objects {
-        let mut node = json!({"name": o.name, "mesh": o.mesh});
-        match &o.animation {
-            None => node["matrix"] = json!(mat(o.transform)),
+    for (o, &mesh) in scene.objects.iter().zip(&mesh_of) {
+        let node = json!({"name": o.name, "mesh": mesh});
+        let root = match &o.animation {
+            None => {
+                let mut node = node;
+                node["matrix"] = json!(mat(o.transform));
+                nodes.push(node);
+                nodes.len() - 1
+            }
             Some(a) => {
-                node["translation"] = json!(a.translation.to_array());
-                node["rotation"] = json!(a.rotation.to_array());
-                node["scale"] = json!(a.scale.to_array());
-                let target = nodes.len();
-                let mut samplers = vec![];
-                let mut channels = vec![];
-                let mut channel = |path: &str, (i, o): (usize, usize), interpolation: &str| {
-                    channels.push(json!({"sampler": samplers.len(), "target": {"node": target, "path": path}}));
-                    samplers.push(json!({"input": i, "output": o, "interpolation": interpolation}));
-                };
-                if let Some(t) = &a.translation_track {
-                    channel("translation", w.track3(t), interpolation(t));
-                }
-                if let Some(t) = &a.scale_track {
-                    channel("scale", w.track3(t), interpolation(t));
-                }
-                if let Some(t) = &a.rotation_track {
-                    channel("rotation", w.track_quat(t), interpolation(t));
-                }
+                let (root, channels, samplers) = animated_nodes(&mut w, &mut nodes, a, node);
                 animations
                     .push(json!({"name": o.name, "samplers": samplers, "channels": channels}));
-                if a.parent != DMat4::IDENTITY {
-                    nodes.push(node);
-                    node = json!({"name": format!("{} parent", o.name), "matrix": mat(a.parent), "children": [target]});
-                    nodes.push(node);
-                    roots.push(nodes.len() - 1);
-                    continue;
-                }
+                root
             }
-        }
-        roots.push(nodes.len());
-        nodes.push(node);
+        };
+        roots.push(root);
     }
 
     let mut lights = vec![];
@@ -410,4 +403,60 @@ pub fn save_gltf(scene: &Scene, path: &Path) -> Result<()> {
     std::fs::write(dir.join(&bin_name), &w.bin).with_context(ctx)?;
     std::fs::write(path, serde_json::to_string_pretty(&doc)?).with_context(ctx)?;
     Ok(())
+}
+
+/// Nodes for `a` and its animated ancestors, outermost first, `node` (the object's) innermost:
+/// each ancestor a node with its channels, the static transforms between them as matrix
+/// nodes. Returns the outermost node and the channels and samplers of them all.
+fn animated_nodes(
+    w: &mut Writer,
+    nodes: &mut Vec<Value>,
+    a: &super::Animation,
+    mut first: Value,
+) -> (usize, Vec<Value>, Vec<Value>) {
+    let (mut channels, mut samplers) = (vec![], vec![]);
+    let mut chain = vec![];
+    let mut at = Some(a);
+    while let Some(a) = at {
+        chain.push(a);
+        at = a.parent_motion.as_deref();
+    }
+    let mut child: Option<usize> = None;
+    for (depth, a) in chain.into_iter().enumerate() {
+        let mut node = if depth == 0 {
+            std::mem::take(&mut first)
+        } else {
+            json!({"name": format!("animated parent {depth}")})
+        };
+        node["translation"] = json!(a.translation.to_array());
+        node["rotation"] = json!(a.rotation.to_array());
+        node["scale"] = json!(a.scale.to_array());
+        if let Some(c) = child {
+            node["children"] = json!([c]);
+        }
+        let target = nodes.len();
+        let mut channel = |path: &str, (i, o): (usize, usize), interpolation: &str| {
+            channels
+                .push(json!({"sampler": samplers.len(), "target": {"node": target, "path": path}}));
+            samplers.push(json!({"input": i, "output": o, "interpolation": interpolation}));
+        };
+        if let Some(t) = &a.translation_track {
+            channel("translation", w.track3(t), interpolation(t));
+        }
+        if let Some(t) = &a.scale_track {
+            channel("scale", w.track3(t), interpolation(t));
+        }
+        if let Some(t) = &a.rotation_track {
+            channel("rotation", w.track_quat(t), interpolation(t));
+        }
+        nodes.push(node);
+        child = Some(target);
+        if a.parent != DMat4::IDENTITY {
+            nodes.push(
+                json!({"name": "static parent", "matrix": mat(a.parent), "children": [target]}),
+            );
+            child = Some(nodes.len() - 1);
+        }
+    }
+    (child.unwrap_or(0), channels, samplers)
 }

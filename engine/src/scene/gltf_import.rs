@@ -7,10 +7,14 @@
 //! live with it (a missing texture, an unsupported optional extension, an orthographic camera).
 
 use super::files::{SceneFiles, SceneFolder, read_uri, short};
+use super::gltf_animation::animations;
 use super::gltf_camera::{camera_pose, local_rotation};
 use super::gltf_importer::Importer;
-use super::gltf_mesh::{animations, primitive};
-use super::{Camera, DEFAULT_MAX_DEPTH, EnvMap, Environment, Light, Material, Mesh, Object, Scene};
+use super::gltf_mesh::primitive;
+use super::{
+    Animation, Camera, DEFAULT_MAX_DEPTH, Deform, EnvMap, Environment, Light, Material, Mesh,
+    Object, Scene,
+};
 use crate::limits::{Budget, Limits, over_budget, read_regular_file};
 use anyhow::{Context, Result, anyhow, bail};
 use glam::{DMat4, DQuat, DVec3, Vec3};
@@ -40,11 +44,17 @@ pub struct LoadOptions {
     /// Largest texture side kept; larger textures are halved until they fit.
     pub max_texture_size: u32,
     pub limits: Limits,
+    /// Which of the file's animations plays (its index); None plays every one at once.
+    pub animation: Option<usize>,
 }
 
 impl Default for LoadOptions {
     fn default() -> Self {
-        LoadOptions { max_texture_size: DEFAULT_MAX_TEXTURE_SIZE, limits: Limits::default() }
+        LoadOptions {
+            max_texture_size: DEFAULT_MAX_TEXTURE_SIZE,
+            limits: Limits::default(),
+            animation: None,
+        }
     }
 }
 
@@ -84,6 +94,7 @@ pub fn load_gltf_from(
             max_texture_size: opts.max_texture_size,
             budget: Budget::new(opts.limits),
             triangles: 0,
+            animation: opts.animation,
         }
         .import(&document, blob, name.to_string())
     });
@@ -191,22 +202,22 @@ impl Importer<'_> {
         self.scene_extras(&gscene, &mut scene)?;
         let data = super::accessor::Data { root: doc.as_json(), buffers: &buffers };
         let mut mesh_cache: HashMap<usize, Vec<usize>> = HashMap::new();
-        let mut animated = animations(&mut self, doc, &data)?;
+        let only = self.animation;
+        let mut animated = animations(&mut self, doc, &data, only)?;
         let mut ortho: Option<Orthographic> = None;
-        // (node, parent world transform, parent world rotation, whether an ancestor is animated).
+        // Each node's rest world transform and, where it or an ancestor is animated, its
+        // animation: what places the joints of skins, filled in as the walk meets them.
+        let mut placed: HashMap<usize, (DMat4, Option<Animation>)> = HashMap::new();
+        // Skinned objects wait for the walk to place every joint: (object, skin).
+        let mut skinned: Vec<(usize, usize)> = vec![];
+        // (node, parent world transform, parent world rotation, the parent's animation).
         // The node hierarchy is a forest (gltf_check), so this walk visits each node once.
-        let mut stack: Vec<(gltf::Node, DMat4, DQuat, bool)> =
-            gscene.nodes().map(|n| (n, DMat4::IDENTITY, DQuat::IDENTITY, false)).collect();
-        while let Some((node, parent, parent_rotation, moving_parent)) = stack.pop() {
-            let mut animation = animated.remove(&node.index());
-            if let Some(a) = animation.as_mut() {
-                if moving_parent {
-                    self.warn(format!("node {:?} is animated under an animated parent; only the parent's rest pose is used", node.name()));
-                }
-                a.parent = parent;
-            }
-            let local = node.transform().matrix().map(|c| c.map(|x| x as f64));
-            let world = parent * DMat4::from_cols_array_2d(&local);
+        let mut stack: Vec<(gltf::Node, DMat4, DQuat, Option<Animation>)> =
+            gscene.nodes().map(|n| (n, DMat4::IDENTITY, DQuat::IDENTITY, None)).collect();
+        while let Some((node, parent, parent_rotation, parent_motion)) = stack.pop() {
+            let local =
+                DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(|x| x as f64)));
+            let world = parent * local;
             let rotation = parent_rotation * local_rotation(&node);
             if !world.is_finite() {
                 self.warn(format!(
@@ -215,6 +226,20 @@ impl Importer<'_> {
                 ));
                 continue;
             }
+            // Its own channels under its parent's motion, or carried by that motion.
+            let animation = match (animated.nodes.remove(&node.index()), parent_motion) {
+                (Some(mut a), Some(up)) => {
+                    a.parent_motion = Some(std::sync::Arc::new(up));
+                    Some(a)
+                }
+                (Some(mut a), None) => {
+                    a.parent = parent;
+                    Some(a)
+                }
+                (None, Some(up)) => Some(Animation::carried(up, local)),
+                (None, None) => None,
+            };
+            placed.insert(node.index(), (world, animation.clone()));
             if let Some(mesh) = node.mesh() {
                 let ids = match mesh_cache.get(&mesh.index()) {
                     Some(ids) => ids.clone(),
@@ -230,12 +255,25 @@ impl Importer<'_> {
                     placed,
                     format_args!("nodes[{}] (meshes[{}])", node.index(), mesh.index()),
                 )?;
+                let morph = self.morph(&node, &mesh, &mut animated.weights);
+                let skin = node
+                    .skin()
+                    .filter(|_| ids.iter().any(|&id| !scene.meshes[id].joints.is_empty()));
                 for id in ids {
+                    let deform = (morph.is_some() || skin.is_some()).then(|| {
+                        std::sync::Arc::new(Deform { skin: vec![], morph: morph.clone() })
+                    });
+                    if let Some(s) = &skin {
+                        skinned.push((scene.objects.len(), s.index()));
+                    }
+                    // A skinned mesh is placed by its joints alone (glTF 2.0 §3.7.3.3).
+                    let skinned = skin.is_some() && !scene.meshes[id].joints.is_empty();
                     scene.objects.push(Object {
                         name: node.name().unwrap_or("").to_string(),
                         mesh: id,
-                        transform: world,
-                        animation: animation.clone(),
+                        transform: if skinned { DMat4::IDENTITY } else { world },
+                        animation: if skinned { None } else { animation.clone() },
+                        deform,
                     });
                 }
             }
@@ -256,17 +294,17 @@ impl Importer<'_> {
                         },
                     }
             }
-            let moving = moving_parent || animation.is_some();
-            if animation.is_some() && node.children().next().is_some() {
+            if animation.is_some() && (node.light().is_some() || node.camera().is_some()) {
                 self.warn(format!(
-                    "children of animated node {:?} are placed at its rest pose",
-                    node.name()
+                    "nodes[{}] moves a light or a camera, which stay at their rest pose",
+                    node.index()
                 ));
             }
             for child in node.children() {
-                stack.push((child, world, rotation, moving));
+                stack.push((child, world, rotation, animation.clone()));
             }
         }
+        self.bind_skins(doc, &data, &placed, &skinned, &mut scene)?;
         if let Some(o) = ortho {
             scene.camera = Some(self.perspective_for(&o, &scene));
         }

@@ -15,6 +15,8 @@ pub(super) struct Importer<'a> {
     pub(super) budget: Budget,
     /// Triangles placed so far (instances counted), against `Limits::triangles`.
     pub(super) triangles: u64,
+    /// The one animation that plays (`LoadOptions::animation`); None: all of them.
+    pub(super) animation: Option<usize>,
 }
 
 impl Importer<'_> {

@@ -1,11 +1,10 @@
-//! glTF mesh primitives and node animations, read through the checked accessors of `accessor`.
+//! glTF mesh primitives, read through the checked accessors of `accessor`.
 
 use super::accessor::{self, Data, Expect};
 use super::gltf_importer::Importer;
-use super::{Animation, Mesh, Track};
+use super::{Mesh, MorphTarget};
 use anyhow::{Result, bail};
-use glam::{DQuat, DVec3, Vec2, Vec3, Vec4};
-use std::collections::HashMap;
+use glam::{Vec2, Vec3, Vec4};
 
 /// Read one primitive as a triangle mesh, or None (with a warning) for points and lines.
 pub(super) fn primitive(
@@ -144,7 +143,10 @@ pub(super) fn primitive(
         tangents: vec![],
         indices,
         material,
+        ..Default::default()
     };
+    super::gltf_deform::read_influences(imp, prim, data, here, &mut m)?;
+    super::gltf_deform::read_targets(imp, prim, data, here, quantized, &mut m)?;
     if m.normals.len() != n {
         // glTF: without NORMAL, clients compute flat normals.
         flatten_with_face_normals(&mut m);
@@ -197,8 +199,31 @@ fn flatten_with_face_normals(m: &mut Mesh) {
             if let Some(c) = m.colors.get(t[k] as usize) {
                 out.colors.push(*c);
             }
+            if let (Some(j), Some(w)) = (m.joints.get(t[k] as usize), m.weights.get(t[k] as usize))
+            {
+                out.joints.push(*j);
+                out.weights.push(*w);
+            }
         }
     }
+    // Morph displacements follow their vertices (the flat normals do not morph).
+    out.targets = m
+        .targets
+        .iter()
+        .map(|target| {
+            let corners = |v: &[Vec3]| -> Vec<Vec3> {
+                if v.is_empty() {
+                    return vec![];
+                }
+                m.indices.chunks_exact(3).flatten().map(|&i| v[i as usize]).collect()
+            };
+            MorphTarget {
+                positions: corners(&target.positions),
+                normals: vec![],
+                tangents: corners(&target.tangents),
+            }
+        })
+        .collect();
     *m = out;
 }
 
@@ -261,118 +286,6 @@ fn generate_tangents(m: &mut Mesh, uv1: bool) {
     // MikkTSpace writes per face-vertex; shared vertices get the last write, which matches for
     // the usual case of vertices split along UV seams.
     let _ = mikktspace::generate_tangents(&mut Geo(m, uv1));
-}
-
-/// Node index -> its animation (translation/rotation/scale channels of every glTF animation).
-/// A channel that cannot be used (unsorted or non-finite keys, a value count that does not match
-/// the keys) is a warning and is ignored; a malformed accessor is an error.
-pub(super) fn animations(
-    imp: &mut Importer,
-    doc: &gltf::Document,
-    data: &Data,
-) -> Result<HashMap<usize, Animation>> {
-    use gltf::animation::{Interpolation, Property};
-    let mut map: HashMap<usize, Animation> = HashMap::new();
-    for anim in doc.animations() {
-        for ch in anim.channels() {
-            let here = format!("animations[{}].channels[{}]", anim.index(), ch.index());
-            let node = ch.target().node();
-            let sampler = ch.sampler();
-            let interp = sampler.interpolation();
-            let property = ch.target().property();
-            let expect = match property {
-                Property::Translation => accessor::TRANSLATION,
-                Property::Rotation => accessor::ROTATION,
-                Property::Scale => accessor::SCALE,
-                Property::MorphTargetWeights => {
-                    imp.warn(format!("{here}: morph target animation is not supported; ignored"));
-                    continue;
-                }
-            };
-            let times: Vec<f64> = accessor::read_f32(
-                data,
-                sampler.input().index(),
-                accessor::KEY_TIMES,
-                &mut imp.budget,
-                &format!("{here} input"),
-            )?
-            .into_iter()
-            .map(|t| t as f64)
-            .collect();
-            let values = accessor::read_f32(
-                data,
-                sampler.output().index(),
-                expect,
-                &mut imp.budget,
-                &format!("{here} output"),
-            )?;
-            let k = expect.ty.multiplicity();
-            // CUBICSPLINE stores (in-tangent, value, out-tangent) per key.
-            let per_key = if interp == Interpolation::CubicSpline { 3 } else { 1 };
-            let keys: Vec<&[f32]> =
-                values.chunks_exact(k).skip(per_key / 2).step_by(per_key).collect();
-            let tangents: Vec<[&[f32]; 2]> = if per_key == 3 {
-                values.chunks_exact(3 * k).map(|c| [&c[..k], &c[2 * k..]]).collect()
-            } else {
-                vec![]
-            };
-            if keys.len() != times.len() || values.len() != times.len() * k * per_key {
-                imp.warn(format!(
-                    "{here}: {} keys but {} values; ignored",
-                    times.len(),
-                    values.len() / k
-                ));
-                continue;
-            }
-            let sorted =
-                times.windows(2).all(|w| w[0] <= w[1]) && times.iter().all(|t| t.is_finite());
-            if !sorted || !values.iter().all(|x| x.is_finite()) {
-                imp.warn(format!("{here} has unsorted or non-finite keys; ignored"));
-                continue;
-            }
-            let (t, r, s) = node.transform().decomposed();
-            let a = map.entry(node.index()).or_insert_with(|| Animation {
-                parent: glam::DMat4::IDENTITY,
-                translation: DVec3::from_array(t.map(|x| x as f64)),
-                rotation: DQuat::from_array(r.map(|x| x as f64)),
-                scale: DVec3::from_array(s.map(|x| x as f64)),
-                translation_track: None,
-                rotation_track: None,
-                scale_track: None,
-            });
-            let step = interp == Interpolation::Step;
-            let d3 = |v: &[f32]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-            let dq =
-                |v: &[f32]| DQuat::from_xyzw(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64);
-            let v3 = || keys.iter().map(|v| d3(v)).collect::<Vec<_>>();
-            let t3 = || tangents.iter().map(|[a, b]| [d3(a), d3(b)]).collect::<Vec<_>>();
-            match property {
-                Property::Translation => {
-                    a.translation_track = Some(Track { times, values: v3(), step, tangents: t3() })
-                }
-                Property::Scale => {
-                    a.scale_track = Some(Track { times, values: v3(), step, tangents: t3() })
-                }
-                _ => {
-                    let values = keys
-                        .iter()
-                        .map(|v| dq(v).normalize())
-                        .map(|q| if q.is_finite() { q } else { DQuat::IDENTITY })
-                        .collect();
-                    // Tangents are not unit quaternions: kept as they are.
-                    let tangents = tangents.iter().map(|[a, b]| [dq(a), dq(b)]).collect();
-                    a.rotation_track = Some(Track { times, values, step, tangents });
-                }
-            }
-        }
-    }
-    map.retain(|_, a| {
-        a.duration() > 0.0
-            || a.translation_track.is_some()
-            || a.rotation_track.is_some()
-            || a.scale_track.is_some()
-    });
-    Ok(map)
 }
 
 #[cfg(test)]

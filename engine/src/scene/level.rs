@@ -166,6 +166,7 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
             mesh: i,
             transform: DMat4::IDENTITY,
             animation: None,
+            deform: None,
         })
         .collect();
     // Arches between the pillars: eight tilted voussoirs per arch, from one shared block mesh.
@@ -183,6 +184,7 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
                     mesh: block,
                     transform: DMat4::from_rotation_translation(r, p),
                     animation: None,
+                    deform: None,
                 });
             }
         }
@@ -191,10 +193,6 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
     let turn: Vec<DQuat> =
         (0..=4).map(|i| DQuat::from_rotation_y(i as f64 * std::f64::consts::FRAC_PI_2)).collect();
     let animation = Animation {
-        parent: DMat4::IDENTITY,
-        translation: DVec3::new(0.0, 1.4, 0.0),
-        rotation: DQuat::IDENTITY,
-        scale: DVec3::ONE,
         translation_track: Some(Track {
             times: vec![0.0, 2.0, 4.0],
             values: vec![
@@ -211,13 +209,14 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
             step: false,
             tangents: vec![],
         }),
-        scale_track: None,
+        ..Animation::rigid(DMat4::IDENTITY, DVec3::new(0.0, 1.4, 0.0), DQuat::IDENTITY, DVec3::ONE)
     };
     objects.push(Object {
         name: "spinning cube".into(),
         mesh: animated_mesh,
         transform: animation.world_at(0.0),
         animation: Some(animation),
+        deform: None,
     });
 
     let (sun, sky) = sky::sun_and_sky(sun_dir);

@@ -5,10 +5,13 @@ mod accessor;
 mod animation;
 mod camera_path;
 mod default_scene;
+mod deform;
 mod environment;
 mod files;
+mod gltf_animation;
 mod gltf_camera;
 mod gltf_check;
+mod gltf_deform;
 mod gltf_export;
 mod gltf_import;
 mod gltf_importer;
@@ -24,6 +27,7 @@ mod texture;
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::{cuboid, default_scene, quad, uv_sphere};
+pub use deform::{Deform, Joint, MAX_INFLUENCES, Morph, MorphTarget};
 pub use environment::{EnvMap, Environment};
 pub use files::{MemoryFiles, SceneFiles, SceneFolder};
 pub use gltf_export::save_gltf;
@@ -39,6 +43,7 @@ pub use texture::{Texture, TextureRef, Wrap, decode_image, mip_chain_texels};
 use anyhow::Result;
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::Path;
+use std::sync::Arc;
 
 /// One triangle mesh (one glTF primitive) in its object's local space.
 #[derive(Clone, Debug, Default)]
@@ -57,6 +62,12 @@ pub struct Mesh {
     pub tangents: Vec<Vec4>,
     pub indices: Vec<u32>,
     pub material: u32,
+    /// Skinned meshes: per vertex, JOINTS_0 then JOINTS_1 (indices into the object's skin) and
+    /// their weights (normalised, 0 for absent influences); empty otherwise.
+    pub joints: Vec<[u16; MAX_INFLUENCES]>,
+    pub weights: Vec<[f32; MAX_INFLUENCES]>,
+    /// Morph targets (glTF 2.0 §3.7.2.2).
+    pub targets: Vec<MorphTarget>,
 }
 
 /// A placed mesh. Transforms are kept in f64 so that a scene far from the origin keeps its
@@ -69,12 +80,39 @@ pub struct Object {
     pub transform: DMat4,
     /// Rigid motion over time, if the object moves.
     pub animation: Option<Animation>,
+    /// Skin and morph targets, if its mesh deforms (then `transform` is the identity for a
+    /// skinned mesh, whose joints place it).
+    pub deform: Option<Arc<Deform>>,
 }
 
 impl Object {
+    /// A static object.
+    pub fn new(name: impl Into<String>, mesh: usize, transform: DMat4) -> Object {
+        Object { name: name.into(), mesh, transform, animation: None, deform: None }
+    }
+
     /// World transform at `time` seconds.
     pub fn transform_at(&self, time: f64) -> DMat4 {
         self.animation.as_ref().map_or(self.transform, |a| a.world_at(time))
+    }
+
+    /// Whether it moves or deforms over time.
+    pub fn moves(&self) -> bool {
+        self.animation.is_some() || self.deform.as_ref().is_some_and(|d| d.moves())
+    }
+
+    /// Whether its mesh must be posed ([`Object::mesh_at`]) rather than read as stored.
+    pub fn deforms(&self) -> bool {
+        self.deform.is_some()
+    }
+
+    /// Its mesh at `time` seconds (None: the rest pose): `mesh` itself, or posed by its skin
+    /// and morph targets.
+    pub fn mesh_at<'a>(&self, mesh: &'a Mesh, time: Option<f64>) -> std::borrow::Cow<'a, Mesh> {
+        match &self.deform {
+            Some(d) => std::borrow::Cow::Owned(d.pose(mesh, time)),
+            None => std::borrow::Cow::Borrowed(mesh),
+        }
     }
 }
 
@@ -303,7 +341,7 @@ impl Scene {
     }
 
     pub fn is_animated(&self) -> bool {
-        self.objects.iter().any(|o| o.animation.is_some())
+        self.objects.iter().any(|o| o.moves())
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -317,7 +355,7 @@ impl Scene {
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
         for o in &self.objects {
-            for p in &self.meshes[o.mesh].positions {
+            for p in &o.mesh_at(&self.meshes[o.mesh], None).positions {
                 let w = o.transform.transform_point3(p.as_dvec3());
                 if w.is_finite() {
                     lo = lo.min(w);

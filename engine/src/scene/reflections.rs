@@ -71,14 +71,11 @@ pub fn reflection_scene(mirror_floor: bool) -> Scene {
             mesh: i,
             transform: DMat4::IDENTITY,
             animation: None,
+            deform: None,
         })
         .collect();
     // The box slides 3 m along x and back every 4 s, between the spheres and the back wall.
     let animation = Animation {
-        parent: DMat4::IDENTITY,
-        translation: DVec3::new(0.0, 0.4, -3.2),
-        rotation: DQuat::IDENTITY,
-        scale: DVec3::ONE,
         translation_track: Some(Track {
             times: vec![0.0, 2.0, 4.0],
             values: vec![
@@ -90,13 +87,14 @@ pub fn reflection_scene(mirror_floor: bool) -> Scene {
             tangents: vec![],
         }),
         rotation_track: None,
-        scale_track: None,
+        ..Animation::rigid(DMat4::IDENTITY, DVec3::new(0.0, 0.4, -3.2), DQuat::IDENTITY, DVec3::ONE)
     };
     objects.push(Object {
         name: "sliding box".into(),
         mesh: moving,
         transform: animation.world_at(0.0),
         animation: Some(animation),
+        deform: None,
     });
     let (sun, sky) = sky::sun_and_sky(Vec3::new(0.4, -0.6, -0.7).normalize());
     Scene {

@@ -72,6 +72,7 @@ pub fn terrain(n: usize) -> Scene {
             mesh: 0,
             transform: DMat4::IDENTITY,
             animation: None,
+            deform: None,
         }],
         materials: vec![lambert("ground", Vec3::new(0.45, 0.4, 0.3))],
         textures: vec![],

@@ -1,0 +1,163 @@
+//! Skins and morph targets: glTF 2.0 §3.7.3 ("Skins") and §3.7.2.2 ("Morph Targets"),
+//! evaluated on the CPU at a scene time into the posed mesh that the GPU scene flattens
+//! (`PreparedScene::expose` re-flattens a deforming object whenever the time changes).
+//!
+//! Order, as the specification gives it: morph targets first, in the mesh's own space
+//! (p + sum of weight_k x delta_k), then skinning, sum over the vertex's influences of
+//! weight_i x (joint_i's world transform x its inverse bind matrix) applied to that point. The
+//! skinned mesh node's own transform is ignored (§3.7.3.3), so a skinned object's vertices come
+//! out in world space and its transform is the identity.
+
+use super::{Animation, Mesh, Track};
+use glam::{DMat3, DMat4, Vec3};
+
+/// Influences a vertex can have: JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1.
+pub const MAX_INFLUENCES: usize = 8;
+
+/// One morph target of a mesh: per-vertex displacements, each list empty or one per vertex.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MorphTarget {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    /// Tangent xyz displacements (the handedness does not morph).
+    pub tangents: Vec<Vec3>,
+}
+
+/// A joint of a skin: the node that places it (its rest world transform and, when it or an
+/// ancestor is animated, its animation) and its inverse bind matrix.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    pub rest: DMat4,
+    pub animation: Option<Animation>,
+    pub inverse_bind: DMat4,
+}
+
+impl Joint {
+    /// World transform x inverse bind matrix at `time` (None: the rest pose). A non-finite
+    /// product falls back to the rest pose's, then to the identity: NaN never reaches a vertex.
+    fn matrix(&self, time: Option<f64>) -> DMat4 {
+        let world = match (&self.animation, time) {
+            (Some(a), Some(t)) => a.world_at(t),
+            _ => self.rest,
+        };
+        [world * self.inverse_bind, self.rest * self.inverse_bind]
+            .into_iter()
+            .find(|m| m.is_finite())
+            .unwrap_or(DMat4::IDENTITY)
+    }
+}
+
+/// glTF morph weights of a node: the rest weights (the node's, else the mesh's) and a channel
+/// per target where an animation drives them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Morph {
+    pub weights: Vec<f32>,
+    /// One per target, or empty when no animation drives the weights.
+    pub tracks: Vec<Track<f64>>,
+    /// The driving animation's length in seconds (the weights loop over it).
+    pub period: f64,
+}
+
+impl Morph {
+    pub fn weights_at(&self, time: Option<f64>) -> Vec<f32> {
+        match time {
+            Some(t) if !self.tracks.is_empty() => self
+                .tracks
+                .iter()
+                .zip(&self.weights)
+                .map(|(k, &w)| k.weight_at(t, self.period).map_or(w, |v| v as f32))
+                .map(|w| if w.is_finite() { w } else { 0.0 })
+                .collect(),
+            _ => self.weights.clone(),
+        }
+    }
+}
+
+/// How an object's mesh deforms.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Deform {
+    /// The joints its JOINTS_n index.
+    pub skin: Vec<Joint>,
+    pub morph: Option<Morph>,
+}
+
+impl Deform {
+    /// Whether the deformation changes with time (an animated joint or driven weights).
+    pub fn moves(&self) -> bool {
+        self.skin.iter().any(|j| j.animation.is_some())
+            || self.morph.as_ref().is_some_and(|m| !m.tracks.is_empty())
+    }
+
+    /// `mesh` posed at `time` (None: the rest pose): morphed, then skinned into world space.
+    pub fn pose(&self, mesh: &Mesh, time: Option<f64>) -> Mesh {
+        let mut m = mesh.clone();
+        if let Some(morph) = &self.morph {
+            let w = morph.weights_at(time);
+            for (target, &w) in mesh.targets.iter().zip(&w) {
+                if w == 0.0 {
+                    continue;
+                }
+                add(&mut m.positions, &target.positions, w);
+                add(&mut m.normals, &target.normals, w);
+                for (t, d) in m.tangents.iter_mut().zip(&target.tangents) {
+                    *t += (*d * w).extend(0.0);
+                }
+            }
+        }
+        if !self.skin.is_empty() && mesh.joints.len() == mesh.positions.len() {
+            let joints: Vec<DMat4> = self.skin.iter().map(|j| j.matrix(time)).collect();
+            skin(&mut m, &joints);
+        }
+        m.normals.iter_mut().for_each(|n| *n = n.normalize_or(Vec3::Z));
+        m
+    }
+}
+
+fn add(v: &mut [Vec3], d: &[Vec3], w: f32) {
+    for (p, d) in v.iter_mut().zip(d) {
+        *p += *d * w;
+    }
+}
+
+/// Linear blend skinning of `m`'s vertices by `joints` (joint matrices); the influences were
+/// checked at load (indices in range, weights normalised).
+fn skin(m: &mut Mesh, joints: &[DMat4]) {
+    for i in 0..m.positions.len() {
+        let (js, ws) = (m.joints[i], m.weights[i]);
+        let mut blended = DMat4::ZERO;
+        for k in 0..MAX_INFLUENCES {
+            if ws[k] > 0.0 {
+                blended += joints[js[k] as usize] * ws[k] as f64;
+            }
+        }
+        let p = blended.transform_point3(m.positions[i].as_dvec3());
+        // Normals by the inverse transpose of the blended matrix's linear part.
+        let linear = DMat3::from_mat4(blended);
+        let normal_matrix = linear.inverse().transpose();
+        let n = |v: Vec3, mat: &DMat3| (*mat * v.as_dvec3()).as_vec3();
+        m.positions[i] = if p.is_finite() { p.as_vec3() } else { Vec3::NAN };
+        if let Some(nrm) = m.normals.get_mut(i) {
+            let v = n(*nrm, &normal_matrix);
+            *nrm = if v.is_finite() { v } else { *nrm };
+        }
+        if let Some(t) = m.tangents.get_mut(i) {
+            let v = n(t.truncate(), &linear).normalize_or_zero();
+            *t = if v.is_finite() && v != Vec3::ZERO { v.extend(t.w) } else { *t };
+        }
+    }
+}
+
+/// Normalise one vertex's weights (glTF: they sum to 1); a vertex whose weights sum to zero or
+/// are not finite follows its first joint alone. Returns whether it needed that fallback.
+pub fn normalise(w: &mut [f32; MAX_INFLUENCES]) -> bool {
+    w.iter_mut().for_each(|x| *x = if x.is_finite() { x.max(0.0) } else { 0.0 });
+    let sum: f32 = w.iter().sum();
+    if sum > 0.0 && sum.is_finite() {
+        w.iter_mut().for_each(|x| *x /= sum);
+        false
+    } else {
+        *w = [0.0; MAX_INFLUENCES];
+        w[0] = 1.0;
+        true
+    }
+}
