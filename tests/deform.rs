@@ -7,7 +7,7 @@
 //! the same samples, within noise with others. Files that bind vertices to missing joints or carry non-finite bind matrices are
 //! refused by name.
 
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 use hush_engine::quality::relmse;
 use hush_engine::scene::{Scene, load_gltf};
 use hush_tests::gltf_writer::{GltfWriter, Prim, write_json};
@@ -58,18 +58,23 @@ fn bar() -> Bar {
 /// The specification's skinning, written out: joint matrices (world x inverse bind) at t, the
 /// morph target added first, the weighted sum of the joint matrices applied to the point.
 fn posed_by_hand(b: &Bar) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
-    // Linear keys from the identity: a fraction F of each turn.
-    let root = Mat4::from_quat(Quat::from_rotation_y(F * FRAC_PI_4));
+    posed_by_hand_at(b, F)
+}
+
+/// At the fraction `f` of the keys' 2 s.
+fn posed_by_hand_at(b: &Bar, f: f32) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    // Linear keys from the identity: a fraction f of each turn.
+    let root = Mat4::from_quat(Quat::from_rotation_y(f * FRAC_PI_4));
     let elbow = root
         * Mat4::from_translation(Vec3::Y)
-        * Mat4::from_quat(Quat::from_rotation_z(F * FRAC_PI_2));
+        * Mat4::from_quat(Quat::from_rotation_z(f * FRAC_PI_2));
     let joints = [root, elbow * Mat4::from_translation(-Vec3::Y)];
     let mut p = vec![];
     let mut n = vec![];
     for i in 0..b.positions.len() {
         let [w0, w1] = b.weights[i];
         let m = joints[0] * w0 + joints[1] * w1;
-        let q = Vec3::from(b.positions[i]) + F * Vec3::from(b.shear[i]);
+        let q = Vec3::from(b.positions[i]) + f * Vec3::from(b.shear[i]);
         p.push(m.transform_point3(q).to_array());
         let nm = glam::Mat3::from_mat4(m).inverse().transpose();
         n.push((nm * Vec3::from(b.normals[i])).normalize().to_array());
@@ -237,4 +242,83 @@ fn hostile_skins_are_refused_or_fall_back() {
     let o = &s.objects[0];
     let posed = o.mesh_at(&s.meshes[o.mesh], Some(T));
     assert!(posed.positions.iter().all(|p| p.is_finite()));
+}
+
+fn project(vp: &Mat4, p: Vec3, size: (u32, u32)) -> Vec2 {
+    let c = *vp * p.extend(1.0);
+    let ndc = Vec2::new(c.x, c.y) / c.w;
+    Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * Vec2::new(size.0 as f32, size.1 as f32)
+}
+
+/// Motion vectors of a deforming surface: between two real-time frames (t = 1.2 s and 1.3 s,
+/// still camera) every G-buffer pixel on the bar moves by what the hand-posed vertices say: the
+/// exact hit of the pixel's centre ray on its stored triangle, carried by the same barycentrics
+/// to that triangle's hand-posed vertices at the earlier time and projected. The bound (0.02 px
+/// and 2^-10 of the motion) is the Rg16Float storage precision plus f32 projection rounding,
+/// as tests/realtime.rs bounds object motion, and inside the 0.05 px Hush asks of it.
+#[test]
+fn motion_vectors_of_skinned_vertices_follow_the_pose() {
+    use hush_engine::frame::{FrameInput, Renderer};
+    use hush_engine::settings::FrameSettings;
+    let scene = skinned_file("skinned-bar-motion", Damage::None, |_| {}).unwrap();
+    let b = bar();
+    let camera = scene.camera.unwrap();
+    let size = (64u32, 64u32);
+    let (gpu, mut r) =
+        Renderer::headless(scene, hush_engine::accel::BvhKind::DEFAULT, size).unwrap();
+    let settings = FrameSettings::default();
+    let (t0, t1) = (1.2f64, 1.3f64);
+    for t in [t0, t1] {
+        r.render(&gpu, &FrameInput { camera, time: t, shutter: None }, &settings, None).unwrap();
+    }
+    let ids = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
+    let motion = r.read_texture(&gpu, "gbuffer/motion").unwrap().0;
+    let setup = r.camera_setup(&camera);
+    let origin = r.prepared.origin.as_vec3();
+    let (before, _) = posed_by_hand_at(&b, t0 as f32 / 2.0);
+    let tris = &r.prepared.tris;
+    let (mut worst, mut checked, mut moving) = (0f32, 0, 0);
+    for y in 0..size.1 as usize {
+        for x in 0..size.0 as usize {
+            let o = (y * size.0 as usize + x) * 8;
+            let slot = u32::from_le_bytes(ids[o + 4..o + 8].try_into().unwrap());
+            if slot == u32::MAX {
+                continue;
+            }
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0,
+            );
+            let d = (setup.fwd + ndc.x * setup.right + ndc.y * setup.up).normalize();
+            let v = |k: usize| tris[slot as usize * 3 + k].truncate();
+            let n = (v(1) - v(0)).cross(v(2) - v(0));
+            let p = setup.pos + d * ((v(0) - setup.pos).dot(n) / d.dot(n));
+            // Barycentrics of p, and the mesh triangle the slot holds (its input index).
+            let (e1, e2, ep) = (v(1) - v(0), v(2) - v(0), p - v(0));
+            let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+            let den = d11 * d22 - d12 * d12;
+            let bu = (d22 * ep.dot(e1) - d12 * ep.dot(e2)) / den;
+            let bv = (d11 * ep.dot(e2) - d12 * ep.dot(e1)) / den;
+            let tri = tris[slot as usize * 3 + 1].w.to_bits() as usize;
+            let corner = |k: usize| Vec3::from(before[b.indices[3 * tri + k] as usize]) - origin;
+            let prev = corner(0) + bu * (corner(1) - corner(0)) + bv * (corner(2) - corner(0));
+            let expected =
+                project(&setup.view_proj, prev, size) - project(&setup.view_proj, p, size);
+            let m = (y * size.0 as usize + x) * 4;
+            let got = Vec2::new(hush_tests::half(&motion[m..]), hush_tests::half(&motion[m + 2..]));
+            let err = (got - expected).length();
+            let bound = 0.02 + expected.length() / 1024.0;
+            assert!(
+                err <= bound,
+                "pixel ({x}, {y}): motion {got}, expected {expected} (error {err} > {bound})"
+            );
+            worst = worst.max(err);
+            checked += 1;
+            moving += (expected.length() > 0.25) as u32;
+        }
+    }
+    println!(
+        "skinned motion vectors: {checked} pixels ({moving} moving over 0.25 px), worst error {worst:.4} px"
+    );
+    assert!(moving > 50, "only {moving} pixels of the bar move");
 }

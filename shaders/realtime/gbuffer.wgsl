@@ -23,7 +23,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     o.bary = select(vec2f(0.0), select(vec2f(0.0, 1.0), vec2f(1.0, 0.0), corner == 1u), corner > 0u);
     o.slot = slot;
     o.cur = frame.unjittered_view_proj * vec4f(p, 1.0);
-    o.prev = frame.prev_view_proj * vec4f(previous_position(object, p), 1.0);
+    o.prev = frame.prev_view_proj * vec4f(previous_vertex(slot, o.bary, object, p), 1.0);
     return o;
 }
 

@@ -6,3 +6,8 @@ fn previous_position(object: u32, p: vec3f) -> vec3f {
     let q = prev_from_current[object] * vec4f(p, 1.0);
     return q.xyz / q.w;
 }
+
+// A point on triangle slot at barycentrics b: it moves with its object.
+fn previous_vertex(slot: u32, b: vec2f, object: u32, p: vec3f) -> vec3f {
+    return previous_position(object, p);
+}

@@ -2,3 +2,7 @@
 fn previous_position(object: u32, p: vec3f) -> vec3f {
     return p;
 }
+
+fn previous_vertex(slot: u32, b: vec2f, object: u32, p: vec3f) -> vec3f {
+    return p;
+}

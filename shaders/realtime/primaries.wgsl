@@ -89,7 +89,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             spec.a += 1.0;
         }
         let cur = to_pixels(frame.unjittered_view_proj * vec4f(p, 1.0));
-        let prev = to_pixels(frame.prev_view_proj * vec4f(previous_position(object, p), 1.0));
+        let prev = to_pixels(frame.prev_view_proj * vec4f(previous_vertex(hit.tri, hit.b, object, p), 1.0));
         motion += prev - cur;
         depth += dot(p - frame.cam_pos.xyz, fwd);
         let d = p - origin;

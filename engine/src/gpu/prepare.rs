@@ -33,6 +33,24 @@ pub struct SceneFeatures {
     /// Some material transmits light (KHR_materials_transmission): the per-material glass table
     /// (`glass`) and the refraction code exist (shaders/common/transmission.wgsl).
     pub transmission: bool,
+    /// Some mesh deforms over time (a skin or animated morph weights): each triangle's previous
+    /// vertices (`tris_prev`) give the motion vectors (realtime/motion_vertices.wgsl).
+    pub deforming: bool,
+}
+
+impl SceneFeatures {
+    /// The motion module for a program that knows each point's triangle (the G-buffer, the
+    /// traced primaries): per-vertex previous positions where a mesh deforms, per-object
+    /// motion where objects move, none otherwise.
+    pub fn vertex_motion_module(&self) -> &'static str {
+        if self.deforming {
+            "realtime/motion_vertices.wgsl"
+        } else if self.animated {
+            "realtime/motion_objects.wgsl"
+        } else {
+            "realtime/motion_static.wgsl"
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -121,6 +139,8 @@ pub struct PreparedScene {
     /// ([`PreparedScene::expose`]; `tris` are at its close), the same as `tris` while the
     /// shutter is closed (no motion blur).
     pub tris_open: Vec<Vec4>,
+    /// [`SceneFeatures::deforming`]: the vertices of `tris` at the previous `animate` call.
+    pub tris_prev: Vec<Vec4>,
     pub shading: Vec<Vec4>,
     pub tangents: Vec<Vec4>,
     /// [`SceneFeatures::vertex_extras`]: TEXCOORD_1 and COLOR_0, three texels (12 words) a
@@ -168,6 +188,10 @@ pub use crate::limits::MAX_TRIANGLES;
 #[derive(Clone, Default)]
 struct Flat {
     tris: Vec<Triangle>,
+    /// Per triangle, its index among the mesh's triangles (degenerate ones are dropped).
+    src: Vec<u32>,
+    /// Per triangle, its vertices at the previous `animate` call; empty: where they are now.
+    prev: Vec<[Vec3; 3]>,
     attrs: Vec<[Vec4; 4]>,
     tans: Vec<[Vec4; 3]>,
     extras: Vec<[[u32; 4]; 3]>,
@@ -192,7 +216,7 @@ fn flatten(
     let nmat = m3.inverse().transpose();
     let mat = if (mesh.material as usize) < scene.materials.len() { mesh.material } else { 0 };
     let mut f = Flat::default();
-    for t in mesh.indices.chunks_exact(3) {
+    for (k, t) in mesh.indices.chunks_exact(3).enumerate() {
         // A mirroring transform reverses the winding; swap to keep the front face CCW.
         let idx = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
         let p64 =
@@ -215,6 +239,7 @@ fn flatten(
             continue;
         }
         f.tris.push(Triangle { v0: p[0].into(), v1: p[1].into(), v2: p[2].into() });
+        f.src.push(k as u32);
         let n = idx.map(|i| {
             let n = mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
             let n = (nmat * n.as_dvec3()).normalize_or_zero().as_vec3();
@@ -297,6 +322,19 @@ fn pack_glass(materials: &[crate::scene::Material]) -> Vec<Vec4> {
     v
 }
 
+/// Each triangle of `now` where it was in `before` (the same object's previous flattening): the
+/// same mesh triangle's vertices, or its current ones where `before` had dropped it.
+fn previous_vertices(before: &Flat, now: &Flat) -> Vec<[Vec3; 3]> {
+    now.src
+        .iter()
+        .zip(&now.tris)
+        .map(|(k, t)| match before.src.binary_search(k) {
+            Ok(j) => [before.tris[j].v0, before.tris[j].v1, before.tris[j].v2].map(Vec3::from),
+            Err(_) => [t.v0, t.v1, t.v2].map(Vec3::from),
+        })
+        .collect()
+}
+
 /// f32 matrix of a rebased world transform.
 fn rebased(m: DMat4, origin: DVec3) -> glam::Mat4 {
     (DMat4::from_translation(-origin) * m).as_mat4()
@@ -342,6 +380,7 @@ impl PreparedScene {
             texture_uses,
             vertex_extras,
             transmission: scene.materials.iter().any(|m| m.transmission > 0.0),
+            deforming: scene.objects.iter().any(|o| o.deform.as_ref().is_some_and(|d| d.moves())),
         };
         let flat: Vec<Flat> = (0..scene.objects.len())
             .map(|i| flatten(scene, i, scene.objects[i].transform, origin, &features, None))
@@ -400,6 +439,7 @@ impl PreparedScene {
             extent,
             tris: vec![],
             tris_open: vec![],
+            tris_prev: vec![],
             shading: vec![],
             tangents: vec![],
             extras: vec![],
@@ -465,8 +505,16 @@ impl PreparedScene {
             };
             let deforms = repose && o.deform.as_ref().is_some_and(|d| d.moves());
             if (o.animation.is_some() && now != before) || deforms {
-                self.flat[i] = flatten(scene, i, now, self.origin, &self.features, Some(time));
+                let mut f = flatten(scene, i, now, self.origin, &self.features, Some(time));
+                if self.features.deforming {
+                    f.prev = previous_vertices(&self.flat[i], &f);
+                }
+                self.flat[i] = f;
                 self.world[i] = now;
+                moved = true;
+            } else if !self.flat[i].prev.is_empty() {
+                // Still since the last call: no motion left to show.
+                self.flat[i].prev.clear();
                 moved = true;
             }
         }
@@ -554,6 +602,18 @@ impl PreparedScene {
         }
         self.tris.clear();
         self.tris_open.clear();
+        self.tris_prev.clear();
+        let prev: Vec<[Vec3; 3]> = if self.features.deforming {
+            self.flat
+                .iter()
+                .flat_map(|f| {
+                    let now = f.tris.iter().map(|t| [t.v0, t.v1, t.v2].map(Vec3::from));
+                    if f.prev.is_empty() { now.collect() } else { f.prev.clone() }
+                })
+                .collect()
+        } else {
+            vec![]
+        };
         self.shading.clear();
         self.tangents.clear();
         self.extras.clear();
@@ -570,6 +630,9 @@ impl PreparedScene {
                     v(o.v1).extend(0.0),
                     v(o.v2).extend(0.0),
                 ]);
+            }
+            if let Some(p) = prev.get(i) {
+                self.tris_prev.extend(p.map(|v| v.extend(0.0)));
             }
             self.shading.extend_from_slice(attrs[i]);
             if self.features.normal_maps {

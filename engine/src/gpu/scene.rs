@@ -17,6 +17,8 @@ pub struct GpuScene {
     pub tri_texels: Texels,
     /// Animated scenes: the vertices at the shutter's open ([`PreparedScene::tris_open`]).
     pub tri_open_texels: Option<Texels>,
+    /// Deforming scenes: the vertices at the previous frame ([`PreparedScene::tris_prev`]).
+    pub tri_prev_texels: Option<Texels>,
     /// Per-triangle normals and UVs (four texels a triangle) and the materials (five texels
     /// each), as texel rows like the nodes.
     pub shading: Texels,
@@ -124,6 +126,15 @@ impl PreparedScene {
                 wgpu::TextureFormat::Rgba32Float,
             )
         });
+        let tri_prev_texels = self.features.deforming.then(|| {
+            Texels::new(
+                gpu,
+                &mut mem,
+                "scene/triangle texels at the previous frame",
+                b(&self.tris_prev),
+                wgpu::TextureFormat::Rgba32Float,
+            )
+        });
         let shading = Texels::new(
             gpu,
             &mut mem,
@@ -185,6 +196,7 @@ impl PreparedScene {
             tris,
             tri_texels,
             tri_open_texels,
+            tri_prev_texels,
             shading,
             materials,
             extras,
@@ -227,6 +239,9 @@ impl GpuScene {
             replaced |= self.tri_texels.write(gpu, mem, b(&p.tris));
             if let Some(t) = self.tri_open_texels.as_mut() {
                 replaced |= t.write(gpu, mem, b(&p.tris_open));
+            }
+            if let Some(t) = self.tri_prev_texels.as_mut() {
+                replaced |= t.write(gpu, mem, b(&p.tris_prev));
             }
             replaced |= self.shading.write(gpu, mem, b(&p.shading));
             if let Some(t) = self.extras.as_mut() {
@@ -275,6 +290,7 @@ impl GpuScene {
             .texture("bvh_texels", &self.nodes.view)
             .texture("tri_texels", &self.tri_texels.view)
             .texture_opt("tri_open_texels", self.tri_open_texels.as_ref().map(|t| &t.view))
+            .texture_opt("tri_prev_texels", self.tri_prev_texels.as_ref().map(|t| &t.view))
             .buffer("tris", &self.tris)
             .texture("shading_texels", &self.shading.view)
             .texture("material_texels", &self.materials.view)

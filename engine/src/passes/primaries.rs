@@ -87,11 +87,7 @@ impl Primaries {
         let (p, cache) = super::chain::made(&mut self.trace[moving as usize], || {
             let mut modules = scene.shading_modules_for(moving);
             modules.push("realtime/frame.wgsl");
-            modules.push(if scene.features.animated {
-                "realtime/motion_objects.wgsl"
-            } else {
-                "realtime/motion_static.wgsl"
-            });
+            modules.push(scene.features.vertex_motion_module());
             modules.extend(["realtime/lens.wgsl", "realtime/primaries.wgsl"]);
             let p = Reloadable::new(
                 gpu,

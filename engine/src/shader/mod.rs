@@ -103,6 +103,7 @@ pub fn shared_module(path: &str) -> bool {
                 | "realtime/gbuffer_in.wgsl"
                 | "realtime/glossy_in.wgsl"
                 | "realtime/motion_objects.wgsl"
+                | "realtime/motion_vertices.wgsl"
         )
 }
 

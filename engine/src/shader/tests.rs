@@ -51,7 +51,11 @@ const FEATURE_SETS: &[[&str; 9]] = &[
 fn all_programs() -> Vec<Program> {
     let mut v = vec![];
     for set in FEATURE_SETS {
-        for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
+        for motion in [
+            "realtime/motion_static.wgsl",
+            "realtime/motion_objects.wgsl",
+            "realtime/motion_vertices.wgsl",
+        ] {
             let m = [
                 "common/math.wgsl",
                 "common/rng.wgsl",
