@@ -12,8 +12,9 @@ pub struct BenchArgs {
     /// A .gltf/.glb file or a built-in scene: `default`, `level`, `reflections`, `spheres`, or
     /// `terrain:N` (a generated height field of about N triangles).
     pub scene: String,
-    /// `reference` (BVH build, rays/s, tracer samples/s) or `realtime` (GPU time per pass of the
-    /// real-time frame).
+    /// `reference` (BVH build, rays/s, tracer samples/s), `realtime` (GPU time per pass of the
+    /// real-time frame) or `animate` (what a frame of the scene's animation costs: posing, the
+    /// BVH, the upload).
     #[arg(long, default_value = "reference")]
     pub mode: String,
     /// Real-time mode: frames measured (after two warm-up frames).
@@ -154,7 +155,7 @@ fn mitsuba_rate(scene: &str) -> Option<f64> {
 pub fn run(a: BenchArgs) -> Result<()> {
     match a.mode.as_str() {
         "reference" => {}
-        m => anyhow::bail!("--mode {m:?}: use reference or realtime"),
+        m => anyhow::bail!("--mode {m:?}: use reference, realtime or animate"),
     }
     let scene = load_scene(&a.scene, &a.load)?;
     let kinds = match &a.bvh {

@@ -1,6 +1,7 @@
 //! `hush-cli`: headless rendering, image comparison and benchmarks.
 
 mod bench;
+mod bench_animate;
 mod bench_realtime;
 mod cli;
 mod compare;
@@ -91,6 +92,7 @@ fn main() {
         Command::Compare(a) => compare::run(a),
         Command::Conformance(a) => conformance::run(a),
         Command::Bench(a) if a.mode == "realtime" => bench_realtime::run(&a),
+        Command::Bench(a) if a.mode == "animate" => bench_animate::run(&a),
         Command::Bench(a) => bench::run(a),
         Command::Level(a) => level(a),
         Command::Quality(a) => quality::run(a),
