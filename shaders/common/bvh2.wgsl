@@ -32,6 +32,13 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     // TRAVERSAL_STACK comes from the scene (engine/src/accel, traversal_stack).
     var stack: array<u32, TRAVERSAL_STACK>;
     var sp = 0u;
+    // An animated scene's moving objects have a tree of their own (engine/src/gpu/prepare/
+    // assemble.rs), rooted at DYNAMIC_ROOT: it waits at the stack's bottom until the static
+    // tree is done.
+    if DYNAMIC_ROOT != 0xffffffffu {
+        stack[0] = DYNAMIC_ROOT;
+        sp = 1u;
+    }
     // Items are (index, count) pairs packed: leaves have their count in the high 8 bits.
     var item = 0u;
     var is_leaf = false;

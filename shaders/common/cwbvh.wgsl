@@ -72,7 +72,13 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
         | select(0x01010101u, 0u, d.z < 0.0);
     var stack: array<vec2u, TRAVERSAL_STACK>;
     var sp = 0u;
-    // The root as the one hit child of a virtual parent.
+    // The root as the one hit child of a virtual parent. An animated scene's moving objects
+    // have a tree of their own (engine/src/gpu/prepare/assemble.rs), rooted at DYNAMIC_ROOT:
+    // it waits at the stack's bottom until the static tree is done.
+    if DYNAMIC_ROOT != 0xffffffffu {
+        stack[0] = vec2u(DYNAMIC_ROOT, 0x80000000u);
+        sp = 1u;
+    }
     var cur = vec2u(0u, 0x80000000u);
     var prim = vec2u(0u);
     loop {

@@ -123,6 +123,20 @@ pub fn traversal_stack(kind: BvhKind, depth: usize, triangles: usize, animated: 
     need.max(4).next_multiple_of(4).min(kind.max_depth()) as u32
 }
 
+/// The stack of an animated scene split into a static tree and a rebuilt one (`gpu::prepare`'s
+/// assemble): the static tree's depth, or what any rebuild of the moving part's `triangles`
+/// can reach (as [`traversal_stack`] reckons it), and one entry more for the second root
+/// waiting under the first tree's traversal.
+pub fn split_traversal_stack(
+    kind: BvhKind,
+    static_depth: usize,
+    depth: usize,
+    triangles: usize,
+) -> u32 {
+    let need = static_depth.max(depth + 4).max(median_depth_bound(triangles)) + 1;
+    need.max(4).next_multiple_of(4).min(kind.max_depth()) as u32
+}
+
 /// The depth a median build ([`median_bvh2`], one triangle per leaf) reaches over `n` triangles
 /// in either layout: ceil(log2 n) + 1.
 fn median_depth_bound(n: usize) -> usize {

@@ -2,13 +2,15 @@
 //! the scene's centre, build the BVH, pack materials, lights, emitters, the environment and
 //! textures into the layouts the shaders read (`shaders/common/*.wgsl`).
 
+mod assemble;
+
 pub use super::pack::GpuLight;
 use super::pack::{EnvPack, pack_light, pack_textures};
 use crate::accel::{self, Accel, BvhKind};
 use crate::scene::{AlphaMode, Environment, Scene};
 use anyhow::{Result, bail};
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat3, DMat4, DVec3, Vec3, Vec3A, Vec4};
+use glam::{DMat3, DMat4, DVec3, Vec3, Vec4};
 use obvhs::triangle::Triangle;
 
 /// Which optional parts of the renderer a scene needs. Each one missing removes its bindings,
@@ -180,6 +182,10 @@ pub struct PreparedScene {
     /// Per object, the rebased transform from where a point is at the shutter's close (`time`)
     /// to where it is at its open; empty while no object moves during the shutter.
     open_from_close: Vec<glam::Mat4>,
+    /// Per object, whether it moves or deforms (its triangles are in the rebuilt part).
+    moving: Vec<bool>,
+    /// An animated scene's part that is built once ([`assemble::StaticPart`]).
+    split: Option<assemble::StaticPart>,
 }
 
 pub use crate::limits::MAX_TRIANGLES;
@@ -462,9 +468,20 @@ impl PreparedScene {
             time: 0.0,
             pose_time: None,
             open_from_close: vec![],
+            moving: scene.objects.iter().map(|o| o.moves()).collect(),
+            split: None,
         };
         p.assemble();
-        p.traversal_stack = accel::traversal_stack(kind, p.accel.depth, count, p.features.animated);
+        p.traversal_stack = match &p.split {
+            None => accel::traversal_stack(kind, p.accel.depth, count, p.features.animated),
+            Some(sp) => {
+                let moving: usize = (0..p.flat.len())
+                    .filter(|&i| p.moving[i])
+                    .map(|i| p.flat[i].tris.len() + p.flat[i].dropped)
+                    .sum();
+                accel::split_traversal_stack(kind, sp.depth, p.accel.depth, moving)
+            }
+        };
         p.features.emitters = !p.emitters.is_empty();
         Ok(p)
     }
@@ -550,126 +567,6 @@ impl PreparedScene {
         let changed = open_from_close != self.open_from_close;
         self.open_from_close = open_from_close;
         changed
-    }
-
-    /// BVH over every object's triangles, then the buffers in BVH leaf order and the emitter CDF.
-    fn assemble(&mut self) {
-        let kind = self.accel.kind;
-        let mut tris_in: Vec<Triangle> = vec![];
-        let mut attrs: Vec<&[Vec4; 4]> = vec![];
-        let mut tans: Vec<&[Vec4; 3]> = vec![];
-        let mut extras: Vec<&[[u32; 4]; 3]> = vec![];
-        let mut mats: Vec<u32> = vec![];
-        let mut open_in: Vec<Triangle> = vec![];
-        for (i, f) in self.flat.iter().enumerate() {
-            tris_in.extend_from_slice(&f.tris);
-            attrs.extend(f.attrs.iter());
-            tans.extend(f.tans.iter());
-            extras.extend(f.extras.iter());
-            mats.extend_from_slice(&f.mats);
-            if let Some(m) = self.open_from_close.get(i) {
-                let to = |v: Vec3A| Vec3A::from(m.transform_point3(v.into()));
-                open_in.extend(f.tris.iter().map(|t| Triangle {
-                    v0: to(t.v0),
-                    v1: to(t.v1),
-                    v2: to(t.v2),
-                }));
-            }
-        }
-        // With motion, the tree is built over each triangle's box at both ends of the shutter:
-        // a degenerate triangle from the box's min to its max has exactly that box.
-        let accel = if open_in.is_empty() {
-            accel::build_within(&tris_in, kind, self.traversal_stack as usize)
-        } else {
-            let swept: Vec<Triangle> = tris_in
-                .iter()
-                .zip(&open_in)
-                .map(|(c, o)| {
-                    let b = c.aabb().union(&o.aabb());
-                    Triangle { v0: b.min, v1: b.max, v2: b.min }
-                })
-                .collect();
-            accel::build_within(&swept, kind, self.traversal_stack as usize)
-        };
-        if accel.depth > self.traversal_stack as usize {
-            // Not reachable: the stack of an animated scene holds any median tree over its
-            // triangles ([`accel::traversal_stack`]).
-            log::error!(
-                "the rebuilt BVH is {} levels deep; the traversal holds {}: geometry will be missing",
-                accel.depth,
-                self.traversal_stack
-            );
-        }
-        self.tris.clear();
-        self.tris_open.clear();
-        self.tris_prev.clear();
-        let prev: Vec<[Vec3; 3]> = if self.features.deforming {
-            self.flat
-                .iter()
-                .flat_map(|f| {
-                    let now = f.tris.iter().map(|t| [t.v0, t.v1, t.v2].map(Vec3::from));
-                    if f.prev.is_empty() { now.collect() } else { f.prev.clone() }
-                })
-                .collect()
-        } else {
-            vec![]
-        };
-        self.shading.clear();
-        self.tangents.clear();
-        self.extras.clear();
-        for &orig in &accel.order {
-            let (t, i) = (&tris_in[orig as usize], orig as usize);
-            let v = |a: Vec3A| Vec3::from(a);
-            self.tris.push(v(t.v0).extend(f32::from_bits(mats[i])));
-            self.tris.push(v(t.v1).extend(f32::from_bits(orig)));
-            self.tris.push(v(t.v2).extend(0.0));
-            if self.features.animated {
-                let o = open_in.get(i).unwrap_or(t);
-                self.tris_open.extend([
-                    v(o.v0).extend(0.0),
-                    v(o.v1).extend(0.0),
-                    v(o.v2).extend(0.0),
-                ]);
-            }
-            if let Some(p) = prev.get(i) {
-                self.tris_prev.extend(p.map(|v| v.extend(0.0)));
-            }
-            self.shading.extend_from_slice(attrs[i]);
-            if self.features.normal_maps {
-                self.tangents.extend_from_slice(tans[i]);
-            }
-            if self.features.vertex_extras {
-                self.extras.extend_from_slice(extras[i]);
-            }
-        }
-        // Emissive triangles by area x luminance (one-sided power up to a constant pi).
-        let mut emitters = vec![];
-        let mut weights = vec![];
-        for (slot, &orig) in accel.order.iter().enumerate() {
-            let m = mats[orig as usize] as usize;
-            let lum = self
-                .materials
-                .get(m)
-                .map_or(0.0, |m| crate::quality::luminance(Vec3::from_slice(&m.emission)));
-            if lum > 0.0 {
-                let t = &tris_in[orig as usize];
-                let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
-                weights.push(area * lum as f64);
-                emitters.push([0u32, slot as u32]);
-            }
-        }
-        let total: f64 = weights.iter().sum();
-        let mut acc = 0.0;
-        for (e, w) in emitters.iter_mut().zip(&weights) {
-            acc += w;
-            e[0] = ((acc / total) as f32).to_bits();
-        }
-        if let Some(last) = emitters.last_mut() {
-            last[0] = 1.0f32.to_bits();
-        }
-        self.emit_inv_total = if total > 0.0 { (1.0 / total) as f32 } else { 0.0 };
-        self.emitters = emitters;
-        self.accel = accel;
     }
 }
 

@@ -9,6 +9,8 @@ pub struct GpuScene {
     pub bvh_kind: BvhKind,
     /// [`PreparedScene::traversal_stack`].
     pub traversal_stack: u32,
+    /// [`PreparedScene::dynamic_root`].
+    pub dynamic_root: Option<u32>,
     /// The BVH nodes as texel rows ([`Texels`]): traversal reads them with textureLoad.
     pub nodes: Texels,
     /// Triangle vertices, three vec4 each: a buffer for the raster pass and shading, and the
@@ -192,6 +194,7 @@ impl PreparedScene {
             features: f,
             bvh_kind: self.accel.kind,
             traversal_stack: self.traversal_stack,
+            dynamic_root: self.dynamic_root(),
             nodes,
             tris,
             tri_texels,
@@ -234,28 +237,34 @@ impl GpuScene {
         }
         let mut replaced = false;
         let mem = &mut self.memory;
+        // An animated scene's static part leads every array and never changes: only what
+        // follows it is written (PreparedScene::static_prefix).
+        let (slots, node_bytes) = p.static_prefix();
         if moved {
-            replaced |= self.nodes.write(gpu, mem, &p.accel.nodes);
-            replaced |= self.tri_texels.write(gpu, mem, b(&p.tris));
+            replaced |= self.nodes.write_from(gpu, mem, &p.accel.nodes, node_bytes);
+            replaced |= self.tri_texels.write_from(gpu, mem, b(&p.tris), slots * 48);
             if let Some(t) = self.tri_open_texels.as_mut() {
-                replaced |= t.write(gpu, mem, b(&p.tris_open));
+                replaced |= t.write_from(gpu, mem, b(&p.tris_open), slots * 48);
             }
             if let Some(t) = self.tri_prev_texels.as_mut() {
-                replaced |= t.write(gpu, mem, b(&p.tris_prev));
+                replaced |= t.write_from(gpu, mem, b(&p.tris_prev), slots * 48);
             }
-            replaced |= self.shading.write(gpu, mem, b(&p.shading));
+            replaced |= self.shading.write_from(gpu, mem, b(&p.shading), slots * 64);
             if let Some(t) = self.extras.as_mut() {
-                replaced |= t.write(gpu, mem, b(&p.extras));
+                replaced |= t.write_from(gpu, mem, b(&p.extras), slots * 48);
             }
         }
-        let mut put = |buf: &mut wgpu::Buffer, label: &str, data: &[u8]| {
+        let mut put = |buf: &mut wgpu::Buffer, label: &str, data: &[u8], from: usize| {
             if data.is_empty() {
                 return;
             }
             if (data.len() as u64) <= buf.size()
                 && buf.usage().contains(wgpu::BufferUsages::COPY_DST)
             {
-                gpu.queue.write_buffer(buf, 0, data);
+                let from = from.min(data.len());
+                if from < data.len() {
+                    gpu.queue.write_buffer(buf, from as u64, &data[from..]);
+                }
             } else {
                 mem.allocations.retain(|(l, _)| l != label);
                 let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
@@ -267,16 +276,16 @@ impl GpuScene {
             }
         };
         if moved {
-            put(&mut self.tris, "scene/triangles", b(&p.tris));
+            put(&mut self.tris, "scene/triangles", b(&p.tris), slots * 48);
             if let Some(t) = self.tangents.as_mut() {
-                put(t, "scene/tangents", b(&p.tangents));
+                put(t, "scene/tangents", b(&p.tangents), slots * 48);
             }
             if let Some(e) = self.emitters.as_mut() {
-                put(e, "scene/emitters", b(&p.emitters));
+                put(e, "scene/emitters", b(&p.emitters), 0);
             }
         }
         if let Some(o) = self.objects.as_mut() {
-            put(o, "scene/object motion", b(&p.prev_from_current));
+            put(o, "scene/object motion", b(&p.prev_from_current), 0);
         }
         self.triangle_count = p.triangle_count() as u32;
         if replaced {
@@ -381,7 +390,11 @@ impl GpuScene {
 
     /// What a program that only traverses needs before its modules.
     pub fn traversal_prelude(&self) -> String {
-        format!("const TRAVERSAL_STACK: u32 = {}u;\n", self.traversal_stack)
+        format!(
+            "const TRAVERSAL_STACK: u32 = {}u;\nconst DYNAMIC_ROOT: u32 = {}u;\n",
+            self.traversal_stack,
+            self.dynamic_root.unwrap_or(u32::MAX)
+        )
     }
 }
 
@@ -438,44 +451,58 @@ impl Texels {
     }
 
     fn upload(&self, gpu: &Gpu, bytes: &[u8]) {
-        if bytes.is_empty() {
-            return;
-        }
-        let full_rows = (bytes.len() / 16) as u32 / TEXEL_ROW;
-        let row_bytes = (TEXEL_ROW * 16) as usize;
+        self.upload_from(gpu, bytes, 0);
+    }
+
+    /// Write `bytes[from..]` (`from` a multiple of 16) at its texels: the rest of the first row
+    /// it starts in, then whole rows, then the start of the last.
+    fn upload_from(&self, gpu: &Gpu, bytes: &[u8], from: usize) {
+        let row = TEXEL_ROW as usize;
         let layout = wgpu::TexelCopyBufferLayout {
             offset: 0,
             bytes_per_row: Some(TEXEL_ROW * 16),
             rows_per_image: None,
         };
-        if full_rows > 0 {
-            let extent =
-                wgpu::Extent3d { width: TEXEL_ROW, height: full_rows, depth_or_array_layers: 1 };
-            gpu.queue.write_texture(
-                self.texture.as_image_copy(),
-                &bytes[..full_rows as usize * row_bytes],
-                layout,
-                extent,
-            );
-        }
-        let rest = &bytes[full_rows as usize * row_bytes..];
-        if !rest.is_empty() {
-            let mut last = rest.to_vec();
-            last.resize(rest.len().next_multiple_of(16), 0);
-            let mut at = self.texture.as_image_copy();
-            at.origin.y = full_rows;
-            let extent = wgpu::Extent3d {
-                width: (last.len() / 16) as u32,
-                height: 1,
-                depth_or_array_layers: 1,
+        let mut texel = from / 16;
+        let mut rest = &bytes[(texel * 16).min(bytes.len())..];
+        while !rest.is_empty() {
+            let (y, x) = (texel / row, texel % row);
+            // A partial row (at either end) or every whole row at once.
+            let (count, rows) = if x == 0 && rest.len() >= row * 16 {
+                let rows = rest.len() / (row * 16);
+                (rows * row, rows)
+            } else {
+                ((row - x).min(rest.len().div_ceil(16)), 1)
             };
-            gpu.queue.write_texture(at, &last, layout, extent);
+            let n = (count * 16).min(rest.len());
+            let mut data = rest[..n].to_vec();
+            data.resize(count * 16, 0);
+            let mut at = self.texture.as_image_copy();
+            at.origin.x = x as u32;
+            at.origin.y = y as u32;
+            let width = if rows > 1 { TEXEL_ROW } else { count as u32 };
+            let extent = wgpu::Extent3d { width, height: rows as u32, depth_or_array_layers: 1 };
+            gpu.queue.write_texture(at, &data, layout, extent);
+            rest = &rest[n..];
+            texel += count;
         }
     }
 
     /// Write `bytes` from texel 0, in a larger texture where they no longer fit (true then:
     /// bind groups must be remade).
     pub fn write(&mut self, gpu: &Gpu, mem: &mut GpuMemory, bytes: &[u8]) -> bool {
+        self.write_from(gpu, mem, bytes, 0)
+    }
+
+    /// [`Texels::write`] of `bytes`, of which the first `from` are already in the texture:
+    /// only the rest is written, unless a larger texture takes them all.
+    pub fn write_from(
+        &mut self,
+        gpu: &Gpu,
+        mem: &mut GpuMemory,
+        bytes: &[u8],
+        from: usize,
+    ) -> bool {
         let rows = texel_row_count(bytes.len());
         let replaced = rows > self.texture.height();
         if replaced {
@@ -486,7 +513,7 @@ impl Texels {
             (self.texture, self.view) =
                 Self::make(gpu, mem, &self.label, (rows + rows / 4 + 1).min(most), self.format);
         }
-        self.upload(gpu, bytes);
+        self.upload_from(gpu, bytes, if replaced { 0 } else { from });
         replaced
     }
 }

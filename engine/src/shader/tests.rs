@@ -192,7 +192,7 @@ fn all_programs() -> Vec<Program> {
     }
     for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
         // A scene sets the traversal's stack length (accel::traversal_stack).
-        let stack = "const TRAVERSAL_STACK: u32 = 16u;\n";
+        let stack = "const TRAVERSAL_STACK: u32 = 16u;\nconst DYNAMIC_ROOT: u32 = 7u;\n";
         v.push(
             compose(
                 "raycast",

@@ -1,0 +1,313 @@
+//! The flattened objects in the order the GPU reads them: a BVH over their triangles, then every
+//! per-triangle array in BVH leaf order, and the emitter CDF.
+//!
+//! A static scene is one tree over everything, built once. In an animated scene the objects
+//! that never move are built once into a static tree whose nodes and triangles lead the GPU
+//! arrays, and only the moving objects' tree is rebuilt when they move: its nodes and triangles
+//! follow the static ones (node and triangle indices rebased past them), the traversal visits
+//! its root after the static tree's (`DYNAMIC_ROOT`, shaders/common/cwbvh.wgsl and bvh2.wgsl),
+//! and only that tail is rewritten on the GPU (`GpuScene::update_geometry`). Measured on the
+//! living room with one 1,008-triangle node turning (`bench --mode animate`): see
+//! `StaticPart`.
+
+use super::{Flat, PreparedScene};
+use crate::accel::{self, Accel, Bvh2GpuNode, BvhKind};
+use glam::{Vec3, Vec3A};
+use obvhs::triangle::Triangle;
+
+/// What an animated scene's static objects hold of the GPU arrays, from their start: their
+/// triangle slots, input triangles, BVH nodes and emitters. The moving objects' part follows.
+/// Rebuilding only that part took the living room with one turning node from 121.6 ms a frame
+/// (the whole tree, CWBVH, lavapipe) to the figure `bench --mode animate` reports.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct StaticPart {
+    pub slots: usize,
+    pub inputs: u32,
+    pub nodes: usize,
+    pub node_bytes: usize,
+    pub depth: usize,
+    /// (area x luminance, slot) of its emissive triangles.
+    emitters: Vec<(f64, u32)>,
+}
+
+/// One part's tree and emitters, its indices already global.
+struct Part {
+    accel: Accel,
+    emitters: Vec<(f64, u32)>,
+}
+
+/// Bytes of one node in `kind`'s GPU layout.
+fn node_size(kind: BvhKind) -> usize {
+    match kind {
+        BvhKind::Bvh2 => std::mem::size_of::<Bvh2GpuNode>(),
+        BvhKind::Cwbvh => 80,
+    }
+}
+
+/// One node no ray enters, in `kind`'s layout: inverted boxes (binary) or no children (CWBVH).
+fn empty_node(kind: BvhKind) -> Vec<u8> {
+    match kind {
+        BvhKind::Bvh2 => {
+            let (lo, hi) = ([f32::MAX; 3], [-f32::MAX; 3]);
+            let n = Bvh2GpuNode {
+                lmin: lo,
+                l_index: 0,
+                lmax: hi,
+                l_count: 1,
+                rmin: lo,
+                r_index: 0,
+                rmax: hi,
+                r_count: 1,
+            };
+            bytemuck::bytes_of(&n).to_vec()
+        }
+        BvhKind::Cwbvh => vec![0; 80],
+    }
+}
+
+/// Shift a part's node references past `node_base` nodes and its triangle references past
+/// `slot_base` slots. Binary nodes: a child with a count is a triangle range, else a node.
+/// CWBVH nodes: the child base index (bytes 16..20) and the primitive base index (20..24).
+fn rebase_nodes(kind: BvhKind, bytes: &mut [u8], node_base: u32, slot_base: u32) {
+    if node_base == 0 && slot_base == 0 {
+        return;
+    }
+    let add = |b: &mut [u8], at: usize, v: u32| {
+        let x = bytemuck::pod_read_unaligned::<u32>(&b[at..at + 4]).wrapping_add(v);
+        b[at..at + 4].copy_from_slice(&x.to_le_bytes());
+    };
+    for n in bytes.chunks_exact_mut(node_size(kind)) {
+        match kind {
+            BvhKind::Bvh2 => {
+                // Bvh2GpuNode: l_index at 12, l_count at 28, r_index at 44, r_count at 60.
+                for (index, count) in [(12, 28), (44, 60)] {
+                    let c = bytemuck::pod_read_unaligned::<u32>(&n[count..count + 4]);
+                    add(n, index, if c > 0 { slot_base } else { node_base });
+                }
+            }
+            BvhKind::Cwbvh => {
+                add(n, 16, node_base);
+                add(n, 20, slot_base);
+            }
+        }
+    }
+}
+
+impl PreparedScene {
+    /// Objects that move (rebuilt with every change) and those that never do.
+    fn moving_objects(&self) -> (Vec<usize>, Vec<usize>) {
+        (0..self.flat.len()).partition(|&i| self.moving[i])
+    }
+
+    /// The BVH and the GPU arrays: everything at once for a static scene; for an animated one,
+    /// the static part at its first call and the moving part at every call.
+    pub(super) fn assemble(&mut self) {
+        let (moving, still) = self.moving_objects();
+        if moving.is_empty() {
+            self.clear_arrays();
+            let all: Vec<usize> = (0..self.flat.len()).collect();
+            let part = self.append_part(&all, 0, 0, 0, false);
+            self.accel = part.accel;
+            self.set_emitters(part.emitters);
+            return;
+        }
+        let kind = self.accel.kind;
+        let sp = match self.split.clone() {
+            Some(sp) => sp,
+            None => {
+                self.clear_arrays();
+                let part = self.append_part(&still, 0, 0, 0, true);
+                let sp = StaticPart {
+                    slots: self.tris.len() / 3,
+                    inputs: part.accel.order.len() as u32,
+                    nodes: part.accel.node_count,
+                    node_bytes: part.accel.nodes.len(),
+                    depth: part.accel.depth,
+                    emitters: part.emitters,
+                };
+                self.accel = part.accel;
+                self.split = Some(sp.clone());
+                sp
+            }
+        };
+        self.truncate_arrays(sp.slots);
+        let part = self.append_part(&moving, sp.inputs, sp.slots, sp.nodes, true);
+        let a = &mut self.accel;
+        a.kind = kind;
+        a.nodes.truncate(sp.node_bytes);
+        a.nodes.extend_from_slice(&part.accel.nodes);
+        a.node_count = sp.nodes + part.accel.node_count;
+        a.order.truncate(sp.slots);
+        a.order.extend_from_slice(&part.accel.order);
+        a.build_time = part.accel.build_time;
+        a.median_fallback = part.accel.median_fallback;
+        a.depth = sp.depth.max(part.accel.depth);
+        let emitters = sp.emitters.iter().copied().chain(part.emitters).collect();
+        self.set_emitters(emitters);
+    }
+
+    /// The root of the moving objects' tree, which the traversal visits after the static
+    /// one's; None for a static scene.
+    pub fn dynamic_root(&self) -> Option<u32> {
+        self.split.as_ref().map(|sp| sp.nodes as u32)
+    }
+
+    /// Input triangles of an animated scene's static part: the moving objects' triangles are
+    /// numbered from here (the index in `tris`' second w); 0 for a static scene.
+    pub fn static_inputs(&self) -> u32 {
+        self.split.as_ref().map_or(0, |sp| sp.inputs)
+    }
+
+    /// How much of the GPU arrays never changes after the first upload: (triangle slots,
+    /// node bytes); (0, 0) for a static scene, which rewrites everything it changes.
+    pub fn static_prefix(&self) -> (usize, usize) {
+        self.split.as_ref().map_or((0, 0), |sp| (sp.slots, sp.node_bytes))
+    }
+
+    fn clear_arrays(&mut self) {
+        self.truncate_arrays(0);
+        self.accel.nodes.clear();
+        self.accel.order.clear();
+    }
+
+    /// Keep the first `slots` triangles of every per-triangle array.
+    fn truncate_arrays(&mut self, slots: usize) {
+        self.tris.truncate(3 * slots);
+        self.tris_open.truncate(3 * slots);
+        self.tris_prev.truncate(3 * slots);
+        self.shading.truncate(4 * slots);
+        self.tangents.truncate(3 * slots);
+        self.extras.truncate(3 * slots);
+    }
+
+    /// Build a tree over `objects`' triangles and append them, in its leaf order, to the GPU
+    /// arrays. Input indices start at `input_base`, slots at `slot_base`, nodes at `node_base`;
+    /// `split`: the tree is one of two, and leaves the traversal one stack entry.
+    fn append_part(
+        &mut self,
+        objects: &[usize],
+        input_base: u32,
+        slot_base: usize,
+        node_base: usize,
+        split: bool,
+    ) -> Part {
+        let kind = self.accel.kind;
+        let mut tris_in: Vec<Triangle> = vec![];
+        let mut attrs: Vec<&[glam::Vec4; 4]> = vec![];
+        let mut tans: Vec<&[glam::Vec4; 3]> = vec![];
+        let mut extras: Vec<&[[u32; 4]; 3]> = vec![];
+        let mut mats: Vec<u32> = vec![];
+        let mut open_in: Vec<Triangle> = vec![];
+        let mut prev: Vec<[Vec3; 3]> = vec![];
+        for &i in objects {
+            let f: &Flat = &self.flat[i];
+            tris_in.extend_from_slice(&f.tris);
+            attrs.extend(f.attrs.iter());
+            tans.extend(f.tans.iter());
+            extras.extend(f.extras.iter());
+            mats.extend_from_slice(&f.mats);
+            if let Some(m) = self.open_from_close.get(i) {
+                let to = |v: Vec3A| Vec3A::from(m.transform_point3(v.into()));
+                open_in.extend(f.tris.iter().map(|t| Triangle {
+                    v0: to(t.v0),
+                    v1: to(t.v1),
+                    v2: to(t.v2),
+                }));
+            }
+            if self.features.deforming {
+                if f.prev.is_empty() {
+                    prev.extend(f.tris.iter().map(|t| [t.v0, t.v1, t.v2].map(Vec3::from)));
+                } else {
+                    prev.extend_from_slice(&f.prev);
+                }
+            }
+        }
+        let max_depth = self.traversal_stack as usize - split as usize;
+        // With motion, the tree is built over each triangle's box at both ends of the shutter:
+        // a degenerate triangle from the box's min to its max has exactly that box.
+        let mut accel = if split && tris_in.is_empty() {
+            Accel { kind, nodes: empty_node(kind), node_count: 1, depth: 1, ..Accel::empty(kind) }
+        } else if open_in.is_empty() {
+            accel::build_within(&tris_in, kind, max_depth)
+        } else {
+            let swept: Vec<Triangle> = tris_in
+                .iter()
+                .zip(&open_in)
+                .map(|(c, o)| {
+                    let b = c.aabb().union(&o.aabb());
+                    Triangle { v0: b.min, v1: b.max, v2: b.min }
+                })
+                .collect();
+            accel::build_within(&swept, kind, max_depth)
+        };
+        if accel.depth > max_depth {
+            // Not reachable: the stack of an animated scene holds any median tree over its
+            // triangles ([`accel::traversal_stack`]).
+            log::error!(
+                "the rebuilt BVH is {} levels deep; the traversal holds {}: geometry will be missing",
+                accel.depth,
+                max_depth
+            );
+        }
+        if split {
+            rebase_nodes(kind, &mut accel.nodes, node_base as u32, slot_base as u32);
+        }
+        let mut emitters = vec![];
+        for (local, &orig) in accel.order.iter().enumerate() {
+            let (t, i) = (&tris_in[orig as usize], orig as usize);
+            let global = input_base + orig;
+            let v = |a: Vec3A| Vec3::from(a);
+            self.tris.push(v(t.v0).extend(f32::from_bits(mats[i])));
+            self.tris.push(v(t.v1).extend(f32::from_bits(global)));
+            self.tris.push(v(t.v2).extend(0.0));
+            if self.features.animated {
+                let o = open_in.get(i).unwrap_or(t);
+                self.tris_open.extend([
+                    v(o.v0).extend(0.0),
+                    v(o.v1).extend(0.0),
+                    v(o.v2).extend(0.0),
+                ]);
+            }
+            if let Some(p) = prev.get(i) {
+                self.tris_prev.extend(p.map(|v| v.extend(0.0)));
+            }
+            self.shading.extend_from_slice(attrs[i]);
+            if self.features.normal_maps {
+                self.tangents.extend_from_slice(tans[i]);
+            }
+            if self.features.vertex_extras {
+                self.extras.extend_from_slice(extras[i]);
+            }
+            // Emissive triangles by area x luminance (one-sided power up to a constant pi).
+            let lum = self
+                .materials
+                .get(mats[i] as usize)
+                .map_or(0.0, |m| crate::quality::luminance(Vec3::from_slice(&m.emission)));
+            if lum > 0.0 {
+                let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
+                emitters.push((area * lum as f64, (slot_base + local) as u32));
+            }
+        }
+        for o in accel.order.iter_mut() {
+            *o += input_base;
+        }
+        Part { accel, emitters }
+    }
+
+    /// The emitter CDF over (weight, slot) pairs.
+    fn set_emitters(&mut self, list: Vec<(f64, u32)>) {
+        let total: f64 = list.iter().map(|e| e.0).sum();
+        let mut acc = 0.0;
+        self.emitters = list
+            .iter()
+            .map(|&(w, slot)| {
+                acc += w;
+                [((acc / total) as f32).to_bits(), slot]
+            })
+            .collect();
+        if let Some(last) = self.emitters.last_mut() {
+            last[0] = 1.0f32.to_bits();
+        }
+        self.emit_inv_total = if total > 0.0 { (1.0 / total) as f32 } else { 0.0 };
+    }
+}
