@@ -9,6 +9,9 @@ use bytemuck::{Pod, Zeroable};
 use obvhs::{BvhBuildParams, triangle::Triangle};
 use std::time::{Duration, Instant};
 
+mod refit;
+pub use refit::{REFIT_LIMIT, RefitTree, build_refittable, refit};
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BvhKind {
     Bvh2,
@@ -150,6 +153,16 @@ pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
 /// [`build`], with the SAH tree kept only where it is at most `max_depth` deep (a traversal
 /// stack of that many entries holds it); the median tree otherwise.
 pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel {
+    build_tree(tris, kind, max_depth).0
+}
+
+/// [`build_within`], with obvhs's binary tree the nodes were packed from (None for an empty
+/// input), for [`refit`].
+fn build_tree(
+    tris: &[Triangle],
+    kind: BvhKind,
+    max_depth: usize,
+) -> (Accel, Option<obvhs::bvh2::Bvh2>) {
     let max_depth = max_depth.min(kind.max_depth());
     let start = Instant::now();
     if tris.is_empty() {
@@ -166,7 +179,7 @@ pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel
         // An empty scene binds one node no ray can enter, in either layout's size.
         let mut nodes = bytemuck::bytes_of(&node).to_vec();
         nodes.resize(80, 0);
-        return Accel {
+        let accel = Accel {
             kind: BvhKind::Bvh2,
             nodes,
             node_count: 1,
@@ -175,6 +188,7 @@ pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel
             median_fallback: false,
             depth: 1,
         };
+        return (accel, None);
     }
     // obvhs's PLOC merges mutual nearest neighbours. Triangles that share one centroid (stacked
     // or nested copies) are all equally near each other: they merge one pair per pass (quadratic
@@ -204,7 +218,7 @@ pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel
         (false, false) => sah_build(tris, kind, max_depth),
     };
     let median_fallback = sah.is_none();
-    let (nodes, node_count, order, depth) = sah.unwrap_or_else(|| {
+    let ((nodes, node_count, order, depth), tree) = sah.unwrap_or_else(|| {
         log::warn!(
             "the {} BVH over {} triangles is built by median splits, which trace slower: many triangles share one bounding box, and the SAH build would be too deep for the GPU's traversal stack",
             kind.name(),
@@ -212,7 +226,16 @@ pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel
         );
         median_build(tris, kind)
     });
-    Accel { kind, nodes, node_count, order, build_time: start.elapsed(), median_fallback, depth }
+    let accel = Accel {
+        kind,
+        nodes,
+        node_count,
+        order,
+        build_time: start.elapsed(),
+        median_fallback,
+        depth,
+    };
+    (accel, Some(tree))
 }
 
 /// Node bytes in the layout's GPU form, node count, triangle order and depth.
@@ -223,7 +246,11 @@ type Built = (Vec<u8>, usize, Vec<u32>, usize);
 /// validation, which panics on a tree deeper than obvhs's own stack. None where the tree is
 /// deeper than the GPU traversal holds: checked before the reinsertion pass, which is slow on
 /// deep trees, and after it.
-fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind, max_depth: usize) -> Option<Built> {
+fn sah_build<T: obvhs::Boundable>(
+    prims: &[T],
+    kind: BvhKind,
+    max_depth: usize,
+) -> Option<(Built, obvhs::bvh2::Bvh2)> {
     let p = params();
     let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(prims.len()).build(
         p.ploc_search_distance,
@@ -253,7 +280,8 @@ fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind, max_depth: usize) 
             let nodes = pack_bvh2(&bvh.nodes);
             let depth = packed_bvh2_depth(&nodes);
             (depth <= max_depth).then(|| {
-                (bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), bvh.primitive_indices, depth)
+                let order = bvh.primitive_indices.clone();
+                ((bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), order, depth), bvh)
             })
         }
         BvhKind::Cwbvh => {
@@ -270,44 +298,34 @@ fn sah_build<T: obvhs::Boundable>(prims: &[T], kind: BvhKind, max_depth: usize) 
             );
             let depth = cwbvh_depth(&cw.nodes);
             (depth <= max_depth).then(|| {
-                (
-                    bytemuck::cast_slice(&cw.nodes).to_vec(),
-                    cw.nodes.len(),
-                    cw.primitive_indices,
-                    depth,
-                )
+                let nodes = bytemuck::cast_slice(&cw.nodes).to_vec();
+                ((nodes, cw.nodes.len(), cw.primitive_indices, depth), bvh)
             })
         }
     }
 }
 
-fn median_build(tris: &[Triangle], kind: BvhKind) -> Built {
+fn median_build(tris: &[Triangle], kind: BvhKind) -> (Built, obvhs::bvh2::Bvh2) {
     let p = params();
     match kind {
         BvhKind::Bvh2 => {
             let bvh = median_bvh2(tris, p.max_prims_per_leaf as usize);
             let nodes = pack_bvh2(&bvh.nodes);
-            (
-                bytemuck::cast_slice(&nodes).to_vec(),
-                nodes.len(),
-                bvh.primitive_indices,
-                packed_bvh2_depth(&nodes),
-            )
+            let depth = packed_bvh2_depth(&nodes);
+            let order = bvh.primitive_indices.clone();
+            ((bytemuck::cast_slice(&nodes).to_vec(), nodes.len(), order, depth), bvh)
         }
         BvhKind::Cwbvh => {
             // obvhs's CWBVH leaves hold at most 3 triangles.
+            let bvh = median_bvh2(tris, 1);
             let cw = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
-                &median_bvh2(tris, 1),
+                &bvh,
                 p.max_prims_per_leaf.clamp(1, 3),
                 true,
                 false,
             );
-            (
-                bytemuck::cast_slice(&cw.nodes).to_vec(),
-                cw.nodes.len(),
-                cw.primitive_indices,
-                cwbvh_depth(&cw.nodes),
-            )
+            let nodes = bytemuck::cast_slice(&cw.nodes).to_vec();
+            ((nodes, cw.nodes.len(), cw.primitive_indices, cwbvh_depth(&cw.nodes)), bvh)
         }
     }
 }

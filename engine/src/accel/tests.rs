@@ -97,3 +97,90 @@ fn traversal_stacks_hold_the_trees_built_within_them() {
     assert_eq!(median_depth_bound(5000), 14);
     assert_eq!(median_depth_bound(1), 1);
 }
+
+/// Every leaf triangle of a packed tree, with the box its parent stores for that leaf (binary:
+/// the child box; CWBVH: the dequantized child planes), and every inner child with its box
+/// and its own node's boxes.
+fn leaf_boxes(a: &Accel) -> Vec<(u32, obvhs::aabb::Aabb)> {
+    use obvhs::aabb::Aabb;
+    let mut out = vec![];
+    match a.kind {
+        BvhKind::Bvh2 => {
+            let nodes: Vec<Bvh2GpuNode> = bytemuck::pod_collect_to_vec(&a.nodes);
+            for n in &nodes {
+                for (lo, hi, index, count) in
+                    [(n.lmin, n.lmax, n.l_index, n.l_count), (n.rmin, n.rmax, n.r_index, n.r_count)]
+                {
+                    let b = Aabb::new(lo.into(), hi.into());
+                    if count > 0 && lo[0] <= hi[0] {
+                        out.extend((index..index + count).map(|s| (s, b)));
+                    }
+                }
+            }
+        }
+        BvhKind::Cwbvh => {
+            let nodes: Vec<obvhs::cwbvh::node::CwBvhNode> = bytemuck::pod_collect_to_vec(&a.nodes);
+            for n in &nodes {
+                for c in 0..8 {
+                    if !n.is_child_empty(c) && n.is_leaf(c) {
+                        let (first, count) = n.child_primitives(c);
+                        out.extend((first..first + count).map(|s| (s, n.child_aabb(c))));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A refit tree's boxes hold every triangle after the triangles moved (bounds within f32
+/// rounding of the dequantized planes), in both layouts; a refit that would grow the tree's
+/// cost past REFIT_LIMIT is refused (the caller rebuilds).
+#[test]
+fn refit_bounds_contain_every_triangle() {
+    let base: Vec<Triangle> = (0..3000)
+        .map(|i| {
+            let o = glam::Vec3A::new(
+                (i % 50) as f32 * 0.3,
+                (i / 50) as f32 * 0.3,
+                (i % 7) as f32 * 0.05,
+            );
+            let s = glam::Vec3A::splat(0.2);
+            Triangle { v0: o, v1: o + s * glam::Vec3A::X, v2: o + s * glam::Vec3A::Y }
+        })
+        .collect();
+    // A bend: each triangle moved by a smooth function of where it is.
+    let bend = |t: &Triangle, a: f32| {
+        let f = |v: glam::Vec3A| v + glam::Vec3A::new(0.0, 0.0, a * (v.x * 0.4).sin());
+        Triangle { v0: f(t.v0), v1: f(t.v1), v2: f(t.v2) }
+    };
+    for kind in [BvhKind::Bvh2, BvhKind::Cwbvh] {
+        let (_, tree) = build_refittable(&base, kind, kind.max_depth());
+        let mut tree = tree.unwrap();
+        for a in [0.1f32, 0.3, 0.6] {
+            let moved: Vec<Triangle> = base.iter().map(|t| bend(t, a)).collect();
+            let accel = refit(&mut tree, &moved).expect("a gentle bend refits");
+            let boxes = leaf_boxes(&accel);
+            assert_eq!(boxes.len(), moved.len(), "{kind:?}: every triangle in one leaf");
+            for (slot, b) in boxes {
+                let t = moved[accel.order[slot as usize] as usize].aabb();
+                let eps = 1e-5 * (1.0 + t.max.abs().max_element());
+                assert!(
+                    (t.min - b.min).min_element() >= -eps && (b.max - t.max).min_element() >= -eps,
+                    "{kind:?} bend {a}: triangle {slot} {t:?} outside its leaf box {b:?}"
+                );
+            }
+        }
+        // Triangles scattered far apart: the old tree's boxes would overlap everywhere.
+        let scattered: Vec<Triangle> = base
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let o = glam::Vec3A::splat(((i * 7919) % 3000) as f32 * 0.1);
+                Triangle { v0: t.v0 + o, v1: t.v1 + o, v2: t.v2 + o }
+            })
+            .collect();
+        assert!(refit(&mut tree, &scattered).is_none(), "{kind:?}: scattered triangles refit");
+        assert_eq!(tree.refits, 3);
+    }
+}

@@ -186,6 +186,11 @@ pub struct PreparedScene {
     moving: Vec<bool>,
     /// An animated scene's part that is built once ([`assemble::StaticPart`]).
     split: Option<assemble::StaticPart>,
+    /// The moving part's last tree, kept for refitting.
+    moving_tree: Option<accel::RefitTree>,
+    /// Whether the moving part's tree is refit while that stays within
+    /// [`accel::REFIT_LIMIT`] of its built cost (true), or rebuilt whenever anything moves.
+    pub refit: bool,
 }
 
 pub use crate::limits::MAX_TRIANGLES;
@@ -215,18 +220,30 @@ fn flatten(
     time: Option<f64>,
 ) -> Flat {
     let o = &scene.objects[object];
-    let mesh = o.mesh_at(&scene.meshes[o.mesh], time);
-    let mesh = mesh.as_ref();
+    let mesh = &scene.meshes[o.mesh];
+    // A deforming mesh's posed vertices; the rest of it as it is stored.
+    let posed = o.deform.as_ref().map(|d| d.pose_vertices(mesh, time));
+    let (positions, normals, tangents) = match &posed {
+        Some(p) => (&p.positions, &p.normals, &p.tangents),
+        None => (&mesh.positions, &mesh.normals, &mesh.tangents),
+    };
     let m3 = DMat3::from_mat4(transform);
     let flip = m3.determinant() < 0.0;
     let nmat = m3.inverse().transpose();
     let mat = if (mesh.material as usize) < scene.materials.len() { mesh.material } else { 0 };
-    let mut f = Flat::default();
+    let n = mesh.indices.len() / 3;
+    let mut f = Flat {
+        tris: Vec::with_capacity(n),
+        src: Vec::with_capacity(n),
+        attrs: Vec::with_capacity(n),
+        mats: Vec::with_capacity(n),
+        ..Flat::default()
+    };
     for (k, t) in mesh.indices.chunks_exact(3).enumerate() {
         // A mirroring transform reverses the winding; swap to keep the front face CCW.
         let idx = if flip { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] };
         let p64 =
-            idx.map(|i| transform.transform_point3(mesh.positions[i as usize].as_dvec3()) - origin);
+            idx.map(|i| transform.transform_point3(positions[i as usize].as_dvec3()) - origin);
         let p = p64.map(|v| v.as_vec3());
         // Degenerate: zero area, or so thin (area below 1e-12 of the longest edge squared)
         // that f32 arithmetic cannot resolve it; such a triangle cannot be hit reliably.
@@ -247,7 +264,7 @@ fn flatten(
         f.tris.push(Triangle { v0: p[0].into(), v1: p[1].into(), v2: p[2].into() });
         f.src.push(k as u32);
         let n = idx.map(|i| {
-            let n = mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+            let n = normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
             let n = (nmat * n.as_dvec3()).normalize_or_zero().as_vec3();
             if n.is_finite() { n } else { Vec3::ZERO }
         });
@@ -267,8 +284,7 @@ fn flatten(
         }
         if features.normal_maps {
             f.tans.push(idx.map(|i| {
-                let t =
-                    mesh.tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
+                let t = tangents.get(i as usize).copied().unwrap_or(Vec4::new(1.0, 0.0, 0.0, 1.0));
                 let xyz = (m3 * t.truncate().as_dvec3()).normalize_or_zero().as_vec3();
                 let w = if flip { -t.w } else { t.w };
                 if xyz.is_finite() { xyz.extend(w) } else { Vec4::new(1.0, 0.0, 0.0, 1.0) }
@@ -470,6 +486,8 @@ impl PreparedScene {
             open_from_close: vec![],
             moving: scene.objects.iter().map(|o| o.moves()).collect(),
             split: None,
+            moving_tree: None,
+            refit: true,
         };
         p.assemble();
         p.traversal_stack = match &p.split {

@@ -9,7 +9,7 @@
 //! out in world space and its transform is the identity.
 
 use super::{Animation, Mesh, Track};
-use glam::{DMat3, DMat4, Vec3};
+use glam::{DMat3, DMat4, Mat3, Mat4, Vec3, Vec4};
 
 /// Influences a vertex can have: JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1.
 pub const MAX_INFLUENCES: usize = 8;
@@ -90,7 +90,18 @@ impl Deform {
 
     /// `mesh` posed at `time` (None: the rest pose): morphed, then skinned into world space.
     pub fn pose(&self, mesh: &Mesh, time: Option<f64>) -> Mesh {
-        let mut m = mesh.clone();
+        let p = self.pose_vertices(mesh, time);
+        Mesh { positions: p.positions, normals: p.normals, tangents: p.tangents, ..mesh.clone() }
+    }
+
+    /// What posing changes of `mesh` at `time`: its positions, normals and tangents (the rest
+    /// is the mesh's own; [`Deform::pose`] for the whole mesh).
+    pub fn pose_vertices(&self, mesh: &Mesh, time: Option<f64>) -> Posed {
+        let mut m = Posed {
+            positions: mesh.positions.clone(),
+            normals: mesh.normals.clone(),
+            tangents: mesh.tangents.clone(),
+        };
         if let Some(morph) = &self.morph {
             let w = morph.weights_at(time);
             for (target, &w) in mesh.targets.iter().zip(&w) {
@@ -106,11 +117,18 @@ impl Deform {
         }
         if !self.skin.is_empty() && mesh.joints.len() == mesh.positions.len() {
             let joints: Vec<DMat4> = self.skin.iter().map(|j| j.matrix(time)).collect();
-            skin(&mut m, &joints);
+            skin(&mut m, mesh, &joints);
         }
         m.normals.iter_mut().for_each(|n| *n = n.normalize_or(Vec3::Z));
         m
     }
+}
+
+/// A mesh's posed vertices ([`Deform::pose_vertices`]).
+pub struct Posed {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub tangents: Vec<Vec4>,
 }
 
 fn add(v: &mut [Vec3], d: &[Vec3], w: f32) {
@@ -120,28 +138,36 @@ fn add(v: &mut [Vec3], d: &[Vec3], w: f32) {
 }
 
 /// Linear blend skinning of `m`'s vertices by `joints` (joint matrices); the influences were
-/// checked at load (indices in range, weights normalised).
-fn skin(m: &mut Mesh, joints: &[DMat4]) {
+/// checked at load (indices in range, weights normalised). In f32, as the GPU would: each
+/// vertex's positions by the weighted sum of its joints' matrices, its normal by the weighted
+/// sum of their inverse transposes (exact for a vertex on one joint, the usual approximation
+/// between joints), its tangent by their linear parts.
+fn skin(m: &mut Posed, mesh: &Mesh, joints: &[DMat4]) {
+    let mats: Vec<Mat4> = joints.iter().map(|j| j.as_mat4()).collect();
+    let normal_mats: Vec<Mat3> = joints
+        .iter()
+        .map(|j| {
+            let n = DMat3::from_mat4(*j).inverse().transpose().as_mat3();
+            if n.is_finite() { n } else { Mat3::IDENTITY }
+        })
+        .collect();
     for i in 0..m.positions.len() {
-        let (js, ws) = (m.joints[i], m.weights[i]);
-        let mut blended = DMat4::ZERO;
+        let (js, ws) = (&mesh.joints[i], &mesh.weights[i]);
+        let (mut blended, mut normal) = (Mat4::ZERO, Mat3::ZERO);
         for k in 0..MAX_INFLUENCES {
             if ws[k] > 0.0 {
-                blended += joints[js[k] as usize] * ws[k] as f64;
+                blended += mats[js[k] as usize] * ws[k];
+                normal += normal_mats[js[k] as usize] * ws[k];
             }
         }
-        let p = blended.transform_point3(m.positions[i].as_dvec3());
-        // Normals by the inverse transpose of the blended matrix's linear part.
-        let linear = DMat3::from_mat4(blended);
-        let normal_matrix = linear.inverse().transpose();
-        let n = |v: Vec3, mat: &DMat3| (*mat * v.as_dvec3()).as_vec3();
-        m.positions[i] = if p.is_finite() { p.as_vec3() } else { Vec3::NAN };
+        let p = blended.transform_point3(m.positions[i]);
+        m.positions[i] = if p.is_finite() { p } else { Vec3::NAN };
         if let Some(nrm) = m.normals.get_mut(i) {
-            let v = n(*nrm, &normal_matrix);
+            let v = normal * *nrm;
             *nrm = if v.is_finite() { v } else { *nrm };
         }
         if let Some(t) = m.tangents.get_mut(i) {
-            let v = n(t.truncate(), &linear).normalize_or_zero();
+            let v = blended.transform_vector3(t.truncate()).normalize_or_zero();
             *t = if v.is_finite() && v != Vec3::ZERO { v.extend(t.w) } else { *t };
         }
     }

@@ -27,7 +27,7 @@ mod texture;
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
 pub use default_scene::{cuboid, default_scene, quad, uv_sphere};
-pub use deform::{Deform, Joint, MAX_INFLUENCES, Morph, MorphTarget};
+pub use deform::{Deform, Joint, MAX_INFLUENCES, Morph, MorphTarget, Posed};
 pub use environment::{EnvMap, Environment};
 pub use files::{MemoryFiles, SceneFiles, SceneFolder};
 pub use gltf_export::save_gltf;

@@ -107,7 +107,7 @@ impl PreparedScene {
         if moving.is_empty() {
             self.clear_arrays();
             let all: Vec<usize> = (0..self.flat.len()).collect();
-            let part = self.append_part(&all, 0, 0, 0, false);
+            let part = self.append_part(&all, 0, 0, 0, false, false);
             self.accel = part.accel;
             self.set_emitters(part.emitters);
             return;
@@ -117,7 +117,7 @@ impl PreparedScene {
             Some(sp) => sp,
             None => {
                 self.clear_arrays();
-                let part = self.append_part(&still, 0, 0, 0, true);
+                let part = self.append_part(&still, 0, 0, 0, true, false);
                 let sp = StaticPart {
                     slots: self.tris.len() / 3,
                     inputs: part.accel.order.len() as u32,
@@ -132,7 +132,7 @@ impl PreparedScene {
             }
         };
         self.truncate_arrays(sp.slots);
-        let part = self.append_part(&moving, sp.inputs, sp.slots, sp.nodes, true);
+        let part = self.append_part(&moving, sp.inputs, sp.slots, sp.nodes, true, true);
         let a = &mut self.accel;
         a.kind = kind;
         a.nodes.truncate(sp.node_bytes);
@@ -151,6 +151,12 @@ impl PreparedScene {
     /// one's; None for a static scene.
     pub fn dynamic_root(&self) -> Option<u32> {
         self.split.as_ref().map(|sp| sp.nodes as u32)
+    }
+
+    /// The moving part's tree: its surface-area cost now and when built (relative to its
+    /// root's area), and the refits since; None for a static scene.
+    pub fn refit_state(&self) -> Option<(f32, f32, u32)> {
+        self.moving_tree.as_ref().map(|t| (t.cost, t.built_cost, t.refits))
     }
 
     /// Input triangles of an animated scene's static part: the moving objects' triangles are
@@ -183,7 +189,9 @@ impl PreparedScene {
 
     /// Build a tree over `objects`' triangles and append them, in its leaf order, to the GPU
     /// arrays. Input indices start at `input_base`, slots at `slot_base`, nodes at `node_base`;
-    /// `split`: the tree is one of two, and leaves the traversal one stack entry.
+    /// `split`: the tree is one of two, and leaves the traversal one stack entry; `refit`: it is
+    /// the moving part, whose last tree is refit rather than rebuilt where that stays good
+    /// enough ([`accel::refit`]).
     fn append_part(
         &mut self,
         objects: &[usize],
@@ -191,15 +199,22 @@ impl PreparedScene {
         slot_base: usize,
         node_base: usize,
         split: bool,
+        refit: bool,
     ) -> Part {
         let kind = self.accel.kind;
-        let mut tris_in: Vec<Triangle> = vec![];
-        let mut attrs: Vec<&[glam::Vec4; 4]> = vec![];
+        let n: usize = objects.iter().map(|&i| self.flat[i].tris.len()).sum();
+        let mut tris_in: Vec<Triangle> = Vec::with_capacity(n);
+        let mut attrs: Vec<&[glam::Vec4; 4]> = Vec::with_capacity(n);
         let mut tans: Vec<&[glam::Vec4; 3]> = vec![];
         let mut extras: Vec<&[[u32; 4]; 3]> = vec![];
-        let mut mats: Vec<u32> = vec![];
+        let mut mats: Vec<u32> = Vec::with_capacity(n);
         let mut open_in: Vec<Triangle> = vec![];
         let mut prev: Vec<[Vec3; 3]> = vec![];
+        let per_slot = |k: usize| k * n;
+        self.tris.reserve(per_slot(3));
+        self.tris_open.reserve(if self.features.animated { per_slot(3) } else { 0 });
+        self.tris_prev.reserve(if self.features.deforming { per_slot(3) } else { 0 });
+        self.shading.reserve(per_slot(4));
         for &i in objects {
             let f: &Flat = &self.flat[i];
             tris_in.extend_from_slice(&f.tris);
@@ -226,12 +241,11 @@ impl PreparedScene {
         let max_depth = self.traversal_stack as usize - split as usize;
         // With motion, the tree is built over each triangle's box at both ends of the shutter:
         // a degenerate triangle from the box's min to its max has exactly that box.
-        let mut accel = if split && tris_in.is_empty() {
-            Accel { kind, nodes: empty_node(kind), node_count: 1, depth: 1, ..Accel::empty(kind) }
-        } else if open_in.is_empty() {
-            accel::build_within(&tris_in, kind, max_depth)
+        let swept: Vec<Triangle>;
+        let boxes = if open_in.is_empty() {
+            &tris_in
         } else {
-            let swept: Vec<Triangle> = tris_in
+            swept = tris_in
                 .iter()
                 .zip(&open_in)
                 .map(|(c, o)| {
@@ -239,7 +253,23 @@ impl PreparedScene {
                     Triangle { v0: b.min, v1: b.max, v2: b.min }
                 })
                 .collect();
-            accel::build_within(&swept, kind, max_depth)
+            &swept
+        };
+        let mut accel = if split && tris_in.is_empty() {
+            Accel { kind, nodes: empty_node(kind), node_count: 1, depth: 1, ..Accel::empty(kind) }
+        } else if refit {
+            // The moving part: refit its last tree where that stays good enough.
+            let refitted = match self.moving_tree.as_mut().filter(|_| self.refit) {
+                Some(tree) => accel::refit(tree, boxes).filter(|a| a.depth <= max_depth),
+                None => None,
+            };
+            refitted.unwrap_or_else(|| {
+                let (a, tree) = accel::build_refittable(boxes, kind, max_depth);
+                self.moving_tree = tree;
+                a
+            })
+        } else {
+            accel::build_within(boxes, kind, max_depth)
         };
         if accel.depth > max_depth {
             // Not reachable: the stack of an animated scene holds any median tree over its
