@@ -158,6 +158,40 @@ def meshopt_strip(stream):
     return pack(d, {**F, "seq.bin": stream})
 scenes['ok-meshopt-strip'] = meshopt_strip(SEQ)
 scenes['bad-meshopt-strip-cut'] = meshopt_strip(SEQ[:6])
+# Skins and morph targets: the quad bound to one joint (node 2) whose rotation is animated,
+# and one morph target lifting its corners, driven by a weights channel; a vertex bound to a
+# joint the skin lacks and a NaN inverse bind matrix are refused.
+def skinned(joint=0, bind_nan=False):
+    SK = struct.pack('<16B', *([joint, 0, 0, 0] * 4)) + struct.pack('<16f', *([1, 0, 0, 0] * 4))
+    ibm = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+    if bind_nan:
+        ibm[12] = float('nan')
+    SK += struct.pack('<16f', *ibm) + struct.pack('<12f', *([0, 0.5, 0] * 4)) + struct.pack('<3f', 0, 1, 0)
+    d = doc()
+    d['buffers'].append({"uri": "sk.bin", "byteLength": len(SK)})
+    d['bufferViews'] += [{"buffer": 1, "byteOffset": 0, "byteLength": 16}, {"buffer": 1, "byteOffset": 16, "byteLength": 64},
+                         {"buffer": 1, "byteOffset": 80, "byteLength": 64}, {"buffer": 1, "byteOffset": 144, "byteLength": 48},
+                         {"buffer": 1, "byteOffset": 192, "byteLength": 12}]
+    d['accessors'] += [{"bufferView": 9, "componentType": 5121, "count": 4, "type": "VEC4"},
+                       {"bufferView": 10, "componentType": 5126, "count": 4, "type": "VEC4"},
+                       {"bufferView": 11, "componentType": 5126, "count": 1, "type": "MAT4"},
+                       {"bufferView": 12, "componentType": 5126, "count": 4, "type": "VEC3"},
+                       {"bufferView": 13, "componentType": 5126, "count": 3, "type": "SCALAR"}]
+    prim = d['meshes'][0]['primitives'][0]
+    prim['attributes'].update(JOINTS_0=9, WEIGHTS_0=10)
+    prim['targets'] = [{"POSITION": 12}]
+    d['meshes'][0]['weights'] = [0.0]
+    d['nodes'][0]['skin'] = 0
+    d['nodes'].append({"name": "joint"})
+    d['scenes'][0]['nodes'].append(2)
+    d['skins'] = [{"joints": [2], "inverseBindMatrices": 11}]
+    d['animations'] = [{"samplers": [{"input": 6, "output": 8}, {"input": 6, "output": 13, "interpolation": "STEP"}],
+                        "channels": [{"sampler": 0, "target": {"node": 2, "path": "rotation"}},
+                                     {"sampler": 1, "target": {"node": 0, "path": "weights"}}]}]
+    return pack(d, {**F, "sk.bin": SK})
+scenes['ok-skinned-morphed'] = skinned()
+scenes['bad-skin-missing-joint'] = skinned(joint=3)
+scenes['bad-skin-nan-bind'] = skinned(bind_nan=True)
 # Refused
 def bad(name, mutate, files=F):
     d = doc(); mutate(d); scenes['bad-' + name] = pack(d, files)

@@ -9,7 +9,7 @@
 //! out in world space and its transform is the identity.
 
 use super::{Animation, Mesh, Track};
-use glam::{DMat3, DMat4, Mat3, Mat4, Vec3, Vec4};
+use glam::{DMat4, Mat3, Mat4, Vec3, Vec4};
 
 /// Influences a vertex can have: JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1.
 pub const MAX_INFLUENCES: usize = 8;
@@ -33,17 +33,19 @@ pub struct Joint {
 }
 
 impl Joint {
-    /// World transform x inverse bind matrix at `time` (None: the rest pose). A non-finite
-    /// product falls back to the rest pose's, then to the identity: NaN never reaches a vertex.
-    fn matrix(&self, time: Option<f64>) -> DMat4 {
+    /// World transform x inverse bind matrix at `time` (None: the rest pose), in the f32 the
+    /// vertices are skinned in. One that is not finite there falls back to the rest pose's, then
+    /// to the identity: NaN and Inf never reach a vertex.
+    fn matrix(&self, time: Option<f64>) -> Mat4 {
         let world = match (&self.animation, time) {
             (Some(a), Some(t)) => a.world_at(t),
             _ => self.rest,
         };
         [world * self.inverse_bind, self.rest * self.inverse_bind]
             .into_iter()
+            .map(|m| m.as_mat4())
             .find(|m| m.is_finite())
-            .unwrap_or(DMat4::IDENTITY)
+            .unwrap_or(Mat4::IDENTITY)
     }
 }
 
@@ -116,7 +118,7 @@ impl Deform {
             }
         }
         if !self.skin.is_empty() && mesh.joints.len() == mesh.positions.len() {
-            let joints: Vec<DMat4> = self.skin.iter().map(|j| j.matrix(time)).collect();
+            let joints: Vec<Mat4> = self.skin.iter().map(|j| j.matrix(time)).collect();
             skin(&mut m, mesh, &joints);
         }
         m.normals.iter_mut().for_each(|n| *n = n.normalize_or(Vec3::Z));
@@ -142,12 +144,11 @@ fn add(v: &mut [Vec3], d: &[Vec3], w: f32) {
 /// vertex's positions by the weighted sum of its joints' matrices, its normal by the weighted
 /// sum of their inverse transposes (exact for a vertex on one joint, the usual approximation
 /// between joints), its tangent by their linear parts.
-fn skin(m: &mut Posed, mesh: &Mesh, joints: &[DMat4]) {
-    let mats: Vec<Mat4> = joints.iter().map(|j| j.as_mat4()).collect();
-    let normal_mats: Vec<Mat3> = joints
+fn skin(m: &mut Posed, mesh: &Mesh, mats: &[Mat4]) {
+    let normal_mats: Vec<Mat3> = mats
         .iter()
         .map(|j| {
-            let n = DMat3::from_mat4(*j).inverse().transpose().as_mat3();
+            let n = Mat3::from_mat4(*j).inverse().transpose();
             if n.is_finite() { n } else { Mat3::IDENTITY }
         })
         .collect();
@@ -185,5 +186,61 @@ pub fn normalise(w: &mut [f32; MAX_INFLUENCES]) -> bool {
         *w = [0.0; MAX_INFLUENCES];
         w[0] = 1.0;
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Animation;
+    use glam::{DQuat, DVec3, Vec2};
+
+    /// A joint whose animation overflows f32 (a scale key of 1e300) poses its vertices at its
+    /// rest pose instead of at infinity or NaN: nothing non-finite reaches the flattened
+    /// triangles.
+    #[test]
+    fn non_finite_joint_matrices_fall_back_to_the_rest_pose() {
+        let mut a = Animation::rigid(DMat4::IDENTITY, DVec3::X, DQuat::IDENTITY, DVec3::ONE);
+        a.scale_track = Some(Track {
+            times: vec![0.0, 1.0],
+            values: vec![DVec3::ONE, DVec3::splat(1e300)],
+            step: false,
+            tangents: vec![],
+        });
+        let joint = Joint {
+            rest: DMat4::from_translation(DVec3::X),
+            animation: Some(a),
+            inverse_bind: DMat4::from_translation(DVec3::NEG_X),
+        };
+        assert!(joint.matrix(Some(0.5)).is_finite());
+        let mesh = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            normals: vec![Vec3::Z; 3],
+            uvs: vec![Vec2::ZERO; 3],
+            indices: vec![0, 1, 2],
+            joints: vec![[0; MAX_INFLUENCES]; 3],
+            weights: vec![
+                {
+                    let mut w = [0.0; MAX_INFLUENCES];
+                    w[0] = 1.0;
+                    w
+                };
+                3
+            ],
+            ..Default::default()
+        };
+        let d = Deform { skin: vec![joint], morph: None };
+        for t in [0.0, 0.5, 0.999, 1.0, f64::NAN] {
+            let p = d.pose_vertices(&mesh, Some(t));
+            assert!(
+                p.positions.iter().chain(&p.normals).all(|v| v.is_finite()),
+                "t = {t}: {:?}",
+                p.positions
+            );
+        }
+        // Near the overflowing key the scale leaves f32: the rest pose (world x inverse bind =
+        // identity) holds.
+        let p = d.pose_vertices(&mesh, Some(0.999));
+        assert_eq!(p.positions, mesh.positions);
     }
 }
