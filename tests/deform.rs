@@ -9,7 +9,7 @@
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 use hush_engine::quality::relmse;
-use hush_engine::scene::{Scene, load_gltf};
+use hush_engine::scene::{LoadOptions, Scene, load_gltf, load_gltf_opts};
 use hush_tests::gltf_writer::{GltfWriter, Prim, write_json};
 use serde_json::{Value, json};
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
@@ -102,6 +102,15 @@ fn skinned_file(
     damage: Damage,
     edit: impl FnOnce(&mut Value),
 ) -> Result<Scene, String> {
+    skinned_file_opts(name, damage, &LoadOptions::default(), edit)
+}
+
+fn skinned_file_opts(
+    name: &str,
+    damage: Damage,
+    opts: &LoadOptions,
+    edit: impl FnOnce(&mut Value),
+) -> Result<Scene, String> {
     let mut b = bar();
     if damage == Damage::ZeroWeights {
         b.weights[..4].fill([0.0, 0.0]);
@@ -150,6 +159,7 @@ fn skinned_file(
     j["skins"] = json!([{"joints": [1, 2], "inverseBindMatrices": ibm}]);
     let sampler = |o: usize| json!({"input": times, "output": o, "interpolation": "LINEAR"});
     j["animations"] = json!([{
+        "name": "bend",
         "samplers": [sampler(root_keys), sampler(elbow_keys), sampler(weight_keys)],
         "channels": [
             {"sampler": 0, "target": {"node": 1, "path": "rotation"}},
@@ -158,7 +168,7 @@ fn skinned_file(
         ],
     }]);
     edit(&mut j);
-    load_gltf(&write_json(name, &j)).map_err(|e| format!("{e:#}"))
+    load_gltf_opts(&write_json(name, &j), opts).map_err(|e| format!("{e:#}"))
 }
 
 fn baked_file(positions: &[[f32; 3]], normals: &[[f32; 3]]) -> Scene {
@@ -321,4 +331,63 @@ fn motion_vectors_of_skinned_vertices_follow_the_pose() {
         "skinned motion vectors: {checked} pixels ({moving} moving over 0.25 px), worst error {worst:.4} px"
     );
     assert!(moving > 50, "only {moving} pixels of the bar move");
+}
+
+/// A file with two animations: all play by default, `LoadOptions::animation` picks one (the
+/// other's channels are left out), an index past the file's is refused, and the scene knows
+/// their names and its loop length.
+#[test]
+fn one_of_several_animations_plays_when_asked() {
+    // "wave": the root joint slides 1 m along X over 4 s.
+    let wave = |j: &mut Value| {
+        let times = j["accessors"].as_array().unwrap().len();
+        let view = j["bufferViews"].as_array().unwrap().len();
+        let data: Vec<u8> = [0.0f32, 4.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0]
+            .iter()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
+        use base64::Engine;
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&data)
+        );
+        j["buffers"].as_array_mut().unwrap().push(json!({"byteLength": 32, "uri": uri}));
+        let buffer = j["buffers"].as_array().unwrap().len() - 1;
+        j["bufferViews"].as_array_mut().unwrap().extend([
+            json!({"buffer": buffer, "byteOffset": 0, "byteLength": 8}),
+            json!({"buffer": buffer, "byteOffset": 8, "byteLength": 24}),
+        ]);
+        j["accessors"].as_array_mut().unwrap().extend([
+            json!({"bufferView": view, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [4.0]}),
+            json!({"bufferView": view + 1, "componentType": 5126, "count": 2, "type": "VEC3"}),
+        ]);
+        j["animations"].as_array_mut().unwrap().push(json!({"name": "wave",
+            "samplers": [{"input": times, "output": times + 1}],
+            "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}));
+    };
+    let opts = |a: Option<usize>| LoadOptions { animation: a, ..LoadOptions::default() };
+    let all = skinned_file_opts("two-animations", Damage::None, &opts(None), wave).unwrap();
+    let bend = skinned_file_opts("two-animations-0", Damage::None, &opts(Some(0)), wave).unwrap();
+    let slide = skinned_file_opts("two-animations-1", Damage::None, &opts(Some(1)), wave).unwrap();
+    assert_eq!(all.animations, ["bend", "wave"]);
+    assert_eq!(
+        (all.animation_length(), bend.animation_length(), slide.animation_length()),
+        (4.0, 2.0, 4.0)
+    );
+    let posed = |s: &Scene, t: f64| {
+        s.objects[0].mesh_at(&s.meshes[s.objects[0].mesh], Some(t)).positions[0]
+    };
+    let rest = Vec3::from(bar().positions[0]);
+    // At 2 s: "bend" alone has looped back to its rest; "wave" alone has slid the bar 0.5 m.
+    assert!((posed(&bend, 2.0) - rest).length() < 1e-5, "{}", posed(&bend, 2.0));
+    assert!(
+        (posed(&slide, 2.0) - (rest + 0.5 * Vec3::X)).length() < 1e-5,
+        "{}",
+        posed(&slide, 2.0)
+    );
+    // Both at once: the bend and the slide.
+    assert!((posed(&all, 1.3) - posed(&slide, 1.3)).length() > 0.01);
+    assert!((posed(&all, 1.3) - posed(&bend, 1.3)).length() > 0.01);
+    let e = skinned_file_opts("two-animations-5", Damage::None, &opts(Some(5)), wave).unwrap_err();
+    assert!(e.contains("animation 5 was asked for; the file has 2"), "{e}");
 }

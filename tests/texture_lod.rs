@@ -69,6 +69,7 @@ fn scene() -> Scene {
         max_depth: 3,
         warnings: vec![],
         procedural_sky: false,
+        animations: vec![],
     }
 }
 

@@ -58,6 +58,7 @@ fn scene(wrap_s: Wrap) -> Scene {
         max_depth: 1,
         warnings: vec![],
         procedural_sky: false,
+        animations: vec![],
     }
 }
 

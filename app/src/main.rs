@@ -95,6 +95,10 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
         sun: r.scene.sun_direction().map(ui::sun_angles),
         paused: false,
         time: 0.0,
+        animation_length: r.scene.animation_length(),
+        animations: r.scene.animations.clone(),
+        animation: None,
+        animation_request: None,
         glossy: r.prepared.features.glossy,
         frame_ms: 0.0,
         pass_ms: vec![],
@@ -186,6 +190,7 @@ impl Viewer {
         renderer.set_async_timings(true);
         let fly = fly::FlyCamera::from_camera(&renderer.scene.camera_or_default(), extent);
         let mut panel = panel_for(&gpu, &renderer, format!("loaded in {load_ms:.0} ms"));
+        panel.animation = self.args.load.animation;
         if let Some(p) = &self.args.preset {
             panel.settings = hush_engine::settings::FrameSettings::load_preset(p)?;
             panel.preset_path = p.display().to_string();
@@ -231,6 +236,7 @@ impl Viewer {
             governed: None,
             load: self.args.load,
             last_pose: None,
+            source: self.args.scene.clone(),
         });
         Ok(())
     }

@@ -35,6 +35,9 @@ pub(crate) struct Running {
     /// The fly camera's pose at the last frame: where a motion-blurred frame's shutter opens
     /// from.
     pub(crate) last_pose: Option<(glam::DVec3, f64, f64)>,
+    /// What the shown scene was loaded from (a file or a built-in scene's name), to load it
+    /// again with another of its animations.
+    pub(crate) source: String,
 }
 
 impl Running {
@@ -76,7 +79,14 @@ impl Running {
     }
 
     fn load(&mut self, path: &Path) {
-        let r = load_scene(&path.to_string_lossy(), &self.load).and_then(|scene| {
+        self.load.animation = None;
+        self.load_source(&path.to_string_lossy());
+    }
+
+    /// Load `source` (a file or a built-in scene) under `self.load`, replacing the scene.
+    fn load_source(&mut self, source: &str) {
+        let path = Path::new(source);
+        let r = load_scene(source, &self.load).and_then(|scene| {
             let prepared = PreparedScene::new(&scene, BvhKind::DEFAULT)?;
             let extent = prepared.extent;
             let size = self.frame_size();
@@ -89,6 +99,8 @@ impl Running {
                 self.fly = fly::FlyCamera::from_camera(&r.scene.camera_or_default(), extent);
                 self.last_pose = None;
                 self.panel = panel_for(&self.gpu, &r, format!("loaded {}", path.display()));
+                self.panel.animation = self.load.animation;
+                self.source = source.to_string();
                 self.window.set_title(&format!("Hush: {}", r.scene.name));
                 self.renderer = r;
             }
@@ -417,6 +429,12 @@ impl Running {
         }
         if actions.save_preset || actions.load_preset {
             self.preset(actions.save_preset);
+        }
+        if let Some(choice) = self.panel.animation_request.take() {
+            // Another of the file's animations: the scene is loaded again with it.
+            self.load.animation = choice;
+            let source = self.source.clone();
+            self.load_source(&source);
         }
         if !self.profiler.message.is_empty() {
             self.panel.message = std::mem::take(&mut self.profiler.message);

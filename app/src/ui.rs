@@ -13,6 +13,13 @@ pub struct Panel {
     pub sun: Option<(f32, f32)>,
     pub paused: bool,
     pub time: f64,
+    /// The scene's loop length in seconds (the scrub slider's range; 0: nothing moves).
+    pub animation_length: f64,
+    /// The file's animations and which one plays (None: all of them); a different choice in
+    /// the panel sets `animation_request`, which reloads the scene with it.
+    pub animations: Vec<String>,
+    pub animation: Option<usize>,
+    pub animation_request: Option<Option<usize>>,
     pub glossy: bool,
     pub frame_ms: f64,
     pub pass_ms: Vec<(&'static str, f64)>,
@@ -143,6 +150,30 @@ impl Panel {
             ui.checkbox(&mut self.paused, "pause animation");
             ui.label(format!("t = {:.2} s", self.time));
         });
+        if self.paused && self.animation_length > 0.0 {
+            // Scrub: the clock within one loop of the animation.
+            let mut t = self.time.rem_euclid(self.animation_length);
+            if ui.add(egui::Slider::new(&mut t, 0.0..=self.animation_length).text("time")).changed()
+            {
+                self.time = t;
+            }
+        }
+        if self.animations.len() > 1 {
+            let name = |a: Option<usize>| match a {
+                None => "all animations".to_string(),
+                Some(i) => self.animations.get(i).cloned().unwrap_or_default(),
+            };
+            let mut choice = self.animation;
+            egui::ComboBox::from_label("plays").selected_text(name(choice)).show_ui(ui, |ui| {
+                ui.selectable_value(&mut choice, None, name(None));
+                for i in 0..self.animations.len() {
+                    ui.selectable_value(&mut choice, Some(i), name(Some(i)));
+                }
+            });
+            if choice != self.animation {
+                self.animation_request = Some(choice);
+            }
+        }
         ui.separator();
         self.chain(ui);
         ui.separator();

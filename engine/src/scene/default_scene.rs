@@ -166,5 +166,6 @@ pub fn default_scene() -> Scene {
         max_depth: super::DEFAULT_MAX_DEPTH,
         warnings: vec![],
         procedural_sky: true,
+        animations: vec![],
     }
 }

@@ -18,8 +18,9 @@ pub(super) struct Animated {
     pub weights: HashMap<usize, Morph>,
 }
 
-/// Which of the file's animations play: `only` picks one (by index), None plays them all
-/// (a node driven by several takes the last channel's).
+/// Which of the file's animations play: `only` picks one (by index), None plays them all (a
+/// node driven by several takes the last one's channel for each property, and loops over the
+/// longest of them).
 /// A channel that cannot be used (unsorted or non-finite keys, a value count that does not match
 /// the keys, weights for a node without morph targets) is a warning and is ignored; a malformed
 /// accessor is an error.

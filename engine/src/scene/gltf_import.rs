@@ -44,7 +44,8 @@ pub struct LoadOptions {
     /// Largest texture side kept; larger textures are halved until they fit.
     pub max_texture_size: u32,
     pub limits: Limits,
-    /// Which of the file's animations plays (its index); None plays every one at once.
+    /// Which of the file's animations plays (its index); None plays every one at once (a node
+    /// that several drive loops over the longest of them).
     pub animation: Option<usize>,
 }
 
@@ -202,6 +203,10 @@ impl Importer<'_> {
         self.scene_extras(&gscene, &mut scene)?;
         let data = super::accessor::Data { root: doc.as_json(), buffers: &buffers };
         let mut mesh_cache: HashMap<usize, Vec<usize>> = HashMap::new();
+        scene.animations = doc
+            .animations()
+            .map(|a| a.name().map_or_else(|| format!("animation {}", a.index()), str::to_string))
+            .collect();
         let only = self.animation;
         let mut animated = animations(&mut self, doc, &data, only)?;
         let mut ortho: Option<Orthographic> = None;

@@ -233,6 +233,7 @@ pub fn default_level_with_sun(sun_dir: Vec3) -> Scene {
         max_depth: super::DEFAULT_MAX_DEPTH,
         warnings: vec![],
         procedural_sky: true,
+        animations: vec![],
     }
 }
 

@@ -313,6 +313,9 @@ pub struct Scene {
     /// The environment is the procedural sky of the first directional light (the sun + sky
     /// preset or the default level): moving the sun regenerates it.
     pub procedural_sky: bool,
+    /// The names of the file's animations ("animation N" where unnamed), whichever play
+    /// (`LoadOptions::animation`).
+    pub animations: Vec<String>,
 }
 
 /// Mitsuba's default path length, also the conventions' default.
@@ -342,6 +345,25 @@ impl Scene {
 
     pub fn is_animated(&self) -> bool {
         self.objects.iter().any(|o| o.moves())
+    }
+
+    /// Seconds after which the animation of every object repeats (the longest loop; 0 when
+    /// nothing moves).
+    pub fn animation_length(&self) -> f64 {
+        let mut d = 0.0f64;
+        for o in &self.objects {
+            d = d.max(o.animation.as_ref().map_or(0.0, |a| a.duration()));
+            if let Some(f) = &o.deform {
+                for j in &f.skin {
+                    d = d.max(j.animation.as_ref().map_or(0.0, |a| a.duration()));
+                }
+                if let Some(m) = &f.morph {
+                    let end = m.tracks.iter().map(|t| t.times.last().copied().unwrap_or(0.0));
+                    d = d.max(end.fold(m.period, f64::max));
+                }
+            }
+        }
+        d
     }
 
     pub fn triangle_count(&self) -> usize {

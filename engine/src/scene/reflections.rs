@@ -110,5 +110,6 @@ pub fn reflection_scene(mirror_floor: bool) -> Scene {
         max_depth: super::DEFAULT_MAX_DEPTH,
         warnings: vec![],
         procedural_sky: true,
+        animations: vec![],
     }
 }

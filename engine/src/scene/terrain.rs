@@ -87,6 +87,7 @@ pub fn terrain(n: usize) -> Scene {
         max_depth: super::DEFAULT_MAX_DEPTH,
         warnings: vec![],
         procedural_sky: true,
+        animations: vec![],
     }
 }
 
