@@ -203,6 +203,9 @@ struct Flat {
     src: Vec<u32>,
     /// Per triangle, its vertices at the previous `animate` call; empty: where they are now.
     prev: Vec<[Vec3; 3]>,
+    /// A deforming mesh's triangles at the shutter's open (`expose`); empty: carried there by
+    /// the object's transform.
+    open: Vec<[Vec3; 3]>,
     attrs: Vec<[Vec4; 4]>,
     tans: Vec<[Vec4; 3]>,
     extras: Vec<[[u32; 4]; 3]>,
@@ -562,13 +565,13 @@ impl PreparedScene {
     /// shutter); whether they changed.
     fn open_shutter(&mut self, scene: &Scene, open: Option<f64>) -> bool {
         let mut open_from_close = vec![];
+        let mut deformed = false;
         if let Some(t) = open.filter(|_| self.features.animated) {
-            let moving = scene
-                .objects
-                .iter()
-                .enumerate()
-                .take(self.world.len())
-                .any(|(i, o)| o.animation.is_some() && o.transform_at(t) != self.world[i]);
+            let deforms = |o: &crate::scene::Object| o.deform.as_ref().is_some_and(|d| d.moves());
+            let moving = scene.objects.iter().enumerate().take(self.world.len()).any(|(i, o)| {
+                (o.animation.is_some() && o.transform_at(t) != self.world[i])
+                    || (deforms(o) && t != self.time)
+            });
             if moving {
                 open_from_close = scene
                     .objects
@@ -580,9 +583,30 @@ impl PreparedScene {
                             * rebased(self.world[i], self.origin).inverse()
                     })
                     .collect();
+                // A deforming mesh's vertices at the open, triangle by triangle: no transform
+                // takes its close to its open.
+                for (i, o) in scene.objects.iter().enumerate().take(self.world.len()) {
+                    if deforms(o) {
+                        let at_open = flatten(
+                            scene,
+                            i,
+                            o.transform_at(t),
+                            self.origin,
+                            &self.features,
+                            Some(t),
+                        );
+                        self.flat[i].open = previous_vertices(&at_open, &self.flat[i]);
+                        deformed = true;
+                    }
+                }
             }
         }
-        let changed = open_from_close != self.open_from_close;
+        if !deformed {
+            for f in &mut self.flat {
+                f.open.clear();
+            }
+        }
+        let changed = deformed || open_from_close != self.open_from_close;
         self.open_from_close = open_from_close;
         changed
     }

@@ -222,7 +222,13 @@ impl PreparedScene {
             tans.extend(f.tans.iter());
             extras.extend(f.extras.iter());
             mats.extend_from_slice(&f.mats);
-            if let Some(m) = self.open_from_close.get(i) {
+            if !f.open.is_empty() {
+                open_in.extend(f.open.iter().map(|v| Triangle {
+                    v0: v[0].into(),
+                    v1: v[1].into(),
+                    v2: v[2].into(),
+                }));
+            } else if let Some(m) = self.open_from_close.get(i) {
                 let to = |v: Vec3A| Vec3A::from(m.transform_point3(v.into()));
                 open_in.extend(f.tris.iter().map(|t| Triangle {
                     v0: to(t.v0),
