@@ -74,7 +74,7 @@ impl AccumulateParams {
 }
 
 struct Accumulate {
-    animated: bool,
+    motion: hush_engine::gpu::Motion,
     params: wgpu::Buffer,
     history: Option<PingPong<Tex>>,
     stage: Option<ChainStage>,
@@ -88,7 +88,7 @@ fn make(gpu: &Gpu, scene: &DenoiserScene) -> anyhow::Result<Box<dyn Denoiser>> {
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    Ok(Box::new(Accumulate { animated: scene.animated, params, history: None, stage: None }))
+    Ok(Box::new(Accumulate { motion: scene.motion, params, history: None, stage: None }))
 }
 
 fn bindings<'a>(
@@ -126,11 +126,7 @@ impl Denoiser for Accumulate {
         let h = self.history.as_ref().context("recording before allocating")?;
         let params = AccumulateParams::new(cx.settings)?;
         rec.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let motion = if self.animated {
-            "realtime/motion_objects.wgsl"
-        } else {
-            "realtime/motion_static.wgsl"
-        };
+        let motion = self.motion.module();
         let modules =
             ["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl", motion, MODULE];
         let offered = bindings(io, &self.params, h, Parity::default());

@@ -79,7 +79,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var c = 0.0;
     if dn.history_valid != 0u {
         if !reflected {
-            let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
+            let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
             r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), gp.reprojection_min_cos);
         }
         // The previous pixel must have had a glossy lobe (its hit class is set).

@@ -35,7 +35,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // Where this surface was: through the motion vector, and by its own (object) motion.
     let x = position_at(p);
     let ids = textureLoad(gb_object, p, 0);
-    let expected = previous_position(ids.x, x);
+    let expected = previous_surface(ids.xy, x);
     let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
     var reason = 0u;
     var c = 0.0;

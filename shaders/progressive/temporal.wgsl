@@ -26,7 +26,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if has_surface(p) {
             let x = position_at(p);
             let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
-            let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
+            let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
             let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
             if r.distance >= 0.0 && r.distance <= dn.d1_px && same_object(p, r.texel) {
                 hist = half_safe(textureLoad(history, r.texel, 0).rgb);

@@ -11,3 +11,9 @@ fn previous_position(object: u32, p: vec3f) -> vec3f {
 fn previous_vertex(slot: u32, b: vec2f, object: u32, p: vec3f) -> vec3f {
     return previous_position(object, p);
 }
+
+// The surface point x of the pixel with G-buffer ids (object, triangle slot): it moves with
+// its object.
+fn previous_surface(ids: vec2u, x: vec3f) -> vec3f {
+    return previous_position(ids.x, x);
+}

@@ -41,7 +41,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if reflected {
             r.distance = select(-1.0, 0.0, in_bounds(r.texel));
         } else {
-            let expected = previous_position(textureLoad(gb_object, p, 0).x, x);
+            let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
             r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
             if r.distance > dn.d1_px || (r.distance >= 0.0 && !same_object(p, r.texel)) {
                 r.distance = -1.0;

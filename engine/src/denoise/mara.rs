@@ -57,9 +57,9 @@ impl Denoiser for Mara {
         let gp = GlossyParams::new(&s.glossy, self.scene.extent, cx.view.static_view);
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
-        let animated = self.scene.animated;
+        let motion = self.scene.motion;
         let matte = crate::passes::chain::made(&mut self.matte, || {
-            MatteChain::new(gpu, &inputs, animated).context("creating the matte chain")
+            MatteChain::new(gpu, &inputs, motion).context("creating the matte chain")
         })?;
         matte.record(rec, cx.key, &inputs, cx.parity)?;
         if let Some(g) = g {
@@ -70,7 +70,7 @@ impl Denoiser for Mara {
                 glossy: g,
             };
             let glossy = crate::passes::chain::made(&mut self.glossy, || {
-                GlossyChain::new(gpu, &inputs, animated).context("creating the glossy chain")
+                GlossyChain::new(gpu, &inputs, motion).context("creating the glossy chain")
             })?;
             glossy.record(rec, cx.key, &inputs, cx.parity, &s.glossy)?;
         }

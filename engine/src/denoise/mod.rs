@@ -36,8 +36,8 @@ use anyhow::Result;
 pub struct DenoiserScene {
     /// The scene has a specular lobe: the trace writes glossy light and reflection data.
     pub glossy: bool,
-    /// Objects move: `prev_from_current` is bound and motion vectors include object motion.
-    pub animated: bool,
+    /// How points move: which motion module the stages that reproject are made with.
+    pub motion: crate::gpu::Motion,
     /// The scene's bounding-box diagonal (metres).
     pub extent: f32,
 }

@@ -234,14 +234,14 @@ pub fn modules(
     stage: &'static str,
     signal: Signal,
     glossy: bool,
-    animated: bool,
+    motion: crate::gpu::Motion,
 ) -> Vec<&'static str> {
     let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl"];
     if glossy {
         m.push("realtime/glossy_in.wgsl");
     }
     m.push("matte/common.wgsl");
-    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.push(motion.module());
     m.extend(["progressive/common.wgsl", signal.module(), stage]);
     m
 }
@@ -305,7 +305,7 @@ impl Resources {
         t: &Targets,
         scene: &DenoiserScene,
     ) -> Result<Stages> {
-        let (g, a) = (scene.glossy, scene.animated);
+        let (g, a) = (scene.glossy, scene.motion);
         let p = Parity::default();
         let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
         let m = modules("progressive/features.wgsl", Signal::Matte, g, a);

@@ -224,7 +224,7 @@ impl SvgfTargets {
 /// The modules of an SVGF program: the frame's inputs, the matte (and for the glossy signal,
 /// the glossy) chain's helpers, SVGF's common code, the signal's features (stages after the
 /// temporal) and the stage.
-pub fn modules(stage: &'static str, glossy: bool, animated: bool) -> Vec<&'static str> {
+pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) -> Vec<&'static str> {
     let mut m = vec!["common/math.wgsl", "realtime/frame.wgsl", "realtime/gbuffer_in.wgsl"];
     if glossy {
         m.push("realtime/glossy_in.wgsl");
@@ -233,7 +233,7 @@ pub fn modules(stage: &'static str, glossy: bool, animated: bool) -> Vec<&'stati
     if glossy {
         m.push("glossy/common.wgsl");
     }
-    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.push(motion.module());
     m.push("svgf/common.wgsl");
     if !stage.starts_with("svgf/temporal") {
         m.push(if glossy { "svgf/features_glossy.wgsl" } else { "svgf/features_matte.wgsl" });
@@ -252,7 +252,12 @@ struct SignalStages {
 }
 
 impl SignalStages {
-    fn new(gpu: &Gpu, glossy: bool, animated: bool, offered: &Bindings) -> Result<SignalStages> {
+    fn new(
+        gpu: &Gpu,
+        glossy: bool,
+        motion: crate::gpu::Motion,
+        offered: &Bindings,
+    ) -> Result<SignalStages> {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
         // Labels are 'static: the profiler and the pass timings key on them.
@@ -274,7 +279,7 @@ impl SignalStages {
             ]
         };
         let stage = |label, file, b: &Bindings| {
-            ChainStage::new(gpu, label, &modules(file, glossy, animated), "main", b)
+            ChainStage::new(gpu, label, &modules(file, glossy, motion), "main", b)
         };
         Ok(SignalStages {
             temporal: stage(labels[0], temporal, offered)?,
@@ -534,13 +539,13 @@ fn motion_stages(
     res: &Resources,
     io: &FrameIo,
     m: &MotionTargets,
-    animated: bool,
+    motion: crate::gpu::Motion,
 ) -> Result<MotionStages> {
     use crate::passes::glossy::modules;
     let p = Parity::default();
     let stage = |label, file, entry, prefilter| {
         let offered = res.motion_bindings(io, m, prefilter, p);
-        ChainStage::new(gpu, label, &modules(file, animated), entry, &offered)
+        ChainStage::new(gpu, label, &modules(file, motion), entry, &offered)
     };
     Ok(MotionStages {
         motion: stage("svgf/motion", "glossy/motion.wgsl", "main", None)?,
@@ -566,7 +571,7 @@ impl Denoiser for Svgf {
         let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
         let stages = |g, s| {
             let offered = res.offered(io, t, s);
-            SignalStages::new(gpu, g, scene.animated, &offered).context("creating SVGF's stages")
+            SignalStages::new(gpu, g, scene.motion, &offered).context("creating SVGF's stages")
         };
         let s = signal(false)?;
         let st = crate::passes::chain::made(matte, || stages(false, s))?;
@@ -575,7 +580,7 @@ impl Denoiser for Svgf {
             let s = signal(true)?;
             let m = s.motion.context("SVGF's glossy motion textures are missing")?;
             let st = crate::passes::chain::made(motion, || {
-                motion_stages(gpu, res, io, m, scene.animated)
+                motion_stages(gpu, res, io, m, scene.motion)
             })?;
             res.record_motion(rec, io, cx, m, st)?;
             let st = crate::passes::chain::made(glossy, || stages(true, s))?;

@@ -166,10 +166,10 @@ impl Renderer {
             SceneInputs { scene: &gpu_scene, params: &u.params, frame: &u.frame, moving };
         let trace_in = TraceInputs { scene: scene_in, g: &targets.gbuffer, t: &targets.trace };
         let trace = TracePass::new(gpu, &trace_in).context("creating the trace pass")?;
-        let io = targets.io(&u.frame, gpu_scene.objects.as_ref());
+        let io = targets.io(&u.frame, &gpu_scene);
         let composite = CompositePass::new(gpu, &u.shown(&targets, &io, None))
             .context("creating the composite pass")?;
-        let taa = TaaStage::new(gpu, &mut uniforms.memory, prepared.features.animated);
+        let taa = TaaStage::new(gpu, &mut uniforms.memory, prepared.features.motion());
         let stages = Stages {
             gbuffer,
             trace,

@@ -128,7 +128,7 @@ impl Renderer {
                 let Some(make) = crate::denoise::find(name)?.make else { return Ok(None) };
                 let scene = DenoiserScene {
                     glossy: self.prepared.features.glossy,
-                    animated: self.prepared.features.animated,
+                    motion: self.prepared.features.motion(),
                     extent: self.prepared.extent as f32,
                 };
                 let denoiser =

@@ -69,7 +69,7 @@ impl Renderer {
         let mut rec = Recorder::new(gpu, &mut enc, timer.as_mut());
         let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
         let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace };
-        let io = t.io(&u.frame, gpu_scene.objects.as_ref());
+        let io = t.io(&u.frame, gpu_scene);
         // primaries [-> pre-filter] -> trace [-> mix] -> denoise -> composite [-> resolve] -> TAA
         // -> display; then this frame's G-buffer becomes the next one's previous.
         s.record_primaries(&mut rec, &plan, scene, t)?;
@@ -124,7 +124,7 @@ impl Renderer {
             );
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             let (t, u) = (&self.targets, &self.uniforms);
-            let io = t.io(&u.frame, self.gpu_scene.objects.as_ref());
+            let io = t.io(&u.frame, &self.gpu_scene);
             let denoised = self.history.denoised_last;
             let fb = u.shown(t, &io, self.stages.taa.output().filter(|_| denoised.is_some()));
             let (view, view_key) = t.view_texture(settings);
@@ -146,7 +146,7 @@ impl Renderer {
     ) -> Result<()> {
         let (t, u) = (&self.targets, &self.uniforms);
         if self.stages.display.as_ref().is_none_or(|d| d.format != target.format) {
-            let io = t.io(&u.frame, self.gpu_scene.objects.as_ref());
+            let io = t.io(&u.frame, &self.gpu_scene);
             let pass = DisplayPass::new(gpu, &u.shown(t, &io, None), target.format);
             self.stages.display = Some(pass.context("creating the display pass")?);
         }

@@ -2,6 +2,7 @@
 //! binds.
 
 use super::FrameParams;
+use crate::gpu::GpuScene;
 use crate::gpu::{Gpu, GpuMemory};
 use crate::passes::composite::FrameBuffers;
 use crate::passes::gbuffer::GBufferTargets;
@@ -64,15 +65,12 @@ impl Targets {
         }
     }
 
-    pub fn io<'a>(
-        &'a self,
-        frame: &'a wgpu::Buffer,
-        objects: Option<&'a wgpu::Buffer>,
-    ) -> FrameIo<'a> {
+    pub fn io<'a>(&'a self, frame: &'a wgpu::Buffer, scene: &'a GpuScene) -> FrameIo<'a> {
         FrameIo {
             size: self.size,
             frame,
-            objects,
+            objects: scene.objects.as_ref(),
+            vertices: scene.tri_prev_texels.as_ref().map(|t| (&scene.tri_texels.view, &t.view)),
             gbuffer: &self.gbuffer,
             previous: self.previous.as_ref(),
             trace: &self.trace,

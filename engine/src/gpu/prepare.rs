@@ -40,17 +40,38 @@ pub struct SceneFeatures {
     pub deforming: bool,
 }
 
+/// How points move between frames, and so which motion module a program that reprojects is
+/// composed with (shaders/realtime/motion_*.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Motion {
+    /// Nothing moves.
+    Static,
+    /// Objects move rigidly: a point moves with its object's transform.
+    Objects,
+    /// Some mesh deforms: a point moves with its triangle's vertices.
+    Vertices,
+}
+
+impl Motion {
+    pub fn module(self) -> &'static str {
+        match self {
+            Motion::Static => "realtime/motion_static.wgsl",
+            Motion::Objects => "realtime/motion_objects.wgsl",
+            Motion::Vertices => "realtime/motion_vertices.wgsl",
+        }
+    }
+}
+
 impl SceneFeatures {
-    /// The motion module for a program that knows each point's triangle (the G-buffer, the
-    /// traced primaries): per-vertex previous positions where a mesh deforms, per-object
-    /// motion where objects move, none otherwise.
-    pub fn vertex_motion_module(&self) -> &'static str {
+    /// Per-vertex previous positions where a mesh deforms, per-object motion where objects
+    /// move, none otherwise.
+    pub fn motion(&self) -> Motion {
         if self.deforming {
-            "realtime/motion_vertices.wgsl"
+            Motion::Vertices
         } else if self.animated {
-            "realtime/motion_objects.wgsl"
+            Motion::Objects
         } else {
-            "realtime/motion_static.wgsl"
+            Motion::Static
         }
     }
 }

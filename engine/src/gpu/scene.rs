@@ -300,6 +300,10 @@ impl GpuScene {
             .texture("tri_texels", &self.tri_texels.view)
             .texture_opt("tri_open_texels", self.tri_open_texels.as_ref().map(|t| &t.view))
             .texture_opt("tri_prev_texels", self.tri_prev_texels.as_ref().map(|t| &t.view))
+            .texture_opt(
+                "tri_now_texels",
+                self.tri_prev_texels.as_ref().map(|_| &self.tri_texels.view),
+            )
             .buffer("tris", &self.tris)
             .texture("shading_texels", &self.shading.view)
             .texture("material_texels", &self.materials.view)

@@ -186,7 +186,7 @@ impl GBufferPass {
             "common/bsdf.wgsl",
         ];
         modules.extend(scene.material_modules());
-        modules.extend(["realtime/frame.wgsl", f.vertex_motion_module(), "realtime/gbuffer.wgsl"]);
+        modules.extend(["realtime/frame.wgsl", f.motion().module(), "realtime/gbuffer.wgsl"]);
         let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         // Reversed Z: larger is nearer.
         let pipeline = Reloadable::new(

@@ -175,7 +175,7 @@ fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: Parity) -> Bindings<'a
 }
 
 /// The modules of a glossy stage's program.
-pub fn modules(stage: &'static str, animated: bool) -> Vec<&'static str> {
+pub fn modules(stage: &'static str, motion: crate::gpu::Motion) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "realtime/frame.wgsl",
@@ -184,7 +184,7 @@ pub fn modules(stage: &'static str, animated: bool) -> Vec<&'static str> {
         "matte/common.wgsl",
         "glossy/common.wgsl",
     ];
-    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.push(motion.module());
     if stage == "glossy/motion.wgsl" {
         m.push("glossy/diamond.wgsl");
     }
@@ -202,7 +202,7 @@ impl GlossyChain {
         self.stages.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 
-    pub fn new(gpu: &Gpu, i: &GlossyInputs, animated: bool) -> Result<GlossyChain> {
+    pub fn new(gpu: &Gpu, i: &GlossyInputs, motion: crate::gpu::Motion) -> Result<GlossyChain> {
         let mut stages = vec![];
         for (kind, label, file, entry) in STAGES {
             stages.push((
@@ -210,7 +210,7 @@ impl GlossyChain {
                 ChainStage::new(
                     gpu,
                     label,
-                    &modules(file, animated),
+                    &modules(file, motion),
                     entry,
                     &bindings(kind, i, Parity::default()),
                 )?,

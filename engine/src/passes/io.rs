@@ -14,6 +14,9 @@ pub struct FrameIo<'a> {
     pub frame: &'a wgpu::Buffer,
     /// Per object, previous-from-current transforms (animated scenes only).
     pub objects: Option<&'a wgpu::Buffer>,
+    /// A deforming scene's triangle vertices now and at the previous frame
+    /// (realtime/motion_vertices.wgsl).
+    pub vertices: Option<(&'a wgpu::TextureView, &'a wgpu::TextureView)>,
     pub gbuffer: &'a GBufferTargets,
     /// The previous frame's G-buffer depth, normal and object ids, where a stage asked for them
     /// ([`crate::denoise::Denoiser::needs_previous_gbuffer`]).
@@ -37,6 +40,8 @@ impl<'a> FrameIo<'a> {
         let mut b = Bindings::new()
             .buffer("frame", self.frame)
             .buffer_opt("prev_from_current", self.objects)
+            .texture_opt("tri_now_texels", self.vertices.map(|v| v.0))
+            .texture_opt("tri_prev_texels", self.vertices.map(|v| v.1))
             .texture("gb_depth", &g.depth.1)
             .texture("gb_normal", g.view(Channel::Normal))
             .texture("gb_motion", g.view(Channel::Motion))

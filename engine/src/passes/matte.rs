@@ -239,14 +239,14 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: Parity) -> Bindings<'a>
     }
 }
 
-fn modules(kind: Kind, animated: bool) -> Vec<&'static str> {
+fn modules(kind: Kind, motion: crate::gpu::Motion) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
         "matte/common.wgsl",
     ];
-    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.push(motion.module());
     m.extend(match kind {
         Kind::Temporal => vec!["matte/temporal.wgsl"],
         Kind::HistoryBilateral => {
@@ -269,7 +269,7 @@ impl MatteChain {
         self.stages.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 
-    pub fn new(gpu: &Gpu, i: &ChainInputs, animated: bool) -> Result<MatteChain> {
+    pub fn new(gpu: &Gpu, i: &ChainInputs, motion: crate::gpu::Motion) -> Result<MatteChain> {
         let mut stages = vec![];
         for (kind, label) in STAGES {
             let entry = match kind {
@@ -282,7 +282,7 @@ impl MatteChain {
                 ChainStage::new(
                     gpu,
                     label,
-                    &modules(kind, animated),
+                    &modules(kind, motion),
                     entry,
                     &bindings(kind, i, Parity::default()),
                 )?,

@@ -87,7 +87,7 @@ impl Primaries {
         let (p, cache) = super::chain::made(&mut self.trace[moving as usize], || {
             let mut modules = scene.shading_modules_for(moving);
             modules.push("realtime/frame.wgsl");
-            modules.push(scene.features.vertex_motion_module());
+            modules.push(scene.features.motion().module());
             modules.extend(["realtime/lens.wgsl", "realtime/primaries.wgsl"]);
             let p = Reloadable::new(
                 gpu,

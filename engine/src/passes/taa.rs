@@ -70,14 +70,14 @@ pub struct TaaStage {
     targets: Option<(u64, TaaTargets)>,
     /// One program per (follows matte, follows glossy), made on first use.
     programs: Vec<((bool, bool), ChainStage)>,
-    animated: bool,
+    motion: crate::gpu::Motion,
 }
 
 impl TaaStage {
-    pub fn new(gpu: &Gpu, memory: &mut GpuMemory, animated: bool) -> TaaStage {
+    pub fn new(gpu: &Gpu, memory: &mut GpuMemory, motion: crate::gpu::Motion) -> TaaStage {
         let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let params = memory.buffer(&gpu.device, "taa/params", size_of::<DenoiseParams>() as u64, u);
-        TaaStage { params, targets: None, programs: vec![], animated }
+        TaaStage { params, targets: None, programs: vec![], motion }
     }
 
     pub fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
@@ -125,7 +125,7 @@ impl TaaStage {
         let i = match self.programs.iter().position(|(v, _)| *v == variant) {
             Some(i) => i,
             None => {
-                let modules = modules(variant, self.animated);
+                let modules = modules(variant, self.motion);
                 let offered = bindings(Parity::default());
                 let stage = ChainStage::new(gpu, LABEL, &modules, "main", &offered)?;
                 self.programs.push((variant, stage));
@@ -171,14 +171,14 @@ fn taa_bindings<'a>(
     b
 }
 
-fn modules((matte, glossy): (bool, bool), animated: bool) -> Vec<&'static str> {
+fn modules((matte, glossy): (bool, bool), motion: crate::gpu::Motion) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
         "matte/common.wgsl",
     ];
-    m.push(if animated { "realtime/motion_objects.wgsl" } else { "realtime/motion_static.wgsl" });
+    m.push(motion.module());
     m.extend(if glossy {
         ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice()
     } else {

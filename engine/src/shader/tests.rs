@@ -47,6 +47,9 @@ const FEATURE_SETS: &[[&str; 9]] = &[
     ],
 ];
 
+const MOTIONS: [crate::gpu::Motion; 3] =
+    [crate::gpu::Motion::Static, crate::gpu::Motion::Objects, crate::gpu::Motion::Vertices];
+
 /// Every program Hush can compose, over both BVH layouts and the feature alternatives.
 fn all_programs() -> Vec<Program> {
     let mut v = vec![];
@@ -96,7 +99,11 @@ fn all_programs() -> Vec<Program> {
         ];
         v.push(compose("realtime/display.wgsl", "", &display).unwrap());
     }
-    for motion in ["realtime/motion_static.wgsl", "realtime/motion_objects.wgsl"] {
+    for motion in [
+        "realtime/motion_static.wgsl",
+        "realtime/motion_objects.wgsl",
+        "realtime/motion_vertices.wgsl",
+    ] {
         for stage in [
             &["matte/temporal.wgsl"][..],
             &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
@@ -123,7 +130,7 @@ fn all_programs() -> Vec<Program> {
             v.push(compose(stage[stage.len() - 1], "", &m).unwrap());
         }
     }
-    for animated in [false, true] {
+    for animated in MOTIONS {
         for stage in [
             "glossy/motion.wgsl",
             "glossy/prefilter.wgsl",
@@ -133,7 +140,7 @@ fn all_programs() -> Vec<Program> {
             v.push(compose(stage, "", &crate::passes::glossy::modules(stage, animated)).unwrap());
         }
     }
-    for animated in [false, true] {
+    for animated in MOTIONS {
         for glossy in [false, true] {
             let temporal =
                 if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
@@ -151,7 +158,7 @@ fn all_programs() -> Vec<Program> {
             }
         }
     }
-    for animated in [false, true] {
+    for animated in MOTIONS {
         for glossy in [false, true] {
             use crate::denoise::progressive::{Signal, modules};
             let signals: &[Signal] = if glossy {
