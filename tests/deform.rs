@@ -11,6 +11,7 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use hush_engine::quality::relmse;
 use hush_engine::scene::{LoadOptions, Scene, load_gltf, load_gltf_opts};
 use hush_tests::gltf_writer::{GltfWriter, Prim, write_json};
+use hush_tests::reproject::{pixel_centre_hit, project};
 use serde_json::{Value, json};
 use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
 
@@ -254,12 +255,6 @@ fn hostile_skins_are_refused_or_fall_back() {
     assert!(posed.positions.iter().all(|p| p.is_finite()));
 }
 
-fn project(vp: &Mat4, p: Vec3, size: (u32, u32)) -> Vec2 {
-    let c = *vp * p.extend(1.0);
-    let ndc = Vec2::new(c.x, c.y) / c.w;
-    Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * Vec2::new(size.0 as f32, size.1 as f32)
-}
-
 /// Motion vectors of a deforming surface: between two real-time frames (t = 1.2 s and 1.3 s,
 /// still camera) every G-buffer pixel on the bar moves by what the hand-posed vertices say: the
 /// exact hit of the pixel's centre ray on its stored triangle, carried by the same barycentrics
@@ -295,14 +290,8 @@ fn motion_vectors_of_skinned_vertices_follow_the_pose() {
             if slot == u32::MAX {
                 continue;
             }
-            let ndc = Vec2::new(
-                (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
-                1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0,
-            );
-            let d = (setup.fwd + ndc.x * setup.right + ndc.y * setup.up).normalize();
+            let p = pixel_centre_hit(&setup, size, (x, y), tris, slot);
             let v = |k: usize| tris[slot as usize * 3 + k].truncate();
-            let n = (v(1) - v(0)).cross(v(2) - v(0));
-            let p = setup.pos + d * ((v(0) - setup.pos).dot(n) / d.dot(n));
             // Barycentrics of p, and the mesh triangle the slot holds (its input index).
             let (e1, e2, ep) = (v(1) - v(0), v(2) - v(0), p - v(0));
             let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));

@@ -1,12 +1,13 @@
 //! The real-time frame: converged accumulation against the reference mode, motion vectors,
 //! feature-driven allocation, the default level.
 
-use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
+use glam::{DVec3, Vec2, Vec4};
 use hush_engine::accel::BvhKind;
 use hush_engine::frame::{FrameInput, Renderer, View};
 use hush_engine::quality::Image;
 use hush_engine::scene::{Camera, load_gltf};
 use hush_engine::settings::FrameSettings;
+use hush_tests::reproject::{pixel_centre_hit, project};
 use hush_tests::{half, oracle, realtime_accumulate, render, trimmed_bias};
 
 /// Accumulated real-time frames converge to the reference tracer's image. The real-time frame
@@ -111,12 +112,6 @@ fn a_diffuse_only_scene_allocates_no_glossy_buffers() {
     );
 }
 
-fn project(vp: &Mat4, p: Vec3, size: (u32, u32)) -> Vec2 {
-    let c = *vp * p.extend(1.0);
-    let ndc = Vec2::new(c.x, c.y) / c.w;
-    Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * Vec2::new(size.0 as f32, size.1 as f32)
-}
-
 /// Motion vectors under camera and object motion, in the default level: for every pixel with a
 /// surface, the G-buffer's motion must equal the motion computed on the CPU from the exact hit
 /// point (ray through the pixel centre and the stored triangle), the object's motion and the two
@@ -160,15 +155,7 @@ fn motion_vectors_follow_camera_and_object_motion() {
                 continue;
             }
             // The exact hit of the ray through the pixel centre on the stored triangle.
-            let ndc = Vec2::new(
-                (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
-                1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0,
-            );
-            let d = (setup1.fwd + ndc.x * setup1.right + ndc.y * setup1.up).normalize();
-            let v = |k: usize| tris[slot as usize * 3 + k].truncate();
-            let n = (v(1) - v(0)).cross(v(2) - v(0));
-            let t = (v(0) - setup1.pos).dot(n) / d.dot(n);
-            let p = setup1.pos + d * t;
+            let p = pixel_centre_hit(&setup1, size, (x, y), tris, slot);
             let prev = r.prepared.prev_from_current[obj as usize] * Vec4::from((p, 1.0));
             let expected = project(&setup0.view_proj, prev.truncate() / prev.w, size)
                 - project(&setup1.view_proj, p, size);

@@ -57,13 +57,25 @@ pub fn render_lod(
     texture_lod: bool,
 ) -> Result<Accumulation> {
     let prepared = PreparedScene::new(scene, kind)?;
+    trace(scene, &prepared, (w, h), spp, seed, texture_lod)
+}
+
+/// `spp` reference samples of `prepared` (as placed by its last `animate`) from `scene`'s camera.
+fn trace(
+    scene: &Scene,
+    prepared: &PreparedScene,
+    (w, h): (u32, u32),
+    spp: u32,
+    seed: u32,
+    texture_lod: bool,
+) -> Result<Accumulation> {
     let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
     let gscene = prepared.upload(&gpu);
     let view = TraceView {
         texture_lod,
         ..TraceView::new(scene.camera_or_default(), (w, h), scene.max_depth, seed)
     };
-    let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
+    let mut tracer = ReferenceTracer::new(&gpu, prepared, &gscene, &view)?;
     let mut done = 0;
     while done < spp {
         let n = (spp - done).min(16);
@@ -77,25 +89,14 @@ pub fn render_lod(
 /// [`render`] with the scene's animation at `time` seconds (objects moved, meshes posed).
 pub fn render_at(
     scene: &Scene,
-    (w, h): (u32, u32),
+    size: (u32, u32),
     spp: u32,
     seed: u32,
     time: f64,
 ) -> Result<Accumulation> {
     let mut prepared = PreparedScene::new(scene, BvhKind::DEFAULT)?;
     prepared.animate(scene, time);
-    let gpu = Gpu::headless(&prepared.requirements(w as u64 * h as u64, 32))?;
-    let gscene = prepared.upload(&gpu);
-    let view = TraceView::new(scene.camera_or_default(), (w, h), scene.max_depth, seed);
-    let mut tracer = ReferenceTracer::new(&gpu, &prepared, &gscene, &view)?;
-    let mut done = 0;
-    while done < spp {
-        let n = (spp - done).min(16);
-        tracer.dispatch(&gpu, n);
-        gpu.wait()?;
-        done += n;
-    }
-    tracer.readback(&gpu)
+    trace(scene, &prepared, size, spp, seed, true)
 }
 
 /// Render `frames` real-time frames of `scene` in accumulate mode (still camera) and return

@@ -61,3 +61,30 @@ impl Surface {
 pub fn neighbours_3x3(x: i64, y: i64) -> impl Iterator<Item = (i64, i64)> {
     (-1..=1).flat_map(move |dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
 }
+
+/// The pixel position (x right, y down) of world point `p` under `view_proj`.
+pub fn project(view_proj: &Mat4, p: Vec3, size: (u32, u32)) -> glam::Vec2 {
+    let c = *view_proj * p.extend(1.0);
+    let ndc = glam::Vec2::new(c.x, c.y) / c.w;
+    glam::Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5)
+        * glam::Vec2::new(size.0 as f32, size.1 as f32)
+}
+
+/// Where the ray through the centre of pixel (x, y) meets the plane of triangle `slot` of
+/// `tris` (PreparedScene::tris): the exact hit the G-buffer rasterized there.
+pub fn pixel_centre_hit(
+    setup: &CameraSetup,
+    size: (u32, u32),
+    (x, y): (usize, usize),
+    tris: &[Vec4],
+    slot: u32,
+) -> Vec3 {
+    let ndc = glam::Vec2::new(
+        (x as f32 + 0.5) / size.0 as f32 * 2.0 - 1.0,
+        1.0 - (y as f32 + 0.5) / size.1 as f32 * 2.0,
+    );
+    let d = (setup.fwd + ndc.x * setup.right + ndc.y * setup.up).normalize();
+    let v = |k: usize| tris[slot as usize * 3 + k].truncate();
+    let n = (v(1) - v(0)).cross(v(2) - v(0));
+    setup.pos + d * ((v(0) - setup.pos).dot(n) / d.dot(n))
+}

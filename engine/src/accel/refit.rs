@@ -3,12 +3,12 @@
 //! (`refit_all`) and packs it again; the CWBVH is refit in place, each node's child boxes
 //! quantized again as obvhs's conversion quantizes them (Ylitie et al. 2017 §3.1: the node's
 //! origin is its box's minimum, its per-axis scale the power of two that spans the box in 255
-//! steps, child planes rounded outwards), which re-converting the refit binary tree cost 12 ms
-//! where this costs about 1 ms (50,000 triangles, `bench --mode animate`). Where motion has
-//! stretched the boxes so that the tree's surface-area cost has grown past [`REFIT_LIMIT`]
-//! times its cost when built, the caller rebuilds instead.
+//! steps, child planes rounded outwards): about 1 ms for 50,000 triangles (`bench --mode
+//! animate`), a tenth of converting a binary tree. Where motion has stretched the boxes so that
+//! the tree's surface-area cost has grown past [`REFIT_LIMIT`] times its cost when built, the
+//! caller rebuilds instead.
 
-use super::{Accel, Built, BvhKind, pack_bvh2, packed_bvh2_depth};
+use super::{Accel, BvhKind, pack_bvh2, packed_bvh2_depth};
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::node::CwBvhNode;
@@ -32,8 +32,6 @@ pub struct RefitTree {
     /// Triangles it was built over (a refit needs the same number).
     pub triangles: usize,
     pub built_cost: f32,
-    /// Its cost after the last refit (relative to its root's area, as `built_cost`).
-    pub cost: f32,
     /// Refits since it was built.
     pub refits: u32,
 }
@@ -86,7 +84,6 @@ pub fn build_refittable(
             depth: accel.depth,
             triangles: tris.len(),
             built_cost,
-            cost: built_cost,
             refits: 0,
         }
     });
@@ -178,19 +175,18 @@ pub fn refit(tree: &mut RefitTree, tris: &[Triangle]) -> Option<Accel> {
             (bytemuck::cast_slice(nodes).to_vec(), nodes.len(), order.clone(), cost)
         }
     };
-    tree.cost = cost;
     if !(cost <= REFIT_LIMIT * tree.built_cost) {
         return None;
     }
     tree.refits += 1;
-    let built: Built = (nodes, node_count, order, tree.depth);
     Some(Accel {
         kind: tree.kind,
-        nodes: built.0,
-        node_count: built.1,
-        order: built.2,
+        nodes,
+        node_count,
+        order,
         build_time: start.elapsed(),
         median_fallback: false,
-        depth: built.3,
+        // A refit keeps the topology.
+        depth: tree.depth,
     })
 }

@@ -371,12 +371,17 @@ fn pack_glass(materials: &[crate::scene::Material]) -> Vec<Vec4> {
 /// Each triangle of `now` where it was in `before` (the same object's previous flattening): the
 /// same mesh triangle's vertices, or its current ones where `before` had dropped it.
 fn previous_vertices(before: &Flat, now: &Flat) -> Vec<[Vec3; 3]> {
+    // Both lists of mesh triangles ascend: one walk matches them.
+    let mut j = 0;
     now.src
         .iter()
         .zip(&now.tris)
-        .map(|(k, t)| match before.src.binary_search(k) {
-            Ok(j) => [before.tris[j].v0, before.tris[j].v1, before.tris[j].v2].map(Vec3::from),
-            Err(_) => [t.v0, t.v1, t.v2].map(Vec3::from),
+        .map(|(&k, t)| {
+            while j < before.src.len() && before.src[j] < k {
+                j += 1;
+            }
+            let t = if before.src.get(j) == Some(&k) { &before.tris[j] } else { t };
+            [t.v0, t.v1, t.v2].map(Vec3::from)
         })
         .collect()
 }

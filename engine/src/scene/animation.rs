@@ -162,8 +162,7 @@ impl Animation {
 
     /// The node's local transform at `time` seconds, looping over its own period.
     fn local_at(&self, time: f64) -> DMat4 {
-        let d = self.own_period();
-        let t = if d > 0.0 && time.is_finite() { time.rem_euclid(d) } else { 0.0 };
+        let t = looped(time, self.own_period());
         let tr =
             self.translation_track.as_ref().and_then(|k| k.sample(t)).unwrap_or(self.translation);
         let r = self.rotation_track.as_ref().and_then(|k| k.sample(t)).unwrap_or(self.rotation);
@@ -185,10 +184,13 @@ impl Animation {
 impl Track<f64> {
     /// A morph target weight at `time` seconds, looping over `period` (or the last key).
     pub fn weight_at(&self, time: f64, period: f64) -> Option<f64> {
-        let d = period.max(self.end());
-        let t = if d > 0.0 && time.is_finite() { time.rem_euclid(d) } else { 0.0 };
-        self.sample(t)
+        self.sample(looped(time, period.max(self.end())))
     }
+}
+
+/// `time` within a loop of `period` seconds (0 for no loop or a time that is not finite).
+fn looped(time: f64, period: f64) -> f64 {
+    if period > 0.0 && time.is_finite() { time.rem_euclid(period) } else { 0.0 }
 }
 
 #[cfg(test)]

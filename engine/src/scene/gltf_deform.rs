@@ -22,8 +22,8 @@ pub(super) fn read_influences(
     m: &mut Mesh,
 ) -> Result<()> {
     let n = m.positions.len();
-    let mut joints = vec![[0u16; MAX_INFLUENCES]; 0];
-    let mut weights = vec![[0f32; MAX_INFLUENCES]; 0];
+    let mut joints: Vec<[u16; MAX_INFLUENCES]> = vec![];
+    let mut weights: Vec<[f32; MAX_INFLUENCES]> = vec![];
     for set in 0..2u32 {
         let (Some(j), Some(w)) =
             (prim.get(&gltf::Semantic::Joints(set)), prim.get(&gltf::Semantic::Weights(set)))

@@ -153,12 +153,6 @@ impl PreparedScene {
         self.split.as_ref().map(|sp| sp.nodes as u32)
     }
 
-    /// The moving part's tree: its surface-area cost now and when built (relative to its
-    /// root's area), and the refits since; None for a static scene.
-    pub fn refit_state(&self) -> Option<(f32, f32, u32)> {
-        self.moving_tree.as_ref().map(|t| (t.cost, t.built_cost, t.refits))
-    }
-
     /// Input triangles of an animated scene's static part: the moving objects' triangles are
     /// numbered from here (the index in `tris`' second w); 0 for a static scene.
     pub fn static_inputs(&self) -> u32 {
@@ -210,11 +204,10 @@ impl PreparedScene {
         let mut mats: Vec<u32> = Vec::with_capacity(n);
         let mut open_in: Vec<Triangle> = vec![];
         let mut prev: Vec<[Vec3; 3]> = vec![];
-        let per_slot = |k: usize| k * n;
-        self.tris.reserve(per_slot(3));
-        self.tris_open.reserve(if self.features.animated { per_slot(3) } else { 0 });
-        self.tris_prev.reserve(if self.features.deforming { per_slot(3) } else { 0 });
-        self.shading.reserve(per_slot(4));
+        self.tris.reserve(3 * n);
+        self.tris_open.reserve(if self.features.animated { 3 * n } else { 0 });
+        self.tris_prev.reserve(if self.features.deforming { 3 * n } else { 0 });
+        self.shading.reserve(4 * n);
         for &i in objects {
             let f: &Flat = &self.flat[i];
             tris_in.extend_from_slice(&f.tris);
