@@ -22,8 +22,12 @@ fn bvh2_node(i: u32) -> Bvh2Node {
     return Bvh2Node(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, bitcast<vec3f>(c.xyz), c.w, bitcast<vec3f>(d.xyz), d.w);
 }
 
-// Closest accepted hit along o + t d, t in (0, tmax). With `any_hit`, the first accepted hit.
-fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
+// Closest accepted hit along o + t d, t in (0, tmax), in the tree rooted at node `root`, then
+// in the one rooted at `second` (none: 0xffffffff). With `any_hit`, the first accepted hit.
+// The scene's tree is rooted at node 0; an animated scene's moving objects have a tree of their
+// own (engine/src/gpu/prepare/assemble.rs), rooted at DYNAMIC_ROOT; a mesh stored once for its
+// instances has one at its own root (common/tlas.wgsl).
+fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
     var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
@@ -32,15 +36,13 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     // TRAVERSAL_STACK comes from the scene (engine/src/accel, traversal_stack).
     var stack: array<u32, TRAVERSAL_STACK>;
     var sp = 0u;
-    // An animated scene's moving objects have a tree of their own (engine/src/gpu/prepare/
-    // assemble.rs), rooted at DYNAMIC_ROOT: it waits at the stack's bottom until the static
-    // tree is done.
-    if DYNAMIC_ROOT != 0xffffffffu {
-        stack[0] = DYNAMIC_ROOT;
+    // The second root waits at the stack's bottom until the first tree is done.
+    if second != 0xffffffffu {
+        stack[0] = second;
         sp = 1u;
     }
     // Items are (index, count) pairs packed: leaves have their count in the high 8 bits.
-    var item = 0u;
+    var item = root;
     var is_leaf = false;
     var count = 0u;
     loop {
@@ -50,7 +52,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
                 let r = intersect_triangle(o, d, slot, tmax);
                 if r.x < tmax && alpha_accept(slot, r.yz, ray) {
                     tmax = r.x;
-                    hit = Hit(r.x, slot, r.yz);
+                    hit = Hit(r.x, slot, r.yz, NO_INSTANCE);
                     if any_hit {
                         return hit;
                     }

@@ -62,7 +62,11 @@ fn cw_intersect(node: u32, o: vec3f, inv_d: vec3f, oct_inv4: u32, tmax: f32) -> 
 // length, TRAVERSAL_STACK, comes from the scene (engine/src/accel, traversal_stack): lavapipe
 // pays for every entry at every traversal.
 
-fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
+// The closest accepted hit in the tree rooted at node `root`, then in the one rooted at `second`
+// (none: 0xffffffff). The scene's tree is rooted at node 0; an animated scene's moving objects
+// have a tree of their own (engine/src/gpu/prepare/assemble.rs), rooted at DYNAMIC_ROOT; a mesh
+// stored once for its instances has one at its own root (common/tlas.wgsl).
+fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
     var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
@@ -72,14 +76,13 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
         | select(0x01010101u, 0u, d.z < 0.0);
     var stack: array<vec2u, TRAVERSAL_STACK>;
     var sp = 0u;
-    // The root as the one hit child of a virtual parent. An animated scene's moving objects
-    // have a tree of their own (engine/src/gpu/prepare/assemble.rs), rooted at DYNAMIC_ROOT:
-    // it waits at the stack's bottom until the static tree is done.
-    if DYNAMIC_ROOT != 0xffffffffu {
-        stack[0] = vec2u(DYNAMIC_ROOT, 0x80000000u);
+    // A root as the one hit child of a virtual parent; the second waits at the stack's bottom
+    // until the first tree is done.
+    if second != 0xffffffffu {
+        stack[0] = vec2u(second, 0x80000000u);
         sp = 1u;
     }
-    var cur = vec2u(0u, 0x80000000u);
+    var cur = vec2u(root, 0x80000000u);
     var prim = vec2u(0u);
     loop {
         while prim.y != 0u {
@@ -89,7 +92,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
             let r = intersect_triangle(o, d, slot, tmax);
             if r.x < tmax && alpha_accept(slot, r.yz, ray) {
                 tmax = r.x;
-                hit = Hit(r.x, slot, r.yz);
+                hit = Hit(r.x, slot, r.yz, NO_INSTANCE);
                 if any_hit {
                     return hit;
                 }

@@ -22,12 +22,16 @@ struct Hit {
     tri: u32,
     // Barycentrics of v1 and v2.
     b: vec2f,
+    // The object whose instance of a stored mesh was hit (its triangle in that mesh's space;
+    // common/instances.wgsl), or NO_INSTANCE for a triangle stored in world space.
+    inst: u32,
 }
 
 const NO_HIT: u32 = 0xffffffffu;
+const NO_INSTANCE: u32 = 0xffffffffu;
 
 fn miss() -> Hit {
-    return Hit(INF, NO_HIT, vec2f(0.0));
+    return Hit(INF, NO_HIT, vec2f(0.0), NO_INSTANCE);
 }
 
 fn tri_material(slot: u32) -> u32 {

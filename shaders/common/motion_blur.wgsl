@@ -13,6 +13,12 @@ fn set_ray_time(t: f32) {
     ray_time = t;
 }
 
+// Where in the shutter the ray is: 0 its open, 1 its close (common/instances.wgsl moves an
+// instance's transform by it).
+fn shutter_time() -> f32 {
+    return ray_time;
+}
+
 fn tri_vertex(i: u32) -> vec3f {
     let close = tri_texel(i).xyz;
     if ray_time >= 1.0 {
@@ -42,8 +48,11 @@ fn normal_at_ray_time(slot: u32, n: vec3f) -> vec3f {
 }
 
 // Moon et al. eq. (2): the world position sample of a hit at the ray's time, carried to the
-// shutter's close by the object's motion (the same barycentrics on the close-time triangle).
-fn compensated_position(slot: u32, b: vec2f, p: vec3f) -> vec3f {
+// shutter's close by the object's motion (the same barycentrics on the close-time triangle, and
+// an instance's transform at the close).
+fn compensated_position(hit: Hit, p: vec3f) -> vec3f {
+    let slot = hit.tri;
+    let b = hit.b;
     let v0 = tri_texel(slot * 3u).xyz;
-    return v0 + b.x * (tri_texel(slot * 3u + 1u).xyz - v0) + b.y * (tri_texel(slot * 3u + 2u).xyz - v0);
+    return inst_close_point(hit.inst, v0 + b.x * (tri_texel(slot * 3u + 1u).xyz - v0) + b.y * (tri_texel(slot * 3u + 2u).xyz - v0));
 }

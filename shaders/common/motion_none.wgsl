@@ -7,10 +7,14 @@ fn tri_vertex(i: u32) -> vec3f {
 fn set_ray_time(t: f32) {
 }
 
+fn shutter_time() -> f32 {
+    return 1.0;
+}
+
 fn normal_at_ray_time(slot: u32, n: vec3f) -> vec3f {
     return n;
 }
 
-fn compensated_position(slot: u32, b: vec2f, p: vec3f) -> vec3f {
+fn compensated_position(hit: Hit, p: vec3f) -> vec3f {
     return p;
 }

@@ -73,9 +73,10 @@ fn tri_tex_coords(slot: u32, b: vec2f) -> TexCoords {
 // footprint whose side in TEXCOORD_0 units is w / |cos_i| x sqrt(uv area / world area);
 // returned as its log2 (textures add log2 of their size in texels). A TEXCOORD_1 read or a
 // KHR_texture_transform's scale uses the same footprint.
-fn cone_lod(slot: u32, width: f32, cos_i: f32) -> f32 {
+fn cone_lod(hit: Hit, width: f32, cos_i: f32) -> f32 {
+    let slot = hit.tri;
     let v0 = tri_vertex(slot * 3u);
-    let world = length(cross(tri_vertex(slot * 3u + 1u) - v0, tri_vertex(slot * 3u + 2u) - v0));
+    let world = length(cross(inst_vector(hit.inst, tri_vertex(slot * 3u + 1u) - v0), inst_vector(hit.inst, tri_vertex(slot * 3u + 2u) - v0)));
     let s0 = shading_at(slot * 4u).w;
     let s1 = shading_at(slot * 4u + 1u).w;
     let s2 = shading_at(slot * 4u + 2u).w;
@@ -109,6 +110,14 @@ fn tri_normal(slot: u32, b: vec2f) -> vec3f {
     return w.x * shading_at(slot * 4u).xyz + w.y * shading_at(slot * 4u + 1u).xyz + w.z * shading_at(slot * 4u + 2u).xyz;
 }
 
+// The object a hit belongs to: the instance's, or the world-space triangle's own.
+fn hit_object(hit: Hit) -> u32 {
+    if hit.inst != NO_INSTANCE {
+        return hit.inst;
+    }
+    return bitcast<u32>(shading_at(hit.tri * 4u + 3u).w);
+}
+
 // What a path needs at a hit.
 struct Surface {
     p: vec3f,
@@ -128,13 +137,17 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     let e2 = tri_vertex(slot * 3u + 2u) - v0;
     var s: Surface;
     s.material = tri_material(slot);
-    s.p = v0 + hit.b.x * e1 + hit.b.y * e2;
-    var ng = normalize(cross(e1, e2));
+    // An instance's triangle is in its mesh's space: its point and normals are carried to the
+    // world, the shading normal after the normal map (exact for rotations, mirrors and uniform
+    // scales; a non-uniform scale turns the mapped normal as it turns the mesh's normal).
+    s.p = inst_point(hit.inst, v0 + hit.b.x * e1 + hit.b.y * e2);
+    let face = cross(e1, e2);
+    var ng = normalize(inst_normal(hit.inst, face));
     s.front = dot(ng, rd) < 0.0;
     var ns = tri_normal(slot, hit.b);
     let len = length(ns);
     let stored = len > 1e-12 && len < 1e30;
-    ns = select(ng, ns / len, stored);
+    ns = select(normalize(face), ns / len, stored);
     if !s.front {
         ng = -ng;
         ns = -ns;
@@ -142,6 +155,9 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     s.tc = tri_tex_coords(slot, hit.b);
     s.ng = ng;
     s.ns = apply_normal_map(slot, hit.b, ns, s.tc, material(s.material));
+    if hit.inst != NO_INSTANCE {
+        s.ns = normalize(inst_normal(hit.inst, s.ns));
+    }
     if stored {
         // The stored normals (and tangents) are the close's: the mapped normal turns with the
         // triangle to the ray's time where objects move during the shutter.

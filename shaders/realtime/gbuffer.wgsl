@@ -1,24 +1,28 @@
 // Raster G-buffer: the primary surfaces, drawn from the same triangle buffers the tracer reads
 // (vertex pulling: vertex i is corner i % 3 of triangle slot i / 3), so raster and trace agree on
 // every triangle. Both faces are drawn: the back of a single-sided surface is a black absorber
-// (as in the tracer) and must still hide what is behind it.
+// (as in the tracer) and must still hide what is behind it. A mesh stored once is drawn
+// instanced, each instance its object (draw_instance; common/instances.wgsl).
 
 struct VsOut {
     @builtin(position) clip: vec4f,
     @location(0) bary: vec2f,
     @location(1) @interpolate(flat) slot: u32,
+    @location(4) @interpolate(flat) inst: u32,
     // Unjittered current and previous clip positions, for motion vectors.
     @location(2) cur: vec4f,
     @location(3) prev: vec4f,
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> VsOut {
     let slot = vi / 3u;
     let corner = vi % 3u;
-    let p = tris[slot * 3u + corner].xyz;
-    let object = bitcast<u32>(shading_at(slot * 4u + 3u).w);
+    let inst = draw_instance(ii);
+    let p = inst_point(inst, tris[slot * 3u + corner].xyz);
+    let object = select(bitcast<u32>(shading_at(slot * 4u + 3u).w), inst, inst != NO_INSTANCE);
     var o: VsOut;
+    o.inst = inst;
     o.clip = frame.view_proj * vec4f(p, 1.0);
     o.bary = select(vec2f(0.0), select(vec2f(0.0, 1.0), vec2f(1.0, 0.0), corner == 1u), corner > 0u);
     o.slot = slot;
@@ -43,7 +47,10 @@ struct GBufferOut {
 }
 
 @fragment
-fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
+fn fs_main(v: VsOut, @builtin(front_facing) facing: bool) -> GBufferOut {
+    // A mirroring instance's triangles reach the raster wound the other way (a flattened one's
+    // winding is swapped instead).
+    let front = facing != inst_mirrored(v.inst);
     let slot = v.slot;
     let b = v.bary;
     // Blended surfaces draw per pixel and frame (the jittered frames then average them).
@@ -61,12 +68,16 @@ fn fs_main(v: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
         ns = -ns;
     }
     ns = apply_normal_map(slot, b, ns, tc, m);
+    // An instance's normals are in its mesh's space (as in surface_at, common/scene.wgsl).
+    if v.inst != NO_INSTANCE {
+        ns = normalize(inst_normal(v.inst, ns));
+    }
     let ms = material_at(m, tc);
     let bsdf = with_glass(material_bsdf(m, ms), m, ms, front);
     var o: GBufferOut;
     o.normal = oct_encode(ns);
     o.motion = to_pixels(v.prev) - to_pixels(v.cur);
-    o.ids = vec2u(bitcast<u32>(shading_at(slot * 4u + 3u).w), slot);
+    o.ids = vec2u(select(bitcast<u32>(shading_at(slot * 4u + 3u).w), v.inst, v.inst != NO_INSTANCE), slot);
     if !front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         // The tracer's black absorber: no material, no light.
         o.base_color = vec4f(0.0);

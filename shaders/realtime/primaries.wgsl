@@ -66,11 +66,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let m = material(s.material);
         let ms = material_at(m, s.tc);
         let bsdf = with_glass(material_bsdf(m, ms), m, ms, s.front);
-        let object = bitcast<u32>(shading_at(hit.tri * 4u + 3u).w);
+        let object = hit_object(hit);
         if j == 0u {
             ids = vec2u(object, hit.tri);
         }
-        let p = compensated_position(hit.tri, hit.b, s.p);
+        let p = compensated_position(hit, s.p);
         if n == 0.0 {
             origin = p;
         }

@@ -207,17 +207,20 @@ fn shade_glass(rd: vec3f, hit: Hit, s: Surface, ms: MaterialSample, rng: ptr<fun
     return Shaded(vec3f(0.0), vec3f(0.0), glossy, 0.0, vec3f(1.0), s.ns, mirror, 0.0, s.ns, false);
 }
 
-// The raster's hit of pixel px's camera ray rd: its triangle (slot), with exact barycentrics of
-// this frame's ray (no bounds test: at a silhouette the sample may sit a hair outside it).
-fn raster_hit(ro: vec3f, rd: vec3f, slot: u32) -> Hit {
-    let v0 = tri_vertex(slot * 3u);
-    let e1 = tri_vertex(slot * 3u + 1u) - v0;
-    let e2 = tri_vertex(slot * 3u + 2u) - v0;
+// The raster's hit of pixel px's camera ray rd: its triangle (G-buffer ids: object, slot), with
+// exact barycentrics of this frame's ray (no bounds test: at a silhouette the sample may sit a
+// hair outside it).
+fn raster_hit(ro: vec3f, rd: vec3f, ids: vec2u) -> Hit {
+    let slot = ids.y;
+    let inst = instance_of_object(ids.x);
+    let v0 = inst_point(inst, tri_vertex(slot * 3u));
+    let e1 = inst_point(inst, tri_vertex(slot * 3u + 1u)) - v0;
+    let e2 = inst_point(inst, tri_vertex(slot * 3u + 2u)) - v0;
     let pv = cross(rd, e2);
     let inv = 1.0 / dot(e1, pv);
     let tv = ro - v0;
     let qv = cross(tv, e1);
-    return Hit(dot(e2, qv) * inv, slot, vec2f(dot(tv, pv) * inv, dot(rd, qv) * inv));
+    return Hit(dot(e2, qv) * inv, slot, vec2f(dot(tv, pv) * inv, dot(rd, qv) * inv), inst);
 }
 
 @compute @workgroup_size(8, 8)
@@ -235,14 +238,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let ray = primary_ray(px, 0u);
     let ro = ray.ro;
     let rd = ray.rd;
-    let slot = textureLoad(gb_ids, px, 0).y;
-    if slot == NO_HIT {
+    let ids = textureLoad(gb_ids, px, 0).xy;
+    if ids.y == NO_HIT {
         // Background: what the camera sees of the environment goes straight to the screen.
         write_all(px, vec3f(0.0), env_radiance(rd));
         write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd, INF);
         return;
     }
-    let hit = raster_hit(ro, rd, slot);
+    let hit = raster_hit(ro, rd, ids);
     let sh = shade(rd, hit, &rng);
     write_all(px, sh.matte, sh.direct);
     write_glossy(px, sh.glossy, sh.glossy_t, select(ro - frame.cam_pos.xyz + rd * hit.t, rd, sh.backface), sh.mirror, sh.hit_reflectance, sh.hit_normal, sh.representative_t);

@@ -11,11 +11,11 @@ fn samples(@builtin(global_invocation_id) gid: vec3u) {
     }
     let pixel = px.y * frame.size.x + px.x;
     let ro = frame.cam_pos.xyz;
-    let slot = textureLoad(gb_ids, px, 0).y;
+    let ids = textureLoad(gb_ids, px, 0).xy;
     var guide = vec4u(bitcast<u32>(-1.0), 0u, NO_GUIDE, 0u);
-    if slot != NO_HIT {
+    if ids.y != NO_HIT {
         let rd = camera_ray(px);
-        let hit = raster_hit(ro, rd, slot);
+        let hit = raster_hit(ro, rd, ids);
         let s = surface_at(hit, rd);
         guide = vec4u(bitcast<u32>(view_depth(rd, hit.t)), pack2x16snorm(oct_encode(s.ns)), s.material, 0u);
     }

@@ -17,7 +17,7 @@ pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP};
 pub use history::{Parity, PingPong, Tex};
 pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use pack::TEXTURE_BUDGET_BYTES;
-pub use prepare::{EnvKind, Motion, PreparedScene, SceneFeatures};
+pub use prepare::{EnvKind, Instancing, Motion, PreparedScene, SceneFeatures};
 pub use record::Recorder;
 pub use scene::GpuScene;
 pub use timestamps::GpuTimer;

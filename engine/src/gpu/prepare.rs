@@ -3,9 +3,11 @@
 //! textures into the layouts the shaders read (`shaders/common/*.wgsl`).
 
 mod assemble;
+mod instances;
 
 pub use super::pack::GpuLight;
 use super::pack::{EnvPack, pack_light, pack_textures};
+pub use instances::{Draw, INSTANCE_TEXELS, Instancing, NO_INSTANCE};
 use crate::accel::{self, Accel, BvhKind};
 use crate::scene::{AlphaMode, Environment, Scene};
 use anyhow::{Result, bail};
@@ -38,6 +40,9 @@ pub struct SceneFeatures {
     /// Some mesh deforms over time (a skin or animated morph weights): each triangle's previous
     /// vertices (`tris_prev`) give the motion vectors (realtime/motion_vertices.wgsl).
     pub deforming: bool,
+    /// Some mesh is stored once for several objects (prepare/instances.rs): the instance
+    /// transforms, the top-level tree and the instanced draws exist.
+    pub instances: bool,
 }
 
 /// How points move between frames, and so which motion module a program that reprojects is
@@ -212,6 +217,25 @@ pub struct PreparedScene {
     /// Whether the moving part's tree is refit while that stays within
     /// [`accel::REFIT_LIMIT`] of its built cost (true), or rebuilt whenever anything moves.
     pub refit: bool,
+    /// Per object, the prototype it instances ([`SceneFeatures::instances`]); None where it is
+    /// flattened in world space. Prototype p's triangles are `flat[objects + p]`.
+    proto_of: Vec<Option<usize>>,
+    protos: Vec<instances::Proto>,
+    /// Per object [`INSTANCE_TEXELS`] texels (shaders/common/instances.wgsl), where the scene
+    /// has instances.
+    pub instances: Vec<Vec4>,
+    /// The top-level tree over the instances' boxes (binary nodes), its leaves' objects and
+    /// its depth; the entries of its traversal stack (fixed at load, as `traversal_stack`).
+    pub tlas: Vec<u8>,
+    pub tlas_order: Vec<u32>,
+    tlas_depth: usize,
+    pub tlas_stack: u32,
+    /// The raster's instanced draws: the objects each prototype's draw names, and the draws.
+    pub draw_list: Vec<u32>,
+    pub draws: Vec<Draw>,
+    /// Whether the last `expose` changed world-space triangles (false where only instances
+    /// moved: their triangles stay as they are on the GPU).
+    pub geometry_moved: bool,
 }
 
 pub use crate::limits::MAX_TRIANGLES;
@@ -406,6 +430,15 @@ impl PreparedScene {
     }
 
     pub fn new(scene: &Scene, kind: BvhKind) -> Result<PreparedScene> {
+        Self::with_instancing(scene, kind, Instancing::Auto)
+    }
+
+    /// [`PreparedScene::new`], storing shared meshes once as `instancing` says.
+    pub fn with_instancing(
+        scene: &Scene,
+        kind: BvhKind,
+        instancing: Instancing,
+    ) -> Result<PreparedScene> {
         let origin = scene.origin();
         let extent =
             scene.bounds().map(|(lo, hi)| (hi - lo).length()).filter(|e| *e > 0.0).unwrap_or(1.0);
@@ -432,10 +465,32 @@ impl PreparedScene {
             vertex_extras,
             transmission: scene.materials.iter().any(|m| m.transmission > 0.0),
             deforming: scene.objects.iter().any(|o| o.deform.as_ref().is_some_and(|d| d.moves())),
+            instances: false,
         };
-        let flat: Vec<Flat> = (0..scene.objects.len())
-            .map(|i| flatten(scene, i, scene.objects[i].transform, origin, &features, None))
+        let meshes = instances::plan(scene, instancing, features.deforming);
+        features.instances = meshes.iter().any(Option::is_some);
+        // One prototype per instanced mesh, in the order objects first use them.
+        let mut protos: Vec<usize> = vec![];
+        let mut proto_of = vec![None; scene.objects.len()];
+        for (i, m) in meshes.iter().enumerate() {
+            if let Some(m) = *m {
+                let p = protos.iter().position(|&q| scene.objects[q].mesh == m).unwrap_or_else(|| {
+                    protos.push(i);
+                    protos.len() - 1
+                });
+                proto_of[i] = Some(p);
+            }
+        }
+        let mut flat: Vec<Flat> = (0..scene.objects.len())
+            .map(|i| match proto_of[i] {
+                Some(_) => Flat::default(),
+                None => flatten(scene, i, scene.objects[i].transform, origin, &features, None),
+            })
             .collect();
+        // A prototype in its mesh's own space (the first object that draws it names it).
+        flat.extend(
+            protos.iter().map(|&i| flatten(scene, i, DMat4::IDENTITY, DVec3::ZERO, &features, None)),
+        );
         let dropped: usize = flat.iter().map(|f| f.dropped).sum();
         if dropped > 0 {
             log::warn!("dropped {dropped} triangles with non-finite vertices or zero area");
@@ -513,16 +568,37 @@ impl PreparedScene {
             time: 0.0,
             pose_time: None,
             open_from_close: vec![],
-            moving: scene.objects.iter().map(|o| o.moves()).collect(),
+            moving: scene
+                .objects
+                .iter()
+                .zip(&proto_of)
+                .map(|(o, p)| o.moves() && p.is_none())
+                .collect(),
             split: None,
             moving_tree: None,
             refit: true,
+            protos: vec![
+                instances::Proto { root: 0, slot_base: 0, slots: 0, lo: Vec3::ZERO, hi: Vec3::ZERO };
+                protos.len()
+            ],
+            proto_of,
+            instances: vec![],
+            tlas: vec![],
+            tlas_order: vec![],
+            tlas_depth: 0,
+            tlas_stack: BvhKind::Bvh2.max_depth() as u32,
+            draw_list: vec![],
+            draws: vec![],
+            geometry_moved: true,
         };
         p.assemble();
+        p.place_instances();
+        let placed = p.tlas_order.len();
+        p.tlas_stack = accel::traversal_stack(BvhKind::Bvh2, p.tlas_depth, placed, p.features.animated);
         p.traversal_stack = match &p.split {
             None => accel::traversal_stack(kind, p.accel.depth, count, p.features.animated),
             Some(sp) => {
-                let moving: usize = (0..p.flat.len())
+                let moving: usize = (0..p.world.len())
                     .filter(|&i| p.moving[i])
                     .map(|i| p.flat[i].tris.len() + p.flat[i].dropped)
                     .sum();
@@ -548,16 +624,26 @@ impl PreparedScene {
     ///
     /// [`animate`]: PreparedScene::animate
     pub fn expose(&mut self, scene: &Scene, time: f64, open: Option<f64>) -> bool {
-        let moved = self.move_objects(scene, time);
+        let (moved, instances_moved) = self.move_objects(scene, time);
         let swept = self.open_shutter(scene, open);
-        if moved || swept {
+        // Instances move by their transforms alone: the world-space triangles are rebuilt only
+        // where one of them moved or swept.
+        let world = moved || (swept && self.moving.iter().any(|&m| m));
+        if world {
             self.assemble();
         }
-        moved || swept
+        if instances_moved || swept {
+            self.place_instances();
+        }
+        self.geometry_moved = world;
+        moved || instances_moved || swept
     }
 
-    fn move_objects(&mut self, scene: &Scene, time: f64) -> bool {
+    /// Move every object to `time`: whether world-space triangles moved, and whether
+    /// instances did.
+    fn move_objects(&mut self, scene: &Scene, time: f64) -> (bool, bool) {
         let mut moved = false;
+        let mut instances_moved = false;
         let repose = self.pose_time != Some(time);
         for (i, o) in scene.objects.iter().enumerate().take(self.world.len()) {
             let now = o.transform_at(time);
@@ -568,7 +654,12 @@ impl PreparedScene {
                 glam::Mat4::IDENTITY
             };
             let deforms = repose && o.deform.as_ref().is_some_and(|d| d.moves());
-            if (o.animation.is_some() && now != before) || deforms {
+            if self.proto_of[i].is_some() {
+                if now != before {
+                    self.world[i] = now;
+                    instances_moved = true;
+                }
+            } else if (o.animation.is_some() && now != before) || deforms {
                 let mut f = flatten(scene, i, now, self.origin, &self.features, Some(time));
                 if self.features.deforming {
                     f.prev = previous_vertices(&self.flat[i], &f);
@@ -584,7 +675,7 @@ impl PreparedScene {
         }
         self.time = time;
         self.pose_time = Some(time);
-        moved
+        (moved, instances_moved)
     }
 
     /// The per-object transforms from the close to `open` (empty while nothing moves during the

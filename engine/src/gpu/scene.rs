@@ -1,6 +1,6 @@
 //! A scene on the GPU: the buffers of a [`PreparedScene`] and what they cost.
 
-use super::prepare::{EnvKind, PreparedScene, SceneFeatures};
+use super::prepare::{Draw, EnvKind, PreparedScene, SceneFeatures};
 use super::{Bindings, Gpu, GpuMemory, GpuRequirements};
 use crate::accel::BvhKind;
 
@@ -38,10 +38,54 @@ pub struct GpuScene {
     pub tangents: Option<wgpu::Buffer>,
     /// Per object: rebased previous-from-current transform (animated scenes only).
     pub objects: Option<wgpu::Buffer>,
+    /// [`SceneFeatures::instances`]: the instances' transforms, the top-level tree and its
+    /// leaves' objects, and the raster's draw list ([`PreparedScene::instances`] and after).
+    pub instancing: Option<InstanceTexels>,
+    /// [`PreparedScene::tlas_stack`].
+    pub tlas_stack: u32,
+    /// The raster's instanced draws and the slots they cover ([`PreparedScene::draws`]).
+    pub draws: Vec<Draw>,
+    pub proto_slots: std::ops::Range<u32>,
     pub memory: GpuMemory,
     pub triangle_count: u32,
     /// Bumped whenever a buffer is replaced, so passes know to rebuild their bind groups.
     pub generation: u64,
+}
+
+/// The GPU half of a scene's instances (shaders/common/instances.wgsl and tlas.wgsl).
+pub struct InstanceTexels {
+    pub instances: Texels,
+    pub tlas: Texels,
+    pub tlas_order: Texels,
+    pub draw_list: Texels,
+}
+
+impl InstanceTexels {
+    fn new(gpu: &Gpu, mem: &mut GpuMemory, p: &PreparedScene) -> InstanceTexels {
+        use wgpu::TextureFormat::{Rgba32Float, Rgba32Uint};
+        let b = |v: &[u32]| bytemuck::cast_slice::<u32, u8>(v).to_vec();
+        InstanceTexels {
+            instances: Texels::new(
+                gpu,
+                mem,
+                "scene/instances",
+                bytemuck::cast_slice(&p.instances),
+                Rgba32Float,
+            ),
+            tlas: Texels::new(gpu, mem, "scene/top-level nodes", &p.tlas, Rgba32Uint),
+            tlas_order: Texels::new(gpu, mem, "scene/top-level order", &b(&p.tlas_order), Rgba32Uint),
+            draw_list: Texels::new(gpu, mem, "scene/draw list", &b(&p.draw_list), Rgba32Uint),
+        }
+    }
+
+    fn write(&mut self, gpu: &Gpu, mem: &mut GpuMemory, p: &PreparedScene) -> bool {
+        let b = |v: &[u32]| bytemuck::cast_slice::<u32, u8>(v).to_vec();
+        let mut replaced = self.instances.write(gpu, mem, bytemuck::cast_slice(&p.instances));
+        replaced |= self.tlas.write(gpu, mem, &p.tlas);
+        replaced |= self.tlas_order.write(gpu, mem, &b(&p.tlas_order));
+        replaced |= self.draw_list.write(gpu, mem, &b(&p.draw_list));
+        replaced
+    }
 }
 
 impl PreparedScene {
@@ -81,6 +125,10 @@ impl PreparedScene {
                 self.extras.len() * 16,
                 self.tex_uses.len() * 16,
                 self.glass.len() * 16,
+                self.instances.len() * 16,
+                self.tlas.len(),
+                self.tlas_order.len() * 4,
+                self.draw_list.len() * 4,
             ]
             .into_iter()
             .map(texel_row_count)
@@ -181,6 +229,7 @@ impl PreparedScene {
         let objects = f
             .animated
             .then(|| mem.buffer_init(d, "scene/object motion", b(&self.prev_from_current), copy));
+        let instancing = f.instances.then(|| InstanceTexels::new(gpu, &mut mem, self));
         log::info!(
             "scene on the GPU: {} triangles, {} BVH nodes ({}), features {:?}, {} bytes: {}",
             self.triangle_count(),
@@ -211,6 +260,10 @@ impl PreparedScene {
             textures,
             tangents,
             objects,
+            instancing,
+            tlas_stack: self.tlas_stack,
+            draws: self.draws.clone(),
+            proto_slots: self.proto_slots(),
             memory: mem,
             triangle_count: self.triangle_count() as u32,
             generation: 0,
@@ -240,6 +293,11 @@ impl GpuScene {
         // An animated scene's static part leads every array and never changes: only what
         // follows it is written (PreparedScene::static_prefix).
         let (slots, node_bytes) = p.static_prefix();
+        if moved && let Some(t) = self.instancing.as_mut() {
+            replaced |= t.write(gpu, mem, p);
+            self.draws.clone_from(&p.draws);
+        }
+        let moved = moved && p.geometry_moved;
         if moved {
             replaced |= self.nodes.write_from(gpu, mem, &p.accel.nodes, node_bytes);
             replaced |= self.tri_texels.write_from(gpu, mem, b(&p.tris), slots * 48);
@@ -316,6 +374,20 @@ impl GpuScene {
             .texture_opt("tex_words", self.textures.as_ref().map(|t| &t.view))
             .buffer_opt("tangents", self.tangents.as_ref())
             .buffer_opt("prev_from_current", self.objects.as_ref())
+            .texture_opt("instance_texels", self.instancing.as_ref().map(|t| &t.instances.view))
+            .texture_opt("tlas_texels", self.instancing.as_ref().map(|t| &t.tlas.view))
+            .texture_opt("tlas_order_texels", self.instancing.as_ref().map(|t| &t.tlas_order.view))
+            .texture_opt("draw_list_texels", self.instancing.as_ref().map(|t| &t.draw_list.view))
+    }
+
+    /// The module that carries an instance's hits to world space
+    /// (shaders/common/instances.wgsl), or its identity where nothing is instanced.
+    pub fn instance_module(&self) -> &'static str {
+        if self.features.instances {
+            "common/instances.wgsl"
+        } else {
+            "common/instances_none.wgsl"
+        }
     }
 
     /// Program modules that match this scene's features, for a program that shades.
@@ -338,13 +410,16 @@ impl GpuScene {
             } else {
                 "common/motion_none.wgsl"
             },
-            self.traversal_module(),
+            self.instance_module(),
+        ];
+        m.extend(self.traversal_modules());
+        m.extend([
             "common/scene.wgsl",
             "common/bsdf.wgsl",
             "common/params.wgsl",
             "common/camera.wgsl",
             "common/path.wgsl",
-        ];
+        ]);
         m.extend(self.material_modules());
         m.push(if f.punctual_lights { "common/lights.wgsl" } else { "common/lights_none.wgsl" });
         m.push(if f.emitters { "common/emitters.wgsl" } else { "common/emitters_none.wgsl" });
@@ -374,11 +449,17 @@ impl GpuScene {
         ]
     }
 
-    pub fn traversal_module(&self) -> &'static str {
-        match self.bvh_kind {
-            BvhKind::Bvh2 => "common/bvh2.wgsl",
-            BvhKind::Cwbvh => "common/cwbvh.wgsl",
-        }
+    /// The trees' traversal (in the scene's layout) and the `traverse` over them: the scene's
+    /// trees alone, or with the instances' top-level tree (shaders/common/tlas.wgsl, which
+    /// needs [`GpuScene::instance_module`]).
+    pub fn traversal_modules(&self) -> [&'static str; 2] {
+        [
+            match self.bvh_kind {
+                BvhKind::Bvh2 => "common/bvh2.wgsl",
+                BvhKind::Cwbvh => "common/cwbvh.wgsl",
+            },
+            if self.features.instances { "common/tlas.wgsl" } else { "common/tlas_none.wgsl" },
+        ]
     }
 
     /// `const` flags the shading modules branch on, and the traversal's stack size.
@@ -395,9 +476,10 @@ impl GpuScene {
     /// What a program that only traverses needs before its modules.
     pub fn traversal_prelude(&self) -> String {
         format!(
-            "const TRAVERSAL_STACK: u32 = {}u;\nconst DYNAMIC_ROOT: u32 = {}u;\n",
+            "const TRAVERSAL_STACK: u32 = {}u;\nconst DYNAMIC_ROOT: u32 = {}u;\nconst TLAS_STACK: u32 = {}u;\n",
             self.traversal_stack,
-            self.dynamic_root.unwrap_or(u32::MAX)
+            self.dynamic_root.unwrap_or(u32::MAX),
+            self.tlas_stack
         )
     }
 }

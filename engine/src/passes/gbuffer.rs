@@ -182,6 +182,7 @@ impl GBufferPass {
             "common/rng.wgsl",
             "common/geometry.wgsl",
             "common/motion_none.wgsl",
+            scene.instance_module(),
             "common/scene.wgsl",
             "common/bsdf.wgsl",
         ];
@@ -219,7 +220,18 @@ impl GBufferPass {
         let mut pass = t.begin_pass(rec, LABEL);
         pass.set_pipeline(p.get());
         set_render_groups(&mut pass, groups);
-        pass.draw(0..scene.triangle_count * 3, 0..1);
+        if scene.draws.is_empty() {
+            pass.draw(0..scene.triangle_count * 3, 0..1);
+        } else {
+            // World-space triangles around the prototypes (draw list entry 0), then each
+            // prototype instanced.
+            let protos = &scene.proto_slots;
+            pass.draw(0..protos.start * 3, 0..1);
+            pass.draw(protos.end * 3..scene.triangle_count * 3, 0..1);
+            for d in &scene.draws {
+                pass.draw(d.vertices.clone(), d.instances.clone());
+            }
+        }
         Ok(())
     }
 }

@@ -24,11 +24,14 @@ pub struct Raycaster {
 
 impl Raycaster {
     pub fn new(gpu: &Gpu, scene: &GpuScene) -> Result<Raycaster> {
+        let [tree, top] = scene.traversal_modules();
         let modules = [
             "common/math.wgsl",
             "common/geometry.wgsl",
             "common/motion_none.wgsl",
-            scene.traversal_module(),
+            scene.instance_module(),
+            tree,
+            top,
             "common/alpha_none.wgsl",
             "accel/raycast.wgsl",
         ];

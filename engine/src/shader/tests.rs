@@ -64,6 +64,11 @@ fn all_programs() -> Vec<Program> {
                 "common/rng.wgsl",
                 "common/geometry.wgsl",
                 "common/motion_none.wgsl",
+                if motion.contains("objects") {
+                    "common/instances.wgsl"
+                } else {
+                    "common/instances_none.wgsl"
+                },
                 "common/scene.wgsl",
                 "common/bsdf.wgsl",
                 set[1],
@@ -199,7 +204,7 @@ fn all_programs() -> Vec<Program> {
     }
     for bvh in ["common/bvh2.wgsl", "common/cwbvh.wgsl"] {
         // A scene sets the traversal's stack length (accel::traversal_stack).
-        let stack = "const TRAVERSAL_STACK: u32 = 16u;\nconst DYNAMIC_ROOT: u32 = 7u;\n";
+        let stack = "const TRAVERSAL_STACK: u32 = 16u;\nconst DYNAMIC_ROOT: u32 = 7u;\nconst TLAS_STACK: u32 = 12u;\n";
         v.push(
             compose(
                 "raycast",
@@ -208,7 +213,9 @@ fn all_programs() -> Vec<Program> {
                     "common/math.wgsl",
                     "common/geometry.wgsl",
                     "common/motion_none.wgsl",
+                    "common/instances.wgsl",
                     bvh,
+                    "common/tlas.wgsl",
                     "common/alpha_none.wgsl",
                     "accel/raycast.wgsl",
                 ],
@@ -221,7 +228,10 @@ fn all_programs() -> Vec<Program> {
                 "common/rng.wgsl",
                 "common/geometry.wgsl",
                 if i % 2 == 0 { "common/motion_none.wgsl" } else { "common/motion_blur.wgsl" },
+                // Instances with and without motion blur, and neither.
+                if i % 3 == 0 { "common/instances_none.wgsl" } else { "common/instances.wgsl" },
                 bvh,
+                if i % 3 == 0 { "common/tlas_none.wgsl" } else { "common/tlas.wgsl" },
                 "common/scene.wgsl",
                 "common/bsdf.wgsl",
                 "common/params.wgsl",

@@ -32,8 +32,8 @@ pub(crate) struct StaticPart {
 }
 
 /// One part's tree and emitters, its indices already global.
-struct Part {
-    accel: Accel,
+pub(super) struct Part {
+    pub(super) accel: Accel,
     emitters: Vec<(f64, u32)>,
 }
 
@@ -97,18 +97,22 @@ fn rebase_nodes(kind: BvhKind, bytes: &mut [u8], node_base: u32, slot_base: u32)
 impl PreparedScene {
     /// Objects that move (rebuilt with every change) and those that never do.
     fn moving_objects(&self) -> (Vec<usize>, Vec<usize>) {
-        (0..self.flat.len()).partition(|&i| self.moving[i])
+        (0..self.world.len()).partition(|&i| self.moving[i])
     }
 
     /// The BVH and the GPU arrays: everything at once for a static scene; for an animated one,
     /// the static part at its first call and the moving part at every call.
     pub(super) fn assemble(&mut self) {
         let (moving, still) = self.moving_objects();
+        // Instanced meshes' prototypes follow the world-space static part
+        // (prepare/instances.rs), and are built once with it.
+        let protos = !self.protos.is_empty();
         if moving.is_empty() {
             self.clear_arrays();
-            let all: Vec<usize> = (0..self.flat.len()).collect();
-            let part = self.append_part(&all, 0, 0, 0, false, false);
+            let all: Vec<usize> = (0..self.world.len()).collect();
+            let part = self.append_part(&all, 0, 0, 0, protos, false);
             self.accel = part.accel;
+            self.append_protos();
             self.set_emitters(part.emitters);
             return;
         }
@@ -118,15 +122,16 @@ impl PreparedScene {
             None => {
                 self.clear_arrays();
                 let part = self.append_part(&still, 0, 0, 0, true, false);
+                self.accel = part.accel;
+                self.append_protos();
                 let sp = StaticPart {
                     slots: self.tris.len() / 3,
-                    inputs: part.accel.order.len() as u32,
-                    nodes: part.accel.node_count,
-                    node_bytes: part.accel.nodes.len(),
-                    depth: part.accel.depth,
+                    inputs: self.accel.order.len() as u32,
+                    nodes: self.accel.node_count,
+                    node_bytes: self.accel.nodes.len(),
+                    depth: self.accel.depth,
                     emitters: part.emitters,
                 };
-                self.accel = part.accel;
                 self.split = Some(sp.clone());
                 sp
             }
@@ -186,7 +191,7 @@ impl PreparedScene {
     /// `split`: the tree is one of two, and leaves the traversal one stack entry; `refit`: it is
     /// the moving part, whose last tree is refit rather than rebuilt where that stays good
     /// enough ([`accel::refit`]).
-    fn append_part(
+    pub(super) fn append_part(
         &mut self,
         objects: &[usize],
         input_base: u32,

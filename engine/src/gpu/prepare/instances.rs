@@ -1,0 +1,215 @@
+//! Meshes stored once for the objects that draw them (two-level acceleration).
+//!
+//! Where several objects draw one mesh, its triangles are flattened once in the mesh's own space
+//! with a tree of their own (a "prototype", placed after the world-space triangles' static part
+//! by `assemble`), and each of those objects is an instance: a transform and a box in a
+//! top-level binary tree over the instances (`tlas`), rebuilt whenever one of them moves. Rays
+//! go through the world-space trees, then the top-level one, into each instance's mesh in its
+//! space (shaders/common/tlas.wgsl); the raster draws each prototype instanced
+//! (shaders/realtime/gbuffer.wgsl). Objects stay flattened in world space where instancing
+//! does not pay ([`Instancing::Auto`]), where their mesh emits light (the emitter table samples
+//! world-space triangles) and in scenes whose meshes deform (their motion vectors are per
+//! vertex, shaders/realtime/motion_vertices.wgsl).
+
+use super::{PreparedScene, rebased};
+use crate::accel::{self, BvhKind};
+use crate::scene::Scene;
+use glam::{Mat4, Vec3, Vec3A, Vec4};
+use obvhs::triangle::Triangle;
+
+/// Whether a mesh that several objects draw is stored once.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Instancing {
+    /// Where flattening every object would store at least twice the triangles that storing each
+    /// shared mesh once does; one level otherwise, whose rays skip the top-level traversal.
+    #[default]
+    Auto,
+    /// Every object flattened in world space.
+    Never,
+    /// Every object that can be an instance is one, shared or not (tests compare the two
+    /// levels' hits against `Never`).
+    Always,
+}
+
+/// Texels per object in [`PreparedScene::instances`] (`INSTANCE_TEXELS` in
+/// shaders/common/instances.wgsl).
+pub const INSTANCE_TEXELS: usize = 10;
+const INSTANCE_FLAG: u32 = 1;
+const INSTANCE_MIRRORED: u32 = 2;
+/// The draw list's entry for world-space triangles (`NO_INSTANCE` in the shaders).
+pub const NO_INSTANCE: u32 = u32::MAX;
+
+/// A mesh stored once: its tree's root node, its triangle slots and its box, in its own space.
+#[derive(Clone, Debug)]
+pub(crate) struct Proto {
+    pub root: u32,
+    pub slot_base: u32,
+    pub slots: u32,
+    pub lo: Vec3,
+    pub hi: Vec3,
+}
+
+/// One instanced draw of the raster: a prototype's vertices, and the range of the draw list
+/// that names its objects.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Draw {
+    pub vertices: std::ops::Range<u32>,
+    pub instances: std::ops::Range<u32>,
+}
+
+/// Per object, the mesh it instances (None: flattened in world space).
+pub(super) fn plan(scene: &Scene, mode: Instancing, deforming: bool) -> Vec<Option<usize>> {
+    let n = scene.objects.len();
+    if mode == Instancing::Never || deforming {
+        return vec![None; n];
+    }
+    let emits = |mesh: usize| {
+        let m = scene.meshes[mesh].material as usize;
+        scene.materials.get(m).is_some_and(|m| m.emission.max_element() > 0.0)
+    };
+    let eligible: Vec<bool> = scene.objects.iter().map(|o| o.deform.is_none() && !emits(o.mesh)).collect();
+    let mut users = vec![0usize; scene.meshes.len()];
+    for (o, _) in scene.objects.iter().zip(&eligible).filter(|(_, e)| **e) {
+        users[o.mesh] += 1;
+    }
+    let tris = |mesh: usize| scene.meshes[mesh].indices.len() / 3;
+    let shared = |i: usize| eligible[i] && users[scene.objects[i].mesh] >= 2;
+    if mode == Instancing::Auto {
+        let flat: usize = scene.objects.iter().map(|o| tris(o.mesh)).sum();
+        let once: usize = (0..n).filter(|&i| !shared(i)).map(|i| tris(scene.objects[i].mesh)).sum::<usize>()
+            + (0..scene.meshes.len()).filter(|&m| users[m] >= 2).map(tris).sum::<usize>();
+        if flat < 2 * once {
+            return vec![None; n];
+        }
+    }
+    (0..n)
+        .map(|i| {
+            let on = if mode == Instancing::Always { eligible[i] } else { shared(i) };
+            on.then_some(scene.objects[i].mesh)
+        })
+        .collect()
+}
+
+/// A box's corners carried by `m`, as a box.
+fn carried(m: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
+    let mut out = (Vec3::splat(f32::MAX), Vec3::splat(-f32::MAX));
+    for k in 0..8 {
+        let c = Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        let p = m.transform_point3(c);
+        out = (out.0.min(p), out.1.max(p));
+    }
+    out
+}
+
+/// The three rows of an affine matrix, as the shaders read them.
+fn rows(m: Mat4) -> [Vec4; 3] {
+    let t = m.transpose();
+    [t.x_axis, t.y_axis, t.z_axis]
+}
+
+impl PreparedScene {
+    /// Every instance's transforms (at the shutter's close and open) and the top-level tree
+    /// over their boxes; the raster's draw list. An object whose transform is not invertible
+    /// in f32 (a zero scale, a non-finite entry) is left out: it draws nothing, and nothing
+    /// non-finite reaches the GPU.
+    pub(super) fn place_instances(&mut self) {
+        if !self.features.instances {
+            return;
+        }
+        let n = self.world.len();
+        self.instances.clear();
+        self.instances.resize(n * INSTANCE_TEXELS, Vec4::ZERO);
+        let mut boxes = Vec::new();
+        let mut placed: Vec<Vec<u32>> = vec![Vec::new(); self.protos.len()];
+        let mut objects = Vec::new();
+        for i in 0..n {
+            let Some(p) = self.proto_of[i] else { continue };
+            let proto = &self.protos[p];
+            if proto.slots == 0 {
+                continue;
+            }
+            let close = rebased(self.world[i], self.origin);
+            let open = self.open_from_close.get(i).map_or(close, |m| *m * close);
+            let inv = close.inverse();
+            let det = close.determinant();
+            if !(close.is_finite() && open.is_finite() && inv.is_finite() && det != 0.0) {
+                continue;
+            }
+            let at = i * INSTANCE_TEXELS;
+            self.instances[at..at + 3].copy_from_slice(&rows(close));
+            self.instances[at + 3..at + 6].copy_from_slice(&rows(inv));
+            self.instances[at + 6..at + 9].copy_from_slice(&rows(open));
+            let flags = INSTANCE_FLAG | if det < 0.0 { INSTANCE_MIRRORED } else { 0 };
+            self.instances[at + 9] =
+                Vec4::new(f32::from_bits(flags), f32::from_bits(proto.root), 0.0, 0.0);
+            let (a, b) = carried(close, proto.lo, proto.hi);
+            let (c, d) = carried(open, proto.lo, proto.hi);
+            // A box as the degenerate triangle from its min to its max (as assemble's swept
+            // boxes are): the tree bounds it exactly.
+            let (lo, hi) = (Vec3A::from(a.min(c)), Vec3A::from(b.max(d)));
+            boxes.push(Triangle { v0: lo, v1: hi, v2: lo });
+            objects.push(i as u32);
+            placed[p].push(i as u32);
+        }
+        let tree = accel::build_within(&boxes, BvhKind::Bvh2, self.tlas_stack as usize);
+        self.tlas_depth = tree.depth;
+        self.tlas = tree.nodes;
+        self.tlas_order = tree.order.iter().map(|&k| objects.get(k as usize).copied().unwrap_or(0)).collect();
+        // Entry 0 draws the world-space triangles; each prototype's objects follow.
+        self.draw_list = vec![NO_INSTANCE];
+        self.draws.clear();
+        for (proto, objs) in self.protos.iter().zip(&placed) {
+            let first = self.draw_list.len() as u32;
+            self.draw_list.extend_from_slice(objs);
+            self.draws.push(Draw {
+                vertices: proto.slot_base * 3..(proto.slot_base + proto.slots) * 3,
+                instances: first..self.draw_list.len() as u32,
+            });
+        }
+    }
+
+    /// The triangle slots the prototypes hold (between the world-space static part and the
+    /// moving part); an empty range without instances.
+    pub fn proto_slots(&self) -> std::ops::Range<u32> {
+        match (self.protos.first(), self.protos.last()) {
+            (Some(a), Some(b)) => a.slot_base..b.slot_base + b.slots,
+            _ => 0..0,
+        }
+    }
+
+    /// Append each prototype's triangles and tree (in its own space) after what the arrays
+    /// hold; their nodes and slots are rebased past it, and the roots recorded.
+    pub(super) fn append_protos(&mut self) {
+        let objects = self.world.len();
+        for p in 0..self.protos.len() {
+            let slot_base = self.tris.len() / 3;
+            let node_base = self.accel.node_count;
+            let inputs = self.accel.order.len() as u32;
+            let part = self.append_part(&[objects + p], inputs, slot_base, node_base, true, false);
+            let f = &self.flat[objects + p];
+            let (lo, hi) = f.tris.iter().fold(
+                (Vec3::splat(f32::MAX), Vec3::splat(-f32::MAX)),
+                |(lo, hi), t| {
+                    let b = t.aabb();
+                    (lo.min(b.min.into()), hi.max(b.max.into()))
+                },
+            );
+            self.protos[p] = Proto {
+                root: node_base as u32,
+                slot_base: slot_base as u32,
+                slots: (self.tris.len() / 3 - slot_base) as u32,
+                lo,
+                hi,
+            };
+            let a = &mut self.accel;
+            a.nodes.extend_from_slice(&part.accel.nodes);
+            a.node_count += part.accel.node_count;
+            a.order.extend_from_slice(&part.accel.order);
+            a.depth = a.depth.max(part.accel.depth);
+        }
+    }
+}

@@ -1,0 +1,202 @@
+//! Meshes stored once for the objects that draw them (engine/src/gpu/prepare/instances.rs): the
+//! two levels find the hits one flattened level finds, on random rays, still and moving; the
+//! instanced scene renders as its flattened copy in both modes; a mesh drawn a thousand times
+//! costs little more GPU memory than drawn once.
+
+use glam::{DMat4, DQuat, DVec3, Vec3};
+use hush_engine::accel::BvhKind;
+use hush_engine::gpu::{Gpu, Instancing, PreparedScene};
+use hush_engine::passes::Raycaster;
+use hush_engine::quality::relmse;
+use hush_engine::scene::{
+    Animation, Camera, Environment, Material, Object, Scene, Track, quad, uv_sphere,
+};
+
+/// A floor, a ceiling light and `n` copies of an off-centre sphere on a grid, each turned,
+/// scaled (one in three non-uniformly) and one in four mirrored. `shared`: one mesh for all
+/// of them, else a copy each (which instancing leaves flattened). `moving`: every other copy
+/// spins about its vertical over 2 s.
+fn field(n: usize, shared: bool, moving: bool) -> Scene {
+    let materials = vec![
+        Material { base_color: glam::Vec4::new(0.7, 0.7, 0.7, 1.0), ..Default::default() },
+        Material { emission: Vec3::splat(6.0), ..Default::default() },
+        Material {
+            base_color: glam::Vec4::new(0.8, 0.3, 0.2, 1.0),
+            roughness: 0.3,
+            ..Default::default()
+        },
+    ];
+    let mut meshes = vec![
+        quad(Vec3::ZERO, Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0), 0),
+        quad(Vec3::new(0.0, 4.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0), 1),
+    ];
+    let sphere = uv_sphere(Vec3::new(0.15, 0.0, 0.05), 0.3, 2, 16, 8);
+    let mut objects = vec![
+        Object::new("floor", 0, DMat4::IDENTITY),
+        Object::new("light", 1, DMat4::IDENTITY),
+    ];
+    let side = (n as f64).sqrt().ceil() as usize;
+    for i in 0..n {
+        let mesh = if shared && i > 0 {
+            meshes.len() - 1
+        } else {
+            meshes.push(sphere.clone());
+            meshes.len() - 1
+        };
+        let (x, z) = ((i % side) as f64, (i / side) as f64);
+        let at = DVec3::new((x - side as f64 / 2.0) * 0.9, 0.4, (z - side as f64 / 2.0) * 0.9);
+        let turn = DQuat::from_rotation_y(i as f64 * 0.7) * DQuat::from_rotation_x(i as f64 * 0.3);
+        let mut scale = DVec3::splat(0.8 + 0.1 * (i % 3) as f64);
+        if i % 3 == 1 {
+            scale.y *= 1.6;
+        }
+        if i % 4 == 3 {
+            scale.x = -scale.x;
+        }
+        let mut o =
+            Object::new(format!("copy{i}"), mesh, DMat4::from_scale_rotation_translation(scale, turn, at));
+        if moving && i % 2 == 0 {
+            let mut a = Animation::rigid(DMat4::IDENTITY, at, turn, scale);
+            a.rotation_track = Some(Track {
+                times: vec![0.0, 1.0, 2.0],
+                values: (0..3).map(|k| DQuat::from_rotation_y(k as f64 * 2.0) * turn).collect(),
+                step: false,
+                tangents: vec![],
+            });
+            o.animation = Some(a);
+        }
+        objects.push(o);
+    }
+    Scene {
+        name: "instance field".into(),
+        meshes,
+        objects,
+        materials,
+        camera: Some(Camera::look_at(DVec3::new(0.0, 2.2, 3.5), DVec3::new(0.0, 0.3, 0.0), 60.0)),
+        environment: Environment::Constant(Vec3::splat(0.2)),
+        max_depth: 4,
+        ..Default::default()
+    }
+}
+
+struct Xorshift(u64);
+
+impl Xorshift {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// Rays from above the field at random points of it and random directions.
+fn rays(seed: u64, origin: DVec3) -> Vec<(Vec3, Vec3, f32)> {
+    let mut rng = Xorshift(seed);
+    let rebase = |p: DVec3| (p - origin).as_vec3();
+    (0..8192)
+        .map(|i| {
+            let o = rebase(DVec3::new(0.0, 2.5, 1.0));
+            let target =
+                rebase(DVec3::new(rng.next() as f64 * 5.0 - 2.5, 0.4, rng.next() as f64 * 5.0 - 2.5));
+            let d = if i % 4 == 3 {
+                Vec3::new(rng.next() - 0.5, rng.next() - 0.9, rng.next() - 0.5).normalize()
+            } else {
+                (target - o).normalize()
+            };
+            (o, d, f32::MAX)
+        })
+        .collect()
+}
+
+/// Hits of the two levels against one level's: the same misses, the same distances (the
+/// instance's ray is carried into its mesh's space, which rounds differently: 1e-4 relative
+/// is about 40 f32 ulps), and the same triangle's vertices. Returns the hits.
+fn compare(kind: BvhKind, step: usize, two: &PreparedScene, one: &PreparedScene, gpu: &Gpu) -> usize {
+    let (g2, g1) = (two.upload(gpu), one.upload(gpu));
+    let rays = rays(99 + step as u64, one.origin);
+    let (a, _) = Raycaster::new(gpu, &g2).unwrap().cast(gpu, &g2, &rays, false).unwrap();
+    let (b, _) = Raycaster::new(gpu, &g1).unwrap().cast(gpu, &g1, &rays, false).unwrap();
+    let (mut hits, mut mismatched) = (0, 0);
+    for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+        match (x, y) {
+            (Some(x), Some(y)) => {
+                hits += 1;
+                let rel = (x.t - y.t).abs() / y.t.max(1.0);
+                assert!(rel < 1e-4, "{kind:?} step {step} ray {i}: t {} against {}", x.t, y.t);
+            }
+            (None, None) => {}
+            // A ray through an edge between two triangles may slip past both in one space
+            // and not the other.
+            _ => mismatched += 1,
+        }
+    }
+    assert!(mismatched * 1000 <= rays.len(), "{kind:?} step {step}: {mismatched} rays disagree");
+    println!("{kind:?} step {step}: {hits} hits, {mismatched} disagree");
+    hits
+}
+
+#[test]
+fn two_levels_find_what_one_level_finds() {
+    let moving = field(40, true, true);
+    for kind in [BvhKind::Bvh2, BvhKind::Cwbvh] {
+        let mut two = PreparedScene::with_instancing(&moving, kind, Instancing::Always).unwrap();
+        let mut one = PreparedScene::with_instancing(&moving, kind, Instancing::Never).unwrap();
+        assert!(two.features.instances && !one.features.instances);
+        // The sphere is stored once: the floor, the light and one sphere.
+        let sphere = moving.meshes[2].indices.len() / 3;
+        assert_eq!(two.triangle_count(), 4 + sphere);
+        assert_eq!(one.triangle_count(), 4 + 40 * sphere);
+        let gpu = Gpu::headless(&one.requirements(0, 0)).unwrap();
+        for (step, time) in [0.0, 0.6, 1.3].into_iter().enumerate() {
+            if step > 0 {
+                assert!(two.animate(&moving, time) && !two.geometry_moved);
+                assert!(one.animate(&moving, time));
+            }
+            assert!(compare(kind, step, &two, &one, &gpu) > 4000);
+        }
+    }
+}
+
+#[test]
+fn auto_instances_only_where_sharing_pays() {
+    let shared = field(12, true, false);
+    let copies = field(12, false, false);
+    let two = PreparedScene::new(&shared, BvhKind::DEFAULT).unwrap();
+    let one = PreparedScene::new(&copies, BvhKind::DEFAULT).unwrap();
+    assert!(two.features.instances);
+    assert!(!one.features.instances);
+    // Two objects of a mesh in a scene of many others do not pay.
+    let mut level = hush_engine::scene::default_level();
+    let first = level.objects[0].clone();
+    level.objects.push(first);
+    assert!(!PreparedScene::new(&level, BvhKind::DEFAULT).unwrap().features.instances);
+}
+
+#[test]
+fn instanced_field_renders_as_its_flattened_copy() {
+    let shared = field(12, true, false);
+    let copies = field(12, false, false);
+    let (w, h) = (64, 48);
+    let bias = |a: &hush_engine::quality::Image, b: &hush_engine::quality::Image| {
+        (a.mean() / b.mean() - Vec3::ONE).abs().max_element()
+    };
+    // Reference mode. With the same samples the paths differ only where a hit's rounding in the
+    // mesh's space moves a later bounce, so the two differ by less than half of what another
+    // seed gives the flattened field, and their means agree.
+    let a = hush_tests::render(&shared, w, h, 32, 5).unwrap().mean;
+    let b = hush_tests::render(&copies, w, h, 32, 5).unwrap().mean;
+    let c = hush_tests::render(&copies, w, h, 32, 6).unwrap().mean;
+    let (e, noise) = (relmse(&a, &b), relmse(&c, &b));
+    println!("reference: relMSE {e:.2e} (another seed {noise:.2e}), bias {:.4}", bias(&a, &b));
+    assert!(e < 0.5 * noise, "reference: relMSE {e} against another seed's {noise}");
+    assert!(bias(&a, &b) < 0.005, "reference: bias {}", bias(&a, &b));
+    // Real time: the G-buffer's instanced draws and the light traced from them.
+    let a = hush_tests::realtime_accumulate(&shared, w, h, 16, 5).unwrap();
+    let b = hush_tests::realtime_accumulate(&copies, w, h, 16, 5).unwrap();
+    let c = hush_tests::realtime_accumulate(&copies, w, h, 16, 6).unwrap();
+    let (e, noise) = (relmse(&a, &b), relmse(&c, &b));
+    println!("real time: relMSE {e:.2e} (another seed {noise:.2e}), bias {:.4}", bias(&a, &b));
+    assert!(e < 0.5 * noise, "real time: relMSE {e} against another seed's {noise}");
+    assert!(bias(&a, &b) < 0.005, "real time: bias {}", bias(&a, &b));
+}
