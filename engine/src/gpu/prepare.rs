@@ -7,12 +7,12 @@ mod instances;
 
 pub use super::pack::GpuLight;
 use super::pack::{EnvPack, pack_light, pack_textures};
-pub use instances::{Draw, INSTANCE_TEXELS, Instancing, NO_INSTANCE};
 use crate::accel::{self, Accel, BvhKind};
 use crate::scene::{AlphaMode, Environment, Scene};
 use anyhow::{Result, bail};
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DMat4, DVec3, Vec3, Vec4};
+pub use instances::{Draw, INSTANCE_TEXELS, Instancing, NO_INSTANCE};
 use obvhs::triangle::Triangle;
 
 /// Which optional parts of the renderer a scene needs. Each one missing removes its bindings,
@@ -474,10 +474,11 @@ impl PreparedScene {
         let mut proto_of = vec![None; scene.objects.len()];
         for (i, m) in meshes.iter().enumerate() {
             if let Some(m) = *m {
-                let p = protos.iter().position(|&q| scene.objects[q].mesh == m).unwrap_or_else(|| {
-                    protos.push(i);
-                    protos.len() - 1
-                });
+                let p =
+                    protos.iter().position(|&q| scene.objects[q].mesh == m).unwrap_or_else(|| {
+                        protos.push(i);
+                        protos.len() - 1
+                    });
                 proto_of[i] = Some(p);
             }
         }
@@ -489,7 +490,9 @@ impl PreparedScene {
             .collect();
         // A prototype in its mesh's own space (the first object that draws it names it).
         flat.extend(
-            protos.iter().map(|&i| flatten(scene, i, DMat4::IDENTITY, DVec3::ZERO, &features, None)),
+            protos
+                .iter()
+                .map(|&i| flatten(scene, i, DMat4::IDENTITY, DVec3::ZERO, &features, None)),
         );
         let dropped: usize = flat.iter().map(|f| f.dropped).sum();
         if dropped > 0 {
@@ -578,7 +581,13 @@ impl PreparedScene {
             moving_tree: None,
             refit: true,
             protos: vec![
-                instances::Proto { root: 0, slot_base: 0, slots: 0, lo: Vec3::ZERO, hi: Vec3::ZERO };
+                instances::Proto {
+                    root: 0,
+                    slot_base: 0,
+                    slots: 0,
+                    lo: Vec3::ZERO,
+                    hi: Vec3::ZERO
+                };
                 protos.len()
             ],
             proto_of,
@@ -594,7 +603,8 @@ impl PreparedScene {
         p.assemble();
         p.place_instances();
         let placed = p.tlas_order.len();
-        p.tlas_stack = accel::traversal_stack(BvhKind::Bvh2, p.tlas_depth, placed, p.features.animated);
+        p.tlas_stack =
+            accel::traversal_stack(BvhKind::Bvh2, p.tlas_depth, placed, p.features.animated);
         p.traversal_stack = match &p.split {
             None => accel::traversal_stack(kind, p.accel.depth, count, p.features.animated),
             Some(sp) => {

@@ -73,7 +73,13 @@ impl InstanceTexels {
                 Rgba32Float,
             ),
             tlas: Texels::new(gpu, mem, "scene/top-level nodes", &p.tlas, Rgba32Uint),
-            tlas_order: Texels::new(gpu, mem, "scene/top-level order", &b(&p.tlas_order), Rgba32Uint),
+            tlas_order: Texels::new(
+                gpu,
+                mem,
+                "scene/top-level order",
+                &b(&p.tlas_order),
+                Rgba32Uint,
+            ),
             draw_list: Texels::new(gpu, mem, "scene/draw list", &b(&p.draw_list), Rgba32Uint),
         }
     }
@@ -383,11 +389,7 @@ impl GpuScene {
     /// The module that carries an instance's hits to world space
     /// (shaders/common/instances.wgsl), or its identity where nothing is instanced.
     pub fn instance_module(&self) -> &'static str {
-        if self.features.instances {
-            "common/instances.wgsl"
-        } else {
-            "common/instances_none.wgsl"
-        }
+        if self.features.instances { "common/instances.wgsl" } else { "common/instances_none.wgsl" }
     }
 
     /// Program modules that match this scene's features, for a program that shades.

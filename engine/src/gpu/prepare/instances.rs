@@ -67,7 +67,8 @@ pub(super) fn plan(scene: &Scene, mode: Instancing, deforming: bool) -> Vec<Opti
         let m = scene.meshes[mesh].material as usize;
         scene.materials.get(m).is_some_and(|m| m.emission.max_element() > 0.0)
     };
-    let eligible: Vec<bool> = scene.objects.iter().map(|o| o.deform.is_none() && !emits(o.mesh)).collect();
+    let eligible: Vec<bool> =
+        scene.objects.iter().map(|o| o.deform.is_none() && !emits(o.mesh)).collect();
     let mut users = vec![0usize; scene.meshes.len()];
     for (o, _) in scene.objects.iter().zip(&eligible).filter(|(_, e)| **e) {
         users[o.mesh] += 1;
@@ -76,8 +77,9 @@ pub(super) fn plan(scene: &Scene, mode: Instancing, deforming: bool) -> Vec<Opti
     let shared = |i: usize| eligible[i] && users[scene.objects[i].mesh] >= 2;
     if mode == Instancing::Auto {
         let flat: usize = scene.objects.iter().map(|o| tris(o.mesh)).sum();
-        let once: usize = (0..n).filter(|&i| !shared(i)).map(|i| tris(scene.objects[i].mesh)).sum::<usize>()
-            + (0..scene.meshes.len()).filter(|&m| users[m] >= 2).map(tris).sum::<usize>();
+        let once: usize =
+            (0..n).filter(|&i| !shared(i)).map(|i| tris(scene.objects[i].mesh)).sum::<usize>()
+                + (0..scene.meshes.len()).filter(|&m| users[m] >= 2).map(tris).sum::<usize>();
         if flat < 2 * once {
             return vec![None; n];
         }
@@ -158,7 +160,8 @@ impl PreparedScene {
         let tree = accel::build_within(&boxes, BvhKind::Bvh2, self.tlas_stack as usize);
         self.tlas_depth = tree.depth;
         self.tlas = tree.nodes;
-        self.tlas_order = tree.order.iter().map(|&k| objects.get(k as usize).copied().unwrap_or(0)).collect();
+        self.tlas_order =
+            tree.order.iter().map(|&k| objects.get(k as usize).copied().unwrap_or(0)).collect();
         // Entry 0 draws the world-space triangles; each prototype's objects follow.
         self.draw_list = vec![NO_INSTANCE];
         self.draws.clear();
