@@ -10,7 +10,8 @@ use std::time::Instant;
 #[derive(Args)]
 pub struct BenchArgs {
     /// A .gltf/.glb file or a built-in scene: `default`, `level`, `reflections`, `spheres`, or
-    /// `terrain:N` (a generated height field of about N triangles).
+    /// `terrain:N` (a generated height field of about N triangles) or `crowd:N` (N moving
+    /// instances of a 1,000-triangle figure).
     pub scene: String,
     /// `reference` (BVH build, rays/s, tracer samples/s), `realtime` (GPU time per pass of the
     /// real-time frame) or `animate` (what a frame of the scene's animation costs: posing, the

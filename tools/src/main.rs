@@ -67,10 +67,11 @@ fn level(a: LevelArgs) -> Result<()> {
     }
     let scene = hush_engine::scene::builtin_scene(&a.scene).ok_or_else(|| {
         anyhow::anyhow!(
-            "--scene {:?}: no such built-in scene (one of {:?}, or terrain:N with N from 2 to {})",
+            "--scene {:?}: no such built-in scene (one of {:?}, terrain:N with N from 2 to {} or crowd:N with N from 1 to {})",
             a.scene,
             hush_engine::scene::BUILTIN_SCENES,
-            hush_engine::scene::MAX_TERRAIN_TRIANGLES
+            hush_engine::scene::MAX_TERRAIN_TRIANGLES,
+            hush_engine::scene::MAX_CROWD
         )
     })?;
     hush_engine::scene::save_gltf(&scene, &a.out)?;

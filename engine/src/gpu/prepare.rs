@@ -229,10 +229,13 @@ pub struct PreparedScene {
     pub tlas: Vec<u8>,
     pub tlas_order: Vec<u32>,
     tlas_depth: usize,
+    tlas_tree: Option<accel::RefitTree>,
     pub tlas_stack: u32,
     /// The raster's instanced draws: the objects each prototype's draw names, and the draws.
     pub draw_list: Vec<u32>,
     pub draws: Vec<Draw>,
+    /// Wall time of the last top-level tree build and instance packing.
+    pub tlas_build_time: std::time::Duration,
     /// Whether the last `expose` changed world-space triangles (false where only instances
     /// moved: their triangles stay as they are on the GPU).
     pub geometry_moved: bool,
@@ -595,10 +598,12 @@ impl PreparedScene {
             tlas: vec![],
             tlas_order: vec![],
             tlas_depth: 0,
+            tlas_tree: None,
             tlas_stack: BvhKind::Bvh2.max_depth() as u32,
             draw_list: vec![],
             draws: vec![],
             geometry_moved: true,
+            tlas_build_time: std::time::Duration::ZERO,
         };
         p.assemble();
         p.place_instances();

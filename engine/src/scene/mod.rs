@@ -4,6 +4,7 @@
 mod accessor;
 mod animation;
 mod camera_path;
+mod crowd;
 mod default_scene;
 mod deform;
 mod environment;
@@ -26,6 +27,7 @@ mod texture;
 
 pub use animation::{Animation, Track};
 pub use camera_path::{CameraKey, CameraPath};
+pub use crowd::{MAX_CROWD, crowd};
 pub use default_scene::{cuboid, default_scene, quad, uv_sphere};
 pub use deform::{Deform, Joint, MAX_INFLUENCES, Morph, MorphTarget, Posed};
 pub use environment::{EnvMap, Environment};
@@ -322,7 +324,8 @@ pub struct Scene {
 pub const DEFAULT_MAX_DEPTH: i32 = 6;
 
 impl Scene {
-    /// Load a `.gltf`/`.glb` file or a built-in scene by name ([`BUILTIN_SCENES`], or `terrain:N`).
+    /// Load a `.gltf`/`.glb` file or a built-in scene by name ([`BUILTIN_SCENES`], `terrain:N` or
+    /// `crowd:N`).
     pub fn load(path_or_default: &str) -> Result<Scene> {
         Scene::load_with(path_or_default, &LoadOptions::default())
     }

@@ -19,7 +19,7 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "level" => Some(super::default_level()),
         "reflections" => Some(reflection_scene(true)),
         "spheres" => Some(reflection_scene(false)),
-        _ => super::terrain::parse_terrain(name),
+        _ => super::terrain::parse_terrain(name).or_else(|| super::crowd::parse_crowd(name)),
     }
 }
 

@@ -122,6 +122,7 @@ impl PreparedScene {
         if !self.features.instances {
             return;
         }
+        let start = std::time::Instant::now();
         let n = self.world.len();
         self.instances.clear();
         self.instances.resize(n * INSTANCE_TEXELS, Vec4::ZERO);
@@ -157,7 +158,20 @@ impl PreparedScene {
             objects.push(i as u32);
             placed[p].push(i as u32);
         }
-        let tree = accel::build_within(&boxes, BvhKind::Bvh2, self.tlas_stack as usize);
+        // Refit while the moved boxes keep the tree within the refit limit of its built cost
+        // (as the moving world-space part is, assemble.rs); rebuilt otherwise.
+        let max_depth = self.tlas_stack as usize;
+        let refitted = self
+            .tlas_tree
+            .as_mut()
+            .filter(|t| t.triangles == boxes.len())
+            .and_then(|t| accel::refit(t, &boxes))
+            .filter(|a| a.depth <= max_depth);
+        let tree = refitted.unwrap_or_else(|| {
+            let (a, tree) = accel::build_refittable(&boxes, BvhKind::Bvh2, max_depth);
+            self.tlas_tree = tree;
+            a
+        });
         self.tlas_depth = tree.depth;
         self.tlas = tree.nodes;
         self.tlas_order =
@@ -173,6 +187,7 @@ impl PreparedScene {
                 instances: first..self.draw_list.len() as u32,
             });
         }
+        self.tlas_build_time = start.elapsed();
     }
 
     /// The triangle slots the prototypes hold (between the world-space static part and the
