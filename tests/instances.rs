@@ -245,3 +245,87 @@ fn instances_blur_as_their_flattened_copies() {
     assert!(e < 0.5 * noise, "blurred: relMSE {e} against another seed's {noise}");
     assert!(bias < 0.005, "blurred: bias {bias}");
 }
+
+#[test]
+#[cfg_attr(
+    not(hush_shared_scenes),
+    ignore = "needs ../shared/scenes (FlightHelmet), absent beside this checkout"
+)]
+fn a_thousand_flight_helmets_cost_little_more_memory_than_one() {
+    let path = hush_tests::shared().join("scenes/FlightHelmet/glTF/FlightHelmet.gltf");
+    let one = Scene::load(path.to_str().unwrap()).unwrap();
+    // A thousand helmets side by side, 0.6 m apart.
+    let mut many = one.clone();
+    many.objects = (0..1000)
+        .flat_map(|k| {
+            let shift = DMat4::from_translation(DVec3::new(
+                (k % 40) as f64 * 0.6,
+                0.0,
+                (k / 40) as f64 * 0.6,
+            ));
+            one.objects.iter().map(move |o| Object { transform: shift * o.transform, ..o.clone() })
+        })
+        .collect();
+    let (p1, p1000) = (
+        PreparedScene::new(&one, BvhKind::DEFAULT).unwrap(),
+        PreparedScene::new(&many, BvhKind::DEFAULT).unwrap(),
+    );
+    assert!(!p1.features.instances && p1000.features.instances);
+    let gpu = Gpu::headless(&p1000.requirements(0, 0)).unwrap();
+    let (m1, m1000) =
+        (p1.upload(&gpu).memory.total_bytes(), p1000.upload(&gpu).memory.total_bytes());
+    let ratio = m1000 as f64 / m1 as f64;
+    println!("FlightHelmet: one {m1} bytes, a thousand {m1000} bytes ({ratio:.3}x)");
+    assert!(ratio <= 1.1, "a thousand helmets take {ratio:.3}x the memory of one");
+}
+
+#[test]
+fn moving_instances_have_their_flattened_copies_motion_vectors() {
+    use hush_engine::frame::{FrameInput, Renderer};
+    use hush_engine::settings::FrameSettings;
+    let size = (96u32, 72u32);
+    // The G-buffer's object ids and motion vectors between 1.2 s and 1.3 s.
+    let gbuffer = |scene: Scene| {
+        let camera = scene.camera.unwrap();
+        let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, size).unwrap();
+        for time in [1.2, 1.3] {
+            let input = FrameInput { camera, time, shutter: None };
+            r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
+        }
+        assert_eq!(r.prepared.features.instances, r.prepared.triangle_count() < 1000);
+        let ids = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
+        let motion = r.read_texture(&gpu, "gbuffer/motion").unwrap().0;
+        (0..(size.0 * size.1) as usize)
+            .map(|i| {
+                let object = u32::from_le_bytes(ids[i * 8..i * 8 + 4].try_into().unwrap());
+                let m = &motion[i * 4..];
+                (object, glam::Vec2::new(hush_tests::half(m), hush_tests::half(&m[2..])))
+            })
+            .collect::<Vec<_>>()
+    };
+    let two = gbuffer(field(12, true, true));
+    let one = gbuffer(field(12, false, true));
+    let (mut same, mut other, mut moving, mut worst) = (0, 0, 0, 0f32);
+    for (i, ((a, ma), (b, mb))) in two.iter().zip(&one).enumerate() {
+        if a != b {
+            // A silhouette pixel may fall on either side in the two rasters.
+            other += 1;
+            continue;
+        }
+        if *a == u32::MAX {
+            continue;
+        }
+        same += 1;
+        let err = (*ma - *mb).length();
+        // Half floats: 11 bits of mantissa.
+        let bound = 0.02 + mb.length() / 1024.0;
+        assert!(err <= bound, "pixel {i}: motion {ma} against {mb}");
+        worst = worst.max(err);
+        moving += (mb.length() > 0.25 && *a >= 2) as u32;
+    }
+    println!(
+        "{same} pixels agree on their object ({other} do not), {moving} move; worst {worst:.4} px"
+    );
+    assert!(other * 100 <= same, "{other} pixels show another object");
+    assert!(moving > 100, "only {moving} pixels move");
+}

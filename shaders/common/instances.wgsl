@@ -94,6 +94,14 @@ fn inst_normal(inst: u32, n: vec3f) -> vec3f {
     return n.x * x.r0.xyz + n.y * x.r1.xyz + n.z * x.r2.xyz;
 }
 
+// A unit shading normal of the mesh's space, in world space.
+fn inst_shading_normal(inst: u32, n: vec3f) -> vec3f {
+    if inst == NO_INSTANCE {
+        return n;
+    }
+    return normalize(inst_normal(inst, n));
+}
+
 fn inst_close_point(inst: u32, p: vec3f) -> vec3f {
     if inst == NO_INSTANCE {
         return p;

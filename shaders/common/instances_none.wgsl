@@ -11,6 +11,10 @@ fn inst_normal(inst: u32, n: vec3f) -> vec3f {
     return n;
 }
 
+fn inst_shading_normal(inst: u32, n: vec3f) -> vec3f {
+    return n;
+}
+
 fn inst_close_point(inst: u32, p: vec3f) -> vec3f {
     return p;
 }

@@ -154,10 +154,7 @@ fn surface_at(hit: Hit, rd: vec3f) -> Surface {
     }
     s.tc = tri_tex_coords(slot, hit.b);
     s.ng = ng;
-    s.ns = apply_normal_map(slot, hit.b, ns, s.tc, material(s.material));
-    if hit.inst != NO_INSTANCE {
-        s.ns = normalize(inst_normal(hit.inst, s.ns));
-    }
+    s.ns = inst_shading_normal(hit.inst, apply_normal_map(slot, hit.b, ns, s.tc, material(s.material)));
     if stored {
         // The stored normals (and tangents) are the close's: the mapped normal turns with the
         // triangle to the ray's time where objects move during the shutter.

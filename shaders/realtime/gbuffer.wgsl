@@ -67,11 +67,8 @@ fn fs_main(v: VsOut, @builtin(front_facing) facing: bool) -> GBufferOut {
     if !front {
         ns = -ns;
     }
-    ns = apply_normal_map(slot, b, ns, tc, m);
     // An instance's normals are in its mesh's space (as in surface_at, common/scene.wgsl).
-    if v.inst != NO_INSTANCE {
-        ns = normalize(inst_normal(v.inst, ns));
-    }
+    ns = inst_shading_normal(v.inst, apply_normal_map(slot, b, ns, tc, m));
     let ms = material_at(m, tc);
     let bsdf = with_glass(material_bsdf(m, ms), m, ms, front);
     var o: GBufferOut;

@@ -31,6 +31,11 @@ pub struct BenchArgs {
     /// BVH layout to measure (bvh2, cwbvh); both when omitted.
     #[arg(long)]
     pub bvh: Option<String>,
+    /// Whether a mesh that several objects draw is stored once, as instances of it: `auto`
+    /// (where flattening would store at least twice the triangles), `never`, or `always`
+    /// (every object that can be, which measures the two-level traversal on any scene).
+    #[arg(long, default_value = "auto")]
+    pub instancing: String,
     /// Image size of the tracer benchmark.
     #[arg(long, default_value_t = 128)]
     pub width: u32,
@@ -167,7 +172,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     let mut adapter = String::new();
     let mut triangles = 0;
     for kind in kinds {
-        let prepared = PreparedScene::new(&scene, kind)?;
+        let prepared = PreparedScene::with_instancing(&scene, kind, instancing(&a.instancing)?)?;
         triangles = prepared.triangle_count();
         let gpu = Gpu::headless(&prepared.requirements(a.width as u64 * a.height as u64, 32))?;
         adapter = gpu.info.name.clone();
@@ -262,4 +267,10 @@ pub fn run(a: BenchArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `--instancing`'s value.
+pub fn instancing(s: &str) -> Result<hush_engine::gpu::Instancing> {
+    hush_engine::gpu::Instancing::parse(s)
+        .with_context(|| format!("--instancing {s:?}: use auto, never or always"))
 }

@@ -54,7 +54,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let scene = load_scene(&a.scene, &a.load)?;
     let size = (a.width, a.height);
-    let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
+    let instancing = crate::bench::instancing(&a.instancing)?;
+    let (gpu, mut r) = Renderer::headless_with(scene, bvh_kind(&a.bvh)?, instancing, size)?;
     if !gpu.timestamps {
         bail!(
             "adapter {} has no timestamp queries; per-pass GPU times are not available",

@@ -16,7 +16,7 @@ pub use crate::settings::{Denoiser as DenoiserName, FrameSettings, View};
 pub use params::{CameraSetup, FrameParams, random_jitter};
 
 use crate::denoise::Denoiser;
-use crate::gpu::{BindKey, Gpu, GpuRequirements, GpuScene, GpuTimer, PreparedScene};
+use crate::gpu::{BindKey, Gpu, GpuRequirements, GpuScene, GpuTimer, Instancing, PreparedScene};
 use crate::passes::composite::CompositePass;
 use crate::passes::gbuffer::{self, GBufferPass};
 use crate::passes::prefilter::Prefilter;
@@ -131,8 +131,18 @@ fn check_size((w, h): (u32, u32)) -> Result<()> {
 impl Renderer {
     /// Prepare `scene`, open a headless device that fits it, and build the frame.
     pub fn headless(scene: Scene, kind: BvhKind, size: (u32, u32)) -> Result<(Gpu, Renderer)> {
+        Self::headless_with(scene, kind, Instancing::Auto, size)
+    }
+
+    /// [`Renderer::headless`], storing shared meshes once as `instancing` says.
+    pub fn headless_with(
+        scene: Scene,
+        kind: BvhKind,
+        instancing: Instancing,
+        size: (u32, u32),
+    ) -> Result<(Gpu, Renderer)> {
         check_size(size)?;
-        let prepared = PreparedScene::new(&scene, kind)
+        let prepared = PreparedScene::with_instancing(&scene, kind, instancing)
             .with_context(|| format!("preparing scene {:?}", scene.name))?;
         let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
         let r = Renderer::new(&gpu, scene, prepared, size)?;

@@ -485,6 +485,15 @@ impl PreparedScene {
                 proto_of[i] = Some(p);
             }
         }
+        // Refused before flattening what would not fit: the objects flattened in world space
+        // and each prototype once.
+        let tris = |i: usize| scene.meshes[scene.objects[i].mesh].indices.len() / 3;
+        let stored: usize =
+            (0..scene.objects.len()).filter(|&i| proto_of[i].is_none()).map(tris).sum::<usize>()
+                + protos.iter().map(|&i| tris(i)).sum::<usize>();
+        if stored >= MAX_TRIANGLES {
+            bail!("{stored} triangles: Hush handles at most {} per scene", MAX_TRIANGLES - 1);
+        }
         let mut flat: Vec<Flat> = (0..scene.objects.len())
             .map(|i| match proto_of[i] {
                 Some(_) => Flat::default(),

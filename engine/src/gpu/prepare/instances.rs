@@ -31,6 +31,17 @@ pub enum Instancing {
     Always,
 }
 
+impl Instancing {
+    pub fn parse(s: &str) -> Option<Instancing> {
+        match s {
+            "auto" => Some(Instancing::Auto),
+            "never" => Some(Instancing::Never),
+            "always" => Some(Instancing::Always),
+            _ => None,
+        }
+    }
+}
+
 /// Texels per object in [`PreparedScene::instances`] (`INSTANCE_TEXELS` in
 /// shaders/common/instances.wgsl).
 pub const INSTANCE_TEXELS: usize = 10;
