@@ -27,18 +27,27 @@ fn bvh2_node(i: u32) -> Bvh2Node {
 // The scene's tree is rooted at node 0; an animated scene's moving objects have a tree of their
 // own (engine/src/gpu/prepare/assemble.rs), rooted at DYNAMIC_ROOT; a mesh stored once for its
 // instances has one at its own root (common/tlas.wgsl).
+alias TraversalStack = array<u32, TRAVERSAL_STACK>;
+
 fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
+    var stack: TraversalStack;
+    return traverse_with(&stack, root, second, o, d, tmax_in, any_hit);
+}
+
+// traverse_from on a stack the caller holds: one that traverses many trees per ray (the
+// instances', common/tlas.wgsl) declares it once, where each declaration costs lavapipe a
+// zero fill of every entry.
+fn traverse_with(stack: ptr<function, TraversalStack>, root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
     var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
     // Stochastic transparency's draw for this ray (common/alpha_mask.wgsl).
     let ray = alpha_ray(o, d);
     // TRAVERSAL_STACK comes from the scene (engine/src/accel, traversal_stack).
-    var stack: array<u32, TRAVERSAL_STACK>;
     var sp = 0u;
     // The second root waits at the stack's bottom until the first tree is done.
     if second != 0xffffffffu {
-        stack[0] = second;
+        (*stack)[0] = second;
         sp = 1u;
     }
     // Items are (index, count) pairs packed: leaves have their count in the high 8 bits.
@@ -78,7 +87,7 @@ fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_h
                     second_c = n.l_count;
                 }
                 if hl && hr && sp < TRAVERSAL_STACK {
-                    stack[sp] = second_i | (min(second_c, 255u) << 24u);
+                    (*stack)[sp] = second_i | (min(second_c, 255u) << 24u);
                     sp += 1u;
                 }
                 item = first_i;
@@ -91,7 +100,7 @@ fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_h
             break;
         }
         sp -= 1u;
-        let e = stack[sp];
+        let e = (*stack)[sp];
         item = e & 0xffffffu;
         count = e >> 24u;
         is_leaf = count > 0u;

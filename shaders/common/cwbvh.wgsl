@@ -66,7 +66,17 @@ fn cw_intersect(node: u32, o: vec3f, inv_d: vec3f, oct_inv4: u32, tmax: f32) -> 
 // (none: 0xffffffff). The scene's tree is rooted at node 0; an animated scene's moving objects
 // have a tree of their own (engine/src/gpu/prepare/assemble.rs), rooted at DYNAMIC_ROOT; a mesh
 // stored once for its instances has one at its own root (common/tlas.wgsl).
+alias TraversalStack = array<vec2u, TRAVERSAL_STACK>;
+
 fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
+    var stack: TraversalStack;
+    return traverse_with(&stack, root, second, o, d, tmax_in, any_hit);
+}
+
+// traverse_from on a stack the caller holds: one that traverses many trees per ray (the
+// instances', common/tlas.wgsl) declares it once, where each declaration costs lavapipe a
+// zero fill of every entry.
+fn traverse_with(stack: ptr<function, TraversalStack>, root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     var hit = miss();
     var tmax = min(tmax_in, INF);
     let inv_d = safe_inverse(d);
@@ -74,12 +84,11 @@ fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_h
     let ray = alpha_ray(o, d);
     let oct_inv4 = select(0x04040404u, 0u, d.x < 0.0) | select(0x02020202u, 0u, d.y < 0.0)
         | select(0x01010101u, 0u, d.z < 0.0);
-    var stack: array<vec2u, TRAVERSAL_STACK>;
     var sp = 0u;
     // A root as the one hit child of a virtual parent; the second waits at the stack's bottom
     // until the first tree is done.
     if second != 0xffffffffu {
-        stack[0] = vec2u(second, 0x80000000u);
+        (*stack)[0] = vec2u(second, 0x80000000u);
         sp = 1u;
     }
     var cur = vec2u(root, 0x80000000u);
@@ -103,7 +112,7 @@ fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_h
             let off = firstLeadingBit(hits);
             cur.y &= ~(1u << off);
             if (cur.y & 0xff000000u) != 0u && sp < TRAVERSAL_STACK {
-                stack[sp] = cur;
+                (*stack)[sp] = cur;
                 sp += 1u;
             }
             let slot_index = (off - 24u) ^ (oct_inv4 & 0xffu);
@@ -120,7 +129,7 @@ fn traverse_from(root: u32, second: u32, o: vec3f, d: vec3f, tmax_in: f32, any_h
                 break;
             }
             sp -= 1u;
-            cur = stack[sp];
+            cur = (*stack)[sp];
         }
     }
     return hit;

@@ -17,6 +17,8 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
     // TLAS_STACK comes from the scene (PreparedScene::tlas_stack).
     var stack: array<u32, TLAS_STACK>;
     var sp = 0u;
+    // One stack for every instance's tree (traverse_with).
+    var mesh_stack: TraversalStack;
     var item = 0u;
     var is_leaf = false;
     var count = 0u;
@@ -26,7 +28,7 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
                 let k = item + i;
                 let inst = textureLoad(tlas_order_texels, texel_at(k / 4u), 0)[k % 4u];
                 let x = mesh_from_world(inst);
-                var h = traverse_from(inst_root(inst), 0xffffffffu, affine_point(x, o), affine_vector(x, d), tmax, any_hit);
+                var h = traverse_with(&mesh_stack, inst_root(inst), 0xffffffffu, affine_point(x, o), affine_vector(x, d), tmax, any_hit);
                 if h.tri != NO_HIT && h.t < tmax {
                     tmax = h.t;
                     h.inst = inst;

@@ -88,10 +88,18 @@ impl Accel {
     }
 }
 
-fn params() -> BvhBuildParams {
+/// Most triangles a leaf holds (obvhs collapses leaves up to it where the surface-area cost
+/// says so).
+pub const LEAF_TRIANGLES: u32 = 4;
+
+fn params(max_leaf: u32) -> BvhBuildParams {
     // No spatial pre-splits: every triangle then sits in exactly one leaf, and the GPU can store
     // triangles in leaf order.
-    BvhBuildParams { pre_split: false, max_prims_per_leaf: 4, ..BvhBuildParams::medium_build() }
+    BvhBuildParams {
+        pre_split: false,
+        max_prims_per_leaf: max_leaf,
+        ..BvhBuildParams::medium_build()
+    }
 }
 
 const EMPTY_MIN: [f32; 3] = [f32::MAX; 3];
@@ -153,15 +161,17 @@ pub fn build(tris: &[Triangle], kind: BvhKind) -> Accel {
 /// [`build`], with the SAH tree kept only where it is at most `max_depth` deep (a traversal
 /// stack of that many entries holds it); the median tree otherwise.
 pub fn build_within(tris: &[Triangle], kind: BvhKind, max_depth: usize) -> Accel {
-    build_tree(tris, kind, max_depth).0
+    build_tree(tris, kind, max_depth, LEAF_TRIANGLES).0
 }
 
 /// [`build_within`], with obvhs's binary tree the nodes were packed from (None for an empty
 /// input), for [`refit`].
+/// Leaves hold at most `max_leaf` primitives.
 fn build_tree(
     tris: &[Triangle],
     kind: BvhKind,
     max_depth: usize,
+    max_leaf: u32,
 ) -> (Accel, Option<obvhs::bvh2::Bvh2>) {
     let max_depth = max_depth.min(kind.max_depth());
     let start = Instant::now();
@@ -213,9 +223,10 @@ fn build_tree(
                     .collect::<Vec<_>>(),
                 kind,
                 max_depth,
+                max_leaf,
             )
         }
-        (false, false) => sah_build(tris, kind, max_depth),
+        (false, false) => sah_build(tris, kind, max_depth, max_leaf),
     };
     let median_fallback = sah.is_none();
     let ((nodes, node_count, order, depth), tree) = sah.unwrap_or_else(|| {
@@ -224,7 +235,7 @@ fn build_tree(
             kind.name(),
             tris.len()
         );
-        median_build(tris, kind)
+        median_build(tris, kind, max_leaf)
     });
     let accel = Accel {
         kind,
@@ -250,8 +261,9 @@ fn sah_build<T: obvhs::Boundable>(
     prims: &[T],
     kind: BvhKind,
     max_depth: usize,
+    max_leaf: u32,
 ) -> Option<(Built, obvhs::bvh2::Bvh2)> {
-    let p = params();
+    let p = params(max_leaf);
     let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(prims.len()).build(
         p.ploc_search_distance,
         prims,
@@ -268,15 +280,18 @@ fn sah_build<T: obvhs::Boundable>(
                 return None;
             }
             reinsert(&mut bvh, p.reinsertion_batch_ratio);
-            obvhs::bvh2::leaf_collapser::collapse(
-                &mut bvh,
-                p.max_prims_per_leaf,
-                p.collapse_traversal_cost,
-            );
-            reinsert(
-                &mut bvh,
-                p.reinsertion_batch_ratio * p.post_collapse_reinsertion_batch_ratio_multiplier,
-            );
+            // PLOC's leaves hold one primitive each.
+            if max_leaf > 1 {
+                obvhs::bvh2::leaf_collapser::collapse(
+                    &mut bvh,
+                    p.max_prims_per_leaf,
+                    p.collapse_traversal_cost,
+                );
+                reinsert(
+                    &mut bvh,
+                    p.reinsertion_batch_ratio * p.post_collapse_reinsertion_batch_ratio_multiplier,
+                );
+            }
             let nodes = pack_bvh2(&bvh.nodes);
             let depth = packed_bvh2_depth(&nodes);
             (depth <= max_depth).then(|| {
@@ -305,8 +320,8 @@ fn sah_build<T: obvhs::Boundable>(
     }
 }
 
-fn median_build(tris: &[Triangle], kind: BvhKind) -> (Built, obvhs::bvh2::Bvh2) {
-    let p = params();
+fn median_build(tris: &[Triangle], kind: BvhKind, max_leaf: u32) -> (Built, obvhs::bvh2::Bvh2) {
+    let p = params(max_leaf);
     match kind {
         BvhKind::Bvh2 => {
             let bvh = median_bvh2(tris, p.max_prims_per_leaf as usize);

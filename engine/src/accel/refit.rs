@@ -59,13 +59,15 @@ fn sah_cost(bvh: &obvhs::bvh2::Bvh2) -> f32 {
         / area
 }
 
-/// [`super::build_within`], keeping what a later [`refit`] needs (None for an empty input).
+/// [`super::build_within`] with leaves of at most `max_leaf` primitives, keeping what a later
+/// [`refit`] needs (None for an empty input).
 pub fn build_refittable(
     tris: &[Triangle],
     kind: BvhKind,
     max_depth: usize,
+    max_leaf: u32,
 ) -> (Accel, Option<RefitTree>) {
-    let (accel, bvh) = super::build_tree(tris, kind, max_depth);
+    let (accel, bvh) = super::build_tree(tris, kind, max_depth, max_leaf);
     let tree = bvh.map(|bvh| {
         let (tree, built_cost) = match accel.kind {
             BvhKind::Bvh2 => {

@@ -155,7 +155,7 @@ fn refit_bounds_contain_every_triangle() {
         Triangle { v0: f(t.v0), v1: f(t.v1), v2: f(t.v2) }
     };
     for kind in [BvhKind::Bvh2, BvhKind::Cwbvh] {
-        let (_, tree) = build_refittable(&base, kind, kind.max_depth());
+        let (_, tree) = build_refittable(&base, kind, kind.max_depth(), LEAF_TRIANGLES);
         let mut tree = tree.unwrap();
         for a in [0.1f32, 0.3, 0.6] {
             let moved: Vec<Triangle> = base.iter().map(|t| bend(t, a)).collect();

@@ -620,7 +620,11 @@ impl PreparedScene {
         p.tlas_stack =
             accel::traversal_stack(BvhKind::Bvh2, p.tlas_depth, placed, p.features.animated);
         p.traversal_stack = match &p.split {
-            None => accel::traversal_stack(kind, p.accel.depth, count, p.features.animated),
+            // Rebuilt only where a world-space object moves (instances move the top level).
+            None => {
+                let rebuilt = p.moving.iter().any(|&m| m);
+                accel::traversal_stack(kind, p.accel.depth, count, rebuilt)
+            }
             Some(sp) => {
                 let moving: usize = (0..p.world.len())
                     .filter(|&i| p.moving[i])

@@ -268,7 +268,8 @@ impl PreparedScene {
                 None => None,
             };
             refitted.unwrap_or_else(|| {
-                let (a, tree) = accel::build_refittable(boxes, kind, max_depth);
+                let (a, tree) =
+                    accel::build_refittable(boxes, kind, max_depth, accel::LEAF_TRIANGLES);
                 self.moving_tree = tree;
                 a
             })

@@ -178,8 +178,10 @@ impl PreparedScene {
             .filter(|t| t.triangles == boxes.len())
             .and_then(|t| accel::refit(t, &boxes))
             .filter(|a| a.depth <= max_depth);
+        // One instance a leaf: entering one costs a traversal of its mesh's tree, so no ray
+        // should pay it for a neighbour's box.
         let tree = refitted.unwrap_or_else(|| {
-            let (a, tree) = accel::build_refittable(&boxes, BvhKind::Bvh2, max_depth);
+            let (a, tree) = accel::build_refittable(&boxes, BvhKind::Bvh2, max_depth, 1);
             self.tlas_tree = tree;
             a
         });
