@@ -192,6 +192,16 @@ def skinned(joint=0, bind_nan=False):
 scenes['ok-skinned-morphed'] = skinned()
 scenes['bad-skin-missing-joint'] = skinned(joint=3)
 scenes['bad-skin-nan-bind'] = skinned(bind_nan=True)
+# One mesh drawn by five nodes (stored once, as instances): turned, mirrored, squashed flat
+# and scaled past f32's determinant; the material does not emit (emitters are not instanced).
+d = doc()
+d['materials'][0]['emissiveFactor'] = [0, 0, 0]
+d['nodes'] += [{"mesh": 0, "translation": [3, 0, 0], "rotation": [0, 0.7071068, 0, 0.7071068]},
+               {"mesh": 0, "translation": [-3, 0, 0], "scale": [-1, 1, 1]},
+               {"mesh": 0, "scale": [1, 0, 1]},
+               {"mesh": 0, "scale": [1e30, 1e30, 1e30]}]
+d['scenes'][0]['nodes'] += [2, 3, 4, 5]
+scenes['ok-instanced-nodes'] = pack(d, F)
 # Refused
 def bad(name, mutate, files=F):
     d = doc(); mutate(d); scenes['bad-' + name] = pack(d, files)

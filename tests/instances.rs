@@ -329,3 +329,24 @@ fn moving_instances_have_their_flattened_copies_motion_vectors() {
     assert!(other * 100 <= same, "{other} pixels show another object");
     assert!(moving > 100, "only {moving} pixels move");
 }
+
+#[test]
+fn degenerate_instances_draw_nothing_and_nothing_non_finite() {
+    // A copy squashed flat, one scaled by 1e30 and one with a NaN in its transform, among
+    // sound ones: all three are left out of the top level (the huge one's determinant
+    // overflows f32, as its triangles' areas do where flattening drops them), and no pixel in
+    // either mode is NaN or Inf.
+    let mut scene = field(12, true, false);
+    scene.objects[2].transform = DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0));
+    scene.objects[3].transform = DMat4::from_scale(DVec3::splat(1e30));
+    scene.objects[4].transform.x_axis.x = f64::NAN;
+    let p = PreparedScene::new(&scene, BvhKind::DEFAULT).unwrap();
+    assert!(p.features.instances);
+    assert!(p.instances.iter().all(|v| v.is_finite()));
+    assert_eq!(p.tlas_order.len(), 9, "{:?}", p.tlas_order);
+    let a = hush_tests::render(&scene, 32, 24, 4, 1).unwrap();
+    assert_eq!(a.nonfinite_samples, 0);
+    assert!(a.mean.data.iter().all(|c| c.is_finite()));
+    let b = hush_tests::realtime_accumulate(&scene, 32, 24, 2, 1).unwrap();
+    assert!(b.data.iter().all(|c| c.is_finite()));
+}
