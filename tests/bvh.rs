@@ -4,28 +4,12 @@ use glam::{DVec3, Vec3, Vec3A};
 use hush_engine::accel::BvhKind;
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::passes::Raycaster;
-use hush_tests::shared;
+use hush_tests::{Xorshift, shared};
 use obvhs::{
     BvhBuildParams,
     ray::{Ray, RayHit},
     triangle::Triangle,
 };
-
-struct Xorshift(u32);
-impl Xorshift {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 17;
-        self.0 ^= self.0 << 5;
-        (self.0 >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn dir(&mut self) -> Vec3 {
-        let z = self.next() * 2.0 - 1.0;
-        let phi = self.next() * std::f32::consts::TAU;
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(s * phi.cos(), s * phi.sin(), z)
-    }
-}
 
 /// Barycentrics (b1, b2) of p in triangle t, in f64.
 fn barycentrics(t: &Triangle, p: DVec3) -> (f64, f64) {
@@ -77,7 +61,7 @@ fn gpu_traversal_matches_obvhs_cpu_traversal_on_the_living_room() {
         let rays: Vec<(Vec3, Vec3, f32)> = (0..8192)
             .map(|i| {
                 let o = if i % 2 == 0 {
-                    lo + (hi - lo) * Vec3::new(rng.next(), rng.next(), rng.next())
+                    lo + (hi - lo) * Vec3::new(rng.uniform(), rng.uniform(), rng.uniform())
                 } else {
                     cam
                 };
@@ -216,7 +200,8 @@ fn split_trees_find_what_one_tree_finds() {
             let rays: Vec<(Vec3, Vec3, f32)> = (0..8192)
                 .map(|i| {
                     let o = cube_at + Vec3::new(3.0, 1.0, 2.5);
-                    let target = cube_at + (Vec3::new(rng.next(), rng.next(), rng.next()) - 0.5);
+                    let target =
+                        cube_at + (Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5);
                     let d = if i % 2 == 0 { (target - o).normalize() } else { rng.dir() };
                     (o, d, f32::MAX)
                 })

@@ -11,6 +11,7 @@ use hush_engine::quality::relmse;
 use hush_engine::scene::{
     Animation, Camera, Environment, Material, Object, Scene, Track, quad, uv_sphere,
 };
+use hush_tests::Xorshift;
 
 /// A floor, a ceiling light and `n` copies of an off-centre sphere on a grid, each turned,
 /// scaled (one in three non-uniformly) and one in four mirrored. `shared`: one mesh for all
@@ -80,31 +81,20 @@ fn field(n: usize, shared: bool, moving: bool) -> Scene {
     }
 }
 
-struct Xorshift(u64);
-
-impl Xorshift {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
 /// Rays from above the field at random points of it and random directions.
-fn rays(seed: u64, origin: DVec3) -> Vec<(Vec3, Vec3, f32)> {
+fn rays(seed: u32, origin: DVec3) -> Vec<(Vec3, Vec3, f32)> {
     let mut rng = Xorshift(seed);
     let rebase = |p: DVec3| (p - origin).as_vec3();
     (0..8192)
         .map(|i| {
             let o = rebase(DVec3::new(0.0, 2.5, 1.0));
             let target = rebase(DVec3::new(
-                rng.next() as f64 * 5.0 - 2.5,
+                rng.uniform() as f64 * 5.0 - 2.5,
                 0.4,
-                rng.next() as f64 * 5.0 - 2.5,
+                rng.uniform() as f64 * 5.0 - 2.5,
             ));
             let d = if i % 4 == 3 {
-                Vec3::new(rng.next() - 0.5, rng.next() - 0.9, rng.next() - 0.5).normalize()
+                Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.9, rng.uniform() - 0.5).normalize()
             } else {
                 (target - o).normalize()
             };
@@ -124,7 +114,7 @@ fn compare(
     gpu: &Gpu,
 ) -> usize {
     let (g2, g1) = (two.upload(gpu), one.upload(gpu));
-    let rays = rays(99 + step as u64, one.origin);
+    let rays = rays(99 + step as u32, one.origin);
     let (a, _) = Raycaster::new(gpu, &g2).unwrap().cast(gpu, &g2, &rays, false).unwrap();
     let (b, _) = Raycaster::new(gpu, &g1).unwrap().cast(gpu, &g1, &rays, false).unwrap();
     let (mut hits, mut mismatched) = (0, 0);

@@ -282,3 +282,24 @@ impl StillConvergence {
         );
     }
 }
+
+/// A small deterministic generator for test rays (xorshift32).
+pub struct Xorshift(pub u32);
+
+impl Xorshift {
+    /// Uniform in [0, 1).
+    pub fn uniform(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        (self.0 >> 8) as f32 / (1u32 << 24) as f32
+    }
+
+    /// A uniform direction on the sphere.
+    pub fn dir(&mut self) -> glam::Vec3 {
+        let z = self.uniform() * 2.0 - 1.0;
+        let phi = self.uniform() * std::f32::consts::TAU;
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        glam::Vec3::new(s * phi.cos(), s * phi.sin(), z)
+    }
+}
