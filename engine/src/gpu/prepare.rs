@@ -470,21 +470,8 @@ impl PreparedScene {
             deforming: scene.objects.iter().any(|o| o.deform.as_ref().is_some_and(|d| d.moves())),
             instances: false,
         };
-        let meshes = instances::plan(scene, instancing, features.deforming);
-        features.instances = meshes.iter().any(Option::is_some);
-        // One prototype per instanced mesh, in the order objects first use them.
-        let mut protos: Vec<usize> = vec![];
-        let mut proto_of = vec![None; scene.objects.len()];
-        for (i, m) in meshes.iter().enumerate() {
-            if let Some(m) = *m {
-                let p =
-                    protos.iter().position(|&q| scene.objects[q].mesh == m).unwrap_or_else(|| {
-                        protos.push(i);
-                        protos.len() - 1
-                    });
-                proto_of[i] = Some(p);
-            }
-        }
+        let (protos, proto_of) = instances::prototypes(scene, instancing, features.deforming);
+        features.instances = !protos.is_empty();
         // Refused before flattening what would not fit: the objects flattened in world space
         // and each prototype once.
         let tris = |i: usize| scene.meshes[scene.objects[i].mesh].indices.len() / 3;

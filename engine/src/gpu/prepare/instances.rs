@@ -68,8 +68,32 @@ pub struct Draw {
     pub instances: std::ops::Range<u32>,
 }
 
+/// The prototypes (each named by the first object that draws its mesh) and, per object, the
+/// prototype it instances (None: flattened in world space).
+pub(super) fn prototypes(
+    scene: &Scene,
+    mode: Instancing,
+    deforming: bool,
+) -> (Vec<usize>, Vec<Option<usize>>) {
+    let mut of_mesh = vec![None; scene.meshes.len()];
+    let mut protos = vec![];
+    let proto_of = plan(scene, mode, deforming)
+        .into_iter()
+        .enumerate()
+        .map(|(i, mesh)| {
+            mesh.map(|m| {
+                *of_mesh[m].get_or_insert_with(|| {
+                    protos.push(i);
+                    protos.len() - 1
+                })
+            })
+        })
+        .collect();
+    (protos, proto_of)
+}
+
 /// Per object, the mesh it instances (None: flattened in world space).
-pub(super) fn plan(scene: &Scene, mode: Instancing, deforming: bool) -> Vec<Option<usize>> {
+fn plan(scene: &Scene, mode: Instancing, deforming: bool) -> Vec<Option<usize>> {
     let n = scene.objects.len();
     if mode == Instancing::Never || deforming {
         return vec![None; n];
