@@ -75,6 +75,9 @@ struct DenoiseParams {
     // texel whose normal is within this cosine of the surface's (-2: any normal;
     // MatteSettings::still_normal_degrees).
     still_normal_min_cos: f32,
+    // The sparse bilateral's taps weigh by a Gaussian of their distance whose sigma is this
+    // fraction of the disk's radius (0: none; MatteSettings::tap_sigma_fraction).
+    tap_sigma: f32,
 }
 
 var<uniform> dn: DenoiseParams;

@@ -50,8 +50,12 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
     let lc = centre.a;
     var sum = c;
     var wsum = 1.0;
+    // Mara et al. §3.2's Gaussian over the disk, where it is on.
+    let sigma = dn.tap_sigma * radius;
+    let inv_two_sigma2 = select(0.0, 1.0 / (2.0 * sigma * sigma), sigma > 0.0);
     for (var i = 0u; i < dn.taps; i++) {
-        let q = p + vec2i(round(spiral_tap(i, dn.taps, radius, p)));
+        let off = spiral_tap(i, dn.taps, radius, p);
+        let q = p + vec2i(round(off));
         if !in_bounds(q) || !has_surface(q) {
             continue;
         }
@@ -61,6 +65,7 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         if sigma_l > 0.0 {
             w *= exp(-abs(tap.a - lc) / sigma_l);
         }
+        w *= exp(-dot(off, off) * inv_two_sigma2);
         sum += t * w;
         wsum += w;
     }

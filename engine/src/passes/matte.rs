@@ -71,7 +71,9 @@ pub struct DenoiseParams {
     pub edge_stop_full_frames: f32,
     /// [`MatteSettings::still_normal_degrees`] as a cosine (-2: off).
     pub still_normal_min_cos: f32,
-    pub _pad: [f32; 3],
+    /// [`MatteSettings::tap_sigma_fraction`].
+    pub tap_sigma: f32,
+    pub _pad: [f32; 2],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -138,7 +140,8 @@ impl DenoiseParams {
             still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
             edge_stop_full_frames: s.edge_stop_full_frames.clamp(0.0, STILL_FRAMES_MAX),
             still_normal_min_cos: normal_test_cos(s.still_normal_degrees),
-            _pad: [0.0; 3],
+            tap_sigma: s.tap_sigma_fraction.clamp(0.0, 4.0),
+            _pad: [0.0; 2],
         }
     }
 }

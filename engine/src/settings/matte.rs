@@ -112,6 +112,19 @@ described! {
         /// 0.000547; frame 60 the same). 0: a fixed k.
         edge_stop_full_frames: f32 = 64.0,
             ("matte.edge_stop_full_frames", "matte/bilateral", "frames", Float(0.0, STILL_FRAMES_MAX as f64, 1.0));
+        /// The sparse bilateral's taps (stages 4 and 7) weighted by a Gaussian of their distance
+        /// whose standard deviation is this fraction of the disk's radius (0: none, each tap of
+        /// the disk weighed by the G-buffer alone). Mara et al. §3.2's kernel is Gaussian, of a
+        /// width the paper does not give; presets/paper.toml uses 0.5 (the disk's edge at 2
+        /// sigma). Off by default: it narrows the blur, which pays where 60 still frames already
+        /// averaged most noise and costs where they did not. Frame 60, 256², Mara against
+        /// Mitsuba, FLIP at sigma 0 / 1.0 / 0.7 / 0.5 / 0.35 / 0.25: cornell_diffuse 0.0369 /
+        /// 0.0358 / 0.0347 / 0.0331 / 0.0311 / 0.0304; cornell_mirror 0.0682 and 0.0674 at 0.5.
+        /// 160x90, 30 still frames, second-half FLIP (relMSE) at 0 / 0.5 / 0.35: level 0.0535
+        /// (0.0270) / 0.0536 (0.0287) / 0.0545 (0.0306); living room 0.1803 (0.1433) / 0.1810
+        /// (0.1476) / 0.1833 (0.1541).
+        tap_sigma_fraction: f32 = 0.0,
+            ("matte.tap_sigma_fraction", "matte/bilateral", "of radius", Float(0.0, 4.0, 0.01));
     }
     hidden {
         /// Fault injection for tests: the temporal stage reads NaN, +Inf and -Inf in place of the
