@@ -3,7 +3,8 @@
 //! Where several objects draw one mesh, its triangles are flattened once in the mesh's own space
 //! with a tree of their own (a "prototype", placed after the world-space triangles' static part
 //! by `assemble`), and each of those objects is an instance: a transform and a box in a
-//! top-level binary tree over the instances (`tlas`), rebuilt whenever one of them moves. Rays
+//! top-level binary tree over the instances (`tlas`), refit whenever one of them moves (rebuilt
+//! past the refit limit). Rays
 //! go through the world-space trees, then the top-level one, into each instance's mesh in its
 //! space (shaders/common/tlas.wgsl); the raster draws each prototype instanced
 //! (shaders/realtime/gbuffer.wgsl). Objects stay flattened in world space where instancing
@@ -21,7 +22,10 @@ use obvhs::triangle::Triangle;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Instancing {
     /// Where flattening every object would store at least twice the triangles that storing each
-    /// shared mesh once does; one level otherwise, whose rays skip the top-level traversal.
+    /// shared mesh once does; one level otherwise. Two levels cost a ray a traversal of each
+    /// instance's tree it enters: the level with every object an instance traced 0.52 M rays/s
+    /// on lavapipe against 2.6 with one level; `crowd:400` 0.6 against 1.2 to 1.4 flattened, in
+    /// 1.3 MiB instead of 83.5.
     #[default]
     Auto,
     /// Every object flattened in world space.
