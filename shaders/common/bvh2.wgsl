@@ -1,25 +1,10 @@
 // Traversal of the binary BVH whose nodes hold both children's boxes (engine/src/accel).
 
-struct Bvh2Node {
-    lmin: vec3f,
-    l_index: u32,
-    lmax: vec3f,
-    l_count: u32,
-    rmin: vec3f,
-    r_index: u32,
-    rmax: vec3f,
-    r_count: u32,
-}
-
-// Four texels per node (read as texels: see tri_texels in geometry.wgsl).
+// Four texels per node (Bvh2Node, common/geometry.wgsl).
 var bvh_texels: texture_2d<u32>;
 
 fn bvh2_node(i: u32) -> Bvh2Node {
-    let a = textureLoad(bvh_texels, texel_at(i * 4u), 0);
-    let b = textureLoad(bvh_texels, texel_at(i * 4u + 1u), 0);
-    let c = textureLoad(bvh_texels, texel_at(i * 4u + 2u), 0);
-    let d = textureLoad(bvh_texels, texel_at(i * 4u + 3u), 0);
-    return Bvh2Node(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, bitcast<vec3f>(c.xyz), c.w, bitcast<vec3f>(d.xyz), d.w);
+    return bvh2_node_in(bvh_texels, i);
 }
 
 // Closest accepted hit along o + t d, t in (0, tmax), in the tree rooted at node `root`, then

@@ -77,3 +77,26 @@ fn intersect_box(o: vec3f, inv_d: vec3f, lo: vec3f, hi: vec3f, tmax: f32) -> f32
     }
     return INF;
 }
+
+// A binary node holding both children's boxes (engine/src/accel, Bvh2GpuNode): a child with
+// a count is a leaf of that many primitives from its index, else the inner node at its index.
+// The binary BVH layout (common/bvh2.wgsl) and the instances' top level (common/tlas.wgsl)
+// store them, four texels each.
+struct Bvh2Node {
+    lmin: vec3f,
+    l_index: u32,
+    lmax: vec3f,
+    l_count: u32,
+    rmin: vec3f,
+    r_index: u32,
+    rmax: vec3f,
+    r_count: u32,
+}
+
+fn bvh2_node_in(t: texture_2d<u32>, i: u32) -> Bvh2Node {
+    let a = textureLoad(t, texel_at(i * 4u), 0);
+    let b = textureLoad(t, texel_at(i * 4u + 1u), 0);
+    let c = textureLoad(t, texel_at(i * 4u + 2u), 0);
+    let d = textureLoad(t, texel_at(i * 4u + 3u), 0);
+    return Bvh2Node(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, bitcast<vec3f>(c.xyz), c.w, bitcast<vec3f>(d.xyz), d.w);
+}

@@ -1,6 +1,6 @@
 // A scene with instances: after the scene's own trees (world-space triangles), a binary tree
-// over the instanced objects' world boxes (engine/src/gpu/prepare/instances.rs, rebuilt when
-// they move), four texels a node as in common/bvh2.wgsl, whose leaves' ranges index
+// over the instanced objects' world boxes (engine/src/gpu/prepare/instances.rs, refit when
+// they move), of binary nodes (Bvh2Node, common/geometry.wgsl), whose leaves' ranges index
 // tlas_order_texels (objects, four to a texel). A ray that enters an object's box is carried
 // into its mesh's space by the object's inverse transform and traverses the mesh's tree from
 // its root; the direction is carried unnormalised, so t is the same along both rays.
@@ -40,21 +40,18 @@ fn traverse(o: vec3f, d: vec3f, tmax_in: f32, any_hit: bool) -> Hit {
             }
             is_leaf = false;
         } else {
-            let a = textureLoad(tlas_texels, texel_at(item * 4u), 0);
-            let b = textureLoad(tlas_texels, texel_at(item * 4u + 1u), 0);
-            let c = textureLoad(tlas_texels, texel_at(item * 4u + 2u), 0);
-            let e = textureLoad(tlas_texels, texel_at(item * 4u + 3u), 0);
-            let tl = intersect_box(o, inv_d, bitcast<vec3f>(a.xyz), bitcast<vec3f>(b.xyz), tmax);
-            let tr = intersect_box(o, inv_d, bitcast<vec3f>(c.xyz), bitcast<vec3f>(e.xyz), tmax);
+            let n = bvh2_node_in(tlas_texels, item);
+            let tl = intersect_box(o, inv_d, n.lmin, n.lmax, tmax);
+            let tr = intersect_box(o, inv_d, n.rmin, n.rmax, tmax);
             let hl = tl < INF;
             let hr = tr < INF;
             if hl || hr {
                 // The nearer child first; the other waits on the stack.
-                var first = vec2u(a.w, b.w);
-                var second = vec2u(c.w, e.w);
+                var first = vec2u(n.l_index, n.l_count);
+                var second = vec2u(n.r_index, n.r_count);
                 if !hl || (hr && tr < tl) {
-                    first = vec2u(c.w, e.w);
-                    second = vec2u(a.w, b.w);
+                    first = vec2u(n.r_index, n.r_count);
+                    second = vec2u(n.l_index, n.l_count);
                 }
                 if hl && hr && sp < TLAS_STACK {
                     stack[sp] = second.x | (min(second.y, 255u) << 24u);

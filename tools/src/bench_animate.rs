@@ -64,12 +64,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     // first where the scene instances.
     let mut configs = vec![];
     if instanced {
-        configs.push(("instanced", true, Instancing::Auto));
+        configs.push(("instanced".to_string(), true, Instancing::Auto));
     }
-    let flat = if instanced { Instancing::Never } else { Instancing::Auto };
-    let label = |l: &'static str| if instanced { ["flattened, ", l].concat() } else { l.into() };
-    configs.push(("refit", true, flat));
-    configs.push(("rebuilt", false, flat));
+    let (flat, prefix) =
+        if instanced { (Instancing::Never, "flattened, ") } else { (Instancing::Auto, "") };
+    configs.push((format!("{prefix}refit"), true, flat));
+    configs.push((format!("{prefix}rebuilt"), false, flat));
     for (name, refit, instancing) in configs {
         let mut prepared = PreparedScene::with_instancing(&scene, kind, instancing)?;
         prepared.refit = refit;
@@ -81,7 +81,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         {
             Ok(g) => Some(g),
             Err(e) if instancing == Instancing::Never => {
-                eprintln!("{}: {e:#}; measured on the CPU alone", label(name));
+                eprintln!("{name}: {e:#}; measured on the CPU alone");
                 None
             }
             Err(e) => return Err(e),
@@ -122,7 +122,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         }
         triangles = triangles.max(prepared.triangle_count());
         runs.push(AnimateRun {
-            run: if name == "instanced" { name.into() } else { label(name) },
+            run: name,
             animate_ms: median_min(&mut animate),
             bvh_ms: median_min(&mut build),
             top_level_ms: median_min(&mut top),

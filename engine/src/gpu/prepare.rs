@@ -584,8 +584,7 @@ impl PreparedScene {
                     root: 0,
                     slot_base: 0,
                     slots: 0,
-                    lo: Vec3::ZERO,
-                    hi: Vec3::ZERO
+                    bounds: obvhs::aabb::Aabb::empty()
                 };
                 protos.len()
             ],

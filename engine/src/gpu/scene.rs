@@ -63,7 +63,7 @@ pub struct InstanceTexels {
 impl InstanceTexels {
     fn new(gpu: &Gpu, mem: &mut GpuMemory, p: &PreparedScene) -> InstanceTexels {
         use wgpu::TextureFormat::{Rgba32Float, Rgba32Uint};
-        let b = |v: &[u32]| bytemuck::cast_slice::<u32, u8>(v).to_vec();
+        let b = bytemuck::cast_slice::<u32, u8>;
         InstanceTexels {
             instances: Texels::new(
                 gpu,
@@ -77,19 +77,19 @@ impl InstanceTexels {
                 gpu,
                 mem,
                 "scene/top-level order",
-                &b(&p.tlas_order),
+                b(&p.tlas_order),
                 Rgba32Uint,
             ),
-            draw_list: Texels::new(gpu, mem, "scene/draw list", &b(&p.draw_list), Rgba32Uint),
+            draw_list: Texels::new(gpu, mem, "scene/draw list", b(&p.draw_list), Rgba32Uint),
         }
     }
 
     fn write(&mut self, gpu: &Gpu, mem: &mut GpuMemory, p: &PreparedScene) -> bool {
-        let b = |v: &[u32]| bytemuck::cast_slice::<u32, u8>(v).to_vec();
+        let b = bytemuck::cast_slice::<u32, u8>;
         let mut replaced = self.instances.write(gpu, mem, bytemuck::cast_slice(&p.instances));
         replaced |= self.tlas.write(gpu, mem, &p.tlas);
-        replaced |= self.tlas_order.write(gpu, mem, &b(&p.tlas_order));
-        replaced |= self.draw_list.write(gpu, mem, &b(&p.draw_list));
+        replaced |= self.tlas_order.write(gpu, mem, b(&p.tlas_order));
+        replaced |= self.draw_list.write(gpu, mem, b(&p.draw_list));
         replaced
     }
 }

@@ -15,7 +15,8 @@
 use super::{PreparedScene, rebased};
 use crate::accel::{self, BvhKind};
 use crate::scene::Scene;
-use glam::{Mat4, Vec3, Vec3A, Vec4};
+use glam::{Mat4, Vec3A, Vec4};
+use obvhs::aabb::Aabb;
 use obvhs::triangle::Triangle;
 
 /// Whether a mesh that several objects draw is stored once.
@@ -60,8 +61,7 @@ pub(crate) struct Proto {
     pub root: u32,
     pub slot_base: u32,
     pub slots: u32,
-    pub lo: Vec3,
-    pub hi: Vec3,
+    pub bounds: Aabb,
 }
 
 /// One instanced draw of the raster: a prototype's vertices, and the range of the draw list
@@ -132,16 +132,11 @@ fn plan(scene: &Scene, mode: Instancing, deforming: bool) -> Vec<Option<usize>> 
 }
 
 /// A box's corners carried by `m`, as a box.
-fn carried(m: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
-    let mut out = (Vec3::splat(f32::MAX), Vec3::splat(-f32::MAX));
+fn carried(m: Mat4, b: &Aabb) -> Aabb {
+    let mut out = Aabb::empty();
     for k in 0..8 {
-        let c = Vec3::new(
-            if k & 1 == 0 { lo.x } else { hi.x },
-            if k & 2 == 0 { lo.y } else { hi.y },
-            if k & 4 == 0 { lo.z } else { hi.z },
-        );
-        let p = m.transform_point3(c);
-        out = (out.0.min(p), out.1.max(p));
+        let c = Vec3A::select(glam::BVec3A::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min);
+        out.extend(m.transform_point3a(c));
     }
     out
 }
@@ -188,12 +183,10 @@ impl PreparedScene {
             let flags = INSTANCE_FLAG | if det < 0.0 { INSTANCE_MIRRORED } else { 0 };
             self.instances[at + 9] =
                 Vec4::new(f32::from_bits(flags), f32::from_bits(proto.root), 0.0, 0.0);
-            let (a, b) = carried(close, proto.lo, proto.hi);
-            let (c, d) = carried(open, proto.lo, proto.hi);
+            let b = carried(close, &proto.bounds).union(&carried(open, &proto.bounds));
             // A box as the degenerate triangle from its min to its max (as assemble's swept
             // boxes are): the tree bounds it exactly.
-            let (lo, hi) = (Vec3A::from(a.min(c)), Vec3A::from(b.max(d)));
-            boxes.push(Triangle { v0: lo, v1: hi, v2: lo });
+            boxes.push(Triangle { v0: b.min, v1: b.max, v2: b.min });
             objects.push(i as u32);
             placed[p].push(i as u32);
         }
@@ -250,19 +243,12 @@ impl PreparedScene {
             let inputs = self.accel.order.len() as u32;
             let part = self.append_part(&[objects + p], inputs, slot_base, node_base, true, false);
             let f = &self.flat[objects + p];
-            let (lo, hi) = f.tris.iter().fold(
-                (Vec3::splat(f32::MAX), Vec3::splat(-f32::MAX)),
-                |(lo, hi), t| {
-                    let b = t.aabb();
-                    (lo.min(b.min.into()), hi.max(b.max.into()))
-                },
-            );
+            let bounds = f.tris.iter().fold(Aabb::empty(), |b, t| b.union(&t.aabb()));
             self.protos[p] = Proto {
                 root: node_base as u32,
                 slot_base: slot_base as u32,
                 slots: (self.tris.len() / 3 - slot_base) as u32,
-                lo,
-                hi,
+                bounds,
             };
             let a = &mut self.accel;
             a.nodes.extend_from_slice(&part.accel.nodes);
