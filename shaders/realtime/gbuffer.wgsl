@@ -9,6 +9,8 @@ struct VsOut {
     @location(0) bary: vec2f,
     @location(1) @interpolate(flat) slot: u32,
     @location(4) @interpolate(flat) inst: u32,
+    // The G-buffer's object id: the instance's, or the world-space triangle's own.
+    @location(5) @interpolate(flat) object: u32,
     // Unjittered current and previous clip positions, for motion vectors.
     @location(2) cur: vec4f,
     @location(3) prev: vec4f,
@@ -23,6 +25,7 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
     let object = select(bitcast<u32>(shading_at(slot * 4u + 3u).w), inst, inst != NO_INSTANCE);
     var o: VsOut;
     o.inst = inst;
+    o.object = object;
     o.clip = frame.view_proj * vec4f(p, 1.0);
     o.bary = select(vec2f(0.0), select(vec2f(0.0, 1.0), vec2f(1.0, 0.0), corner == 1u), corner > 0u);
     o.slot = slot;
@@ -74,7 +77,7 @@ fn fs_main(v: VsOut, @builtin(front_facing) facing: bool) -> GBufferOut {
     var o: GBufferOut;
     o.normal = oct_encode(ns);
     o.motion = to_pixels(v.prev) - to_pixels(v.cur);
-    o.ids = vec2u(select(bitcast<u32>(shading_at(slot * 4u + 3u).w), v.inst, v.inst != NO_INSTANCE), slot);
+    o.ids = vec2u(v.object, slot);
     if !front && (m.flags & MAT_DOUBLE_SIDED) == 0u {
         // The tracer's black absorber: no material, no light.
         o.base_color = vec4f(0.0);
