@@ -21,40 +21,10 @@
 var prev_depth: texture_depth_2d;
 var history: texture_2d<f32>;
 var prev_normal: texture_2d<f32>;
-var prev_hit: texture_2d<f32>;
 var neighbourhood: texture_2d<f32>;
 var dst: texture_storage_2d<rgba32float, write>;
 var motion: texture_2d<f32>;
 var out_info: texture_storage_2d<rgba16float, write>;
-
-// Eq. (11) on the reflected hit, as `reproject` does it on the surface (matte/common.wgsl): the
-// previous frame saw each pixel's reflection at another jitter, so where the pixel under the
-// reflection motion vector shows another point, its 3x3 neighbours are tried and the closest
-// reflected hit is read (point sampled). Distances are in reflected footprints (`reach`). Testing
-// the one pixel alone cut the history of curved mirrors (the hall's metal spheres) short in
-// every frame of a still view, and their bilateral then ran at full sigma.
-fn reproject_mirror(prev: vec2f, hit: vec3f, reach: f32) -> Reprojection {
-    let q = vec2i(floor(prev));
-    var best = Reprojection(q, true, -1.0);
-    for (var k = 0; k < 9; k++) {
-        let t = q + neighbour_3x3(k);
-        if !in_bounds(t) {
-            continue;
-        }
-        let ph = textureLoad(prev_hit, t, 0);
-        if decode_hit_class(ph.w) != HIT_MIRROR {
-            continue;
-        }
-        let d = length(hit - ph.xyz) / reach;
-        if best.distance < 0.0 || d < best.distance {
-            best = Reprojection(t, k == 0, d);
-        }
-        if k == 0 && d <= gp.d0_px {
-            break;
-        }
-    }
-    return best;
-}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
@@ -106,7 +76,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         n = next_length(texel.a, still);
         var hist = half_safe(texel.rgb);
         if r.bilinear {
-            hist = half_safe(load_bilinear(history, prev).rgb);
+            // Each tap tested as the texel was: a glossy lobe, and the surface (eq. (11) on the
+            // primary surface) or, on a mirror, the reflected hit.
+            let b = bilinear_taps(prev);
+            var ok = lobe_taps(b);
+            if !reflected {
+                let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
+                ok = ok & surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), gp.reprojection_min_cos);
+            } else if is_mirror(roughness) {
+                ok = mirror_taps(b, representative_hit(p, x), reflected_footprint(p, x));
+            }
+            hist = half_safe(load_taps(history, b, passing_weights(b, ok)).rgb);
             n = resampled_length(n, prev, gp.resampled_history_frames);
         }
         own = select(0.0, 1.0, all(r.texel == p) && (!r.bilinear || all(prev == vec2f(p) + 0.5)));

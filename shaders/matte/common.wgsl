@@ -132,6 +132,15 @@ fn same_object(p: vec2i, t: vec2i) -> bool {
     return textureLoad(prev_object, t, 0).x == textureLoad(gb_object, p, 0).x;
 }
 
+// `ok` and showing p's object, tap by tap (taps off the image are not ok already).
+fn same_object_taps(p: vec2i, b: BilinearTaps, ok: vec4<bool>) -> vec4<bool> {
+    var both = ok;
+    for (var k = 0; k < 4; k++) {
+        both[k] = ok[k] && same_object(p, bilinear_tap(b, k));
+    }
+    return both;
+}
+
 // Linear view depth of a rebased world position.
 fn linear_depth(x: vec3f) -> f32 {
     return dot(x - frame.cam_pos.xyz, frame.cam_fwd.xyz) / length(frame.cam_fwd.xyz);
@@ -242,15 +251,60 @@ fn resampled_length(n: f32, prev: vec2f, cap: f32) -> f32 {
 // Bilinear fetch of a history at pixel coordinates `at` (texel centres at +0.5), edges clamped.
 // The histories are 32-bit floats, which WebGPU does not filter without an optional feature.
 fn load_bilinear(t: texture_2d<f32>, at: vec2f) -> vec4f {
+    let b = bilinear_taps(at);
+    return load_taps(t, b, b.w);
+}
+
+// The four texels a bilinear read at `at` blends, base + (0,0), (1,0), (0,1), (1,1), and their
+// weights in that order.
+struct BilinearTaps {
+    base: vec2i,
+    w: vec4f,
+}
+
+fn bilinear_taps(at: vec2f) -> BilinearTaps {
     let f = at - 0.5;
-    let base = vec2i(floor(f));
-    let w = f - floor(f);
+    let t = f - floor(f);
+    let s = 1.0 - t;
+    return BilinearTaps(vec2i(floor(f)), vec4f(s.x * s.y, t.x * s.y, s.x * t.y, t.x * t.y));
+}
+
+fn bilinear_tap(b: BilinearTaps, k: i32) -> vec2i {
+    return b.base + vec2i(k & 1, k >> 1);
+}
+
+// The taps of `b` read with weights `w` (which sum to 1), edges clamped.
+fn load_taps(t: texture_2d<f32>, b: BilinearTaps, w: vec4f) -> vec4f {
     let hi = vec2i(frame.size) - 1;
-    let a = textureLoad(t, clamp(base, vec2i(0), hi), 0);
-    let b = textureLoad(t, clamp(base + vec2i(1, 0), vec2i(0), hi), 0);
-    let c = textureLoad(t, clamp(base + vec2i(0, 1), vec2i(0), hi), 0);
-    let d = textureLoad(t, clamp(base + vec2i(1, 1), vec2i(0), hi), 0);
-    return mix(mix(a, b, w.x), mix(c, d, w.x), w.y);
+    var sum = vec4f(0.0);
+    for (var k = 0; k < 4; k++) {
+        sum += w[k] * textureLoad(t, clamp(bilinear_tap(b, k), vec2i(0), hi), 0);
+    }
+    return sum;
+}
+
+// The bilinear weights of the taps that are `ok`, renormalised over them (SVGF §4.1: each tap of
+// the bilinear read is tested for consistency and the rejected taps' weight goes to the
+// others). Untested, a read beside a silhouette took up to 3/4 of its history from the surface
+// behind it. None passing: zero weights.
+fn passing_weights(b: BilinearTaps, ok: vec4<bool>) -> vec4f {
+    let w = select(vec4f(0.0), b.w, ok);
+    let sum = w.x + w.y + w.z + w.w;
+    if sum <= 0.0 {
+        return vec4f(0.0);
+    }
+    return w / sum;
+}
+
+// Which taps of a bilinear read show the expected surface: eq. (11)'s distance within d1
+// footprints (and the normal test), as `reproject` judges one texel.
+fn surface_taps(depth: texture_depth_2d, normals: texture_2d<f32>, b: BilinearTaps, expected: vec3f, s: SurfaceFrame, min_cos: f32) -> vec4<bool> {
+    var ok = vec4<bool>(false);
+    for (var k = 0; k < 4; k++) {
+        let d = previous_distance(depth, normals, bilinear_tap(b, k), expected, s, min_cos);
+        ok[k] = d >= 0.0 && d <= dn.d1_px;
+    }
+    return ok;
 }
 
 // Offset k of a 3x3 neighbourhood, its centre first (k = 0).

@@ -40,9 +40,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var reason = 0u;
     var c = 0.0;
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
+    // A long still-view history tests normals too (MatteSettings::still_normal_degrees).
+    var min_cos = dn.reprojection_min_cos;
     if dn.history_valid != 0u {
-        // A long still-view history tests normals too (MatteSettings::still_normal_degrees).
-        var min_cos = dn.reprojection_min_cos;
         let own = clamp(vec2i(floor(prev)), vec2i(0), vec2i(frame.size) - 1);
         if dn.static_view != 0u && dn.edge_stop_full_frames > 0.0 && textureLoad(history, own, 0).a > dn.edge_stop_full_frames {
             min_cos = max(min_cos, dn.still_normal_min_cos);
@@ -65,7 +65,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         n = next_length(texel.a, still);
         var hist = half_safe(texel.rgb);
         if r.bilinear {
-            hist = half_safe(load_bilinear(history, prev).rgb);
+            let b = bilinear_taps(prev);
+            let w = passing_weights(b, surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), min_cos));
+            hist = half_safe(load_taps(history, b, w).rgb);
             n = resampled_length(n, prev, dn.resampled_history_frames);
         } else {
             reason |= REASON_NEIGHBOUR;

@@ -1,6 +1,6 @@
 // SVGF §4.1 for the glossy light, with Voorhuis §4: below the roughness threshold the history
 // follows the reflection motion vectors of the diamond search (glossy/motion.wgsl) without the
-// surface consistency tests, and below the clip roughness it is clipped to the 5x5 box of the
+// surface consistency tests (a mirror's reflected hit is tested, glossy/reproject.wgsl), and below the clip roughness it is clipped to the 5x5 box of the
 // 7x7-blurred current frame (glossy/prefilter.wgsl; §4.2.3); above, it is reprojected as the
 // matte light. Behind mirrors the light is divided by the reflected surface's reflectance
 // (glossy_input, §4.1) and multiplied back by the final stage.
@@ -8,7 +8,6 @@
 
 var prev_depth: texture_depth_2d;
 var prev_normal: texture_2d<f32>;
-var prev_hit: texture_2d<f32>;
 var history: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var motion: texture_2d<f32>;
@@ -38,7 +37,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let reflected = sv_on(SV_REFLECTION_REPROJECTION) && roughness < gp.roughness_threshold && gp.static_view == 0u;
         let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
         var r = Reprojection(vec2i(floor(prev)), true, -1.0);
-        if reflected {
+        if reflected && is_mirror(roughness) {
+            // A mirror's reflected hit is tested as the glossy chain tests it
+            // (glossy/reproject.wgsl); untested, the history kept what the mirror showed before
+            // a reflected object moved.
+            r = reproject_mirror(prev, representative_hit(p, x), reflected_footprint(p, x));
+            if r.distance > gp.d1_px {
+                r.distance = -1.0;
+            }
+        } else if reflected {
             r.distance = select(-1.0, 0.0, in_bounds(r.texel));
         } else {
             let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
@@ -52,8 +59,19 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             mom = textureLoad(moments, r.texel, 0);
             hist = half_safe(textureLoad(history, r.texel, 0).rgb);
             if r.bilinear {
-                hist = half_safe(load_bilinear(history, prev).rgb);
-                mom = vec4f(load_bilinear(moments, prev).xy, mom.zw);
+                // Each tap tested as the texel was: a glossy lobe, and where the surface test
+                // applies, the surface and its object.
+                let b = bilinear_taps(prev);
+                var ok = lobe_taps(b);
+                if !reflected {
+                    let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
+                    ok = same_object_taps(p, b, ok & surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), dn.reprojection_min_cos));
+                } else if is_mirror(roughness) {
+                    ok = mirror_taps(b, representative_hit(p, x), reflected_footprint(p, x));
+                }
+                let w = passing_weights(b, ok);
+                hist = half_safe(load_taps(history, b, w).rgb);
+                mom = vec4f(load_taps(moments, b, w).xy, mom.zw);
             }
             reprojected = mom.z >= 1.0;
             if reprojected && sv_on(SV_CLIPPING) && roughness < gp.clip_roughness {

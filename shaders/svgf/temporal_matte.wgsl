@@ -1,8 +1,9 @@
 // SVGF §4.1 for the matte light: reverse-reproject last frame's filtered light and moments with
 // the G-buffer's motion vectors, test the previous depth and normal (matte/common.wgsl's
-// `reproject`: the texel under the vector sampled bilinearly where it passes, else the closest
-// of its 3x3 neighbours) and object (matte/common.wgsl: same_object), and integrate (common.wgsl). Also writes the features every later
-// stage edge-stops on: linear depth and its gradient.
+// `reproject`: the texel under the vector sampled bilinearly where it passes, from those of the
+// four taps that pass too, else the closest of its 3x3 neighbours) and object (matte/common.wgsl:
+// same_object), and integrate (common.wgsl). Also writes the features every later stage
+// edge-stops on: linear depth and its gradient.
 // Outputs: integrated (rgb, this frame's raw luminance), moments (m1, m2, h), features (z, dz).
 
 var prev_depth: texture_depth_2d;
@@ -42,8 +43,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             mom = textureLoad(moments, r.texel, 0);
             hist = half_safe(textureLoad(history, r.texel, 0).rgb);
             if r.bilinear {
-                hist = half_safe(load_bilinear(history, prev).rgb);
-                mom = vec4f(load_bilinear(moments, prev).xy, mom.zw);
+                let b = bilinear_taps(prev);
+                let ok = surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), dn.reprojection_min_cos);
+                let w = passing_weights(b, same_object_taps(p, b, ok));
+                hist = half_safe(load_taps(history, b, w).rgb);
+                mom = vec4f(load_taps(moments, b, w).xy, mom.zw);
             }
             // A previous texel without a history (a miss then) does not count.
             reprojected = mom.z >= 1.0;

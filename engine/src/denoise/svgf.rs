@@ -233,6 +233,9 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
     if glossy {
         m.push("glossy/common.wgsl");
     }
+    if stage == "svgf/temporal_glossy.wgsl" {
+        m.push("glossy/reproject.wgsl");
+    }
     m.push(motion.module());
     m.push("svgf/common.wgsl");
     if !stage.starts_with("svgf/temporal") {

@@ -188,6 +188,9 @@ pub fn modules(stage: &'static str, motion: crate::gpu::Motion) -> Vec<&'static 
     if stage == "glossy/motion.wgsl" {
         m.push("glossy/diamond.wgsl");
     }
+    if stage == "glossy/temporal.wgsl" {
+        m.push("glossy/reproject.wgsl");
+    }
     m.push(stage);
     m
 }
