@@ -48,6 +48,8 @@ var<uniform> gp: GlossyParams;
 const GSTAGE_TEMPORAL: u32 = 1u;
 const GSTAGE_CLIPPING: u32 = 2u;
 const GSTAGE_BILATERAL: u32 = 4u;
+// The reflected-hit test of glossy (not only mirror) lobes below the roughness threshold.
+const GSTAGE_HIT_TEST: u32 = 8u;
 
 const MV_PRIMARY: u32 = 0u;
 const MV_VIRTUAL: u32 = 1u;

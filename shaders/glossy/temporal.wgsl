@@ -56,8 +56,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if in_bounds(r.texel) && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
             if !reflected {
                 c = confidence(gp.hysteresis, r.distance);
-            } else if is_mirror(roughness) {
-                r = reproject_mirror(prev, representative_hit(p, x), reflected_footprint(p, x));
+            } else if tested_class(roughness, gstage_on(GSTAGE_HIT_TEST)) != HIT_NONE {
+                r = reproject_hit(prev, representative_hit(p, x), hit_reach(p, x, roughness), tested_class(roughness, true));
                 if r.distance >= 0.0 {
                     c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, r.distance));
                 }
@@ -83,8 +83,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             if !reflected {
                 let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
                 ok = ok & surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), gp.reprojection_min_cos);
-            } else if is_mirror(roughness) {
-                ok = mirror_taps(b, representative_hit(p, x), reflected_footprint(p, x));
+            } else if tested_class(roughness, gstage_on(GSTAGE_HIT_TEST)) != HIT_NONE {
+                ok = hit_taps(b, representative_hit(p, x), hit_reach(p, x, roughness), tested_class(roughness, true));
             }
             hist = half_safe(load_taps(history, b, passing_weights(b, ok)).rgb);
             n = resampled_length(n, prev, gp.resampled_history_frames);

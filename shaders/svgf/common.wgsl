@@ -52,6 +52,7 @@ const SV_VARIANCE_OF_MEAN: u32 = 512u;
 const SV_FILTERED_HISTORY: u32 = 1024u;
 const SV_GLOSSY_TEMPORAL: u32 = 2048u;
 const SV_REGRESSION: u32 = 4096u;
+const SV_HIT_TEST: u32 = 8192u;
 
 fn sv_on(bit: u32) -> bool {
     return (sv.bits & bit) != 0u;

@@ -1,6 +1,6 @@
 // SVGF §4.1 for the glossy light, with Voorhuis §4: below the roughness threshold the history
 // follows the reflection motion vectors of the diamond search (glossy/motion.wgsl) without the
-// surface consistency tests (a mirror's reflected hit is tested, glossy/reproject.wgsl), and below the clip roughness it is clipped to the 5x5 box of the
+// surface consistency tests (the reflected hit is tested instead, glossy/reproject.wgsl), and below the clip roughness it is clipped to the 5x5 box of the
 // 7x7-blurred current frame (glossy/prefilter.wgsl; §4.2.3); above, it is reprojected as the
 // matte light. Behind mirrors the light is divided by the reflected surface's reflectance
 // (glossy_input, §4.1) and multiplied back by the final stage.
@@ -37,11 +37,12 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let reflected = sv_on(SV_REFLECTION_REPROJECTION) && roughness < gp.roughness_threshold && gp.static_view == 0u;
         let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
         var r = Reprojection(vec2i(floor(prev)), true, -1.0);
-        if reflected && is_mirror(roughness) {
-            // A mirror's reflected hit is tested as the glossy chain tests it
-            // (glossy/reproject.wgsl); untested, the history kept what the mirror showed before
-            // a reflected object moved.
-            r = reproject_mirror(prev, representative_hit(p, x), reflected_footprint(p, x));
+        let lobe_class = select(HIT_NONE, tested_class(roughness, true), sv_on(SV_HIT_TEST));
+        if reflected && lobe_class != HIT_NONE {
+            // The reflected hit is tested as the glossy chain tests it (glossy/reproject.wgsl);
+            // untested, the history kept what the surface reflected before a reflected object
+            // moved.
+            r = reproject_hit(prev, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
             if r.distance > gp.d1_px {
                 r.distance = -1.0;
             }
@@ -54,7 +55,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 r.distance = -1.0;
             }
         }
-        // The previous pixel must have had a glossy lobe (its hit class is set).
+        // The previous pixel must have had a glossy lobe (its hit lobe_class is set).
         if r.distance >= 0.0 && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
             mom = textureLoad(moments, r.texel, 0);
             hist = half_safe(textureLoad(history, r.texel, 0).rgb);
@@ -66,8 +67,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 if !reflected {
                     let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
                     ok = same_object_taps(p, b, ok & surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), dn.reprojection_min_cos));
-                } else if is_mirror(roughness) {
-                    ok = mirror_taps(b, representative_hit(p, x), reflected_footprint(p, x));
+                } else if lobe_class != HIT_NONE {
+                    ok = hit_taps(b, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
                 }
                 let w = passing_weights(b, ok);
                 hist = half_safe(load_taps(history, b, w).rgb);

@@ -99,6 +99,13 @@ described! {
         /// Neighbourhood clipping applies below this roughness (§4.2.3: 0.9).
         clip_roughness: f32 = 0.9,
             ("glossy.clip_roughness", "glossy/temporal", "roughness", Float(0.0, 1.0, 0.005));
+        /// Below the roughness threshold a glossy pixel's history, not only a mirror's, must have
+        /// reflected the same point: a previous pixel (and each bilinear tap) whose traced
+        /// representative hit lies within d1 reaches of this one's, a reach being a pixel's
+        /// footprint there plus the lobe's spread (roughness^2 x the secondary distance). Off,
+        /// such history is taken wherever the previous pixel had a glossy lobe (Voorhuis §4.2.3).
+        hit_test: bool = true,
+            ("glossy.hit_test", "glossy/temporal", "", Bool);
         /// The separable bilateral (stages 9 and 10).
         bilateral: bool = true,
             ("glossy.bilateral", "glossy/bilateral", "", Bool);
@@ -142,7 +149,10 @@ described! {
 impl GlossySettings {
     /// Stage bits as shaders/glossy/common.wgsl reads them.
     pub fn stage_bits(&self) -> u32 {
-        self.temporal as u32 | (self.clipping as u32) << 1 | (self.bilateral as u32) << 2
+        self.temporal as u32
+            | (self.clipping as u32) << 1
+            | (self.bilateral as u32) << 2
+            | (self.hit_test as u32) << 3
     }
 
     /// The glossy bilateral's Gaussian sigma in pixels: Mara et al. §3.4's 7 r^0.1 + epsilon,

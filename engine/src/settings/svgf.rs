@@ -62,6 +62,11 @@ described! {
         /// Voorhuis §4.2.3: the roughness below which the glossy history is clipped (0.9).
         clip_roughness: f32 = 0.9,
             ("svgf.clip_roughness", "svgf/temporal", "", Float(0.0, 1.0, 0.01));
+        /// Below the roughness threshold a pixel's history (mirror or glossy) must have reflected
+        /// the same point, as in the Mara glossy chain (`glossy.hit_test`). Off, it is taken
+        /// wherever the previous pixel had a glossy lobe, as Voorhuis §4.2.3 does.
+        hit_test: bool = true,
+            ("svgf.hit_test", "svgf/temporal", "", Bool);
         /// The spatial variance estimate (7x7, SVGF §4.2) where fewer than 4 frames accumulated;
         /// off, those pixels use the temporal moments as they are.
         spatial_variance: bool = true,
@@ -161,6 +166,7 @@ impl SvgfSettings {
             regression: false,
             reflection_reprojection: false,
             clipping: false,
+            hit_test: false,
             mirror_features: false,
             still_frames: 0.0,
             settled_samples: 0.0,
@@ -186,6 +192,7 @@ impl SvgfSettings {
             self.filtered_history,
             self.glossy_temporal,
             self.regression,
+            self.hit_test,
         ]
         .iter()
         .enumerate()
