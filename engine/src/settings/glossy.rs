@@ -104,6 +104,8 @@ described! {
         /// representative hit lies within d1 reaches of this one's, a reach being a pixel's
         /// footprint there plus the lobe's spread (roughness^2 x the secondary distance). Off,
         /// such history is taken wherever the previous pixel had a glossy lobe (Voorhuis §4.2.3).
+        /// `hush-cli reflections` strafe (160x90), ghost-region FLIP 0.2211 on, 0.2219 off
+        /// (no reprojection 0.2106); still views are unchanged.
         hit_test: bool = true,
             ("glossy.hit_test", "glossy/temporal", "", Bool);
         /// The separable bilateral (stages 9 and 10).
