@@ -9,7 +9,8 @@ use hush_engine::gpu::{Gpu, Instancing, PreparedScene};
 use hush_engine::passes::Raycaster;
 use hush_engine::quality::relmse;
 use hush_engine::scene::{
-    Animation, Camera, Environment, Material, Object, Scene, Track, quad, uv_sphere,
+    Animation, Camera, Deform, Environment, Material, Morph, MorphTarget, Object, Scene, Track,
+    quad, uv_sphere,
 };
 use hush_tests::Xorshift;
 
@@ -269,8 +270,53 @@ fn a_thousand_flight_helmets_cost_little_more_memory_than_one() {
     assert!(ratio <= 1.1, "a thousand helmets take {ratio:.3}x the memory of one");
 }
 
+/// `s` with a quad beside the field whose one morph target lifts it 0.5 over 2 s: a scene whose
+/// meshes deform, where motion vectors are per vertex (realtime/motion_vertices.wgsl).
+fn with_morph(mut s: Scene) -> Scene {
+    let mut m =
+        quad(Vec3::new(1.8, 0.05, 1.2), Vec3::new(0.8, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.8), 2);
+    m.targets = vec![MorphTarget {
+        positions: vec![Vec3::new(0.0, 0.5, 0.0); m.positions.len()],
+        ..Default::default()
+    }];
+    s.meshes.push(m);
+    let mut o = Object::new("morph", s.meshes.len() - 1, DMat4::IDENTITY);
+    o.deform = Some(std::sync::Arc::new(Deform {
+        skin: vec![],
+        morph: Some(Morph {
+            weights: vec![0.0],
+            tracks: vec![Track {
+                times: vec![0.0, 2.0],
+                values: vec![0.0, 1.0],
+                step: false,
+                tangents: vec![],
+            }],
+            period: 2.0,
+        }),
+    }));
+    s.objects.push(o);
+    s
+}
+
+/// The G-buffer's object ids and motion vectors of moving instances equal their flattened
+/// copies', in a scene of rigid objects and in one where a mesh also deforms (per-vertex
+/// motion, where an instanced mesh's previous vertices are marked (w = 1) so that its points move
+/// by their instances' transforms). Measured: 5,064 pixels agree on their object; rigid, 235
+/// move, worst difference 0.001 px; with the morphing quad, 812 move, worst 0.0002 px (reading
+/// the prototypes' slots as world-space vertices put a still pixel 17 px off).
 #[test]
 fn moving_instances_have_their_flattened_copies_motion_vectors() {
+    for deforming in [false, true] {
+        let scene = |shared| {
+            let s = field(12, shared, true);
+            if deforming { with_morph(s) } else { s }
+        };
+        let (two, one) = (scene(true), scene(false));
+        motion_vectors_agree(two, one, deforming);
+    }
+}
+
+fn motion_vectors_agree(two: Scene, one: Scene, deforming: bool) {
     use hush_engine::frame::{FrameInput, Renderer};
     use hush_engine::settings::FrameSettings;
     let size = (96u32, 72u32);
@@ -283,6 +329,7 @@ fn moving_instances_have_their_flattened_copies_motion_vectors() {
             r.render(&gpu, &input, &FrameSettings::default(), None).unwrap();
         }
         assert_eq!(r.prepared.features.instances, r.prepared.triangle_count() < 1000);
+        assert_eq!(r.prepared.features.deforming, deforming);
         let ids = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
         let motion = r.read_texture(&gpu, "gbuffer/motion").unwrap().0;
         (0..(size.0 * size.1) as usize)
@@ -293,8 +340,8 @@ fn moving_instances_have_their_flattened_copies_motion_vectors() {
             })
             .collect::<Vec<_>>()
     };
-    let two = gbuffer(field(12, true, true));
-    let one = gbuffer(field(12, false, true));
+    let two = gbuffer(two);
+    let one = gbuffer(one);
     let (mut same, mut other, mut moving, mut worst) = (0, 0, 0, 0f32);
     for (i, ((a, ma), (b, mb))) in two.iter().zip(&one).enumerate() {
         if a != b {
@@ -314,7 +361,7 @@ fn moving_instances_have_their_flattened_copies_motion_vectors() {
         moving += (mb.length() > 0.25 && *a >= 2) as u32;
     }
     println!(
-        "{same} pixels agree on their object ({other} do not), {moving} move; worst {worst:.4} px"
+        "deforming {deforming}: {same} pixels agree on their object ({other} do not), {moving} move; worst {worst:.4} px"
     );
     assert!(other * 100 <= same, "{other} pixels show another object");
     assert!(moving > 100, "only {moving} pixels move");

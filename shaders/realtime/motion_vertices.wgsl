@@ -1,5 +1,5 @@
 // A mesh deforms (a skin or animated morph weights; engine/src/scene/deform.rs): every
-// triangle's vertices at the previous frame are stored (tri_prev_texels,
+// world-space triangle's vertices at the previous frame are stored (tri_prev_texels,
 // PreparedScene::tris_prev), and a surface point's previous position is its barycentric mix of
 // them, exact for skinned, morphed, rigid and still surfaces alike. The temporal passes know a
 // pixel's triangle by its G-buffer ids and find the point's barycentrics in the triangle's
@@ -19,8 +19,18 @@ fn previous_position(object: u32, p: vec3f) -> vec3f {
     return q.xyz / q.w;
 }
 
+// An instanced mesh's triangles are stored once in the mesh's space, and their previous
+// vertices' w is 1 (PreparedScene::tris_prev; 0 elsewhere): a point on them moves with its
+// instance's transform.
+fn instanced_slot(slot: u32) -> bool {
+    return textureLoad(tri_prev_texels, vec2u((slot * 3u) & 4095u, (slot * 3u) >> 12u), 0).w > 0.5;
+}
+
 // The point at barycentrics b of triangle slot, at the previous frame.
 fn previous_vertex(slot: u32, b: vec2f, object: u32, p: vec3f) -> vec3f {
+    if instanced_slot(slot) {
+        return previous_position(object, p);
+    }
     let v0 = motion_texel(tri_prev_texels, slot * 3u);
     let v1 = motion_texel(tri_prev_texels, slot * 3u + 1u);
     let v2 = motion_texel(tri_prev_texels, slot * 3u + 2u);
@@ -31,6 +41,9 @@ fn previous_vertex(slot: u32, b: vec2f, object: u32, p: vec3f) -> vec3f {
 // previous frame: its barycentrics in the triangle now, carried to the triangle then.
 fn previous_surface(ids: vec2u, x: vec3f) -> vec3f {
     let slot = ids.y;
+    if instanced_slot(slot) {
+        return previous_position(ids.x, x);
+    }
     let v0 = motion_texel(tri_now_texels, slot * 3u);
     let e1 = motion_texel(tri_now_texels, slot * 3u + 1u) - v0;
     let e2 = motion_texel(tri_now_texels, slot * 3u + 2u) - v0;

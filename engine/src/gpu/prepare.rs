@@ -167,7 +167,8 @@ pub struct PreparedScene {
     /// ([`PreparedScene::expose`]; `tris` are at its close), the same as `tris` while the
     /// shutter is closed (no motion blur).
     pub tris_open: Vec<Vec4>,
-    /// [`SceneFeatures::deforming`]: the vertices of `tris` at the previous `animate` call.
+    /// [`SceneFeatures::deforming`]: the vertices of `tris` at the previous `animate` call, w 0;
+    /// an instanced mesh's prototype slots hold w 1 (their points move with their instances).
     pub tris_prev: Vec<Vec4>,
     pub shading: Vec<Vec4>,
     pub tangents: Vec<Vec4>,
@@ -470,7 +471,7 @@ impl PreparedScene {
             deforming: scene.objects.iter().any(|o| o.deform.as_ref().is_some_and(|d| d.moves())),
             instances: false,
         };
-        let (protos, proto_of) = instances::prototypes(scene, instancing, features.deforming);
+        let (protos, proto_of) = instances::prototypes(scene, instancing);
         features.instances = !protos.is_empty();
         // Refused before flattening what would not fit: the objects flattened in world space
         // and each prototype once.

@@ -9,8 +9,10 @@
 //! space (shaders/common/tlas.wgsl); the raster draws each prototype instanced
 //! (shaders/realtime/gbuffer.wgsl). Objects stay flattened in world space where instancing
 //! does not pay ([`Instancing::Auto`]), where their mesh emits light (the emitter table samples
-//! world-space triangles) and in scenes whose meshes deform (their motion vectors are per
-//! vertex, shaders/realtime/motion_vertices.wgsl).
+//! world-space triangles) and where they deform (skins and morph targets are posed into world
+//! space). In a scene whose meshes deform, the prototypes' previous vertices are NaN, which
+//! tells the per-vertex motion (shaders/realtime/motion_vertices.wgsl) to move their points by
+//! their instances' transforms.
 
 use super::{PreparedScene, rebased};
 use crate::accel::{self, BvhKind};
@@ -74,14 +76,10 @@ pub struct Draw {
 
 /// The prototypes (each named by the first object that draws its mesh) and, per object, the
 /// prototype it instances (None: flattened in world space).
-pub(super) fn prototypes(
-    scene: &Scene,
-    mode: Instancing,
-    deforming: bool,
-) -> (Vec<usize>, Vec<Option<usize>>) {
+pub(super) fn prototypes(scene: &Scene, mode: Instancing) -> (Vec<usize>, Vec<Option<usize>>) {
     let mut of_mesh = vec![None; scene.meshes.len()];
     let mut protos = vec![];
-    let proto_of = plan(scene, mode, deforming)
+    let proto_of = plan(scene, mode)
         .into_iter()
         .enumerate()
         .map(|(i, mesh)| {
@@ -97,9 +95,9 @@ pub(super) fn prototypes(
 }
 
 /// Per object, the mesh it instances (None: flattened in world space).
-fn plan(scene: &Scene, mode: Instancing, deforming: bool) -> Vec<Option<usize>> {
+fn plan(scene: &Scene, mode: Instancing) -> Vec<Option<usize>> {
     let n = scene.objects.len();
-    if mode == Instancing::Never || deforming {
+    if mode == Instancing::Never {
         return vec![None; n];
     }
     let emits = |mesh: usize| {
