@@ -35,9 +35,10 @@ pub struct RenderArgs {
     /// matte/history_bilateral, matte/disocclusion, matte/firefly, matte/bilateral, taa,
     /// glossy/temporal, glossy/bilateral; svgf/temporal, svgf/temporal_glossy, svgf/variance,
     /// svgf/atrous; progressive/temporal, progressive/atrous), and switches that cover several
-    /// stages or part of one by their settings (glossy.clipping; svgf.accumulated_moments,
-    /// svgf.bandwidth_boost, svgf.firefly, svgf.reflection_reprojection, svgf.clipping,
-    /// svgf.mirror_features). An unknown name's error lists them all.
+    /// stages or part of one by their settings (glossy.clipping, glossy.hit_test;
+    /// svgf.accumulated_moments, svgf.bandwidth_boost, svgf.firefly,
+    /// svgf.reflection_reprojection, svgf.clipping, svgf.mirror_features, svgf.hit_test). An
+    /// unknown name's error lists them all.
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
     /// Real-time mode: how the glossy chain reprojects reflections: diamond (Voorhuis's search),

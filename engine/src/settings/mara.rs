@@ -25,6 +25,7 @@ pub const INFO: DenoiserInfo = DenoiserInfo {
         Stage::named("matte/bilateral", "matte.bilateral"),
         Stage::named("glossy/temporal", "glossy.temporal"),
         Stage::switch("glossy.clipping"),
+        Stage::switch("glossy.hit_test"),
         Stage::named("glossy/bilateral", "glossy.bilateral"),
     ],
     views: VIEWS,

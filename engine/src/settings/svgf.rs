@@ -236,6 +236,7 @@ pub const INFO: DenoiserInfo = DenoiserInfo {
         Stage::switch("svgf.reflection_reprojection"),
         Stage::switch("svgf.clipping"),
         Stage::switch("svgf.mirror_features"),
+        Stage::switch("svgf.hit_test"),
     ],
     views: VIEWS,
     fractions: false,
