@@ -1,6 +1,7 @@
 // Stage (5): r = (1 - min over a 2R x 2R box of c) x R by two 1D min passes (horizontal, then
 // vertical), times `low_confidence_multiplier` where the pixel's own c < 1/2 (capped at
-// max_radius_px). Entry points: min_h reads c from the temporal output, min_v writes r.
+// max_radius_px). Entry points: min_h reads c as the temporal stage wrote it alone (in the
+// radius texture, 1 off the surface), min_v writes r.
 
 var filter_in: texture_2d<f32>;
 var min_in: texture_2d<f32>;
@@ -20,8 +21,7 @@ fn min_h(@builtin(global_invocation_id) gid: vec3u) {
     let r = box_radius();
     for (var d = -r; d < r; d++) {
         let q = vec2i(clamp(p.x + d, 0, i32(frame.size.x) - 1), p.y);
-        // Background pixels carry no confidence but need no filling either.
-        m = min(m, select(1.0, textureLoad(filter_in, q, 0).a, has_surface(q)));
+        m = min(m, textureLoad(min_in, q, 0).r);
     }
     textureStore(out_min, p, vec4f(m, 0.0, 0.0, 0.0));
 }

@@ -19,6 +19,9 @@ var history: texture_2d<f32>;
 var prev_normal: texture_2d<f32>;
 var out_temporal: texture_storage_2d<rgba32float, write>;
 var out_reason: texture_storage_2d<r32uint, write>;
+// c alone for stage (5)'s minimum, 1 off the surface (which needs no filling): its horizontal
+// pass then reads 4 bytes a tap where it read this output's 16 and the G-buffer's ids.
+var out_confidence: texture_storage_2d<r32float, write>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
@@ -30,6 +33,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !has_surface(p) || !stage_on(STAGE_TEMPORAL) {
         textureStore(out_temporal, p, vec4f(current, 0.0));
         textureStore(out_reason, p, vec4u(select(0u, REASON_DISOCCLUDED, has_surface(p)) | (1u << 8u), 0u, 0u, 0u));
+        textureStore(out_confidence, p, vec4f(select(1.0, 0.0, has_surface(p)), 0.0, 0.0, 0.0));
         return;
     }
     // Where this surface was: through the motion vector, and by its own (object) motion.
@@ -98,5 +102,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         result = mix(clamped, current, new_frame_weight(c, n, dn.still_frames, still));
     }
     textureStore(out_temporal, p, vec4f(half_safe(result), c));
+    textureStore(out_confidence, p, vec4f(c, 0.0, 0.0, 0.0));
     textureStore(out_reason, p, vec4u(reason | (u32(n) << 8u), 0u, 0u, 0u));
 }

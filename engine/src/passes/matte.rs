@@ -220,7 +220,10 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: Parity) -> Bindings<'a>
         Kind::Temporal => b
             .texture("history", &m.history.history(parity).1)
             .texture("out_temporal", &m.temporal.1)
-            .texture("out_reason", &m.reason.1),
+            .texture("out_reason", &m.reason.1)
+            // c alone, for the disocclusion minimum, in the radius texture that stage
+            // rewrites after reading it.
+            .texture("out_confidence", &m.radius.1),
         Kind::HistoryBilateral => b
             .texture("filter_in", &m.temporal.1)
             .texture("reason_in", &m.reason.1)
