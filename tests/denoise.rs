@@ -7,8 +7,8 @@ use hush_engine::passes::matte::history_rejected;
 use hush_engine::quality::{Image, compare, flip_over};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MatteSettings, TaaSettings};
-use hush_tests::reproject::{DepthFrame, Surface, neighbours_3x3};
-use hush_tests::{half, oct_normal};
+use hush_tests::half;
+use hush_tests::reproject::{DepthFrame, Stepped, neighbours_3x3, stepped};
 
 const SIZE: (u32, u32) = (96, 54);
 
@@ -294,30 +294,20 @@ fn history_resets_on_disocclusion() {
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
     let d1 = MatteSettings::default().d1_px;
     let (mut rejected, mut flagged, mut exact) = (0, 0, 0);
-    for y in 0..SIZE.1 as i64 {
-        for x in 0..SIZE.0 as i64 {
-            let Some(p) = now.world(x, y) else { continue };
-            let i = now.index(x, y).unwrap();
-            let surface = Surface::new(p, oct_normal(&normal[i * 4..]), &setup1, SIZE.1);
-            let q = (
-                x as f32 + 0.5 + half(&motion[i * 4..]),
-                y as f32 + 0.5 + half(&motion[i * 4 + 2..]),
-            );
-            let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
-                .filter_map(|(tx, ty)| before.world(tx, ty))
-                .map(|prev| surface.distance(prev))
-                .fold(f32::INFINITY, f32::min);
-            if closest <= 1.5 * d1 {
-                continue;
-            }
-            rejected += 1;
-            let why = u32::from_le_bytes(reason[i * 4..i * 4 + 4].try_into().unwrap()) & 255;
-            flagged += (why & 3 != 0) as u32;
-            // The temporal output is 32-bit, the input half: the new sample converts exactly.
-            let same =
-                (0..3).all(|k| f32_at(&temporal, i * 4 + k) == half(&input[i * 8 + k * 2..]));
-            exact += (same && f32_at(&temporal, i * 4 + 3) == 0.0) as u32;
+    for Stepped { i, surface, prev: q, .. } in stepped(&now, &normal, &motion, &setup1) {
+        let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
+            .filter_map(|(tx, ty)| before.world(tx, ty))
+            .map(|prev| surface.distance(prev))
+            .fold(f32::INFINITY, f32::min);
+        if closest <= 1.5 * d1 {
+            continue;
         }
+        rejected += 1;
+        let why = u32::from_le_bytes(reason[i * 4..i * 4 + 4].try_into().unwrap()) & 255;
+        flagged += (why & 3 != 0) as u32;
+        // The temporal output is 32-bit, the input half: the new sample converts exactly.
+        let same = (0..3).all(|k| f32_at(&temporal, i * 4 + k) == half(&input[i * 8 + k * 2..]));
+        exact += (same && f32_at(&temporal, i * 4 + 3) == 0.0) as u32;
     }
     println!(
         "after the step: {rejected} pixels without history, {flagged} flagged, {exact} restarted from the new sample"
@@ -376,49 +366,39 @@ fn bilinear_history_reads_only_taps_that_pass() {
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
     let (d0, d1) = (MatteSettings::default().d0_px, MatteSettings::default().d1_px);
     let (mut edges, mut outside) = (0, 0);
-    for y in 0..SIZE.1 as i64 {
-        for x in 0..SIZE.0 as i64 {
-            let Some(p) = now.world(x, y) else { continue };
-            let i = now.index(x, y).unwrap();
-            let surface = Surface::new(p, oct_normal(&normal[i * 4..]), &setup1, SIZE.1);
-            let q = (
-                x as f32 + 0.5 + half(&motion[i * 4..]),
-                y as f32 + 0.5 + half(&motion[i * 4 + 2..]),
-            );
-            let distance = |tx: i64, ty: i64| before.world(tx, ty).map(|w| surface.distance(w));
-            if !distance(q.0.floor() as i64, q.1.floor() as i64).is_some_and(|d| d <= 0.5 * d0) {
-                continue;
-            }
-            let (fx, fy) = (q.0 - 0.5 - (q.0 - 0.5).floor(), q.1 - 0.5 - (q.1 - 0.5).floor());
-            let (bx, by) = ((q.0 - 0.5).floor() as i64, (q.1 - 0.5).floor() as i64);
-            let taps = [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(dx, dy)| {
-                let w =
-                    (if dx == 0 { 1.0 - fx } else { fx }) * (if dy == 0 { 1.0 - fy } else { fy });
-                (bx + dx, by + dy, w, distance(bx + dx, by + dy))
-            });
-            let rejected = |d: Option<f32>| d.is_none_or(|d| d > 1.5 * d1);
-            if !taps.iter().any(|t| t.2 >= 0.1 && rejected(t.3)) {
-                continue;
-            }
-            edges += 1;
-            let current: [f32; 3] = std::array::from_fn(|k| half(&input[i * 8 + k * 2..]));
-            let mut lo = current;
-            let mut hi = current;
-            for t in taps.iter().filter(|t| !rejected(t.3)) {
-                let h = rgb(&history, before.index(t.0, t.1).unwrap());
-                for k in 0..3 {
-                    lo[k] = lo[k].min(h[k]);
-                    hi[k] = hi[k].max(h[k]);
-                }
-            }
-            let out: [f32; 3] = std::array::from_fn(|k| {
-                f32::from_le_bytes(temporal[i * 16 + k * 4..i * 16 + k * 4 + 4].try_into().unwrap())
-            });
-            let tolerance = |v: f32| 2e-3 * v.abs().max(1.0);
-            outside += (0..3)
-                .any(|k| out[k] < lo[k] - tolerance(lo[k]) || out[k] > hi[k] + tolerance(hi[k]))
-                as u32;
+    for Stepped { i, surface, prev: q, .. } in stepped(&now, &normal, &motion, &setup1) {
+        let distance = |tx: i64, ty: i64| before.world(tx, ty).map(|w| surface.distance(w));
+        if !distance(q.0.floor() as i64, q.1.floor() as i64).is_some_and(|d| d <= 0.5 * d0) {
+            continue;
         }
+        let (fx, fy) = (q.0 - 0.5 - (q.0 - 0.5).floor(), q.1 - 0.5 - (q.1 - 0.5).floor());
+        let (bx, by) = ((q.0 - 0.5).floor() as i64, (q.1 - 0.5).floor() as i64);
+        let taps = [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(dx, dy)| {
+            let w = (if dx == 0 { 1.0 - fx } else { fx }) * (if dy == 0 { 1.0 - fy } else { fy });
+            (bx + dx, by + dy, w, distance(bx + dx, by + dy))
+        });
+        let rejected = |d: Option<f32>| d.is_none_or(|d| d > 1.5 * d1);
+        if !taps.iter().any(|t| t.2 >= 0.1 && rejected(t.3)) {
+            continue;
+        }
+        edges += 1;
+        let current: [f32; 3] = std::array::from_fn(|k| half(&input[i * 8 + k * 2..]));
+        let mut lo = current;
+        let mut hi = current;
+        for t in taps.iter().filter(|t| !rejected(t.3)) {
+            let h = rgb(&history, before.index(t.0, t.1).unwrap());
+            for k in 0..3 {
+                lo[k] = lo[k].min(h[k]);
+                hi[k] = hi[k].max(h[k]);
+            }
+        }
+        let out: [f32; 3] = std::array::from_fn(|k| {
+            f32::from_le_bytes(temporal[i * 16 + k * 4..i * 16 + k * 4 + 4].try_into().unwrap())
+        });
+        let tolerance = |v: f32| 2e-3 * v.abs().max(1.0);
+        outside += (0..3)
+            .any(|k| out[k] < lo[k] - tolerance(lo[k]) || out[k] > hi[k] + tolerance(hi[k]))
+            as u32;
     }
     println!(
         "{outside} of {edges} pixels with a rejected bilinear tap lie outside their accepted taps' range"

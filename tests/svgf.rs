@@ -9,8 +9,8 @@ use hush_engine::gpu::Gpu;
 use hush_engine::quality::{Image, compare, luminance};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings, SvgfSettings, TaaSettings};
-use hush_tests::reproject::{DepthFrame, Surface, neighbours_3x3};
-use hush_tests::{half, oct_normal};
+use hush_tests::half;
+use hush_tests::reproject::{DepthFrame, Stepped, neighbours_3x3, stepped};
 
 const SIZE: (u32, u32) = (96, 54);
 
@@ -141,35 +141,26 @@ fn svgf_history_resets_on_disocclusion() {
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
     let d1 = MatteSettings::default().d1_px;
     let (mut rejected, mut restarted, mut kept) = (0, 0, 0);
-    for y in 0..SIZE.1 as i64 {
-        for x in 0..SIZE.0 as i64 {
-            let Some(p) = now.world(x, y) else { continue };
-            let i = now.index(x, y).unwrap();
-            let surface = Surface::new(p, oct_normal(&normal[i * 4..]), &setup1, SIZE.1);
-            let q = (
-                x as f32 + 0.5 + half(&motion[i * 4..]),
-                y as f32 + 0.5 + half(&motion[i * 4 + 2..]),
-            );
-            let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
-                .filter_map(|(tx, ty)| before.world(tx, ty))
-                .map(|prev| surface.distance(prev))
-                .fold(f32::INFINITY, f32::min);
-            let h = f32_at(&moments, i * 4 + 2);
-            if closest <= 0.5 {
-                kept += (h > 1.0) as u32;
-            }
-            if closest <= 1.5 * d1 {
-                continue;
-            }
-            rejected += 1;
-            let sample: Vec<f32> = (0..3).map(|k| half(&input[i * 8 + k * 2..])).collect();
-            let l = luminance(glam::Vec3::new(sample[0], sample[1], sample[2]));
-            let same_light = (0..3).all(|k| f32_at(&integrated, i * 4 + k) == sample[k]);
-            let same_moments = h == 1.0
-                && f32_at(&moments, i * 4) == l
-                && (f32_at(&moments, i * 4 + 1) - l * l).abs() <= 1e-6 * (l * l).max(1.0);
-            restarted += (same_light && same_moments) as u32;
+    for Stepped { i, surface, prev: q, .. } in stepped(&now, &normal, &motion, &setup1) {
+        let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
+            .filter_map(|(tx, ty)| before.world(tx, ty))
+            .map(|prev| surface.distance(prev))
+            .fold(f32::INFINITY, f32::min);
+        let h = f32_at(&moments, i * 4 + 2);
+        if closest <= 0.5 {
+            kept += (h > 1.0) as u32;
         }
+        if closest <= 1.5 * d1 {
+            continue;
+        }
+        rejected += 1;
+        let sample: Vec<f32> = (0..3).map(|k| half(&input[i * 8 + k * 2..])).collect();
+        let l = luminance(glam::Vec3::new(sample[0], sample[1], sample[2]));
+        let same_light = (0..3).all(|k| f32_at(&integrated, i * 4 + k) == sample[k]);
+        let same_moments = h == 1.0
+            && f32_at(&moments, i * 4) == l
+            && (f32_at(&moments, i * 4 + 1) - l * l).abs() <= 1e-6 * (l * l).max(1.0);
+        restarted += (same_light && same_moments) as u32;
     }
     println!(
         "after the step: {rejected} pixels without history, {restarted} restarted; {kept} pixels on seen surfaces kept theirs"

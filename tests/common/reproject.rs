@@ -88,3 +88,34 @@ pub fn pixel_centre_hit(
     let n = (v(1) - v(0)).cross(v(2) - v(0));
     setup.pos + d * ((v(0) - setup.pos).dot(n) / d.dot(n))
 }
+
+/// A pixel with a surface in the frame after a step: its index, its surface for eq. (11), and
+/// where its motion vector puts it in the previous frame (pixel coordinates, centres at +0.5).
+pub struct Stepped {
+    pub x: i64,
+    pub y: i64,
+    pub i: usize,
+    pub surface: Surface,
+    pub prev: (f32, f32),
+}
+
+/// Every pixel with a surface of `now`, from its G-buffer normal (octahedral half floats) and
+/// motion vector (two half floats) read back.
+pub fn stepped<'a>(
+    now: &'a DepthFrame,
+    normal: &'a [u8],
+    motion: &'a [u8],
+    camera: &'a CameraSetup,
+) -> impl Iterator<Item = Stepped> + 'a {
+    let (w, h) = (now.size.0 as i64, now.size.1 as i64);
+    (0..h).flat_map(move |y| (0..w).map(move |x| (x, y))).filter_map(move |(x, y)| {
+        let p = now.world(x, y)?;
+        let i = now.index(x, y)?;
+        let surface = Surface::new(p, crate::oct_normal(&normal[i * 4..]), camera, now.size.1);
+        let prev = (
+            x as f32 + 0.5 + crate::half(&motion[i * 4..]),
+            y as f32 + 0.5 + crate::half(&motion[i * 4 + 2..]),
+        );
+        Some(Stepped { x, y, i, surface, prev })
+    })
+}
