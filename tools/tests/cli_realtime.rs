@@ -171,8 +171,8 @@ fn quality_writes_scores_and_a_plot() {
         );
     }
     let ablations = std::fs::read_to_string(dir.join("ablations.csv")).unwrap();
-    // Header, the full chain, and each of the 6 matte and 3 glossy stages off.
-    assert_eq!(ablations.lines().count(), 11, "{ablations}");
+    // Header, the full chain, and each of the 6 matte and 4 glossy stages and switches off.
+    assert_eq!(ablations.lines().count(), 12, "{ablations}");
     let png = image_size(&dir.join("quality.png"));
     assert_eq!(png, (960, 720));
 }
