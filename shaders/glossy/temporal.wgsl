@@ -13,9 +13,12 @@
 //   F(w_s), and the chain filters light divided by F, so their mix is biased, not just noisy;
 // - reflection motion vectors on a mirror: eq. (11) on the reflected hit (exact for mirrors),
 //   in pixel footprints at the reflected hit (reflected_footprint: curved mirrors minify);
-// - reflection motion vectors on a glossy surface: h wherever the previous pixel had a glossy
-//   surface. Its samples scatter, so a position test would reject good history; Voorhuis drops
-//   the consistency test there and lets the neighbourhood clip remove ghosts.
+// - reflection motion vectors on a glossy surface: with glossy.hit_test (and traced
+//   representative rays), eq. (11) on the reflected hit as for mirrors, in reaches grown by the
+//   lobe's spread (glossy/reproject.wgsl: hit_reach), since its samples scatter and a tighter
+//   test would reject good history; without, h wherever the previous pixel had a glossy
+//   surface, as Voorhuis, who drops the consistency test there and lets the neighbourhood clip
+//   remove ghosts.
 // Output: history (rgb, n) and info (c, clip amount, n, 0).
 
 var prev_depth: texture_depth_2d;
@@ -45,6 +48,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // which differ between frames with the jitter and the sampled ray.
     let reflected = roughness < gp.roughness_threshold && gp.mode != MV_PRIMARY && gp.static_view == 0u;
     let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
+    // The lobe whose reflected hit is tested (HIT_NONE: none is).
+    let lobe_class = tested_class(roughness, gstage_on(GSTAGE_HIT_TEST));
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     var c = 0.0;
     if dn.history_valid != 0u {
@@ -56,8 +61,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if in_bounds(r.texel) && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
             if !reflected {
                 c = confidence(gp.hysteresis, r.distance);
-            } else if tested_class(roughness, gstage_on(GSTAGE_HIT_TEST)) != HIT_NONE {
-                r = reproject_hit(prev, representative_hit(p, x), hit_reach(p, x, roughness), tested_class(roughness, true));
+            } else if lobe_class != HIT_NONE {
+                r = reproject_hit(prev, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
                 if r.distance >= 0.0 {
                     c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, r.distance));
                 }
@@ -77,14 +82,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             // Each tap tested as the texel was: a glossy lobe, and the surface (eq. (11) on the
-            // primary surface) or, on a mirror, the reflected hit.
+            // primary surface) or, where it is tested, the reflected hit.
             let b = bilinear_taps(prev);
             var ok = lobe_taps(b);
             if !reflected {
                 let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
                 ok = ok & surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), gp.reprojection_min_cos);
-            } else if tested_class(roughness, gstage_on(GSTAGE_HIT_TEST)) != HIT_NONE {
-                ok = hit_taps(b, representative_hit(p, x), hit_reach(p, x, roughness), tested_class(roughness, true));
+            } else if lobe_class != HIT_NONE {
+                ok = hit_taps(b, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
             }
             hist = half_safe(load_taps(history, b, passing_weights(b, ok)).rgb);
             n = resampled_length(n, prev, gp.resampled_history_frames);
