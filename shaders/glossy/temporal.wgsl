@@ -52,17 +52,26 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let lobe_class = tested_class(roughness, gstage_on(GSTAGE_HIT_TEST));
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     var c = 0.0;
+    // What the texel was tested with, for the bilinear taps: the surface's expected point and
+    // frame, or the reflected hit and its reach.
+    var expected = x;
+    var s = SurfaceFrame(vec3f(0.0), 1.0, 1.0);
+    var hit = x;
+    var reach = 1.0;
     if dn.history_valid != 0u {
         if !reflected {
-            let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
-            r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), gp.reprojection_min_cos);
+            expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
+            s = surface_frame(p, x);
+            r = reproject(prev_depth, prev_normal, prev, expected, s, gp.reprojection_min_cos);
         }
         // The previous pixel must have had a glossy lobe (its hit class is set).
         if in_bounds(r.texel) && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
             if !reflected {
                 c = confidence(gp.hysteresis, r.distance);
             } else if lobe_class != HIT_NONE {
-                r = reproject_hit(prev, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
+                hit = representative_hit(p, x);
+                reach = hit_reach(p, x, roughness);
+                r = reproject_hit(prev, hit, reach, lobe_class);
                 if r.distance >= 0.0 {
                     c = gp.hysteresis * (1.0 - smoothstep(gp.d0_px, gp.d1_px, r.distance));
                 }
@@ -86,10 +95,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             let b = bilinear_taps(prev);
             var ok = lobe_taps(b);
             if !reflected {
-                let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
-                ok = ok & surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), gp.reprojection_min_cos);
+                ok = ok & surface_taps(prev_depth, prev_normal, b, expected, s, gp.reprojection_min_cos);
             } else if lobe_class != HIT_NONE {
-                ok = hit_taps(b, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
+                ok = hit_taps(b, hit, reach, lobe_class);
             }
             hist = half_safe(load_taps(history, b, passing_weights(b, ok)).rgb);
             n = resampled_length(n, prev, gp.resampled_history_frames);

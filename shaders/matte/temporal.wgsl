@@ -40,6 +40,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let x = position_at(p);
     let ids = textureLoad(gb_object, p, 0);
     let expected = previous_surface(ids.xy, x);
+    let s = surface_frame(p, x);
     let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
     var reason = 0u;
     var c = 0.0;
@@ -51,7 +52,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if dn.static_view != 0u && dn.edge_stop_full_frames > 0.0 && textureLoad(history, own, 0).a > dn.edge_stop_full_frames {
             min_cos = max(min_cos, dn.still_normal_min_cos);
         }
-        r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), min_cos);
+        r = reproject(prev_depth, prev_normal, prev, expected, s, min_cos);
     }
     if r.distance < 0.0 {
         reason = REASON_DISOCCLUDED;
@@ -70,7 +71,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             let b = bilinear_taps(prev);
-            let w = passing_weights(b, surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), min_cos));
+            let w = passing_weights(b, surface_taps(prev_depth, prev_normal, b, expected, s, min_cos));
             hist = half_safe(load_taps(history, b, w).rgb);
             n = resampled_length(n, prev, dn.resampled_history_frames);
         } else {
@@ -89,7 +90,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                     m = moments_add(m, half_safe(matte_input(clamp(p + vec2i(dx, dy), vec2i(0), vec2i(frame.size) - 1))));
                 }
             }
-            m = surface_moments(m, p, x, oct_decode(textureLoad(gb_normal, p, 0).xy), footprint(x), 24u, 4.0);
+            m = surface_moments(m, p, x, s.n, s.footprint, 24u, 4.0);
             let m1 = m.m1.xyz / m.count;
             let sigma = sqrt(max(m.m2.xyz / m.count - m1 * m1, vec3f(0.0)));
             let lo = m1 - dn.clamp_sigma * sigma;

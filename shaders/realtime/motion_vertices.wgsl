@@ -10,8 +10,12 @@ var<storage, read> prev_from_current: array<mat4x4f>;
 var tri_now_texels: texture_2d<f32>;
 var tri_prev_texels: texture_2d<f32>;
 
+fn motion_texel4(t: texture_2d<f32>, i: u32) -> vec4f {
+    return textureLoad(t, vec2u(i & 4095u, i >> 12u), 0);
+}
+
 fn motion_texel(t: texture_2d<f32>, i: u32) -> vec3f {
-    return textureLoad(t, vec2u(i & 4095u, i >> 12u), 0).xyz;
+    return motion_texel4(t, i).xyz;
 }
 
 fn previous_position(object: u32, p: vec3f) -> vec3f {
@@ -23,7 +27,7 @@ fn previous_position(object: u32, p: vec3f) -> vec3f {
 // vertices' w is 1 (PreparedScene::tris_prev; 0 elsewhere): a point on them moves with its
 // instance's transform.
 fn instanced_slot(slot: u32) -> bool {
-    return textureLoad(tri_prev_texels, vec2u((slot * 3u) & 4095u, (slot * 3u) >> 12u), 0).w > 0.5;
+    return motion_texel4(tri_prev_texels, slot * 3u).w > 0.5;
 }
 
 // The point at barycentrics b of triangle slot, at the previous frame.

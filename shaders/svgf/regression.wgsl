@@ -41,10 +41,10 @@ const NARROW_GAMMA: f32 = 3.0;
 // The weighted fit of L(q) over the basis phi(u, v), (u, v) = (q - p) / 32: (1), (1, u, v) or
 // (1, u, v, u^2, uv, v^2) for regression_order 0, 1, 2, summed window by window. The normal
 // matrix of the quadric basis holds only the 15 weighted moments sum w u^a v^b, a + b <= 4, so a
-// tap adds four vec4 FMAs instead of a 6x6 outer product: a matrix indexed by loop counters
-// lives in local memory on GPUs and in per-lane stack slots on lavapipe (living room, 1280x720,
-// H200: 14.9 ms per signal for the indexed form). The right-hand sides b (rgb each, one per basis
-// function), sum w^2 and sum w var give the estimate's variance.
+// tap adds four vec4 FMAs instead of a 6x6 outer product, whose matrix, indexed by loop
+// counters, would live in local memory on GPUs and in per-lane stack slots on lavapipe (its
+// cost: docs/decisions.md). The right-hand sides b (rgb each, one per basis function), sum w^2
+// and sum w var give the estimate's variance.
 struct Sums {
     // sum w (1, u, v, u^2), (uv, v^2, u^3, u^2 v), (u v^2, v^3, u^4, u^3 v), (u^2 v^2, u v^3, v^4, 0)
     m0: vec4f,

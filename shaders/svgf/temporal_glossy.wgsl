@@ -1,8 +1,8 @@
 // SVGF §4.1 for the glossy light, with Voorhuis §4: below the roughness threshold the history
 // follows the reflection motion vectors of the diamond search (glossy/motion.wgsl) without the
-// surface consistency tests (the reflected hit is tested instead, glossy/reproject.wgsl), and below the clip roughness it is clipped to the 5x5 box of the
-// 7x7-blurred current frame (glossy/prefilter.wgsl; §4.2.3); above, it is reprojected as the
-// matte light. Behind mirrors the light is divided by the reflected surface's reflectance
+// surface consistency tests (the reflected hit is tested instead, glossy/reproject.wgsl), and
+// below the clip roughness it is clipped to the 5x5 box of the 7x7-blurred current frame
+// (glossy/prefilter.wgsl; §4.2.3); above, it is reprojected as the matte light. Behind mirrors the light is divided by the reflected surface's reflectance
 // (glossy_input, §4.1) and multiplied back by the final stage.
 // Outputs: integrated (rgb, this frame's raw luminance), moments (m1, m2, h).
 
@@ -38,24 +38,33 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
         var r = Reprojection(vec2i(floor(prev)), true, -1.0);
         let lobe_class = select(HIT_NONE, tested_class(roughness, true), sv_on(SV_HIT_TEST));
+        // What the texel was tested with, for the bilinear taps: the surface's expected point
+        // and frame, or the reflected hit and its reach.
+        var expected = x;
+        var s = SurfaceFrame(vec3f(0.0), 1.0, 1.0);
+        var hit = x;
+        var reach = 1.0;
         if reflected && lobe_class != HIT_NONE {
             // The reflected hit is tested as the glossy chain tests it (glossy/reproject.wgsl);
             // untested, the history kept what the surface reflected before a reflected object
             // moved.
-            r = reproject_hit(prev, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
+            hit = representative_hit(p, x);
+            reach = hit_reach(p, x, roughness);
+            r = reproject_hit(prev, hit, reach, lobe_class);
             if r.distance > gp.d1_px {
                 r.distance = -1.0;
             }
         } else if reflected {
             r.distance = select(-1.0, 0.0, in_bounds(r.texel));
         } else {
-            let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
-            r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
+            expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
+            s = surface_frame(p, x);
+            r = reproject(prev_depth, prev_normal, prev, expected, s, dn.reprojection_min_cos);
             if r.distance > dn.d1_px || (r.distance >= 0.0 && !same_object(p, r.texel)) {
                 r.distance = -1.0;
             }
         }
-        // The previous pixel must have had a glossy lobe (its hit lobe_class is set).
+        // The previous pixel must have had a glossy lobe (its hit class is set).
         if r.distance >= 0.0 && decode_hit_class(textureLoad(prev_hit, r.texel, 0).w) != HIT_NONE {
             mom = textureLoad(moments, r.texel, 0);
             hist = half_safe(textureLoad(history, r.texel, 0).rgb);
@@ -65,10 +74,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 let b = bilinear_taps(prev);
                 var ok = lobe_taps(b);
                 if !reflected {
-                    let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
-                    ok = same_object_taps(p, b, ok & surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), dn.reprojection_min_cos));
+                    ok = same_object_taps(p, b, ok & surface_taps(prev_depth, prev_normal, b, expected, s, dn.reprojection_min_cos));
                 } else if lobe_class != HIT_NONE {
-                    ok = hit_taps(b, representative_hit(p, x), hit_reach(p, x, roughness), lobe_class);
+                    ok = hit_taps(b, hit, reach, lobe_class);
                 }
                 let w = passing_weights(b, ok);
                 hist = half_safe(load_taps(history, b, w).rgb);

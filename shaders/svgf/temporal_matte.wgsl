@@ -38,13 +38,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
         let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
         let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
-        let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
+        let s = surface_frame(p, x);
+        let r = reproject(prev_depth, prev_normal, prev, expected, s, dn.reprojection_min_cos);
         if r.distance >= 0.0 && r.distance <= dn.d1_px && same_object(p, r.texel) {
             mom = textureLoad(moments, r.texel, 0);
             hist = half_safe(textureLoad(history, r.texel, 0).rgb);
             if r.bilinear {
                 let b = bilinear_taps(prev);
-                let ok = surface_taps(prev_depth, prev_normal, b, expected, surface_frame(p, x), dn.reprojection_min_cos);
+                let ok = surface_taps(prev_depth, prev_normal, b, expected, s, dn.reprojection_min_cos);
                 let w = passing_weights(b, same_object_taps(p, b, ok));
                 hist = half_safe(load_taps(history, b, w).rgb);
                 mom = vec4f(load_taps(moments, b, w).xy, mom.zw);

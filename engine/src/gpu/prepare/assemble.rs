@@ -201,9 +201,10 @@ impl PreparedScene {
         refit: bool,
     ) -> Part {
         let kind = self.accel.kind;
-        // An instanced mesh's prototype (appended alone by `append_protos`): its previous
-        // vertices' w is 1 (realtime/motion_vertices.wgsl).
-        let instanced = if objects.iter().all(|&i| i >= self.world.len()) { 1.0 } else { 0.0 };
+        // An instanced mesh's prototype (appended alone by `append_protos`): its points move
+        // with their instances' transforms, which its previous vertices' w = 1 says
+        // (realtime/motion_vertices.wgsl).
+        let prototype = objects.iter().all(|&i| i >= self.world.len());
         let n: usize = objects.iter().map(|&i| self.flat[i].tris.len()).sum();
         let mut tris_in: Vec<Triangle> = Vec::with_capacity(n);
         let mut attrs: Vec<&[glam::Vec4; 4]> = Vec::with_capacity(n);
@@ -238,8 +239,7 @@ impl PreparedScene {
                 }));
             }
             if self.features.deforming {
-                if i >= self.world.len() {
-                    // A prototype's points move with their instances' transforms instead.
+                if prototype {
                     prev.extend(f.tris.iter().map(|_| [Vec3::ZERO; 3]));
                 } else if f.prev.is_empty() {
                     prev.extend(f.tris.iter().map(|t| [t.v0, t.v1, t.v2].map(Vec3::from)));
@@ -311,7 +311,7 @@ impl PreparedScene {
                 ]);
             }
             if let Some(p) = prev.get(i) {
-                self.tris_prev.extend(p.map(|v| v.extend(instanced)));
+                self.tris_prev.extend(p.map(|v| v.extend(if prototype { 1.0 } else { 0.0 })));
             }
             self.shading.extend_from_slice(attrs[i]);
             if self.features.normal_maps {

@@ -10,7 +10,7 @@
 //! (shaders/realtime/gbuffer.wgsl). Objects stay flattened in world space where instancing
 //! does not pay ([`Instancing::Auto`]), where their mesh emits light (the emitter table samples
 //! world-space triangles) and where they deform (skins and morph targets are posed into world
-//! space). In a scene whose meshes deform, the prototypes' previous vertices are NaN, which
+//! space). In a scene whose meshes deform, the prototypes' previous vertices carry w = 1, which
 //! tells the per-vertex motion (shaders/realtime/motion_vertices.wgsl) to move their points by
 //! their instances' transforms.
 
