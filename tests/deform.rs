@@ -281,7 +281,8 @@ fn motion_vectors_of_skinned_vertices_follow_the_pose() {
     let setup = r.camera_setup(&camera);
     let origin = r.prepared.origin.as_vec3();
     let (before, _) = posed_by_hand_at(&b, t0 as f32 / 2.0);
-    let tris = &r.prepared.tris;
+    // Posed on the GPU: its triangles, not the CPU's last flattening.
+    let tris = &r.read_triangles(&gpu).unwrap();
     let (mut worst, mut checked, mut moving) = (0f32, 0, 0);
     for y in 0..size.1 as usize {
         for x in 0..size.0 as usize {
@@ -485,4 +486,132 @@ fn deforming_surfaces_keep_their_history() {
     assert!(kept * 10 >= on_bar * 9, "only {kept} of {on_bar} bar pixels kept their history");
     assert!(fast > 200, "only {fast} pixels move over 10 px a frame");
     assert!(fast_kept * 10 >= fast * 9, "{fast_kept} of {fast} fast pixels kept their history");
+}
+
+/// Posing on the GPU (gpu/posing.rs): the bar posed by the real-time frame at each of 12 times
+/// over its animation equals the CPU's flattening at that time triangle by triangle (matched by
+/// input index; the bound is f32 rounding of a 2 m bar, the CPU skinning in world space and then
+/// rebasing, the GPU in rebased space), nothing non-finite reaches the triangles, and every
+/// triangle lies inside each box on its path from the moving tree's root as the GPU refit
+/// quantized them, before and after a CPU rebuild halfway. The CPU's nodes from the rest pose
+/// fail that last test on the bent bar, so the boxes are the GPU's own.
+#[test]
+fn gpu_posing_matches_the_cpu_and_its_refit_boxes_hold_every_triangle() {
+    use hush_engine::frame::{FrameInput, Renderer};
+    use hush_engine::gpu::PreparedScene;
+    use hush_engine::settings::FrameSettings;
+    let scene = skinned_file("skinned-bar-gpu", Damage::None, |_| {}).unwrap();
+    let camera = scene.camera.unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, (16, 16)).unwrap();
+    assert!(r.gpu_posing().is_some(), "the bar is posed on the CPU");
+    let rest_nodes = r.prepared.accel.nodes.clone();
+    let settings = FrameSettings::default();
+    let (mut worst, mut rest_misses) = (0f32, 0);
+    for k in 0..12 {
+        let t = 0.17 * k as f64;
+        // Halfway, one CPU flattening and rebuild as a degraded refit asks for: the GPU takes
+        // over again from its slots and tree.
+        if k == 6 {
+            r.prepared.rebuild_posing = true;
+        }
+        r.render(&gpu, &FrameInput { camera, time: t, shutter: None }, &settings, None).unwrap();
+        let got = r.read_triangles(&gpu).unwrap();
+        assert!(got.iter().all(|v| v.is_finite()), "t = {t}: a non-finite vertex");
+        let mut cpu = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
+        cpu.animate(&scene, t);
+        let by_input = |tris: &[glam::Vec4]| {
+            let mut m: Vec<(u32, [Vec3; 3])> = tris
+                .chunks_exact(3)
+                .map(|v| (v[1].w.to_bits(), [v[0], v[1], v[2]].map(|p| p.truncate())))
+                .collect();
+            m.sort_by_key(|e| e.0);
+            m
+        };
+        let (g, c) = (by_input(&got), by_input(&cpu.tris));
+        assert_eq!(g.len(), c.len());
+        for ((gi, gv), (ci, cv)) in g.iter().zip(&c) {
+            assert_eq!(gi, ci);
+            for (a, b) in gv.iter().zip(cv) {
+                worst = worst.max((*a - *b).length());
+            }
+        }
+        let root = r.prepared.dynamic_root().unwrap() as usize;
+        let nodes = r.read_bvh_nodes(&gpu).unwrap();
+        let misses = boxes_missing_triangles(&nodes, root, &got);
+        assert_eq!(misses, 0, "t = {t}: {misses} triangle vertices outside a box on their path");
+        rest_misses += boxes_missing_triangles(&rest_nodes, root, &got);
+    }
+    // The refit's cost, read back a frame or two late: still at one time until it arrives,
+    // against the CPU's refit of the same (rest) tree to that pose.
+    let still = 1.9;
+    for _ in 0..3 {
+        r.render(&gpu, &FrameInput { camera, time: still, shutter: None }, &settings, None)
+            .unwrap();
+    }
+    let mut cpu = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
+    cpu.animate(&scene, still);
+    let (built, refit) = cpu.moving_tree_costs().unwrap();
+    let p = r.gpu_posing().unwrap();
+    let gpu_ratio = p.last_cost_ratio.unwrap_or(f32::NAN);
+    println!(
+        "GPU-posed bar within {worst:e} m of the CPU's; {rest_misses} vertices outside the rest pose's boxes; refit cost {gpu_ratio} x its built cost on the GPU, {} on the CPU; {} rebuilds asked",
+        refit / built,
+        p.rebuilds
+    );
+    assert!((gpu_ratio / (refit / built) - 1.0).abs() < 1e-3, "GPU refit cost {gpu_ratio}");
+    assert!(worst < 2e-6, "GPU pose {worst} m from the CPU's");
+    assert!(rest_misses > 100, "the rest pose's boxes hold the posed bar: the check is vacuous");
+}
+
+/// Triangle vertices (of `tris`, three vec4 a slot) outside a box on their path from the CWBVH
+/// node `root`: each child box dequantized as the traversal reads it (p + q x 2^e).
+fn boxes_missing_triangles(nodes: &[u8], root: usize, tris: &[glam::Vec4]) -> usize {
+    let node = |i: usize| &nodes[i * 80..i * 80 + 80];
+    let word = |n: &[u8], w: usize| u32::from_le_bytes(n[w * 4..w * 4 + 4].try_into().unwrap());
+    let mut misses = 0;
+    let mut stack = vec![(root, vec![])];
+    while let Some((i, path)) = stack.pop() {
+        let n = node(i);
+        let p = Vec3::new(
+            f32::from_bits(word(n, 0)),
+            f32::from_bits(word(n, 1)),
+            f32::from_bits(word(n, 2)),
+        );
+        let e = Vec3::new(
+            f32::from_bits((n[12] as u32) << 23),
+            f32::from_bits((n[13] as u32) << 23),
+            f32::from_bits((n[14] as u32) << 23),
+        );
+        let imask = n[15];
+        let (child_base, prim_base) = (word(n, 4), word(n, 5));
+        for c in 0..8 {
+            let meta = n[24 + c];
+            if meta == 0 {
+                continue;
+            }
+            let q = |at: usize| n[at + c] as f32;
+            let lo = p + Vec3::new(q(32), q(48), q(64)) * e;
+            let hi = p + Vec3::new(q(40), q(56), q(72)) * e;
+            let mut path = path.clone();
+            path.push((lo, hi));
+            if imask & (1 << c) == 0 {
+                let first = prim_base + (meta & 31) as u32;
+                for s in first..first + (meta & 0xe0).count_ones() {
+                    for k in 0..3 {
+                        let v = tris[s as usize * 3 + k].truncate();
+                        let slack = 1e-6 * (1.0 + v.abs().max_element());
+                        misses += path.iter().any(|(lo, hi)| {
+                            v.cmplt(*lo - slack).any() || v.cmpgt(*hi + slack).any()
+                        }) as usize;
+                    }
+                }
+            } else {
+                let slot = (meta & 31) as u32 - 24;
+                let rel = (imask as u32 & !(u32::MAX << slot)).count_ones();
+                stack.push(((child_base + rel) as usize, path));
+            }
+        }
+    }
+    misses
 }

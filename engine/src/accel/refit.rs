@@ -32,6 +32,8 @@ pub struct RefitTree {
     /// Triangles it was built over (a refit needs the same number).
     pub triangles: usize,
     pub built_cost: f32,
+    /// Its cost at the last refit (the built cost until one).
+    pub last_cost: f32,
     /// Refits since it was built.
     pub refits: u32,
 }
@@ -86,6 +88,7 @@ pub fn build_refittable(
             depth: accel.depth,
             triangles: tris.len(),
             built_cost,
+            last_cost: built_cost,
             refits: 0,
         }
     });
@@ -177,6 +180,7 @@ pub fn refit(tree: &mut RefitTree, tris: &[Triangle]) -> Option<Accel> {
             (bytemuck::cast_slice(nodes).to_vec(), nodes.len(), order.clone(), cost)
         }
     };
+    tree.last_cost = cost;
     if !(cost <= REFIT_LIMIT * tree.built_cost) {
         return None;
     }

@@ -101,6 +101,9 @@ pub struct Renderer {
     timer: Option<GpuTimer>,
     /// Pass times are picked up by [`Renderer::poll_pass_spans`] frames later, not read back.
     async_timings: bool,
+    /// Deforming meshes posed on the GPU (None: the scene has none, or they are posed on the
+    /// CPU).
+    posing: Option<crate::gpu::posing::GpuPosing>,
 }
 
 impl PreparedScene {
@@ -190,7 +193,7 @@ impl Renderer {
             primaries: Primaries::default(),
             prefilter: Prefilter::default(),
         };
-        let r = Renderer {
+        let mut r = Renderer {
             scene,
             prepared,
             gpu_scene,
@@ -201,9 +204,30 @@ impl Renderer {
             history: FrameHistory::default(),
             timer: GpuTimer::new(gpu, TIMED_PASSES),
             async_timings: false,
+            posing: None,
         };
+        r.set_gpu_posing(gpu, true)?;
         log::info!("{}", r.report());
         Ok(r)
+    }
+
+    /// Pose deforming meshes and refit their tree on the GPU (`on`, the default where the scene
+    /// allows it: [`crate::gpu::PreparedScene::posing_supported`]) or on the CPU, which
+    /// flattens them and uploads their triangles every frame.
+    pub fn set_gpu_posing(&mut self, gpu: &Gpu, on: bool) -> Result<()> {
+        self.posing = if on {
+            crate::gpu::posing::GpuPosing::new(gpu, &self.prepared)
+                .context("creating the GPU posing passes")?
+        } else {
+            None
+        };
+        self.prepared.gpu_posing = self.posing.is_some();
+        Ok(())
+    }
+
+    /// The GPU posing passes, where deforming meshes are posed on the GPU.
+    pub fn gpu_posing(&self) -> Option<&crate::gpu::posing::GpuPosing> {
+        self.posing.as_ref()
     }
 
     /// What the frame enabled and allocated, for logs and the viewer.

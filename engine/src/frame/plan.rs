@@ -53,6 +53,9 @@ impl Renderer {
             puffin::profile_scope!("animate");
             moved = self.prepared.expose(&self.scene, input.time, input.shutter.map(|s| s.time));
             self.gpu_scene.update_geometry(gpu, &self.prepared, moved);
+            if let Some(p) = self.posing.as_mut() {
+                p.prepare(gpu, &self.scene, &mut self.prepared, &self.gpu_scene)?;
+            }
         }
         let _setup = crate::profile::scope("upload");
         self.update_accumulation(gpu, input, settings);

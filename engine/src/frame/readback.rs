@@ -132,4 +132,21 @@ impl Renderer {
         })?;
         crate::gpu::readback_buffer(&gpu.device, &gpu.queue, b, b.size())
     }
+
+    /// The scene's triangle vertices as the GPU holds them now (three vec4 a slot, as
+    /// [`crate::gpu::PreparedScene::tris`] lays them out): where deforming meshes are posed on
+    /// the GPU, the CPU's copy keeps their last CPU flattening.
+    pub fn read_triangles(&self, gpu: &Gpu) -> Result<Vec<glam::Vec4>> {
+        let n = self.gpu_scene.triangle_count as u64 * 48;
+        let b = crate::gpu::readback_buffer(&gpu.device, &gpu.queue, &self.gpu_scene.tris, n)?;
+        Ok(bytemuck::cast_slice(&b).to_vec())
+    }
+
+    /// The scene's BVH nodes as the GPU holds them now, in [`crate::gpu::PreparedScene::accel`]'s
+    /// layout.
+    pub fn read_bvh_nodes(&self, gpu: &Gpu) -> Result<Vec<u8>> {
+        let mut b = crate::gpu::readback_texture(gpu, &self.gpu_scene.nodes.texture)?;
+        b.truncate(self.prepared.accel.nodes.len());
+        Ok(b)
+    }
 }

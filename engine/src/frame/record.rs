@@ -62,11 +62,23 @@ impl Renderer {
         let encode = crate::profile::scope("encode");
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let moving = self.prepared.shutter_moves();
-        let Renderer { gpu_scene, targets: t, uniforms: u, stages: s, denoisers, timer, .. } = self;
+        let Renderer {
+            gpu_scene,
+            targets: t,
+            uniforms: u,
+            stages: s,
+            denoisers,
+            timer,
+            posing,
+            ..
+        } = self;
         if let Some(t) = timer.as_mut() {
             t.begin_frame();
         }
         let mut rec = Recorder::new(gpu, &mut enc, timer.as_mut());
+        if let Some(p) = posing.as_mut() {
+            p.record(&mut rec, gpu_scene);
+        }
         let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
         let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace };
         let io = t.io(&u.frame, gpu_scene);
@@ -100,6 +112,9 @@ impl Renderer {
         gpu.queue.submit([enc.finish()]);
         if let Some(timer) = self.timer.as_mut() {
             timer.submitted();
+        }
+        if let Some(p) = self.posing.as_mut() {
+            p.submitted();
         }
         let h = &mut self.history;
         h.prev_view_proj = Some(plan.view_proj);

@@ -5,6 +5,7 @@ mod context;
 pub mod history;
 mod memory;
 mod pack;
+pub mod posing;
 pub mod prepare;
 mod record;
 pub mod scene;

@@ -4,6 +4,7 @@
 
 mod assemble;
 mod instances;
+pub mod posing;
 
 pub use super::pack::GpuLight;
 use super::pack::{EnvPack, pack_light, pack_textures};
@@ -240,6 +241,20 @@ pub struct PreparedScene {
     /// Whether the last `expose` changed world-space triangles (false where only instances
     /// moved: their triangles stay as they are on the GPU).
     pub geometry_moved: bool,
+    /// The moving part is posed on the GPU (`gpu/posing.rs`) where
+    /// [`PreparedScene::posing_supported`]: `expose` then leaves its triangles and tree to the
+    /// GPU and asks for a pose in `pose_request`, except where `rebuild_posing` asks for one
+    /// CPU flattening and rebuild.
+    pub gpu_posing: bool,
+    /// The (close, open) times the GPU poses the moving part at this frame.
+    pub pose_request: Option<(f64, Option<f64>)>,
+    pub rebuild_posing: bool,
+    /// Bumped by every CPU flattening of the moving part (its slots and tree change).
+    pub posing_epoch: u64,
+    /// The GPU posed the moving part at the last `expose`.
+    posed_last: bool,
+    /// The GPU has posed the moving part since its last CPU flattening: `flat` is stale.
+    flat_stale: bool,
 }
 
 pub use crate::limits::MAX_TRIANGLES;
@@ -600,6 +615,12 @@ impl PreparedScene {
             draws: vec![],
             geometry_moved: true,
             tlas_build_time: std::time::Duration::ZERO,
+            gpu_posing: false,
+            pose_request: None,
+            rebuild_posing: false,
+            posing_epoch: 0,
+            posed_last: false,
+            flat_stale: false,
         };
         p.assemble();
         p.place_instances();
@@ -639,26 +660,40 @@ impl PreparedScene {
     ///
     /// [`animate`]: PreparedScene::animate
     pub fn expose(&mut self, scene: &Scene, time: f64, open: Option<f64>) -> bool {
-        let (moved, instances_moved) = self.move_objects(scene, time);
-        let swept = self.open_shutter(scene, open);
+        let on_gpu = self.gpu_posing && !self.rebuild_posing && self.posing_supported();
+        let (moved, instances_moved, posed) = self.move_objects(scene, time, on_gpu);
+        let swept = self.open_shutter(scene, open, on_gpu);
         // Instances move by their transforms alone: the world-space triangles are rebuilt only
         // where one of them moved or swept.
-        let world = moved || (swept && self.moving.iter().any(|&m| m));
+        let world = moved || (swept && !on_gpu && self.moving.iter().any(|&m| m));
         if world {
             self.assemble();
+            if self.split.is_some() {
+                self.posing_epoch += 1;
+            }
+            self.rebuild_posing = false;
         }
         if instances_moved || swept {
             self.place_instances();
         }
         self.geometry_moved = world;
-        moved || instances_moved || swept
+        // The GPU poses again while anything moves, and once more after it stops, so that
+        // the previous vertices catch up with the current ones.
+        let pose = on_gpu && (posed || self.posed_last || swept);
+        self.pose_request = pose.then_some((time, open.filter(|_| self.shutter_moves())));
+        self.posed_last = on_gpu && (posed || swept);
+        moved || instances_moved || swept || posed
     }
 
-    /// Move every object to `time`: whether world-space triangles moved, and whether
-    /// instances did.
-    fn move_objects(&mut self, scene: &Scene, time: f64) -> (bool, bool) {
+    /// Move every object to `time`: whether world-space triangles moved, whether instances
+    /// did, and whether the moving part moved on the GPU (`on_gpu`: it is posed there and
+    /// only its transforms are kept here).
+    fn move_objects(&mut self, scene: &Scene, time: f64, on_gpu: bool) -> (bool, bool, bool) {
         let mut moved = false;
         let mut instances_moved = false;
+        let mut posed = false;
+        // The CPU flattening after GPU poses: the last one it made is stale.
+        let stale = self.flat_stale && !on_gpu;
         let repose = self.pose_time != Some(time);
         for (i, o) in scene.objects.iter().enumerate().take(self.world.len()) {
             let now = o.transform_at(time);
@@ -674,8 +709,18 @@ impl PreparedScene {
                     self.world[i] = now;
                     instances_moved = true;
                 }
-            } else if (o.animation.is_some() && now != before) || deforms {
+            } else if on_gpu && self.moving[i] {
+                posed |= (o.animation.is_some() && now != before) || deforms;
+                self.world[i] = now;
+            } else if (o.animation.is_some() && now != before)
+                || deforms
+                || (stale && self.moving[i])
+            {
                 let mut f = flatten(scene, i, now, self.origin, &self.features, Some(time));
+                if stale {
+                    let t = self.pose_time.unwrap_or(time);
+                    self.flat[i] = flatten(scene, i, before, self.origin, &self.features, Some(t));
+                }
                 if self.features.deforming {
                     f.prev = previous_vertices(&self.flat[i], &f);
                 }
@@ -690,14 +735,18 @@ impl PreparedScene {
         }
         self.time = time;
         self.pose_time = Some(time);
-        (moved, instances_moved)
+        self.flat_stale = if on_gpu { self.flat_stale || posed } else { false };
+        (moved, instances_moved, posed)
     }
 
     /// The per-object transforms from the close to `open` (empty while nothing moves during the
     /// shutter); whether they changed.
-    fn open_shutter(&mut self, scene: &Scene, open: Option<f64>) -> bool {
+    fn open_shutter(&mut self, scene: &Scene, open: Option<f64>, on_gpu: bool) -> bool {
         let mut open_from_close = vec![];
         let mut deformed = false;
+        // Deforming meshes posed on the GPU sweep there: every frame while the shutter is
+        // open on them.
+        let mut swept_on_gpu = false;
         if let Some(t) = open.filter(|_| self.features.animated) {
             let deforms = |o: &crate::scene::Object| o.deform.as_ref().is_some_and(|d| d.moves());
             let moving = scene.objects.iter().enumerate().take(self.world.len()).any(|(i, o)| {
@@ -705,6 +754,7 @@ impl PreparedScene {
                     || (deforms(o) && t != self.time)
             });
             if moving {
+                swept_on_gpu = on_gpu;
                 open_from_close = scene
                     .objects
                     .iter()
@@ -718,7 +768,7 @@ impl PreparedScene {
                 // A deforming mesh's vertices at the open, triangle by triangle: no transform
                 // takes its close to its open.
                 for (i, o) in scene.objects.iter().enumerate().take(self.world.len()) {
-                    if deforms(o) {
+                    if deforms(o) && !on_gpu {
                         let at_open = flatten(
                             scene,
                             i,
@@ -738,7 +788,7 @@ impl PreparedScene {
                 f.open.clear();
             }
         }
-        let changed = deformed || open_from_close != self.open_from_close;
+        let changed = deformed || swept_on_gpu || open_from_close != self.open_from_close;
         self.open_from_close = open_from_close;
         changed
     }

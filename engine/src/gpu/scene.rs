@@ -147,9 +147,12 @@ impl PreparedScene {
 
     pub fn upload(&self, gpu: &Gpu) -> GpuScene {
         let mut mem = GpuMemory::default();
-        // Animated scenes rewrite their geometry every frame.
+        // Animated scenes rewrite their geometry every frame (posed on the GPU: copied from the
+        // triangles into their texels, gpu/posing.rs).
         let s = if self.features.animated {
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC
         } else {
             wgpu::BufferUsages::STORAGE
         };
@@ -331,7 +334,9 @@ impl GpuScene {
                 }
             } else {
                 mem.allocations.retain(|(l, _)| l != label);
-                let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+                let usage = wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC;
                 // Headroom, so that a BVH a few nodes larger next frame does not reallocate again.
                 let size = (data.len() as u64 * 5 / 4).next_multiple_of(16);
                 *buf = mem.buffer(&gpu.device, label, size, usage);
@@ -534,7 +539,10 @@ impl Texels {
             label,
             (TEXEL_ROW, rows),
             format,
-            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            // COPY_SRC: posing on the GPU copies the current vertices to the previous ones.
+            wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
         )
     }
 

@@ -36,7 +36,7 @@ impl Joint {
     /// World transform x inverse bind matrix at `time` (None: the rest pose), in the f32 the
     /// vertices are skinned in. One that is not finite there falls back to the rest pose's, then
     /// to the identity: NaN and Inf never reach a vertex.
-    fn matrix(&self, time: Option<f64>) -> Mat4 {
+    pub fn matrix(&self, time: Option<f64>) -> Mat4 {
         let world = match (&self.animation, time) {
             (Some(a), Some(t)) => a.world_at(t),
             _ => self.rest,

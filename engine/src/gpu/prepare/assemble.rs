@@ -96,7 +96,7 @@ fn rebase_nodes(kind: BvhKind, bytes: &mut [u8], node_base: u32, slot_base: u32)
 
 impl PreparedScene {
     /// Objects that move (rebuilt with every change) and those that never do.
-    fn moving_objects(&self) -> (Vec<usize>, Vec<usize>) {
+    pub(super) fn moving_objects(&self) -> (Vec<usize>, Vec<usize>) {
         (0..self.world.len()).partition(|&i| self.moving[i])
     }
 
