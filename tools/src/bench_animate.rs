@@ -48,6 +48,51 @@ fn median_min(v: &mut [f64]) -> [f64; 2] {
     [v[v.len() / 2], v[0]]
 }
 
+/// The scene's frames with its deforming meshes posed on the GPU: `animate_ms` the CPU's part
+/// (transforms, joint matrices, morph weights), `upload_ms` recording, submitting and waiting
+/// for the pose, refit and copies.
+fn gpu_posed(
+    scene: &hush_engine::scene::Scene,
+    kind: BvhKind,
+    a: &BenchArgs,
+) -> Result<AnimateRun> {
+    use hush_engine::gpu::Recorder;
+    use hush_engine::gpu::posing::GpuPosing;
+    let mut prepared = PreparedScene::new(scene, kind)?;
+    let gpu = Gpu::headless(&prepared.requirements(a.width as u64 * a.height as u64, 32))?;
+    let mut gs = prepared.upload(&gpu);
+    let mut posing = GpuPosing::new(&gpu, &prepared)?.context("posing on the GPU")?;
+    prepared.gpu_posing = true;
+    let (mut cpu, mut gpu_ms, mut total) = (vec![], vec![], vec![]);
+    for f in 0..=a.frames.max(1) {
+        let start = Instant::now();
+        let moved = prepared.animate(scene, f as f64 / 60.0);
+        gs.update_geometry(&gpu, &prepared, moved);
+        posing.prepare(&gpu, scene, &mut prepared, &gs)?;
+        let posed = start.elapsed();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        posing.record(&mut Recorder::new(&gpu, &mut enc, None), &gs);
+        gpu.queue.submit([enc.finish()]);
+        posing.submitted();
+        gpu.wait()?;
+        let all = start.elapsed();
+        if f > 0 {
+            cpu.push(posed.as_secs_f64() * 1e3);
+            gpu_ms.push((all - posed).as_secs_f64() * 1e3);
+            total.push(all.as_secs_f64() * 1e3);
+        }
+    }
+    Ok(AnimateRun {
+        run: format!("gpu posed ({} CPU rebuilds)", posing.rebuilds),
+        animate_ms: median_min(&mut cpu),
+        bvh_ms: [0.0; 2],
+        top_level_ms: [0.0; 2],
+        gpu_bytes: gs.memory.total_bytes() + posing.memory_bytes(),
+        upload_ms: median_min(&mut gpu_ms),
+        total_ms: median_min(&mut total),
+    })
+}
+
 pub fn run(a: &BenchArgs) -> Result<()> {
     let scene = load_scene(&a.scene, &a.load)?;
     if !scene.is_animated() {
@@ -63,6 +108,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     // The same frames with the moving part's tree refit, then rebuilt every frame; instanced
     // first where the scene instances.
     let mut configs = vec![];
+    if PreparedScene::new(&scene, kind)?.posing_supported() {
+        runs.push(gpu_posed(&scene, kind, a)?);
+    }
     if instanced {
         configs.push(("instanced".to_string(), true, Instancing::Auto));
     }

@@ -1,6 +1,8 @@
 //! Skins and morph targets: glTF 2.0 §3.7.3 ("Skins") and §3.7.2.2 ("Morph Targets"),
 //! evaluated on the CPU at a scene time into the posed mesh that the GPU scene flattens
-//! (`PreparedScene::expose` re-flattens a deforming object whenever the time changes).
+//! (`PreparedScene::expose` re-flattens a deforming object whenever the time changes, unless
+//! the real-time frame poses it on the GPU: `gpu/posing.rs` and shaders/accel/pose.wgsl follow
+//! the same order and fallbacks).
 //!
 //! Order, as the specification gives it: morph targets first, in the mesh's own space
 //! (p + sum of weight_k x delta_k), then skinning, sum over the vertex's influences of
