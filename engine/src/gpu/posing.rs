@@ -23,6 +23,14 @@ use std::sync::atomic::{AtomicU8, Ordering};
 
 pub const LABEL: &str = "pose";
 
+/// Its programs: label and module (each one module alone).
+pub const PROGRAMS: [(&str, &str); 4] = [
+    ("pose/vertices", "accel/pose.wgsl"),
+    ("pose/slots", "accel/pose_slots.wgsl"),
+    ("pose/refit", "accel/refit.wgsl"),
+    ("pose/refit cost", "accel/refit_cost.wgsl"),
+];
+
 const POSE: [&str; 8] = [
     "pose_params",
     "rest",
@@ -112,14 +120,14 @@ impl GpuPosing {
         if !prepared.posing_supported() {
             return Ok(None);
         }
-        let make = |label: &str, module: &'static str, offered: &[&str]| {
+        let make = |(label, module): (&str, &'static str), offered: &[&str]| {
             FixedCompute::new(gpu, label, "", &[module], offered)
         };
         let programs = Programs {
-            pose: make("pose/vertices", "accel/pose.wgsl", &POSE)?,
-            slots: make("pose/slots", "accel/pose_slots.wgsl", &SLOTS)?,
-            refit: make("pose/refit", "accel/refit.wgsl", &REFIT)?,
-            cost: make("pose/refit cost", "accel/refit_cost.wgsl", &COST)?,
+            pose: make(PROGRAMS[0], &POSE)?,
+            slots: make(PROGRAMS[1], &SLOTS)?,
+            refit: make(PROGRAMS[2], &REFIT)?,
+            cost: make(PROGRAMS[3], &COST)?,
         };
         Ok(Some(GpuPosing {
             programs,

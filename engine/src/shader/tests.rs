@@ -163,6 +163,9 @@ fn all_programs() -> Vec<Program> {
             }
         }
     }
+    for (label, module) in crate::gpu::posing::PROGRAMS {
+        v.push(compose(label, "", &[module]).unwrap());
+    }
     for animated in MOTIONS {
         for glossy in [false, true] {
             use crate::denoise::progressive::{Signal, modules};
