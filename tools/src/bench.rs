@@ -36,6 +36,10 @@ pub struct BenchArgs {
     /// (every object that can be, which measures the two-level traversal on any scene).
     #[arg(long, default_value = "auto")]
     pub instancing: String,
+    /// Real-time mode: pose deforming meshes and refit their BVH on the CPU instead of in the
+    /// GPU's posing pass (the frame's CPU time then carries the pose, refit and upload).
+    #[arg(long)]
+    pub cpu_posing: bool,
     /// Image size of the tracer benchmark.
     #[arg(long, default_value_t = 128)]
     pub width: u32,

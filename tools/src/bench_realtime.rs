@@ -56,6 +56,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let size = (a.width, a.height);
     let instancing = crate::bench::instancing(&a.instancing)?;
     let (gpu, mut r) = Renderer::headless_with(scene, bvh_kind(&a.bvh)?, instancing, size)?;
+    if a.cpu_posing {
+        r.set_gpu_posing(&gpu, false)?;
+    }
     if !gpu.timestamps {
         bail!(
             "adapter {} has no timestamp queries; per-pass GPU times are not available",

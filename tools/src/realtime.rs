@@ -131,6 +131,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
+    if a.cpu_posing {
+        r.set_gpu_posing(&gpu, false)?;
+    }
     if let Some(dir) = &a.out_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

@@ -57,6 +57,10 @@ pub struct RenderArgs {
     /// al. 2017 pre-filter).
     #[arg(long)]
     pub no_prefilter: bool,
+    /// Real-time mode: pose deforming meshes (skins, morph targets) and refit their BVH on the
+    /// CPU, uploading their triangles every frame, instead of in the GPU's posing pass.
+    #[arg(long)]
+    pub cpu_posing: bool,
     /// Real-time mode: hold this frame time (ms) with the governor, which picks the resolution
     /// scale and (for denoisers that fill untraced pixels) the sample fraction each frame; with
     /// --out-dir, writes frames.csv (frame, wall_ms, gpu_ms, spp, width, height). --spp pins the
