@@ -564,6 +564,68 @@ fn gpu_posing_matches_the_cpu_and_its_refit_boxes_hold_every_triangle() {
     assert!(rest_misses > 100, "the rest pose's boxes hold the posed bar: the check is vacuous");
 }
 
+/// Posing on the GPU with the shutter open (motion blur, 1.2 s to 1.3 s, real-time frames):
+/// the GPU's vertices at the open and at the close equal the CPU's exposure of the same
+/// interval (which `a_deforming_mesh_blurs_from_its_pose_at_the_shutters_open` checks by hand),
+/// and the refit boxes hold both
+/// ends of every triangle. The boxes of a frame with the shutter closed at 1.3 s miss the
+/// open ends, so the check sees the sweep.
+#[test]
+fn gpu_posing_blurs_from_the_pose_at_the_shutters_open() {
+    use hush_engine::frame::{FrameInput, Renderer, ShutterOpen};
+    use hush_engine::gpu::PreparedScene;
+    use hush_engine::settings::FrameSettings;
+    let scene = skinned_file("skinned-bar-gpu-shutter", Damage::None, |_| {}).unwrap();
+    let camera = scene.camera.unwrap();
+    let (gpu, mut r) =
+        Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, (16, 16)).unwrap();
+    assert!(r.gpu_posing().is_some());
+    let settings = FrameSettings::default();
+    let root = r.prepared.dynamic_root().unwrap() as usize;
+    let (open_t, close_t) = (1.2, 1.3);
+    r.render(&gpu, &FrameInput { camera, time: close_t, shutter: None }, &settings, None).unwrap();
+    let instant_nodes = r.read_bvh_nodes(&gpu).unwrap();
+    let shutter = Some(ShutterOpen { camera, time: open_t });
+    r.render(&gpu, &FrameInput { camera, time: close_t, shutter }, &settings, None).unwrap();
+    let close = r.read_triangles(&gpu).unwrap();
+    let open = r.read_triangles_at_open(&gpu).unwrap().unwrap();
+    let mut cpu = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
+    cpu.expose(&scene, close_t, Some(open_t));
+    let by_input = |tris: &[glam::Vec4], ends: &[glam::Vec4]| {
+        let mut m: Vec<(u32, [Vec3; 3], [Vec3; 3])> = tris
+            .chunks_exact(3)
+            .zip(ends.chunks_exact(3))
+            .map(|(v, o)| {
+                let p = |v: &[glam::Vec4]| [v[0], v[1], v[2]].map(|p| p.truncate());
+                (v[1].w.to_bits(), p(v), p(o))
+            })
+            .collect();
+        m.sort_by_key(|e| e.0);
+        m
+    };
+    let (g, c) = (by_input(&close, &open), by_input(&cpu.tris, &cpu.tris_open));
+    assert_eq!(g.len(), c.len());
+    let (mut worst, mut swept) = (0f32, 0f32);
+    for ((gi, gc, go), (ci, cc, co)) in g.iter().zip(&c) {
+        assert_eq!(gi, ci);
+        for k in 0..3 {
+            worst = worst.max((gc[k] - cc[k]).length()).max((go[k] - co[k]).length());
+            swept = swept.max((go[k] - gc[k]).length());
+        }
+    }
+    let nodes = r.read_bvh_nodes(&gpu).unwrap();
+    let misses = boxes_missing_triangles(&nodes, root, &close)
+        + boxes_missing_triangles(&nodes, root, &open);
+    let instant_misses = boxes_missing_triangles(&instant_nodes, root, &open);
+    println!(
+        "GPU-posed shutter ends within {worst:e} m of the CPU's (the bar sweeps up to {swept} m); {misses} vertices outside the swept boxes, {instant_misses} of the open ends outside the instant's"
+    );
+    assert!(worst < 2e-6, "GPU shutter ends {worst} m from the CPU's");
+    assert!(swept > 0.01, "the bar barely moves during the shutter ({swept} m)");
+    assert_eq!(misses, 0, "{misses} vertices outside the swept boxes");
+    assert!(instant_misses > 10, "the instant's boxes hold the open ends: the check is vacuous");
+}
+
 /// Triangle vertices (of `tris`, three vec4 a slot) outside a box on their path from the CWBVH
 /// node `root`: each child box dequantized as the traversal reads it (p + q x 2^e).
 fn boxes_missing_triangles(nodes: &[u8], root: usize, tris: &[glam::Vec4]) -> usize {

@@ -142,6 +142,15 @@ impl Renderer {
         Ok(bytemuck::cast_slice(&b).to_vec())
     }
 
+    /// The scene's triangle vertices at the shutter's open as the GPU holds them now (the
+    /// current ones while nothing moves during the shutter); None in a scene that never moves.
+    pub fn read_triangles_at_open(&self, gpu: &Gpu) -> Result<Option<Vec<glam::Vec4>>> {
+        let Some(t) = &self.gpu_scene.tri_open_texels else { return Ok(None) };
+        let b = crate::gpu::readback_texture(gpu, &t.texture)?;
+        let v: &[glam::Vec4] = bytemuck::cast_slice(&b);
+        Ok(Some(v[..self.gpu_scene.triangle_count as usize * 3].to_vec()))
+    }
+
     /// The scene's BVH nodes as the GPU holds them now, in [`crate::gpu::PreparedScene::accel`]'s
     /// layout.
     pub fn read_bvh_nodes(&self, gpu: &Gpu) -> Result<Vec<u8>> {
