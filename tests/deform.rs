@@ -567,9 +567,8 @@ fn gpu_posing_matches_the_cpu_and_its_refit_boxes_hold_every_triangle() {
 /// Posing on the GPU with the shutter open (motion blur, 1.2 s to 1.3 s, real-time frames):
 /// the GPU's vertices at the open and at the close equal the CPU's exposure of the same
 /// interval (which `a_deforming_mesh_blurs_from_its_pose_at_the_shutters_open` checks by hand),
-/// and the refit boxes hold both
-/// ends of every triangle. The boxes of a frame with the shutter closed at 1.3 s miss the
-/// open ends, so the check sees the sweep.
+/// and the refit boxes hold both ends of every triangle. The boxes of a frame with the shutter
+/// closed at 1.3 s miss the open ends, so the check sees the sweep.
 #[test]
 fn gpu_posing_blurs_from_the_pose_at_the_shutters_open() {
     use hush_engine::frame::{FrameInput, Renderer, ShutterOpen};
