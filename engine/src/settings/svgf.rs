@@ -56,7 +56,7 @@ described! {
         clipping: bool = false,
             ("svgf.clipping", "svgf/temporal", "", Bool);
         /// Voorhuis §4.2.1: the roughness below which reflections are reprojected with reflection
-        /// motion vectors (0.4).
+        /// motion vectors (his 0.4 is a Beckmann alpha, 0.632 here: `glossy.roughness_threshold`).
         roughness_threshold: f32 = 0.4,
             ("svgf.roughness_threshold", "svgf/temporal", "", Float(0.0, 1.0, 0.01));
         /// Voorhuis §4.2.3: the roughness below which the glossy history is clipped (0.9).
