@@ -211,6 +211,7 @@ impl PreparedScene {
         weights: &mut Vec<f32>,
     ) -> bool {
         let mut rewound = false;
+        let first = out.len();
         for p in &layout.objects {
             let o = &scene.objects[p.object];
             let now = o.transform_at(time);
@@ -235,7 +236,7 @@ impl PreparedScene {
                 weights.extend((0..n).map(|k| w.get(k).copied().unwrap_or(0.0)));
             }
         }
-        debug_assert_eq!(out.len(), layout.matrices as usize * MATRIX_TEXELS);
+        debug_assert_eq!(out.len() - first, layout.matrices as usize * MATRIX_TEXELS);
         rewound
     }
 }
