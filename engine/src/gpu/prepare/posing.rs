@@ -12,12 +12,11 @@ use obvhs::cwbvh::node::CwBvhNode;
 /// Texels of one joint matrix: its four columns, then its normal matrix's three.
 pub const MATRIX_TEXELS: usize = 7;
 
-/// One posed object: which scene object, where its matrices and weights start.
+/// One posed object, whose matrices and weights follow the previous object's.
 #[derive(Clone, Debug)]
 pub struct PosedObject {
+    /// Its index among the scene's objects.
     pub object: usize,
-    pub matrix_base: u32,
-    pub weight_base: u32,
     /// Whether its joints place it (a skin); otherwise its transform is its one matrix.
     skinned: bool,
     /// Its transform mirrored when flattened (the slots keep that winding).
@@ -145,8 +144,6 @@ impl PreparedScene {
             }
             l.objects.push(PosedObject {
                 object: i,
-                matrix_base: l.matrices,
-                weight_base: l.weights,
                 skinned,
                 flip,
             });
