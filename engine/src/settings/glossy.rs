@@ -47,8 +47,8 @@ described! {
             ("glossy.reflection_mv", "glossy/motion", "", Choice(reflection_mvs));
         /// Below this roughness reflections are reprojected with reflection motion vectors; above it
         /// with the surface's. Voorhuis §4.2.1's 0.4 is a Beckmann alpha: 0.632 here (GGX alpha =
-        /// roughness²), which on the level's strafe past its r 0.4 steel sphere lowers the moving
-        /// frames' FLIP 1% and changes nothing after a stop (docs/decisions.md).
+        /// roughness²), which moved the level's and the living room's FLIP by at most 1% on a
+        /// strafe (docs/decisions.md; presets/voorhuis.toml carries it).
         roughness_threshold: f32 = 0.4,
             ("glossy.roughness_threshold", "glossy/motion", "roughness", Float(0.0, 1.0, 0.005));
         /// At or below this roughness a surface is a mirror: its chain matches exact reflected hit

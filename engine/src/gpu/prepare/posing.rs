@@ -142,11 +142,7 @@ impl PreparedScene {
                     l.deltas.extend([at(&t.positions), at(&t.normals), at(&t.tangents)]);
                 }
             }
-            l.objects.push(PosedObject {
-                object: i,
-                skinned,
-                flip,
-            });
+            l.objects.push(PosedObject { object: i, skinned, flip });
             l.matrices += joints as u32;
             l.weights += targets as u32;
             vertex_base.push(first);
