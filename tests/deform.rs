@@ -625,6 +625,69 @@ fn gpu_posing_blurs_from_the_pose_at_the_shutters_open() {
     assert!(instant_misses > 10, "the instant's boxes hold the open ends: the check is vacuous");
 }
 
+/// Joint matrices that overflow on the GPU: a skinned quad whose joint scales towards 1e37
+/// (finite in f32) with corners 100 m out, so that posed corners pass f32's range (about
+/// 3.4e38). The GPU's pose keeps such a vertex at rest (shaders/accel/pose.wgsl) where the CPU
+/// drops its triangle: nothing non-finite reaches the triangles, and the frame stays finite.
+/// Without the shader's guard the first frame's triangles hold Inf and the test fails.
+#[test]
+fn overflowing_joints_never_reach_the_gpu_trace() {
+    use glam::{DMat4, DQuat, DVec3, Vec4};
+    use hush_engine::frame::{FrameInput, Renderer};
+    use hush_engine::scene::{
+        Animation, Camera, Deform, Environment, Joint, MAX_INFLUENCES, Material, Object, Track,
+        quad,
+    };
+    use hush_engine::settings::FrameSettings;
+    let mut a = Animation::rigid(DMat4::IDENTITY, DVec3::ZERO, DQuat::IDENTITY, DVec3::ONE);
+    a.scale_track = Some(Track {
+        times: vec![0.0, 1.0],
+        values: vec![DVec3::ONE, DVec3::splat(1e37)],
+        step: false,
+        tangents: vec![],
+    });
+    let joint = Joint { rest: DMat4::IDENTITY, animation: Some(a), inverse_bind: DMat4::IDENTITY };
+    let mut skinned = quad(Vec3::ZERO, Vec3::new(100.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -100.0), 0);
+    let mut w = [0.0; MAX_INFLUENCES];
+    w[0] = 1.0;
+    skinned.joints = vec![[0; MAX_INFLUENCES]; skinned.positions.len()];
+    skinned.weights = vec![w; skinned.positions.len()];
+    let floor =
+        quad(Vec3::new(0.0, -1.0, 0.0), Vec3::new(5.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -5.0), 0);
+    let mut o = Object::new("hostile", 1, DMat4::IDENTITY);
+    o.deform = Some(std::sync::Arc::new(Deform { skin: vec![joint], morph: None }));
+    let scene = Scene {
+        name: "overflowing joint".into(),
+        meshes: vec![floor, skinned],
+        objects: vec![Object::new("floor", 0, DMat4::IDENTITY), o],
+        materials: vec![Material { base_color: Vec4::splat(0.7), ..Default::default() }],
+        camera: Some(Camera::look_at(DVec3::new(0.0, 3.0, 6.0), DVec3::ZERO, 60.0)),
+        environment: Environment::Constant(Vec3::splat(0.5)),
+        max_depth: 3,
+        ..Default::default()
+    };
+    let camera = scene.camera.unwrap();
+    let times = [0.5, 0.9];
+    // The specification's pose leaves f32's range at both times: the guard is what holds.
+    let deform = scene.objects[1].deform.clone().unwrap();
+    for t in times {
+        let posed = deform.pose_vertices(&scene.meshes[1], Some(t));
+        let out = posed.positions.iter().filter(|p| !p.is_finite()).count();
+        assert!(out > 0, "t = {t}: the pose stays within f32's range");
+    }
+    let (gpu, mut r) =
+        Renderer::headless(scene, hush_engine::accel::BvhKind::DEFAULT, (16, 16)).unwrap();
+    assert!(r.gpu_posing().is_some(), "the quad is posed on the CPU");
+    let settings = FrameSettings::default();
+    for t in times {
+        r.render(&gpu, &FrameInput { camera, time: t, shutter: None }, &settings, None).unwrap();
+        let tris = r.read_triangles(&gpu).unwrap();
+        assert!(tris.iter().all(|v| v.is_finite()), "t = {t}: a non-finite vertex");
+        let img = r.read_hdr(&gpu).unwrap();
+        assert!(img.data.iter().all(|p| p.is_finite()), "t = {t}: a non-finite pixel");
+    }
+}
+
 /// Triangle vertices (of `tris`, three vec4 a slot) outside a box on their path from the CWBVH
 /// node `root`: each child box dequantized as the traversal reads it (p + q x 2^e).
 fn boxes_missing_triangles(nodes: &[u8], root: usize, tris: &[glam::Vec4]) -> usize {
