@@ -18,6 +18,7 @@ use crate::scene::Scene;
 use crate::shader::FixedCompute;
 use anyhow::Result;
 use glam::Vec4;
+use std::mem::take;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
 
@@ -105,6 +106,8 @@ struct State {
     groups: Option<Groups>,
     /// Shutter ends of the pose to record this frame (0: none).
     ends: u32,
+    /// The ends the passes' parameters were last written for (0: not yet).
+    written_ends: u32,
 }
 
 struct Groups {
@@ -185,14 +188,18 @@ impl GpuPosing {
         if !self.weights.is_empty() {
             gpu.queue.write_buffer(&s.morph_weights, 0, bytemuck::cast_slice(&self.weights));
         }
-        let l = &s.layout;
-        let params = [s.vertex_count, ends, l.matrices, l.weights];
-        gpu.queue.write_buffer(&s.pose_params, 0, bytemuck::cast_slice(&params));
-        let params = [s.slot_count, l.slot_base, ends, s.vertex_count];
-        gpu.queue.write_buffer(&s.slot_params, 0, bytemuck::cast_slice(&params));
-        for (buf, &(first, count)) in s.level_params.iter().zip(&l.levels) {
-            let p = [first, count, l.node_base, l.slot_base, (ends > 1) as u32, 0, 0, 0];
-            gpu.queue.write_buffer(buf, 0, bytemuck::cast_slice(&p));
+        // The passes' parameters change only with the shutter's ends.
+        if ends != s.written_ends {
+            let l = &s.layout;
+            let params = [s.vertex_count, ends, l.matrices, l.weights];
+            gpu.queue.write_buffer(&s.pose_params, 0, bytemuck::cast_slice(&params));
+            let params = [s.slot_count, l.slot_base, ends, s.vertex_count];
+            gpu.queue.write_buffer(&s.slot_params, 0, bytemuck::cast_slice(&params));
+            for (buf, &(first, count)) in s.level_params.iter().zip(&l.levels) {
+                let p = [first, count, l.node_base, l.slot_base, (ends > 1) as u32, 0, 0, 0];
+                gpu.queue.write_buffer(buf, 0, bytemuck::cast_slice(&p));
+            }
+            s.written_ends = ends;
         }
         s.ends = ends;
         Ok(())
@@ -284,7 +291,9 @@ impl GpuPosing {
 }
 
 impl State {
-    fn new(gpu: &Gpu, layout: PosingLayout, prepared: &PreparedScene) -> State {
+    /// Upload `layout`; its per-vertex, per-slot and per-node arrays go to the GPU and are not
+    /// kept.
+    fn new(gpu: &Gpu, mut layout: PosingLayout, prepared: &PreparedScene) -> State {
         use wgpu::BufferUsages as U;
         let mut mem = GpuMemory::default();
         let d = &gpu.device;
@@ -301,14 +310,15 @@ impl State {
         let mut init = |label: &str, b: &[u8], usage: U| mem.buffer_init(d, label, b, usage);
         let slots_from = layout.slot_base as usize;
         let shading = bytes(&prepared.shading[slots_from * 4..]);
-        let rest = init("pose/rest", &bytes(&layout.rest), storage);
-        let influences = init("pose/influences", &bytes(&layout.influences), storage);
-        let objects = init("pose/objects", &bytes(&layout.object_records), storage);
-        let deltas = init("pose/deltas", &bytes(&layout.deltas), storage);
-        let slot_verts = init("pose/slot vertices", &bytes(&layout.slot_verts), storage);
+        let rest = init("pose/rest", &bytes(&take(&mut layout.rest)), storage);
+        let influences = init("pose/influences", &bytes(&take(&mut layout.influences)), storage);
+        let objects = init("pose/objects", &bytes(&take(&mut layout.object_records)), storage);
+        let deltas = init("pose/deltas", &bytes(&take(&mut layout.deltas)), storage);
+        let slot_verts = init("pose/slot vertices", &bytes(&take(&mut layout.slot_verts)), storage);
         let posed_shading = init("pose/shading", &shading, storage | U::COPY_SRC);
-        let level_nodes = init("pose/level nodes", &bytes(&layout.level_nodes), storage);
-        let refit_nodes = init("pose/nodes", &bytes(&layout.nodes), storage | U::COPY_SRC);
+        let level_nodes = init("pose/level nodes", &bytes(&take(&mut layout.level_nodes)), storage);
+        let refit_nodes =
+            init("pose/nodes", &bytes(&take(&mut layout.nodes)), storage | U::COPY_SRC);
         let node_params = [node_count, 0, 0, 0];
         let cost_params = init("pose/cost params", bytemuck::cast_slice(&node_params), U::UNIFORM);
         let mut buffer =
@@ -365,6 +375,7 @@ impl State {
             read_state: Arc::new(AtomicU8::new(IDLE)),
             groups: None,
             ends: 0,
+            written_ends: 0,
         }
     }
 

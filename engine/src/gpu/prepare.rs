@@ -248,6 +248,8 @@ pub struct PreparedScene {
     pub gpu_posing: bool,
     /// The (close, open) times the GPU poses the moving part at this frame.
     pub pose_request: Option<(f64, Option<f64>)>,
+    /// The next `expose` flattens and rebuilds the moving part on the CPU (its refit on the
+    /// GPU has degraded, or an object's transform started mirroring); cleared by that rebuild.
     pub rebuild_posing: bool,
     /// Bumped by every CPU flattening of the moving part (its slots and tree change).
     pub posing_epoch: u64,

@@ -63,7 +63,9 @@ impl PreparedScene {
             && self.accel.kind == crate::accel::BvhKind::Cwbvh
             && self.tris.len() / 3 > sp.slots
             && self.moving_tree.is_some()
-            && self.emitters.iter().all(|e| (e[1] as usize) < sp.slots)
+            // Emitters are listed by slot, the static part's first: the last is the moving
+            // part's if any is.
+            && self.emitters.last().is_none_or(|e| (e[1] as usize) < sp.slots)
     }
 
     /// The moving tree's surface-area cost when built and at its last CPU refit, relative to
