@@ -29,7 +29,7 @@ without a window use the command-line tool, e.g.\n    hush-cli render level --mo
 
 const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-path PATH.json]
             [--preset SETTINGS.toml] [--shaders DIR] [--profiler] [--puffin-http [PORT]]
-            [--limit NAME=VALUE[,NAME=VALUE...]] [--animation INDEX]
+            [--limit NAME=VALUE[,NAME=VALUE...]] [--animation INDEX] [--paused]
   no scene: the default level. Keys: WASD move, Q/E down/up, right-drag look, wheel speed,
   shift run, middle-click focus the depth of field there, F12 screenshot (PNG + EXR),
   R record a camera path, P play it, F9 profiler,
@@ -39,7 +39,9 @@ const USAGE: &str = "usage: hush [SCENE.gltf|SCENE.glb|level|default] [--camera-
   --profiler opens the profiler window at start; --puffin-http serves profiles to puffin_viewer on 127.0.0.1 (default port 8585).
   --limit sets a budget on what a scene file may make Hush read and build (file-bytes, json-bytes,
   image-pixels, decoded-bytes, nodes, hierarchy-depth, triangles); a file over one is refused.
-  --animation plays only that one of the file's animations (by index); without it all play.";
+  --animation plays only that one of the file's animations (by index); without it all play.
+  --paused starts with the animation paused at its first frame (a still view to compare with a
+  reference rendered at --time 0).";
 
 struct Args {
     scene: String,
@@ -48,6 +50,8 @@ struct Args {
     shaders: Option<PathBuf>,
     puffin_http: Option<u16>,
     profiler: bool,
+    /// Start with the animation paused at time 0.
+    paused: bool,
     /// Budgets for every scene loaded, dropped files included.
     load: hush_engine::scene::LoadOptions,
 }
@@ -110,6 +114,7 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
         governor: ui::GovernorPanel {
             on: true,
             target_ms: default_target_ms(gpu),
+            still_ratio: hush_engine::governor::STILL_RATIO,
             pin_scale: false,
             pin_fraction: false,
             choice: String::new(),
@@ -191,6 +196,7 @@ impl Viewer {
         let fly = fly::FlyCamera::from_camera(&renderer.scene.camera_or_default(), extent);
         let mut panel = panel_for(&gpu, &renderer, format!("loaded in {load_ms:.0} ms"));
         panel.animation = self.args.load.animation;
+        panel.paused = self.args.paused;
         if let Some(p) = &self.args.preset {
             panel.settings = hush_engine::settings::FrameSettings::load_preset(p)?;
             panel.preset_path = p.display().to_string();
@@ -280,6 +286,7 @@ fn parse_args() -> Result<Option<Args>> {
     let mut scene = None;
     let (mut camera_path, mut preset, mut shaders, mut puffin_http, mut profiler) =
         (None, None, None, None, false);
+    let mut paused = false;
     let mut load = hush_engine::scene::LoadOptions::default();
     let mut it = std::env::args().skip(1).peekable();
     while let Some(a) = it.next() {
@@ -293,6 +300,7 @@ fn parse_args() -> Result<Option<Args>> {
                 shaders = Some(PathBuf::from(it.next().context("--shaders needs a folder")?))
             }
             "--profiler" => profiler = true,
+            "--paused" => paused = true,
             "--limit" => load.limits.apply(&it.next().context("--limit needs NAME=VALUE")?)?,
             "--animation" => {
                 let i = it.next().context("--animation needs an index")?;
@@ -321,6 +329,7 @@ fn parse_args() -> Result<Option<Args>> {
         shaders,
         puffin_http,
         profiler,
+        paused,
         load,
     }))
 }

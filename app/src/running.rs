@@ -241,6 +241,7 @@ impl Running {
             return;
         }
         g.target_ms = p.governor.target_ms;
+        g.still_ratio = p.governor.still_ratio;
         g.pinned_scale = p.governor.pin_scale.then_some(p.resolution_scale);
         g.pinned_fraction = p.governor.pin_fraction.then_some(p.settings.sample_fraction);
         g.fractions_allowed =
@@ -255,8 +256,9 @@ impl Running {
         p.resolution_scale = choice.scale;
         p.settings.sample_fraction = choice.fraction;
         let predicted = g.predict(choice).map_or(String::new(), |t| format!(", about {t:.0} ms"));
+        let still = if g.still() { " (still view: most samples per second)" } else { "" };
         p.governor.choice =
-            format!("scale {:.3}, {} spp{predicted}", choice.scale, choice.fraction);
+            format!("scale {:.3}, {} spp{predicted}{still}", choice.scale, choice.fraction);
         self.governed = Some((choice, input.camera));
     }
 

@@ -84,6 +84,8 @@ impl LensPanel {
 pub struct GovernorPanel {
     pub on: bool,
     pub target_ms: f64,
+    /// A still view's frames may take this multiple of the target (Governor::still_ratio).
+    pub still_ratio: f64,
     pub pin_scale: bool,
     pub pin_fraction: bool,
     pub choice: String,
@@ -114,6 +116,12 @@ impl Panel {
         });
         if g.on {
             ui.label(&g.choice).on_hover_text("The resolution scale and sample fraction the governor chose to hold the target; pin either to keep it and let the governor turn the other.");
+            ui.add(
+                egui::Slider::new(&mut g.still_ratio, 1.0..=10.0)
+                    .text("still view: x target")
+                    .suffix("x"),
+            )
+            .on_hover_text("While the camera stands still the samples accumulate, so the governor picks the sample fraction that traces the most samples per second, letting a frame take up to this multiple of the target: a larger one converges sooner, and a move waits longer for the frame in flight. 1 holds the target.");
             ui.horizontal(|ui| {
                 ui.checkbox(&mut g.pin_scale, "pin scale");
                 ui.checkbox(&mut g.pin_fraction, "pin sample fraction");

@@ -1,22 +1,32 @@
 //! A frame-time governor: picks the resolution scale and the sample fraction (Dundr et al. §5)
 //! that hold a target frame time on whatever device runs, from the frames it has seen.
 //!
-//! Model: a frame at scale s (of each side) and fraction f costs s^2 (rest + trace f) ms, where
-//! `trace` is the trace pass's time per full-resolution frame at f = 1 and `rest` everything
-//! else (raster, denoiser, display, the CPU's share of the wall time). Both are re-estimated
-//! after every frame from its wall time and its trace time, and smoothed by the median of the
-//! last [`WINDOW`] frames: one slow frame (a hitch, a shader compile) moves nothing, a load
-//! that lasts (another program) is followed within three frames, and two frames in a row over
-//! [`OVER`] x the target (a cut to a heavier view) within two.
+//! Model: a frame at scale s (of each side) and fraction f costs
+//! `fixed + s^2 (rest + trace f)` ms, where `trace` is the trace pass's time per
+//! full-resolution frame at f = 1, `rest` the other passes that run at the frame's resolution
+//! (raster, denoiser), and `fixed` what no choice changes: the wall time outside those passes
+//! (the CPU's recording, the viewer's UI and present) and the display pass, which draws at the
+//! window's size. All three are re-estimated after every frame from its wall time and its
+//! passes' GPU times, and smoothed by the median of the last [`WINDOW`] frames: one slow frame
+//! (a hitch, a shader compile) moves nothing, a load that lasts (another program) is followed
+//! within three frames, and two frames in a row over [`OVER`] x the frame's limit (a cut to a
+//! heavier view) within two.
 //!
-//! Choice: among the scales [`SCALES`] down to `min_scale` and the fractions the denoiser
-//! accepts, the largest scale whose best fraction fits, then the largest fraction that fits
-//! (a still camera can afford a smaller fraction, since its samples accumulate; a moving one
-//! wants fresh samples, so a fraction below 1/4 while the camera moves, or below 1/8 while it
-//! stands, costs a step of scale first). Changing the scale reallocates the frame and restarts
-//! every history, so the scale rises only after [`RISE_FRAMES`] frames in a row predicted under
-//! 80% of the target at the larger scale, and on a still view only within [`YOUNG_FRAMES`]
-//! frames of its last change; it falls at once when the prediction is over the target.
+//! Moving: among the scales [`SCALES`] down to `min_scale` and the fractions the denoiser
+//! accepts, the largest scale whose best fraction fits the target, then the largest fraction
+//! that fits (a fraction below 1/4 costs a step of scale first: a moving camera wants fresh
+//! samples). Where the fixed cost alone leaves less than [`SCALABLE_FLOOR`] of the target, the
+//! scaled part still gets that much: the frame rate is then the fixed cost's whatever the
+//! choice, and a smaller image would buy almost none of it back.
+//!
+//! Still (the camera has not moved for [`STILL_AFTER`] frames): the samples accumulate, so what
+//! a person sees improving is the samples traced per pixel per second, f / frame time, not the
+//! frame rate. At its scale the governor takes the fraction that traces the most of them within
+//! `still_ratio` x the target, the slowest frame a still view's UI may take. Changing the scale
+//! reallocates the frame and restarts every history, so the scale rises only after
+//! [`RISE_FRAMES`] frames in a row predicted under 80% of the target at the larger scale, and on
+//! a still view only within [`YOUNG_FRAMES`] frames of its last change; it falls at once when
+//! the prediction is over the frame's limit.
 
 use crate::settings::SampleFraction;
 
@@ -28,8 +38,19 @@ pub const WINDOW: usize = 5;
 pub const RISE_FRAMES: u32 = 8;
 /// Frames at one scale during which a still view may still rise from it (its history is young).
 pub const YOUNG_FRAMES: u32 = 16;
-/// A frame over this multiple of the target counts towards a lasting overload.
+/// A frame over this multiple of its limit counts towards a lasting overload.
 pub const OVER: f64 = 1.5;
+/// Frames without camera motion after which a view counts as still: a person stepping with
+/// the keys pauses for a frame or two between steps, and a still view's frames are slower.
+pub const STILL_AFTER: u32 = 3;
+/// The share of the target the scaled part of a frame keeps when the fixed cost takes more.
+pub const SCALABLE_FLOOR: f64 = 0.25;
+/// A still view's frames may take this multiple of the target (`Governor::still_ratio`): at the
+/// viewer's 100 ms on a software rasterizer, a person who starts to move waits at most half a
+/// second for the frame in flight. There the default level's still view (scale 0.25, 300 ms a
+/// frame of UI and present) goes from 1/128 to 1/8 spp, and its FLIP after 90 s from 0.186 to
+/// 0.076 (docs/decisions.md, "Fixed cost and still views").
+pub const STILL_RATIO: f64 = 5.0;
 
 /// What the governor runs the next frame at.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,16 +61,26 @@ pub struct Choice {
 
 impl FrameCost {
     /// A frame rendered at `choice` that took `wall_ms`, from its passes' GPU times (label, ms;
-    /// the trace's is the part a sample fraction scales).
+    /// the trace's is the part a sample fraction scales, the display's draws at the window's
+    /// size and is not scaled).
     pub fn from_passes(
         wall_ms: f64,
         passes: &[(&'static str, f64)],
         choice: Choice,
         moving: bool,
     ) -> FrameCost {
+        let sum = |keep: &dyn Fn(&str) -> bool| -> f64 {
+            passes.iter().filter(|(l, _)| keep(l)).map(|(_, ms)| ms).sum()
+        };
         let trace = crate::passes::trace::LABEL;
-        let trace_ms = passes.iter().filter(|(l, _)| *l == trace).map(|(_, ms)| ms).sum();
-        FrameCost { wall_ms, trace_ms, choice, moving }
+        let display = crate::passes::composite::DISPLAY;
+        FrameCost {
+            wall_ms,
+            trace_ms: sum(&|l| l == trace),
+            scaled_ms: sum(&|l| l != display),
+            choice,
+            moving,
+        }
     }
 }
 
@@ -58,19 +89,34 @@ impl FrameCost {
 pub struct FrameCost {
     /// Wall time from the start of the frame to the start of the next (ms).
     pub wall_ms: f64,
-    /// The trace pass's GPU time (ms); 0 when the device has no timestamps (then all of the
-    /// frame is taken to scale with the pixels alone).
+    /// The trace pass's GPU time (ms); 0 when the device has no timestamps.
     pub trace_ms: f64,
+    /// GPU time of the passes that run at the frame's resolution, the trace's included (ms);
+    /// 0 when the device has no timestamps: then all of the frame is taken to scale with the
+    /// pixels.
+    pub scaled_ms: f64,
     /// The choice the frame ran at.
     pub choice: Choice,
     /// The camera moved since the last frame.
     pub moving: bool,
 }
 
+/// One frame's costs in the model's terms (ms): fixed, rest and trace per full-resolution
+/// frame at f = 1.
+#[derive(Clone, Copy, Debug)]
+struct Costs {
+    fixed: f64,
+    rest: f64,
+    trace: f64,
+}
+
 #[derive(Clone, Debug)]
 pub struct Governor {
-    /// The frame time to hold (ms).
+    /// The frame time to hold while the camera moves (ms).
     pub target_ms: f64,
+    /// A still view's frames may take up to this multiple of `target_ms`, to trace more samples
+    /// per second. 1 holds the target in a still view too.
+    pub still_ratio: f64,
     /// The smallest scale it may pick.
     pub min_scale: f32,
     /// Knobs the user pinned: the governor keeps them and turns the other.
@@ -78,29 +124,36 @@ pub struct Governor {
     pub pinned_fraction: Option<SampleFraction>,
     /// Whether fractions below 1 are allowed (the denoiser fills untraced pixels).
     pub fractions_allowed: bool,
-    /// Recent (rest, trace) costs per full-resolution frame at f = 1 (ms).
-    costs: Vec<(f64, f64)>,
+    /// Recent costs, oldest first.
+    costs: Vec<Costs>,
     current: Choice,
+    /// The frame time the current choice was picked to stay within (ms).
+    limit_ms: f64,
     room_frames: u32,
-    /// Consecutive frames over OVER x the target.
+    /// Consecutive frames over OVER x their limit.
     over_frames: u32,
     /// Frames rendered at the current scale.
     scale_frames: u32,
+    /// Consecutive frames without camera motion.
+    still_frames: u32,
 }
 
 impl Governor {
     pub fn new(target_ms: f64) -> Governor {
         Governor {
             target_ms,
+            still_ratio: STILL_RATIO,
             min_scale: 0.25,
             pinned_scale: None,
             pinned_fraction: None,
             fractions_allowed: false,
             costs: vec![],
             current: Choice { scale: 1.0, fraction: SampleFraction::ONE },
+            limit_ms: target_ms,
             room_frames: 0,
             over_frames: 0,
             scale_frames: 0,
+            still_frames: 0,
         }
     }
 
@@ -112,28 +165,46 @@ impl Governor {
         }
     }
 
+    /// Whether the last frames were of a still view (the governor then trades frame rate for
+    /// samples per second).
+    pub fn still(&self) -> bool {
+        self.still_frames >= STILL_AFTER
+    }
+
     /// Predicted frame time (ms) of `c` from the current estimate; None before any frame.
     pub fn predict(&self, c: Choice) -> Option<f64> {
-        let (rest, trace) = self.estimate()?;
+        let e = self.estimate()?;
         let area = (c.scale * c.scale) as f64;
-        Some(area * (rest + trace / c.fraction.period() as f64))
+        Some(e.fixed + area * (e.rest + e.trace / c.fraction.period() as f64))
+    }
+
+    /// Samples traced per pixel per second at `c` (its fraction over its predicted frame time).
+    pub fn samples_per_second(&self, c: Choice) -> Option<f64> {
+        let t = self.predict(c)?;
+        Some(1e3 / (c.fraction.period() as f64 * t.max(1e-6)))
     }
 
     /// Take a finished frame into account and choose the next.
     pub fn record(&mut self, f: FrameCost) -> Choice {
         let area = (f.choice.scale * f.choice.scale).max(1e-6) as f64;
         let period = f.choice.fraction.period() as f64;
-        let (wall, trace) =
-            (finite_or(f.wall_ms, 0.0).max(0.0), finite_or(f.trace_ms, 0.0).max(0.0));
-        let trace = trace.min(wall);
-        self.costs.push(((wall - trace) / area, trace * period / area));
+        let wall = finite_or(f.wall_ms, 0.0).max(0.0);
+        let scaled = finite_or(f.scaled_ms, 0.0).clamp(0.0, wall);
+        let trace = finite_or(f.trace_ms, 0.0).clamp(0.0, scaled);
+        // Without timestamps nothing is known of the fixed part: all of it scales.
+        let fixed = if scaled > 0.0 { wall - scaled } else { 0.0 };
+        self.costs.push(Costs {
+            fixed,
+            rest: (wall - fixed - trace) / area,
+            trace: trace * period / area,
+        });
         if self.costs.len() > WINDOW {
             self.costs.remove(0);
         }
-        // Two frames in a row far over the target (a cut to a heavier view): the older costs
+        // Two frames in a row far over their limit (a cut to a heavier view): the older costs
         // no longer apply, so the estimate follows these two at once rather than after the
         // window's median turns (three frames). One such frame alone stays a hitch.
-        self.over_frames = if wall > OVER * self.target_ms { self.over_frames + 1 } else { 0 };
+        self.over_frames = if wall > OVER * self.limit_ms { self.over_frames + 1 } else { 0 };
         if self.over_frames >= 2 {
             let n = self.costs.len();
             self.costs.drain(..n.saturating_sub(2));
@@ -143,23 +214,33 @@ impl Governor {
         } else {
             1
         };
+        self.still_frames = if f.moving { 0 } else { self.still_frames.saturating_add(1) };
         self.current = self.pick(f.moving);
         self.choice()
     }
 
     /// Median of the window, per component.
-    fn estimate(&self) -> Option<(f64, f64)> {
+    fn estimate(&self) -> Option<Costs> {
         if self.costs.is_empty() {
             return None;
         }
-        let median = |mut v: Vec<f64>| {
+        let median = |get: fn(&Costs) -> f64| {
+            let mut v: Vec<f64> = self.costs.iter().map(get).collect();
             v.sort_by(f64::total_cmp);
             v[v.len() / 2]
         };
-        Some((
-            median(self.costs.iter().map(|c| c.0).collect()),
-            median(self.costs.iter().map(|c| c.1).collect()),
-        ))
+        Some(Costs {
+            fixed: median(|c| c.fixed),
+            rest: median(|c| c.rest),
+            trace: median(|c| c.trace),
+        })
+    }
+
+    /// The frame time a moving camera's choice must fit: the target, or the fixed cost plus
+    /// SCALABLE_FLOOR of the target where the fixed cost leaves less.
+    fn budget(&self) -> f64 {
+        let fixed = self.estimate().map_or(0.0, |e| e.fixed);
+        self.target_ms.max(fixed + SCALABLE_FLOOR * self.target_ms)
     }
 
     fn fractions(&self) -> Vec<SampleFraction> {
@@ -184,8 +265,23 @@ impl Governor {
         })
     }
 
+    /// A still view at `scale`: the fraction that traces the most samples per second within
+    /// the still view's limit (None when none fits it).
+    fn still_fraction(&self, scale: f32, limit: f64) -> Option<SampleFraction> {
+        let rate = |f: &SampleFraction| {
+            let c = Choice { scale, fraction: *f };
+            self.predict(c).filter(|&t| t <= limit).and(self.samples_per_second(c))
+        };
+        self.fractions()
+            .into_iter()
+            .filter_map(|f| Some((f, rate(&f)?)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(f, _)| f)
+    }
+
     fn pick(&mut self, moving: bool) -> Choice {
         let scales = self.scales();
+        let budget = self.budget();
         let fits = |g: &Governor, budget: f64| -> Option<Choice> {
             for floor in [floor(moving), u32::MAX] {
                 for &s in &scales {
@@ -200,8 +296,20 @@ impl Governor {
             scale: *scales.last().unwrap_or(&1.0),
             fraction: *self.fractions().last().unwrap_or(&SampleFraction::ONE),
         };
-        let want = fits(self, self.target_ms).unwrap_or(smallest);
-        let cur = self.current;
+        let want = fits(self, budget).unwrap_or(smallest);
+        let cur = self.choice();
+        self.limit_ms = budget;
+        if !moving && self.still() && !(want.scale > cur.scale && self.scale_frames < YOUNG_FRAMES)
+        {
+            // A still view keeps its scale (a fall or a rise would restart every history) while
+            // its fraction traces the most samples per second within the still limit.
+            let limit = budget.max(self.still_ratio * self.target_ms);
+            if let Some(fraction) = self.still_fraction(cur.scale, limit) {
+                self.room_frames = 0;
+                self.limit_ms = limit;
+                return Choice { scale: cur.scale, fraction };
+            }
+        }
         if want.scale > cur.scale {
             // Rise after RISE_FRAMES frames that would fit the larger scale with room, and on a
             // still view only while the history at this scale is young: a rise restarts every
@@ -210,12 +318,12 @@ impl Governor {
             // stop, back to 0.156 only after 3.6 s), while a scale chosen from the first
             // frames (a shader compile) must not stay until the camera moves.
             let roomy = (moving || self.scale_frames < YOUNG_FRAMES)
-                && fits(self, 0.8 * self.target_ms).is_some_and(|c| c.scale > cur.scale);
+                && fits(self, 0.8 * budget).is_some_and(|c| c.scale > cur.scale);
             self.room_frames = if roomy { self.room_frames + 1 } else { 0 };
             if self.room_frames < RISE_FRAMES {
                 let fraction = self
-                    .best_fraction(cur.scale, self.target_ms, floor(moving))
-                    .or_else(|| self.best_fraction(cur.scale, self.target_ms, u32::MAX))
+                    .best_fraction(cur.scale, budget, floor(moving))
+                    .or_else(|| self.best_fraction(cur.scale, budget, u32::MAX))
                     .unwrap_or(smallest.fraction);
                 return Choice { scale: cur.scale, fraction };
             }
@@ -242,11 +350,11 @@ fn finite_or(v: f64, or: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// A device whose frame costs `area * (rest + trace f)` ms.
-    fn run(
+    /// A device whose frame costs `fixed + area * (rest + trace f)` ms, of which its passes'
+    /// timestamps show the scaled part.
+    fn run_fixed(
         g: &mut Governor,
-        rest: f64,
-        trace: f64,
+        (fixed, rest, trace): (f64, f64, f64),
         frames: usize,
         moving: bool,
     ) -> Vec<(Choice, f64)> {
@@ -255,17 +363,37 @@ mod tests {
             let c = g.choice();
             let area = (c.scale * c.scale) as f64;
             let t = area * trace / c.fraction.period() as f64;
-            let wall = area * rest + t;
+            let scaled = area * rest + t;
+            let wall = fixed + scaled;
             out.push((c, wall));
-            g.record(FrameCost { wall_ms: wall, trace_ms: t, choice: c, moving });
+            g.record(FrameCost {
+                wall_ms: wall,
+                trace_ms: t,
+                scaled_ms: scaled,
+                choice: c,
+                moving,
+            });
         }
         out
+    }
+
+    /// A device whose whole frame scales: `area * (rest + trace f)` ms.
+    fn run(
+        g: &mut Governor,
+        rest: f64,
+        trace: f64,
+        frames: usize,
+        moving: bool,
+    ) -> Vec<(Choice, f64)> {
+        run_fixed(g, (0.0, rest, trace), frames, moving)
     }
 
     #[test]
     fn holds_the_target_and_keeps_an_eighth_when_still() {
         let mut g = Governor::new(100.0);
         g.fractions_allowed = true;
+        // A still view held to the target, as a moving one is.
+        g.still_ratio = 1.0;
         // Full frame: 60 ms of raster/denoise/display, 1200 ms of trace.
         let frames = run(&mut g, 60.0, 1200.0, 20, false);
         let (c, t) = frames.last().copied().unwrap();
@@ -278,6 +406,7 @@ mod tests {
         // Where nothing fits at 1/8 even at the smallest scale, smaller fractions are taken.
         let mut g = Governor::new(100.0);
         g.fractions_allowed = true;
+        g.still_ratio = 1.0;
         let (c, t) = run(&mut g, 60.0, 40000.0, 20, false).last().copied().unwrap();
         assert!(t <= 100.0 && c.fraction.period() > 8, "{c:?} {t}");
     }
@@ -303,11 +432,18 @@ mod tests {
     fn one_slow_frame_changes_nothing_a_lasting_load_is_followed() {
         let mut g = Governor::new(100.0);
         g.fractions_allowed = true;
+        g.still_ratio = 1.0;
         run(&mut g, 60.0, 1200.0, 20, false);
         let settled = g.choice();
         // One frame ten times slower (a hitch).
         let c = g.choice();
-        g.record(FrameCost { wall_ms: 1000.0, trace_ms: 400.0, choice: c, moving: false });
+        g.record(FrameCost {
+            wall_ms: 1000.0,
+            trace_ms: 400.0,
+            scaled_ms: 1000.0,
+            choice: c,
+            moving: false,
+        });
         assert_eq!(g.choice(), settled, "one hitch moved the choice");
         let after = run(&mut g, 60.0, 1200.0, 5, false);
         assert!(after.iter().all(|(c, _)| *c == settled));
@@ -334,7 +470,13 @@ mod tests {
         let mut g = Governor::new(100.0);
         // The first frame compiles its shaders: 20 times its later cost.
         let c = g.choice();
-        g.record(FrameCost { wall_ms: 1200.0, trace_ms: 0.0, choice: c, moving: false });
+        g.record(FrameCost {
+            wall_ms: 1200.0,
+            trace_ms: 0.0,
+            scaled_ms: 0.0,
+            choice: c,
+            moving: false,
+        });
         assert!(g.choice().scale < 0.5);
         let frames = run(&mut g, 60.0, 0.0, 20, false);
         assert_eq!(frames.last().unwrap().0.scale, 1.0, "{frames:?}");
@@ -370,9 +512,90 @@ mod tests {
         assert_eq!(g.choice().fraction, SampleFraction::ONE);
         for wall in [f64::NAN, f64::INFINITY, -5.0, 0.0] {
             let c = g.choice();
-            let next =
-                g.record(FrameCost { wall_ms: wall, trace_ms: f64::NAN, choice: c, moving: false });
+            let next = g.record(FrameCost {
+                wall_ms: wall,
+                trace_ms: f64::NAN,
+                scaled_ms: f64::NAN,
+                choice: c,
+                moving: false,
+            });
             assert!(next.scale > 0.0 && next.scale <= 1.0);
         }
+    }
+
+    /// The viewer on a software rasterizer, the default level in a 1600x900 window, as measured
+    /// at scale 0.25 and 1/8 spp: a 472 ms frame, 170 ms of it in the passes that run at the
+    /// frame's resolution, the trace's 76.5 ms among them. Per full-resolution frame at 1 spp:
+    /// 300 ms fixed, 1500 ms of raster and denoiser, 9800 ms of trace; target 100 ms.
+    const VIEWER: (f64, f64, f64) = (300.0, 1500.0, 9800.0);
+
+    #[test]
+    fn the_fixed_cost_is_not_scaled() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        run_fixed(&mut g, (40.0, 400.0, 2000.0), 10, true);
+        // Its prediction holds for a choice it has not run: 40 + 0.25 (400 + 500) = 265 ms,
+        // where a model that scales everything would say 0.25 x 4 x the frame it ran.
+        let c = Choice { scale: 0.5, fraction: SampleFraction::one_in(4).unwrap() };
+        let t = g.predict(c).unwrap();
+        assert!((t - 265.0).abs() < 1e-6, "{t}");
+        // The fixed part alone over the target: the frame still gets SCALABLE_FLOOR of it for
+        // the image, not the smallest choice at 1/128 spp.
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        let frames = run_fixed(&mut g, (110.0, 100.0, 200.0), 20, true);
+        let (c, t) = frames.last().copied().unwrap();
+        assert!(t <= 110.0 + SCALABLE_FLOOR * 100.0 + 1e-9, "{c:?} {t}");
+        // 0.5: 110 + 0.25 (100 + 200 f) > 135 at every f; 0.375: 110 + 0.14 (100 + 50) = 131
+        // fits at 1/4.
+        assert_eq!((c.scale, c.fraction.period()), (0.375, 4), "{c:?} {t}");
+    }
+
+    #[test]
+    fn a_still_view_traces_the_most_samples_per_second_within_its_limit() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        // Moving, nothing fits the target: the smallest scale and fraction, about 400 ms.
+        let moving = run_fixed(&mut g, VIEWER, 12, true);
+        let (c, t) = moving.last().copied().unwrap();
+        assert_eq!((c.scale, c.fraction.period()), (0.25, 128), "{c:?} {t}");
+        let rate_moving = g.samples_per_second(c).unwrap();
+        // Stopped: after STILL_AFTER frames the scale stays and the fraction rises to the one
+        // that traces the most samples per second within still_ratio x the target (500 ms):
+        // 300 + 93.75 + 612.5 f <= 500 allows 1/8 (470.3 ms, the viewer measured 472 ms).
+        let still = run_fixed(&mut g, VIEWER, 12, false);
+        assert!(still[..STILL_AFTER as usize].iter().all(|(s, _)| *s == c), "{still:?}");
+        let (s, t) = still.last().copied().unwrap();
+        assert_eq!((s.scale, s.fraction.period()), (0.25, 8), "{s:?} {t}");
+        assert!(t <= STILL_RATIO * 100.0, "{t}");
+        let rate_still = g.samples_per_second(s).unwrap();
+        // 13.6x: 1 / (8 x 470.3 ms) against 1 / (128 x 398.5 ms).
+        assert!(rate_still > 13.0 * rate_moving, "{rate_still} against {rate_moving}");
+        // No other fraction within the limit traces more.
+        for f in SampleFraction::all() {
+            let o = Choice { scale: 0.25, fraction: f };
+            if g.predict(o).unwrap() <= STILL_RATIO * 100.0 {
+                assert!(g.samples_per_second(o).unwrap() <= rate_still, "{o:?}");
+            }
+        }
+        // A move: the next frame is back under the moving budget.
+        let moved = run_fixed(&mut g, VIEWER, 2, true);
+        assert!(moved[1].1 <= 300.0 + SCALABLE_FLOOR * 100.0 + 93.75, "{moved:?}");
+        // still_ratio 1 keeps the target's choice in a still view.
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        g.still_ratio = 1.0;
+        run_fixed(&mut g, VIEWER, 12, true);
+        let held = run_fixed(&mut g, VIEWER, 12, false);
+        assert_eq!(held.last().unwrap().0, c, "{held:?}");
+    }
+
+    #[test]
+    fn a_pinned_fraction_stays_in_a_still_view() {
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        g.pinned_fraction = Some(SampleFraction::one_in(16).unwrap());
+        run_fixed(&mut g, VIEWER, 20, false);
+        assert_eq!(g.choice().fraction.period(), 16);
     }
 }
