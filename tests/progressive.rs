@@ -141,9 +141,15 @@ fn missing_samples_leave_history_and_moments_unchanged() {
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     // a = 0.4 takes over from 1 / age at the third sample, within the test's 10 frames.
     let a = 0.4;
+    // Without the feedback level, whose output replaces young histories (tested below).
     let s = progressive(
         4,
-        ProgressiveSettings { still_samples: 0.0, alpha: a as f32, ..Default::default() },
+        ProgressiveSettings {
+            still_samples: 0.0,
+            alpha: a as f32,
+            feedback_samples: 0.0,
+            ..Default::default()
+        },
     );
     let n = (SIZE.0 * SIZE.1) as usize;
     // Per pixel: light, m1, m2, age.
@@ -208,6 +214,70 @@ fn missing_samples_leave_history_and_moments_unchanged() {
     assert!(agree * 100 >= checked * 99, "only {agree} of {checked} pixel-frames agree");
 }
 
+/// Dundr's feedback at 1/4 spp with a still camera, two levels: after every frame, a pixel
+/// traced this frame whose light, this sample included, holds fewer than `feedback_samples`
+/// samples (2: its first sample only) has the first
+/// level's output (the step-1 level, `pong`) as its history, within half-float rounding; every
+/// other pixel's history is the temporal stage's accumulation (the variance stage's 32-bit
+/// light, bit for bit); untraced pixels keep their history bit for bit. The fed pixels must
+/// differ from their unfiltered light, so a feedback that wrote nothing fails.
+#[test]
+fn the_first_level_feeds_the_history_of_young_traced_pixels() {
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    let input = FrameInput { camera: view(), time: 0.0, shutter: None };
+    let feedback = 2.0;
+    let p = ProgressiveSettings { levels: 2, feedback_samples: feedback, ..Default::default() };
+    let s = progressive(4, p);
+    let n = (SIZE.0 * SIZE.1) as usize;
+    let mut before: Vec<u8> = vec![];
+    let (mut fed, mut fed_ok, mut fed_moved, mut kept, mut kept_ok) = (0u32, 0u32, 0u32, 0, 0);
+    for frame in 0..12u32 {
+        r.render(&gpu, &input, &s, None).unwrap();
+        let written = 1 - (frame % 2) as usize;
+        let history =
+            r.read_texture(&gpu, &format!("progressive/matte history {written}")).unwrap().0;
+        let moments =
+            r.read_texture(&gpu, &format!("progressive/matte moments {written}")).unwrap().0;
+        let light = r.read_texture(&gpu, "progressive/matte variance").unwrap().0;
+        let first = r.read_texture(&gpu, "progressive/matte pong").unwrap().0;
+        let ids = r.read_texture(&gpu, "gbuffer/ids").unwrap().0;
+        let (tw, th) = tile(4);
+        for i in 0..n {
+            let (x, y) = (i as u32 % SIZE.0, i as u32 / SIZE.0);
+            if u32::from_le_bytes(ids[i * 8 + 4..i * 8 + 8].try_into().unwrap()) == u32::MAX {
+                continue; // sky
+            }
+            let traced = scheduled_pixel(x / tw, y / th, frame, 4) == (x, y);
+            let h = [0, 1, 2].map(|k| f32_at(&history, i * 4 + k));
+            let l = [0, 1, 2].map(|k| f32_at(&light, i * 4 + k));
+            // Samples accumulated, this frame's included.
+            let age = f32_at(&moments, i * 4 + 2);
+            if traced && age < feedback {
+                fed += 1;
+                let f = [0, 1, 2].map(|k| half(&first[i * 8 + k * 2..]));
+                fed_ok += (0..3).all(|k| (h[k] - f[k]).abs() <= 1e-3 * f[k].abs().max(1e-2)) as u32;
+                fed_moved +=
+                    (0..3).any(|k| (h[k] - l[k]).abs() > 1e-3 * l[k].abs().max(1e-2)) as u32;
+            } else if traced || frame == 0 {
+                kept += 1;
+                kept_ok += (h == l) as u32;
+            } else {
+                kept += 1;
+                kept_ok += (history[i * 16..i * 16 + 12] == before[i * 16..i * 16 + 12]) as u32;
+            }
+        }
+        before = history;
+    }
+    println!(
+        "fed {fed} ({fed_ok} hold the first level, {fed_moved} moved), kept {kept} ({kept_ok})"
+    );
+    assert!(fed > 500 && kept > 5000, "fed {fed}, kept {kept}");
+    assert_eq!(fed_ok, fed, "fed histories that are not the first level's output");
+    assert_eq!(kept_ok, kept, "histories the feedback should have left alone");
+    assert!(fed_moved * 2 > fed, "the first level changed only {fed_moved} of {fed} histories");
+}
+
 /// One a-trous level (step 1) against a CPU implementation of §4.4 from the same inputs (the
 /// variance stage's light and variance, the features, the G-buffer normals): the 3x3 kernel,
 /// w_N, w_D with its steep-gradient switch, w_L with its epsilon falling past
@@ -232,7 +302,8 @@ fn an_atrous_level_matches_a_cpu_implementation() {
     let normals = r.read_texture(&gpu, "gbuffer/normal").unwrap().0;
     let (w, h) = (SIZE.0 as i32, SIZE.1 as i32);
     let at = |x: i32, y: i32| (y * w + x) as usize;
-    let texel = |i: usize| [0, 1, 2, 3].map(|k| half(&src[i * 8 + k * 2..]) as f64);
+    // The variance stage's output is 32-bit (the feedback level writes it back to the history).
+    let texel = |i: usize| [0, 1, 2, 3].map(|k| f32_at(&src, i * 4 + k) as f64);
     let feat = |i: usize| (f32_at(&features, i * 4) as f64, f32_at(&features, i * 4 + 1) as f64);
     let normal = |i: usize| oct_normal(&normals[i * 4..]).as_dvec3();
     let (mut surface, mut agree) = (0u32, 0u32);

@@ -4,11 +4,15 @@
 // a luminance weight) and so has a sample for the next level. The variance follows the weights
 // (Dundr's var_{L+1} = w^2 var_L, normalised as the variance of the weighted mean:
 // sum w^2 var / (sum w)^2). The direct light's levels only fill missing pixels.
+// The feedback level (step 1, run first; ProgressiveSettings::feedback_samples) also writes its
+// output as the history of each pixel traced this frame whose history is young (§4.4, §5).
 
 var src: texture_2d<f32>;
 // The light's moments (m1, m2, age): the age sets the luminance weight's epsilon.
 var moments: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
+// The temporal stage's output, next frame's history (the feedback level only).
+var out_history: texture_storage_2d<rgba32float, write>;
 var<uniform> level: Level;
 
 @compute @workgroup_size(8, 8)
@@ -27,7 +31,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let nc = oct_decode(f.zw);
     let lc = select(luma(c.rgb), -1.0, missing);
-    let epsilon = luminance_epsilon(textureLoad(moments, p, 0).z);
+    let age = textureLoad(moments, p, 0).z;
+    let epsilon = luminance_epsilon(age);
     var sum = vec3f(0.0);
     var sum_var = 0.0;
     var wsum = 0.0;
@@ -61,5 +66,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         textureStore(dst, p, c);
         return;
     }
-    textureStore(dst, p, vec4f(half_safe(sum / wsum), clamp(sum_var / (wsum * wsum), 0.0, 60000.0)));
+    let filtered = half_safe(sum / wsum);
+    textureStore(dst, p, vec4f(filtered, clamp(sum_var / (wsum * wsum), 0.0, 60000.0)));
+    // A pixel whose history took a sample this frame (§5: once per sample, not every frame)
+    // takes the filtered light; the others get back the light they had (the variance stage's
+    // output is 32-bit for that). The store is under a uniform branch: lavapipe (Mesa 22.3)
+    // crashes on a storage store under a branch that diverges on a float comparison.
+    if level.feedback != 0u {
+        let feed = !missing && traced(p) && age < pp.feedback_samples;
+        textureStore(out_history, p, vec4f(select(c.rgb, filtered, feed), 1.0));
+    }
 }

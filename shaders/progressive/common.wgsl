@@ -15,15 +15,22 @@ struct ProgressiveParams {
     temporal: u32,
     // In a still view epsilon_l falls as this / age past this many samples (0: never).
     epsilon_full_samples: f32,
+    // The feedback level's output becomes the history of a pixel traced this frame whose
+    // history holds fewer samples than this (0: never).
+    feedback_samples: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
-// Per dispatch: the a-trous step (large scale first) and whether the signal only fills pixels
-// without samples (the direct light: it carries the material, which a filter would blur).
+// Per dispatch: the a-trous step (large scale first), whether the signal only fills pixels
+// without samples (the direct light: it carries the material, which a filter would blur), and
+// whether this level's output feeds the history (Dundr §4.4: the step-1 level, run first).
 struct Level {
     step: i32,
     fill_only: u32,
+    feedback: u32,
     _pad0: u32,
-    _pad1: u32,
 }
 
 var<uniform> pp: ProgressiveParams;

@@ -6,7 +6,9 @@
 
 var integrated: texture_2d<f32>;
 var moments: texture_2d<f32>;
-var dst: texture_storage_2d<rgba16float, write>;
+// 32-bit: the feedback level writes this light back into the 32-bit history where it does not
+// feed it.
+var dst: texture_storage_2d<rgba32float, write>;
 
 const UNKNOWN_VARIANCE: f32 = 60000.0;
 

@@ -9,8 +9,10 @@
 //! (depth and its gradient) -> per signal `temporal` (r = max(a, 1/age); an untraced pixel keeps
 //! light, age and moments) -> `variance` (3x3-blurred m2 - m1^2) -> `atrous` (3x3 kernel, large
 //! scale first, missing samples skipped and filled; the direct light only fills). The history is
-//! the accumulated light before the spatial filter (see docs/decisions.md). The composite and
-//! TAA (Dundr's §4.5 blend with a clamped history) follow as for every denoiser.
+//! the accumulated light before the spatial filter, except for a pixel's first samples
+//! (`feedback_samples`): then the step-1 level runs first and its output becomes the history of
+//! the pixels traced this frame (Dundr §4.4-5; docs/decisions.md). The composite and TAA
+//! (Dundr's §4.5 blend with a clamped history) follow as for every denoiser.
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
@@ -39,6 +41,8 @@ pub struct ProgressiveParams {
     pub epsilon_l: f32,
     pub temporal: u32,
     pub epsilon_full_samples: f32,
+    pub feedback_samples: f32,
+    pub _pad: [u32; 3],
 }
 
 impl ProgressiveParams {
@@ -52,6 +56,8 @@ impl ProgressiveParams {
             epsilon_l: s.epsilon_l.max(1e-6),
             temporal: s.temporal as u32,
             epsilon_full_samples: s.epsilon_full_samples.clamp(0.0, STILL_FRAMES_MAX),
+            feedback_samples: s.feedback_samples.clamp(0.0, STILL_FRAMES_MAX),
+            _pad: [0; 3],
         }
     }
 }
@@ -62,8 +68,15 @@ impl ProgressiveParams {
 struct Level {
     step: i32,
     fill_only: u32,
-    _pad: [u32; 2],
+    feedback: u32,
+    _pad: u32,
 }
+
+/// Which of the level uniforms a level binds: a filtering signal's, the direct light's (fill
+/// only) or the feedback level's (step 1, its output also the history).
+const FILTER: usize = 0;
+const FILL_ONLY: usize = 1;
+const FEEDBACK: usize = 2;
 
 /// The reprojection's normal test, as SVGF's.
 const NORMAL_TEST_DEGREES: f32 = 25.0;
@@ -121,7 +134,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let d = &gpu.device;
     let pp = memory.buffer(d, "progressive/params", size_of::<ProgressiveParams>() as u64, u);
     let dn = memory.buffer(d, "progressive/denoise params", size_of::<DenoiseParams>() as u64, u);
-    let levels = [false, true].map(|fill_only| {
+    let levels = [FILTER, FILL_ONLY, FEEDBACK].map(|kind| {
         std::array::from_fn(|i| {
             let b =
                 memory.buffer(d, &format!("progressive/level {i}"), size_of::<Level>() as u64, u);
@@ -130,8 +143,9 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
                 0,
                 bytemuck::bytes_of(&Level {
                     step: 1 << i,
-                    fill_only: fill_only as u32,
-                    _pad: [0; 2],
+                    fill_only: (kind == FILL_ONLY) as u32,
+                    feedback: (kind == FEEDBACK) as u32,
+                    _pad: 0,
                 }),
             );
             b
@@ -145,7 +159,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
 }
 
-/// One signal's textures: 88 bytes per pixel.
+/// One signal's textures: 96 bytes per pixel.
 pub struct SignalTargets {
     /// The accumulated light (rgb) by parity: this frame's is next frame's history.
     pub history: PingPong<Tex>,
@@ -168,7 +182,8 @@ impl SignalTargets {
             // 32-bit: a half float stalls a 1 / age mean after about a thousand samples.
             history: PingPong::new(|i| t(&format!("history {i}"), RGBA32F)),
             moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
-            variance: t("variance", RGBA16F),
+            // 32-bit: with feedback, the first level writes it back into the history.
+            variance: t("variance", RGBA32F),
             ping: t("ping", RGBA16F),
             pong: t("pong", RGBA16F),
         }
@@ -189,7 +204,18 @@ struct Targets {
     /// a-trous tap where three were.
     features: Tex,
     signals: Vec<(Signal, SignalTargets)>,
+    /// This frame's level count and feedback ([`pack_levels`]).
     levels: usize,
+}
+
+/// The a-trous level count and whether the first level feeds the history, as one number (the
+/// bind groups' key holds one).
+fn pack_levels(levels: usize, feedback: bool) -> usize {
+    levels | (feedback as usize) << 8
+}
+
+fn unpack_levels(packed: usize) -> (usize, bool) {
+    (packed & 0xff, packed >> 8 != 0)
 }
 
 struct SignalStages {
@@ -211,8 +237,9 @@ enum Pass {
 struct Resources {
     pp: wgpu::Buffer,
     dn: wgpu::Buffer,
-    /// Per level, for filtering signals and for the direct light (fill only).
-    levels: [[wgpu::Buffer; LEVELS]; 2],
+    /// Per level: for filtering signals, for the direct light (fill only) and for the feedback
+    /// level.
+    levels: [[wgpu::Buffer; LEVELS]; 3],
     targets: Option<Targets>,
 }
 
@@ -275,12 +302,22 @@ impl Resources {
             Pass::Atrous(i) => {
                 let src = if i == 0 { &s.variance } else { s.output(i) };
                 let dst = s.output(i + 1);
-                // Large scale first: level i of n steps 2^(n - 1 - i) pixels.
-                let step = levels.saturating_sub(1 + i).min(LEVELS - 1);
+                let (levels, feedback) = unpack_levels(levels);
+                let feedback = feedback && signal != Signal::Direct;
+                // Large scale first: level i of n steps 2^(n - 1 - i) pixels. With feedback
+                // the step-1 level runs first (its output is the history, Dundr §4.4), then
+                // the others from the largest: level i >= 1 steps 2^(n - i).
+                let (kind, step) = match (signal, feedback, i) {
+                    (Signal::Direct, ..) => (FILL_ONLY, levels.saturating_sub(1 + i)),
+                    (_, true, 0) => (FEEDBACK, 0),
+                    (_, true, _) => (FILTER, levels.saturating_sub(i)),
+                    (_, false, _) => (FILTER, levels.saturating_sub(1 + i)),
+                };
                 b.texture("src", &src.1)
                     .texture("moments", &s.moments.output(parity).1)
                     .texture("dst", &dst.1)
-                    .buffer("level", &self.levels[(signal == Signal::Direct) as usize][step])
+                    .texture("out_history", &s.history.output(parity).1)
+                    .buffer("level", &self.levels[kind][step.min(LEVELS - 1)])
             }
         }
     }
@@ -358,27 +395,30 @@ impl Denoiser for Progressive {
         let gpu = rec.gpu;
         let Progressive { scene, res, stages, .. } = self;
         let missing = "the progressive filter records before its textures exist";
+        let p = &cx.settings.progressive;
+        let feedback = p.feedback_samples > 0.0 && p.levels > 0;
         res.targets.as_mut().context(missing)?.levels =
-            cx.settings.progressive.levels.min(PROGRESSIVE_MAX_LEVELS) as usize;
+            pack_levels(p.levels.min(PROGRESSIVE_MAX_LEVELS) as usize, feedback);
         let t = res.targets.as_ref().context(missing)?;
         res.write_params(gpu, io, cx);
-        let (key, parity, size, levels) = (cx.key, cx.parity, io.size, t.levels);
+        let (key, parity, size, packed) = (cx.key, cx.parity, io.size, t.levels);
+        let levels = unpack_levels(packed).0;
         let stages = crate::passes::chain::made(stages, || {
             res.make_stages(gpu, io, t, scene).context("creating the progressive filter's stages")
         })?;
         let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
         stages.features.record(rec, key, parity, size, |p| {
-            res.bindings(io, t, matte, Pass::Features, p, levels)
+            res.bindings(io, t, matte, Pass::Features, p, packed)
         })?;
         for (st, (signal, s)) in stages.signals.iter_mut().zip(&t.signals) {
             let sig = (*signal, s);
-            let b = |pass, p| res.bindings(io, t, sig, pass, p, levels);
+            let b = |pass, p| res.bindings(io, t, sig, pass, p, packed);
             st.temporal.record(rec, key, parity, size, |p| b(Pass::Temporal, p))?;
             st.variance.record(rec, key, parity, size, |p| b(Pass::Variance, p))?;
             for i in 0..levels {
-                // Bind groups are keyed by (parity, level); the level count is in the key, since
-                // it picks each level's step.
-                let k = crate::gpu::BindKey { levels, ..key };
+                // Bind groups are keyed by (parity, level); the level count and the feedback are
+                // in the key, since they pick each level's step and uniform.
+                let k = crate::gpu::BindKey { levels: packed, ..key };
                 st.atrous.record_variant(
                     rec,
                     k,
@@ -393,9 +433,9 @@ impl Denoiser for Progressive {
 
     fn output(&self, _parity: Parity) -> Denoised<'_> {
         let Some(t) = &self.res.targets else { return Denoised::default() };
-        let out = |s: Signal| {
-            t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(t.levels).1)
-        };
+        let levels = unpack_levels(t.levels).0;
+        let out =
+            |s: Signal| t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(levels).1);
         Denoised {
             matte: out(Signal::Matte),
             glossy: out(Signal::Glossy),
