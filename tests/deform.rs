@@ -535,11 +535,20 @@ fn gpu_posing_matches_the_cpu_and_its_refit_boxes_hold_every_triangle() {
         rest_misses += boxes_missing_triangles(&rest_nodes, root, &got);
     }
     // The refit's cost, read back a frame or two late: still at one time until it arrives,
-    // against the CPU's refit of the same (rest) tree to that pose.
+    // against the CPU's refit of the same (rest) tree to that pose. Each frame waits for the
+    // GPU, so a readback copied in one frame is mapped by the next and taken by the one after;
+    // the value has arrived once three frames in a row have read back the same cost (a loaded
+    // machine can leave the mapping pending a frame longer without the wait).
     let still = 1.9;
-    for _ in 0..3 {
+    let mut seen = vec![];
+    for _ in 0..24 {
         r.render(&gpu, &FrameInput { camera, time: still, shutter: None }, &settings, None)
             .unwrap();
+        gpu.wait().unwrap();
+        seen.push(r.gpu_posing().unwrap().last_cost_ratio);
+        if seen.len() >= 6 && seen[seen.len() - 3..].windows(2).all(|w| w[0] == w[1]) {
+            break;
+        }
     }
     let mut cpu = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
     cpu.animate(&scene, still);
