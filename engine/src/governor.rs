@@ -47,9 +47,9 @@ pub const STILL_AFTER: u32 = 3;
 pub const SCALABLE_FLOOR: f64 = 0.25;
 /// A still view's frames may take this multiple of the target (`Governor::still_ratio`): at the
 /// viewer's 100 ms on a software rasterizer, a person who starts to move waits at most half a
-/// second for the frame in flight. There the default level's still view (scale 0.25, 300 ms a
-/// frame of UI and present) goes from 1/128 to 1/8 spp, and its FLIP after 90 s from 0.186 to
-/// 0.076 (docs/decisions.md, "Fixed cost and still views").
+/// second for the frame in flight. There the default level's still view (scale 0.25, about
+/// 300 ms a frame of UI, present and display) goes from 1/128 to 1/8 spp, and its FLIP after
+/// 90 s from 0.186 to 0.076 (docs/decisions.md, "Fixed cost and still views").
 pub const STILL_RATIO: f64 = 5.0;
 
 /// What the governor runs the next frame at.
