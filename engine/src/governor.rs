@@ -268,13 +268,13 @@ impl Governor {
     /// A still view at `scale`: the fraction that traces the most samples per second within
     /// the still view's limit (None when none fits it).
     fn still_fraction(&self, scale: f32, limit: f64) -> Option<SampleFraction> {
-        let rate = |f: &SampleFraction| {
-            let c = Choice { scale, fraction: *f };
-            self.predict(c).filter(|&t| t <= limit).and(self.samples_per_second(c))
+        let rate = |f: SampleFraction| {
+            let t = self.predict(Choice { scale, fraction: f }).filter(|&t| t <= limit)?;
+            Some((f, 1.0 / (f.period() as f64 * t.max(1e-6))))
         };
         self.fractions()
             .into_iter()
-            .filter_map(|f| Some((f, rate(&f)?)))
+            .filter_map(rate)
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(f, _)| f)
     }

@@ -72,12 +72,6 @@ struct Level {
     _pad: u32,
 }
 
-/// Which of the level uniforms a level binds: a filtering signal's, the direct light's (fill
-/// only) or the feedback level's (step 1, its output also the history).
-const FILTER: usize = 0;
-const FILL_ONLY: usize = 1;
-const FEEDBACK: usize = 2;
-
 /// The reprojection's normal test, as SVGF's.
 const NORMAL_TEST_DEGREES: f32 = 25.0;
 
@@ -134,28 +128,21 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let d = &gpu.device;
     let pp = memory.buffer(d, "progressive/params", size_of::<ProgressiveParams>() as u64, u);
     let dn = memory.buffer(d, "progressive/denoise params", size_of::<DenoiseParams>() as u64, u);
-    let levels = [FILTER, FILL_ONLY, FEEDBACK].map(|kind| {
-        std::array::from_fn(|i| {
-            let b =
-                memory.buffer(d, &format!("progressive/level {i}"), size_of::<Level>() as u64, u);
-            gpu.queue.write_buffer(
-                &b,
-                0,
-                bytemuck::bytes_of(&Level {
-                    step: 1 << i,
-                    fill_only: (kind == FILL_ONLY) as u32,
-                    feedback: (kind == FEEDBACK) as u32,
-                    _pad: 0,
-                }),
-            );
-            b
-        })
+    let mut level = |label: &str, step: i32, fill_only: bool, feedback: bool| {
+        let b = memory.buffer(d, label, size_of::<Level>() as u64, u);
+        let l = Level { step, fill_only: fill_only as u32, feedback: feedback as u32, _pad: 0 };
+        gpu.queue.write_buffer(&b, 0, bytemuck::bytes_of(&l));
+        b
+    };
+    let levels = [false, true].map(|fill_only| {
+        std::array::from_fn(|i| level(&format!("progressive/level {i}"), 1 << i, fill_only, false))
     });
+    let feedback = level("progressive/feedback level", 1, false, true);
     let mut signals = vec![Signal::Matte, Signal::Direct];
     if scene.glossy {
         signals.insert(1, Signal::Glossy);
     }
-    let res = Resources { pp, dn, levels, targets: None };
+    let res = Resources { pp, dn, levels, feedback, targets: None };
     Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
 }
 
@@ -204,18 +191,21 @@ struct Targets {
     /// a-trous tap where three were.
     features: Tex,
     signals: Vec<(Signal, SignalTargets)>,
-    /// This frame's level count and feedback ([`pack_levels`]).
-    levels: usize,
+    levels: Levels,
 }
 
-/// The a-trous level count and whether the first level feeds the history, as one number (the
-/// bind groups' key holds one).
-fn pack_levels(levels: usize, feedback: bool) -> usize {
-    levels | (feedback as usize) << 8
+/// This frame's a-trous levels: how many, and whether the first feeds the history.
+#[derive(Clone, Copy, Default)]
+struct Levels {
+    count: usize,
+    feedback: bool,
 }
 
-fn unpack_levels(packed: usize) -> (usize, bool) {
-    (packed & 0xff, packed >> 8 != 0)
+impl Levels {
+    /// Both in the bind groups' key, since they pick each level's step and uniform.
+    fn key(self) -> usize {
+        self.count | (self.feedback as usize) << 8
+    }
 }
 
 struct SignalStages {
@@ -237,9 +227,10 @@ enum Pass {
 struct Resources {
     pp: wgpu::Buffer,
     dn: wgpu::Buffer,
-    /// Per level: for filtering signals, for the direct light (fill only) and for the feedback
-    /// level.
-    levels: [[wgpu::Buffer; LEVELS]; 3],
+    /// Per level, for filtering signals and for the direct light (fill only).
+    levels: [[wgpu::Buffer; LEVELS]; 2],
+    /// The feedback level's: step 1, its output also the history.
+    feedback: wgpu::Buffer,
     targets: Option<Targets>,
 }
 
@@ -281,7 +272,7 @@ impl Resources {
         (signal, s): (Signal, &'a SignalTargets),
         pass: Pass,
         parity: Parity,
-        levels: usize,
+        levels: Levels,
     ) -> Bindings<'a> {
         let b = io
             .bindings()
@@ -302,22 +293,22 @@ impl Resources {
             Pass::Atrous(i) => {
                 let src = if i == 0 { &s.variance } else { s.output(i) };
                 let dst = s.output(i + 1);
-                let (levels, feedback) = unpack_levels(levels);
-                let feedback = feedback && signal != Signal::Direct;
+                let (n, direct) = (levels.count, signal == Signal::Direct);
                 // Large scale first: level i of n steps 2^(n - 1 - i) pixels. With feedback
                 // the step-1 level runs first (its output is the history, Dundr §4.4), then
                 // the others from the largest: level i >= 1 steps 2^(n - i).
-                let (kind, step) = match (signal, feedback, i) {
-                    (Signal::Direct, ..) => (FILL_ONLY, levels.saturating_sub(1 + i)),
-                    (_, true, 0) => (FEEDBACK, 0),
-                    (_, true, _) => (FILTER, levels.saturating_sub(i)),
-                    (_, false, _) => (FILTER, levels.saturating_sub(1 + i)),
+                let level = match (levels.feedback && !direct, i) {
+                    (true, 0) => &self.feedback,
+                    (true, _) => &self.levels[0][n.saturating_sub(i).min(LEVELS - 1)],
+                    (false, _) => {
+                        &self.levels[direct as usize][n.saturating_sub(1 + i).min(LEVELS - 1)]
+                    }
                 };
                 b.texture("src", &src.1)
                     .texture("moments", &s.moments.output(parity).1)
                     .texture("dst", &dst.1)
                     .texture("out_history", &s.history.output(parity).1)
-                    .buffer("level", &self.levels[kind][step.min(LEVELS - 1)])
+                    .buffer("level", level)
             }
         }
     }
@@ -346,14 +337,15 @@ impl Resources {
         let p = Parity::default();
         let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
         let m = modules("progressive/features.wgsl", Signal::Matte, g, a);
-        let offered = self.bindings(io, t, matte, Pass::Features, p, t.levels);
+        let one = Levels { count: 1, feedback: false };
+        let offered = self.bindings(io, t, matte, Pass::Features, p, one);
         let features = ChainStage::new(gpu, "progressive/features", &m, "main", &offered)?;
         let mut signals = vec![];
         for (signal, s) in &t.signals {
             let offered = [Pass::Temporal, Pass::Variance, Pass::Atrous(0)]
                 .into_iter()
-                .fold(self.bindings(io, t, (*signal, s), Pass::Features, p, 1), |b, pass| {
-                    b.with(&self.bindings(io, t, (*signal, s), pass, p, 1))
+                .fold(self.bindings(io, t, (*signal, s), Pass::Features, p, one), |b, pass| {
+                    b.with(&self.bindings(io, t, (*signal, s), pass, p, one))
                 });
             let [lt, lv, la] = signal.labels();
             let stage = |label, file| {
@@ -388,7 +380,7 @@ impl Denoiser for Progressive {
             .iter()
             .map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name())))
             .collect();
-        self.res.targets = Some(Targets { features, signals, levels: 0 });
+        self.res.targets = Some(Targets { features, signals, levels: Levels::default() });
     }
 
     fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
@@ -396,29 +388,28 @@ impl Denoiser for Progressive {
         let Progressive { scene, res, stages, .. } = self;
         let missing = "the progressive filter records before its textures exist";
         let p = &cx.settings.progressive;
-        let feedback = p.feedback_samples > 0.0 && p.levels > 0;
-        res.targets.as_mut().context(missing)?.levels =
-            pack_levels(p.levels.min(PROGRESSIVE_MAX_LEVELS) as usize, feedback);
+        res.targets.as_mut().context(missing)?.levels = Levels {
+            count: p.levels.min(PROGRESSIVE_MAX_LEVELS) as usize,
+            feedback: p.feedback_samples > 0.0 && p.levels > 0,
+        };
         let t = res.targets.as_ref().context(missing)?;
         res.write_params(gpu, io, cx);
-        let (key, parity, size, packed) = (cx.key, cx.parity, io.size, t.levels);
-        let levels = unpack_levels(packed).0;
+        let (key, parity, size, levels) = (cx.key, cx.parity, io.size, t.levels);
         let stages = crate::passes::chain::made(stages, || {
             res.make_stages(gpu, io, t, scene).context("creating the progressive filter's stages")
         })?;
         let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
         stages.features.record(rec, key, parity, size, |p| {
-            res.bindings(io, t, matte, Pass::Features, p, packed)
+            res.bindings(io, t, matte, Pass::Features, p, levels)
         })?;
         for (st, (signal, s)) in stages.signals.iter_mut().zip(&t.signals) {
             let sig = (*signal, s);
-            let b = |pass, p| res.bindings(io, t, sig, pass, p, packed);
+            let b = |pass, p| res.bindings(io, t, sig, pass, p, levels);
             st.temporal.record(rec, key, parity, size, |p| b(Pass::Temporal, p))?;
             st.variance.record(rec, key, parity, size, |p| b(Pass::Variance, p))?;
-            for i in 0..levels {
-                // Bind groups are keyed by (parity, level); the level count and the feedback are
-                // in the key, since they pick each level's step and uniform.
-                let k = crate::gpu::BindKey { levels: packed, ..key };
+            for i in 0..levels.count {
+                // Bind groups are keyed by (parity, level) and by the levels.
+                let k = crate::gpu::BindKey { levels: levels.key(), ..key };
                 st.atrous.record_variant(
                     rec,
                     k,
@@ -433,7 +424,7 @@ impl Denoiser for Progressive {
 
     fn output(&self, _parity: Parity) -> Denoised<'_> {
         let Some(t) = &self.res.targets else { return Denoised::default() };
-        let levels = unpack_levels(t.levels).0;
+        let levels = t.levels.count;
         let out =
             |s: Signal| t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(levels).1);
         Denoised {

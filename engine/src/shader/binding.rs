@@ -132,7 +132,8 @@ pub struct BindKey {
     pub denoiser: Option<usize>,
     /// The debug view the display shows (its index in the view list; 0: the final image).
     pub view: usize,
-    /// A stage's own choice that changes what it binds (the progressive filter's level count).
+    /// A stage's own choice that changes what it binds (the progressive filter's level count
+    /// and feedback).
     pub levels: usize,
 }
 
