@@ -102,6 +102,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         result = mix(clamped, current, new_frame_weight(c, n, dn.still_frames, still));
     }
+    // A history that restarts here (a surface a move uncovered) starts from the radiance
+    // cache's prior where there is one (passes/cache.rs): its cell's mean, weighed as the
+    // frames' worth of samples it holds, instead of this one sample.
+    if c <= 0.0 && dn.history_valid != 0u {
+        let prior = cache_prior_at(p);
+        if prior.a > 0.0 {
+            result = mix(prior.rgb, current, 1.0 / (1.0 + prior.a));
+            n = 1.0 + prior.a;
+        }
+    }
     textureStore(out_temporal, p, vec4f(half_safe(result), c));
     textureStore(out_confidence, p, vec4f(c, 0.0, 0.0, 0.0));
     textureStore(out_reason, p, vec4u(reason | (u32(n) << 8u), 0u, 0u, 0u));

@@ -19,3 +19,19 @@ fn primary_ray(px: vec2u, j: u32) -> CameraRay {
     }
     return camera_sample(ndc, &rng);
 }
+
+// The raster's hit of pixel px's camera ray rd: its triangle (G-buffer ids: object, slot), with
+// exact barycentrics of this frame's ray (no bounds test: at a silhouette the sample may sit a
+// hair outside it).
+fn raster_hit(ro: vec3f, rd: vec3f, ids: vec2u) -> Hit {
+    let slot = ids.y;
+    let inst = instance_of_object(ids.x);
+    let v0 = inst_point(inst, tri_vertex(slot * 3u));
+    let e1 = inst_point(inst, tri_vertex(slot * 3u + 1u)) - v0;
+    let e2 = inst_point(inst, tri_vertex(slot * 3u + 2u)) - v0;
+    let pv = cross(rd, e2);
+    let inv = 1.0 / dot(e1, pv);
+    let tv = ro - v0;
+    let qv = cross(tv, e1);
+    return Hit(dot(e2, qv) * inv, slot, vec2f(dot(tv, pv) * inv, dot(rd, qv) * inv), inst);
+}

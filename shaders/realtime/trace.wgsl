@@ -21,25 +21,6 @@ var gb_ids: texture_2d<u32>;
 var out_matte: texture_storage_2d<rgba16float, write>;
 var out_direct: texture_storage_2d<rgba16float, write>;
 
-fn area_groups() -> u32 {
-    return select(0u, 1u, HAS_EMITTERS) + select(0u, 1u, HAS_ENV);
-}
-
-// One sample of the non-delta lights (emitters or environment, chosen uniformly).
-fn sample_area_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
-    let n = area_groups();
-    let u = rand(rng);
-    var s: LightSample;
-    if HAS_EMITTERS && (!HAS_ENV || u < 0.5) {
-        s = sample_emitter(p, vec3f(rand(rng), rand(rng), rand(rng)));
-    } else {
-        s = sample_env(rand2(rng));
-    }
-    s.li *= f32(n);
-    s.pdf /= f32(n);
-    return s;
-}
-
 fn write_all(px: vec2u, matte: vec3f, direct: vec3f) {
     textureStore(out_matte, px, vec4f(half_safe(matte), 1.0));
     textureStore(out_direct, px, vec4f(half_safe(direct), 1.0));
@@ -205,22 +186,6 @@ fn shade_glass(rd: vec3f, hit: Hit, s: Surface, ms: MaterialSample, rng: ptr<fun
     glossy = max(glossy / f32(paths) - select(vec3f(0.0), ms.emission, s.front), vec3f(0.0));
     let mirror = reflect(rd, s.ns);
     return Shaded(vec3f(0.0), vec3f(0.0), glossy, 0.0, vec3f(1.0), s.ns, mirror, 0.0, s.ns, false);
-}
-
-// The raster's hit of pixel px's camera ray rd: its triangle (G-buffer ids: object, slot), with
-// exact barycentrics of this frame's ray (no bounds test: at a silhouette the sample may sit a
-// hair outside it).
-fn raster_hit(ro: vec3f, rd: vec3f, ids: vec2u) -> Hit {
-    let slot = ids.y;
-    let inst = instance_of_object(ids.x);
-    let v0 = inst_point(inst, tri_vertex(slot * 3u));
-    let e1 = inst_point(inst, tri_vertex(slot * 3u + 1u)) - v0;
-    let e2 = inst_point(inst, tri_vertex(slot * 3u + 2u)) - v0;
-    let pv = cross(rd, e2);
-    let inv = 1.0 / dot(e1, pv);
-    let tv = ro - v0;
-    let qv = cross(tv, e1);
-    return Hit(dot(e2, qv) * inv, slot, vec2f(dot(tv, pv) * inv, dot(rd, qv) * inv), inst);
 }
 
 @compute @workgroup_size(8, 8)

@@ -5,6 +5,7 @@
 // same_object), and integrate (common.wgsl). Also writes the features every later stage
 // edge-stops on: linear depth and its gradient.
 // Outputs: integrated (rgb, this frame's raw luminance), moments (m1, m2, h), features (z, dz).
+// Where the history restarts, the radiance cache's prior (cache/prior.wgsl) stands in for it.
 
 var prev_depth: texture_depth_2d;
 var prev_normal: texture_2d<f32>;
@@ -54,7 +55,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             reprojected = mom.z >= 1.0;
         }
     }
-    let i = integrate(current, hist, mom, reprojected);
+    var i = integrate(current, hist, mom, reprojected);
+    // A history that restarts here starts from the radiance cache's prior where there is one
+    // (passes/cache.rs), as `prior.a` samples of the cell's mean beside this one; the moments
+    // keep this sample's (the spread of the pixel's own samples).
+    if !reprojected && sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
+        let prior = cache_prior_at(p);
+        if prior.a > 0.0 {
+            let w = 1.0 / (1.0 + prior.a);
+            i = Integrated(mix(prior.rgb, current, w), vec4f(i.moments.xy, 1.0 + prior.a, w));
+        }
+    }
     textureStore(out_integrated, p, vec4f(half_safe(i.light), luminance(current)));
     textureStore(out_moments, p, i.moments);
 }

@@ -58,6 +58,10 @@ impl Denoiser for Mara {
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
         let motion = self.scene.motion;
+        // Made again when the radiance cache starts or stops offering its prior.
+        if self.matte.as_ref().is_some_and(|c| c.prior != io.cache_prior.is_some()) {
+            self.matte = None;
+        }
         let matte = crate::passes::chain::made(&mut self.matte, || {
             MatteChain::new(gpu, &inputs, motion).context("creating the matte chain")
         })?;

@@ -247,6 +247,8 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
 
 /// One signal's passes.
 struct SignalStages {
+    /// The matte temporal reads the radiance cache's prior (made for a frame that offers one).
+    prior: bool,
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
@@ -260,6 +262,7 @@ impl SignalStages {
         glossy: bool,
         motion: crate::gpu::Motion,
         offered: &Bindings,
+        prior: bool,
     ) -> Result<SignalStages> {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
@@ -284,8 +287,14 @@ impl SignalStages {
         let stage = |label, file, b: &Bindings| {
             ChainStage::new(gpu, label, &modules(file, glossy, motion), "main", b)
         };
+        // The matte history restarts from the radiance cache's prior where there is one.
+        let mut temporal_modules = modules(temporal, glossy, motion);
+        if !glossy {
+            temporal_modules.push(if prior { "cache/prior.wgsl" } else { "cache/prior_none.wgsl" });
+        }
         Ok(SignalStages {
-            temporal: stage(labels[0], temporal, offered)?,
+            prior,
+            temporal: ChainStage::new(gpu, labels[0], &temporal_modules, "main", offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
             regression: stage(labels[3], "svgf/regression.wgsl", offered)?,
@@ -574,9 +583,14 @@ impl Denoiser for Svgf {
         let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
         let stages = |g, s| {
             let offered = res.offered(io, t, s);
-            SignalStages::new(gpu, g, scene.motion, &offered).context("creating SVGF's stages")
+            SignalStages::new(gpu, g, scene.motion, &offered, io.cache_prior.is_some())
+                .context("creating SVGF's stages")
         };
         let s = signal(false)?;
+        // Made again when the radiance cache starts or stops offering its prior.
+        if matte.as_ref().is_some_and(|m| m.prior != io.cache_prior.is_some()) {
+            *matte = None;
+        }
         let st = crate::passes::chain::made(matte, || stages(false, s))?;
         res.record_stages(rec, io, cx, s, st)?;
         if scene.glossy {

@@ -17,6 +17,7 @@ pub use params::{CameraSetup, FrameParams, random_jitter};
 
 use crate::denoise::Denoiser;
 use crate::gpu::{BindKey, Gpu, GpuRequirements, GpuScene, GpuTimer, Instancing, PreparedScene};
+use crate::passes::cache::RadianceCache;
 use crate::passes::composite::CompositePass;
 use crate::passes::gbuffer::{self, GBufferPass};
 use crate::passes::prefilter::Prefilter;
@@ -110,8 +111,9 @@ impl PreparedScene {
     /// Features and limits of the real-time frame on this scene.
     pub fn realtime_requirements(&self, size: (u32, u32)) -> GpuRequirements {
         let mut r = self.requirements(size.0 as u64 * size.1 as u64, 16);
-        // The supersampling's samples pass binds the trace's buffers and two of its own.
-        r.max_storage_buffers_per_shader_stage += 2;
+        // The supersampling's samples pass binds the trace's buffers and two of its own, the
+        // radiance cache's update five.
+        r.max_storage_buffers_per_shader_stage += 5;
         r.max_color_attachment_bytes_per_sample = gbuffer::COLOR_BYTES_PER_SAMPLE;
         // matte, direct, and with a glossy lobe glossy, reflection, mirror and mirror hit; the
         // pre-filter's covariance step writes 4 (WebGPU's default).
@@ -192,6 +194,7 @@ impl Renderer {
             supersample: Supersample::new(),
             primaries: Primaries::default(),
             prefilter: Prefilter::default(),
+            cache: RadianceCache::default(),
         };
         let mut r = Renderer {
             scene,
@@ -272,6 +275,9 @@ impl Renderer {
         let mut v = self.gpu_scene.memory.allocations.clone();
         v.extend(self.targets.memory.allocations.iter().cloned());
         v.extend(self.uniforms.memory.allocations.iter().cloned());
+        if let Some(c) = self.stages.cache.cells() {
+            v.extend(c.memory.allocations.iter().cloned());
+        }
         v
     }
 

@@ -23,6 +23,8 @@ pub(super) struct FramePlan<'s> {
     pub traced: bool,
     /// Moon et al. 2017's pre-filter runs between the traced features and the G-buffer.
     pub prefilter: bool,
+    /// The radiance cache runs (passes/cache.rs): it is on and a denoiser may read it.
+    pub cache: bool,
     /// The cameras of this frame and the last, as the denoisers and TAA see them.
     pub view: ChainView,
     /// This frame's jittered view-projection, its jitter and its unjittered view-projection:
@@ -68,6 +70,15 @@ impl Renderer {
         }
         let (samples, period) = self.sampling(gpu, settings, denoiser)?;
         let (traced, primary_samples, prefilter) = self.primaries(gpu, input, settings, samples)?;
+        let cache = settings.cache.enabled && denoiser.is_some();
+        if cache {
+            if self.stages.cache.prepare(gpu, &settings.cache, settings.exposure_scale()) {
+                self.targets.generation += 1;
+            }
+            self.targets.ensure_cache(gpu);
+            // The gather's test of what the last frame saw.
+            self.targets.ensure_previous(gpu);
+        }
         let cam = self.camera_setup(&input.camera);
         let h = &self.history;
         // The raster's position in the pixel: Halton for TAA, uniformly random for the
@@ -103,6 +114,7 @@ impl Renderer {
             period,
             traced,
             prefilter,
+            cache,
             view,
             jittered,
             jitter,

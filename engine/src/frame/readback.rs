@@ -123,9 +123,12 @@ impl Renderer {
         Ok((d > 0.0 && d.is_finite()).then(|| self.near() as f64 / d as f64))
     }
 
-    /// The bytes of the frame's buffer labelled `name` (`supersample/samples`, ...).
+    /// The bytes of the frame's buffer labelled `name` (`supersample/samples`, the radiance
+    /// cache's `cache/cells`, ...).
     pub fn read_buffer(&self, gpu: &Gpu, name: &str) -> Result<Vec<u8>> {
-        let b = self.targets.memory.find_buffer(name).with_context(|| {
+        let cache = self.stages.cache.cells().map(|c| &c.memory);
+        let found = self.targets.memory.find_buffer(name);
+        let b = found.or_else(|| cache.and_then(|m| m.find_buffer(name))).with_context(|| {
             let labels: Vec<&str> =
                 self.targets.memory.buffers.iter().map(|(l, _)| l.as_str()).collect();
             format!("no buffer {name:?} in this frame (its buffers: {})", labels.join(", "))

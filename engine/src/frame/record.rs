@@ -6,6 +6,7 @@ use super::targets::{Targets, Uniforms};
 use super::{DisplayTarget, FrameInput, MadeDenoiser, Renderer};
 use crate::denoise::{Denoiser, FrameContext};
 use crate::gpu::{BindKey, Gpu, Recorder};
+use crate::passes::cache::{CacheInputs, RadianceCache};
 use crate::passes::composite::{self, CompositePass, DisplayPass, FrameBuffers};
 use crate::passes::gbuffer::{self, GBufferPass};
 use crate::passes::io::FrameIo;
@@ -30,6 +31,7 @@ pub(super) struct Stages {
     pub supersample: Supersample,
     pub primaries: Primaries,
     pub prefilter: Prefilter,
+    pub cache: RadianceCache,
 }
 
 /// What the next frame needs of the ones before it.
@@ -82,11 +84,12 @@ impl Renderer {
         let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
         let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace };
         let io = t.io(&u.frame, gpu_scene);
-        // primaries [-> pre-filter] -> trace [-> mix] -> denoise -> composite [-> resolve] -> TAA
+        // primaries [-> pre-filter] -> trace [-> mix] [-> radiance cache] -> denoise -> composite [-> resolve] -> TAA
         // -> display; then this frame's G-buffer becomes the next one's previous.
         s.record_primaries(&mut rec, &plan, scene, t)?;
         s.record_trace(&mut rec, &plan, &trace, t.size)?;
         let io = s.record_mix(&mut rec, &plan, &trace, t, io)?;
+        let io = s.record_cache(&mut rec, &plan, scene, t, io)?;
         let denoiser = record_denoiser(&mut rec, &plan, denoisers, &io)?;
         s.record_composite(&mut rec, &plan, &io, denoiser, u.shown(t, &io, None))?;
         s.record_resolve(&mut rec, &plan, &io, t)?;
@@ -251,6 +254,22 @@ impl Stages {
             self.supersample.record_mix(rec, plan.key, trace, &io, ss)?;
             io.mixed = Some(&ss.mixed);
         }
+        Ok(io)
+    }
+
+    /// The radiance cache where it runs: the I/O then offers its prior (`cache_prior`).
+    fn record_cache<'a>(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        scene: SceneInputs,
+        t: &'a Targets,
+        mut io: FrameIo<'a>,
+    ) -> Result<FrameIo<'a>> {
+        let Some(ct) = t.cache.as_ref().filter(|_| plan.cache) else { return Ok(io) };
+        let inputs = CacheInputs { scene, io: &io, targets: ct };
+        self.cache.record(rec, plan.key, &inputs, &plan.settings.cache, plan.frame_index)?;
+        io.cache_prior = Some(&ct.prior.1);
         Ok(io)
     }
 

@@ -24,6 +24,7 @@ impl Renderer {
             v.push(p);
         }
         v.extend(self.stages.prefilter.pipelines());
+        v.extend(self.stages.cache.pipelines());
         for d in &mut self.denoisers {
             v.extend(d.denoiser.pipelines());
         }

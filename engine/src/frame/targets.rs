@@ -4,6 +4,7 @@
 use super::FrameParams;
 use crate::gpu::GpuScene;
 use crate::gpu::{Gpu, GpuMemory};
+use crate::passes::cache::CacheTargets;
 use crate::passes::composite::FrameBuffers;
 use crate::passes::gbuffer::GBufferTargets;
 use crate::passes::io::{FrameIo, PreviousGBuffer};
@@ -29,6 +30,8 @@ pub(super) struct Targets {
     /// the pre-filter first runs.
     pub primaries: Option<PrimaryTargets>,
     pub prefilter: Option<PrefilterTargets>,
+    /// The radiance cache's per-pixel outputs, made when it first runs.
+    pub cache: Option<CacheTargets>,
     /// Every per-pixel allocation, the denoisers' and TAA's included: bytes per pixel, and
     /// textures by label for readback.
     pub memory: GpuMemory,
@@ -59,6 +62,7 @@ impl Targets {
             supersample: None,
             primaries: None,
             prefilter: None,
+            cache: None,
             memory,
             epoch,
             generation,
@@ -75,6 +79,7 @@ impl Targets {
             previous: self.previous.as_ref(),
             trace: &self.trace,
             mixed: None,
+            cache_prior: None,
             hdr: &self.hdr,
             memory: &self.memory,
         }
@@ -122,6 +127,16 @@ impl Targets {
         if prefilter && self.prefilter.as_ref().is_none_or(|p| p.epoch != epoch) {
             self.memory.forget(PrefilterTargets::PREFIX);
             self.prefilter = Some(PrefilterTargets::new(d, &mut self.memory, size, epoch));
+            self.generation += 1;
+        }
+    }
+
+    /// The radiance cache's per-pixel outputs (made on first use).
+    pub fn ensure_cache(&mut self, gpu: &Gpu) {
+        if self.cache.as_ref().is_none_or(|c| c.epoch != self.epoch) {
+            self.memory.forget(CacheTargets::PREFIX);
+            self.cache =
+                Some(CacheTargets::new(&gpu.device, &mut self.memory, self.size, self.epoch));
             self.generation += 1;
         }
     }

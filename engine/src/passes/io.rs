@@ -24,6 +24,8 @@ pub struct FrameIo<'a> {
     pub trace: &'a TraceTargets,
     /// With supersampling (k > 1), the guides' light after eq. (7): offered as the trace's.
     pub mixed: Option<&'a MixedLight>,
+    /// The radiance cache's prior per pixel (passes/cache.rs), where the cache ran this frame.
+    pub cache_prior: Option<&'a wgpu::TextureView>,
     /// The composite's linear HDR image, one vec4 per pixel.
     pub hdr: &'a wgpu::Buffer,
     /// Every per-pixel allocation of the frame, textures findable by label.
@@ -33,7 +35,7 @@ pub struct FrameIo<'a> {
 impl<'a> FrameIo<'a> {
     /// The frame's resources by WGSL name: `frame`, the G-buffer (`gb_*`, realtime/gbuffer_in.wgsl),
     /// the trace's light (`tr_*`, raw; a stage that filters offers its own `tr_matte` on top),
-    /// object motion, and the previous depth, normal and object ids where they exist.
+    /// object motion, the radiance cache's prior (`cache_prior`), and the previous depth, normal and object ids where they exist.
     pub fn bindings(&self) -> Bindings<'a> {
         let g = self.gbuffer;
         let t = self.trace;
@@ -50,7 +52,8 @@ impl<'a> FrameIo<'a> {
             .texture("gb_emission", g.view(Channel::Emission))
             .texture("gb_object", g.view(Channel::Ids))
             .texture("tr_matte", &t.matte.1)
-            .texture("tr_direct", &t.direct.1);
+            .texture("tr_direct", &t.direct.1)
+            .texture_opt("cache_prior", self.cache_prior);
         if let Some(gl) = &t.glossy {
             b = b
                 .texture("tr_glossy", &gl.light.1)

@@ -245,7 +245,7 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: Parity) -> Bindings<'a>
     }
 }
 
-fn modules(kind: Kind, motion: crate::gpu::Motion) -> Vec<&'static str> {
+fn modules(kind: Kind, motion: crate::gpu::Motion, prior: &'static str) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "realtime/frame.wgsl",
@@ -254,7 +254,7 @@ fn modules(kind: Kind, motion: crate::gpu::Motion) -> Vec<&'static str> {
     ];
     m.push(motion.module());
     m.extend(match kind {
-        Kind::Temporal => vec!["matte/temporal.wgsl"],
+        Kind::Temporal => vec![prior, "matte/temporal.wgsl"],
         Kind::HistoryBilateral => {
             vec!["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"]
         }
@@ -267,6 +267,8 @@ fn modules(kind: Kind, motion: crate::gpu::Motion) -> Vec<&'static str> {
 
 pub struct MatteChain {
     stages: Vec<(Kind, ChainStage)>,
+    /// The temporal stage reads the radiance cache's prior (made for a frame that offers one).
+    pub prior: bool,
 }
 
 impl MatteChain {
@@ -277,6 +279,7 @@ impl MatteChain {
 
     pub fn new(gpu: &Gpu, i: &ChainInputs, motion: crate::gpu::Motion) -> Result<MatteChain> {
         let mut stages = vec![];
+        let prior = super::cache::prior_module(&i.io);
         for (kind, label) in STAGES {
             let entry = match kind {
                 Kind::MinH => "min_h",
@@ -288,13 +291,13 @@ impl MatteChain {
                 ChainStage::new(
                     gpu,
                     label,
-                    &modules(kind, motion),
+                    &modules(kind, motion, prior),
                     entry,
                     &bindings(kind, i, Parity::default()),
                 )?,
             ));
         }
-        Ok(MatteChain { stages })
+        Ok(MatteChain { stages, prior: i.io.cache_prior.is_some() })
     }
 
     /// Record stages 3-7.

@@ -6,6 +6,7 @@ pub mod reference;
 pub use raycast::{RayHit, Raycaster};
 pub use reference::{Accumulation, ReferenceTracer, TraceView};
 
+pub mod cache;
 pub mod chain;
 pub mod composite;
 pub mod gbuffer;

@@ -90,6 +90,7 @@ pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
     let mut m = scene.shading_modules();
     m.push("realtime/frame.wgsl");
     m.push("realtime/lens.wgsl");
+    m.push("realtime/area_light.wgsl");
     m.push(if scene.features.glossy {
         "realtime/trace_glossy.wgsl"
     } else {

@@ -69,6 +69,7 @@ fn program(
     let mut modules = scene.shading_modules_for(moving);
     modules.push("realtime/frame.wgsl");
     modules.push("realtime/lens.wgsl");
+    modules.push("realtime/area_light.wgsl");
     modules.push(if scene.features.glossy {
         "realtime/trace_glossy.wgsl"
     } else {

@@ -107,12 +107,13 @@ const FRAME_FIELDS: &[Field] = &[
 ];
 
 /// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then
-/// each denoiser's as the registry lists them ([`super::registry`]), then TAA's.
+/// the radiance cache's, each denoiser's as the registry lists them ([`super::registry`]), then
+/// TAA's.
 pub fn fields() -> impl Iterator<Item = &'static Field> {
     let denoisers = super::registry::denoisers();
     let own: Vec<&'static Field> =
         denoisers.iter().flat_map(|d| d.fields.iter().flat_map(|f| f.iter())).collect();
-    FRAME_FIELDS.iter().chain(own).chain(super::taa::FIELDS)
+    FRAME_FIELDS.iter().chain(super::cache::FIELDS).chain(own).chain(super::taa::FIELDS)
 }
 
 /// The value at a dotted path of a serde form.

@@ -1,6 +1,7 @@
 //! Tunables of the real-time frame, with their units and defaults. `fields.rs` describes each
 //! one for panels and presets; `preset.rs` saves and loads them as TOML.
 
+mod cache;
 mod denoiser_info;
 mod field;
 mod fields;
@@ -16,6 +17,7 @@ mod taa;
 mod view;
 mod view_spec;
 
+pub use cache::{CacheSettings, MAX_CELLS_LOG2};
 pub use fields::{Field, Kind, fields, get as get_field, get_mut as get_field_mut, leaves};
 pub use fraction::{MAX_SAMPLE_PERIOD, SampleFraction};
 pub use glossy::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv};
@@ -54,6 +56,8 @@ pub struct FrameSettings {
     pub glossy: GlossySettings,
     pub svgf: SvgfSettings,
     pub progressive: ProgressiveSettings,
+    /// The radiance cache (passes/cache.rs), a stage of the frame any denoiser may read.
+    pub cache: CacheSettings,
     /// Indirect paths per pixel per frame (each of the matte and glossy estimators, and the
     /// area-light sample, is averaged over them). 1 is the paper's real-time setting.
     pub paths_per_pixel: u32,
@@ -139,6 +143,7 @@ impl FrameSettings {
             glossy: GlossySettings::default(),
             svgf: SvgfSettings::default(),
             progressive: ProgressiveSettings::default(),
+            cache: CacheSettings::default(),
             paths_per_pixel: 1,
             texture_lod: true,
             samples_per_pixel: 1,

@@ -110,7 +110,8 @@ fn all_programs() -> Vec<Program> {
         "realtime/motion_vertices.wgsl",
     ] {
         for stage in [
-            &["matte/temporal.wgsl"][..],
+            &["cache/prior_none.wgsl", "matte/temporal.wgsl"][..],
+            &["cache/prior.wgsl", "matte/temporal.wgsl"],
             &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
             &["matte/disocclusion.wgsl"],
             &["matte/firefly.wgsl"],
@@ -156,13 +157,20 @@ fn all_programs() -> Vec<Program> {
                 "svgf/regression.wgsl",
                 "svgf/final.wgsl",
             ] {
-                v.push(
-                    compose(stage, "", &crate::denoise::svgf::modules(stage, glossy, animated))
-                        .unwrap(),
-                );
+                let mut m = crate::denoise::svgf::modules(stage, glossy, animated);
+                if stage == "svgf/temporal_matte.wgsl" {
+                    // The radiance cache's prior, and none.
+                    let mut with_prior = m.clone();
+                    with_prior.push("cache/prior.wgsl");
+                    v.push(compose(stage, "", &with_prior).unwrap());
+                    m.push("cache/prior_none.wgsl");
+                }
+                v.push(compose(stage, "", &m).unwrap());
             }
         }
     }
+    let resolve = ["common/math.wgsl", "common/rng.wgsl", "cache/cells.wgsl", "cache/resolve.wgsl"];
+    v.push(compose("cache/resolve.wgsl", "", &resolve).unwrap());
     for (label, module) in crate::gpu::posing::PROGRAMS {
         v.push(compose(label, "", &[module]).unwrap());
     }
@@ -267,8 +275,23 @@ fn all_programs() -> Vec<Program> {
                 "realtime/primaries.wgsl",
             ]);
             v.push(compose(&format!("primaries {bvh} {i}"), &prelude, &primaries).unwrap());
-            m.extend(["realtime/frame.wgsl", "realtime/lens.wgsl", glossy, "realtime/trace.wgsl"]);
+            let mut cache = m.clone();
+            m.extend([
+                "realtime/frame.wgsl",
+                "realtime/lens.wgsl",
+                "realtime/area_light.wgsl",
+                glossy,
+                "realtime/trace.wgsl",
+            ]);
             v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
+            cache.extend([
+                "realtime/frame.wgsl",
+                "realtime/lens.wgsl",
+                "realtime/area_light.wgsl",
+                "cache/cells.wgsl",
+                "cache/update.wgsl",
+            ]);
+            v.push(compose(&format!("cache update {bvh} {i}"), &prelude, &cache).unwrap());
             m.extend(["supersample/common.wgsl", "supersample/samples.wgsl"]);
             v.push(compose(&format!("supersample samples {bvh} {i}"), &prelude, &m).unwrap());
         }
@@ -432,6 +455,12 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(offs[12] as usize, offset_of!(SvgfParams, regression_order));
     assert_eq!(offs[13] as usize, offset_of!(SvgfParams, regression_full_samples));
     assert_eq!(wgsl_layout(atrous, "Level").0, 16);
+    let resolve = programs.iter().find(|p| p.label == "cache/resolve.wgsl").unwrap();
+    use crate::passes::cache::CacheParams;
+    let (size, offs) = wgsl_layout(resolve, "CacheParams");
+    assert_eq!(size as usize, size_of::<CacheParams>());
+    assert_eq!(offs[5] as usize, offset_of!(CacheParams, update_tile));
+    assert_eq!(offs[7] as usize, offset_of!(CacheParams, sample_clamp));
     // obvhs's CWBVH node is read as five vec4u.
     assert_eq!(size_of::<obvhs::cwbvh::node::CwBvhNode>(), 80);
 }

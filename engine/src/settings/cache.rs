@@ -1,0 +1,47 @@
+//! The radiance cache's settings (passes/cache.rs, shaders/cache/*.wgsl): a world-space hashed
+//! cache of the matte light on surfaces, a stage of the frame between the trace and the
+//! denoiser, which a denoiser's temporal stage reads where a pixel's history restarts. The
+//! measurements behind each default are in `docs/decisions.md`.
+
+use super::field::{Kind::*, described};
+use serde::{Deserialize, Serialize};
+
+/// The most cells the table may hold (2^22: 168 MiB at 40 bytes a cell).
+pub const MAX_CELLS_LOG2: u32 = 22;
+
+described! {
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    #[serde(default)]
+    pub struct CacheSettings / FIELDS {
+        /// Keep the cache and give a pixel whose matte history restarts (uncovered by a move)
+        /// its cell's mean as a prior worth up to `prior_frames` frames (Mara's and SVGF's
+        /// temporal stages). Off: no passes, no memory, a restarted pixel starts from its one
+        /// sample.
+        enabled: bool = false,
+            ("cache.enabled", "cache", "", Bool);
+        /// A cell's edge in pixels at its distance from the camera (rounded up to a power of two
+        /// in scene units): larger cells fill faster and blur the light more.
+        cell_pixels: f32 = 8.0,
+            ("cache.cell_pixels", "cache", "pixels", Float(1.0, 32.0, 0.5));
+        /// The most frames' worth of samples a prior stands for (a cell with fewer samples gives
+        /// fewer): the weight of the cell's blur against the pixel's own samples.
+        prior_frames: f32 = 16.0,
+            ("cache.prior_frames", "cache", "frames", Float(0.0, 256.0, 1.0));
+        /// One secondary sample per tile of this many pixels squared per frame: from the tile's
+        /// surface to the one it sees, whose cell it fills (0: the cache takes only what the
+        /// camera sees). Costs a ray, a shadow ray and a matte path per tile.
+        update_tile: u32 = 4,
+            ("cache.update_tile", "cache", "pixels", Int(0, 64));
+        /// The most samples a cell's running mean holds; past it new samples weigh 1 / this.
+        max_samples: f32 = 1024.0,
+            ("cache.max_samples", "cache", "samples", Float(1.0, 65536.0, 16.0));
+        /// Frames a cell without a sample is kept before its slot is freed.
+        max_age_frames: u32 = 64,
+            ("cache.max_age_frames", "cache", "frames", Int(1, 100000));
+        /// Cells in the table, as a power of two (16: 65536 cells, 2.5 MiB).
+        cells_log2: u32 = 16,
+            ("cache.cells_log2", "cache", "", Int(10, MAX_CELLS_LOG2 as i64));
+    }
+    hidden {
+    }
+}

@@ -1,0 +1,44 @@
+// The radiance cache's resolve (engine/src/passes/cache.rs), one thread per slot, after the
+// frame's samples are in: each cell's mean takes this frame's samples in as a running mean of
+// up to max_samples samples (then an exponential one, so that a change of light fades in), and
+// the samples' centroid likewise; a cell with no sample for max_age frames frees its slot.
+
+@compute @workgroup_size(256)
+fn resolve(@builtin(global_invocation_id) gid: vec3u) {
+    let s = gid.x;
+    if s >= cache.capacity || atomicLoad(&cache_keys[s]) == 0u {
+        return;
+    }
+    let i = CACHE_SUMS * s;
+    let count = atomicLoad(&cache_sums[i + 3u]);
+    if count == 0u {
+        let age = cache_ages[s] + 1u;
+        cache_ages[s] = age;
+        if age > cache.max_age {
+            atomicStore(&cache_keys[s], 0u);
+            cache_cells[s] = vec4f(0.0);
+            cache_centroids[s] = vec4f(0.0);
+        }
+        return;
+    }
+    let sum = vec3f(
+        f32(atomicLoad(&cache_sums[i])),
+        f32(atomicLoad(&cache_sums[i + 1u])),
+        f32(atomicLoad(&cache_sums[i + 2u])),
+    );
+    let at = vec3f(
+        f32(atomicLoad(&cache_sums[i + 4u])),
+        f32(atomicLoad(&cache_sums[i + 5u])),
+        f32(atomicLoad(&cache_sums[i + 6u])),
+    ) / (1024.0 * f32(count));
+    let mean = sum / (cache.fixed_scale * f32(count));
+    let old = cache_cells[s];
+    let n = min(old.a + f32(count), max(cache.max_samples, 1.0));
+    let w = min(f32(count) / n, 1.0);
+    cache_cells[s] = vec4f(mix(old.rgb, mean, w), n);
+    cache_centroids[s] = vec4f(mix(cache_centroids[s].xyz, at, w), 0.0);
+    cache_ages[s] = 0u;
+    for (var k = 0u; k < CACHE_SUMS; k++) {
+        atomicStore(&cache_sums[i + k], 0u);
+    }
+}
