@@ -12,13 +12,13 @@ use crate::cli::preset_settings;
 use crate::cli::{bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use glam::{Mat4, Vec4};
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
-use hush_engine::passes::matte::history_rejected;
 use hush_engine::quality::{
     Image, compare, compare_with_flip_map, luminance, region_mean, save_flip_heatmap,
 };
-use hush_engine::scene::{CameraPath, Scene};
+use hush_engine::scene::{Camera, CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -103,50 +103,65 @@ pub struct Scores {
     /// GPU milliseconds of the frame (all passes).
     pub gpu_ms: Vec<f64>,
     /// Mean FLIP over the uncovered pixels (see `Uncovered`) and how many there are; NaN and 0
-    /// where there are none (a still camera, or no matte temporal stage).
+    /// where there are none (a still camera, or the raw stream).
     pub uncovered_flip: Vec<f64>,
     pub uncovered_pixels: Vec<usize>,
 }
 
-/// Pixels that the matte temporal flagged (disoccluded, or a confidence under h / 2) within the
-/// last UNCOVERED_FRAMES frames, where they were flagged on screen: after a camera stops, the
-/// region a move uncovered, whose FLIP tells how fast it recovers (it should reach a still
-/// view's FLIP within 10 frames; a whole frame's FLIP hides a small region's lag).
+/// Pixels the previous frame did not see, within the last UNCOVERED_FRAMES frames, where they
+/// were on screen: after a camera stops, the region a move uncovered, whose FLIP tells how fast
+/// it recovers (it should reach a still view's FLIP within 10 frames; a whole frame's FLIP hides
+/// a small region's lag). Decided from the depth buffers alone, so that every denoiser, and the
+/// same denoiser with and without the radiance cache, is scored on the same pixels.
 struct Uncovered {
-    /// Frames since each pixel was last flagged.
+    /// Frames since each pixel was last uncovered.
     age: Vec<u32>,
+    /// The previous frame's depth buffer and unjittered view-projection.
+    previous: Option<(Vec<f32>, Mat4)>,
 }
 
 const UNCOVERED_FRAMES: u32 = 10;
 
 impl Uncovered {
-    /// Age the pixels by a frame and restart those whose matte history restarted in this one:
-    /// the Mara matte temporal's flags (hush_engine::passes::matte::history_rejected), or
-    /// SVGF's history length (h = 1 in the moments it wrote this frame, frame `index`).
-    fn update(
-        &mut self,
-        r: &Renderer,
-        gpu: &Gpu,
-        denoiser: &Denoiser,
-        index: usize,
-    ) -> Result<Vec<bool>> {
-        let rejected: Vec<bool> = if *denoiser == Denoiser::MARA {
-            let (reason, _) = r
-                .read_texture(gpu, "matte/reason")
-                .context("reading the matte temporal's flags")?;
-            history_rejected(&reason)
-        } else {
-            let name = hush_engine::denoise::svgf::moments_label("matte", 1 - index % 2);
-            let (moments, _) =
-                r.read_texture(gpu, &name).with_context(|| format!("reading {name}"))?;
-            moments
-                .chunks_exact(16)
-                .map(|m| f32::from_le_bytes(m[8..12].try_into().unwrap()) == 1.0)
-                .collect()
+    fn new(size: (u32, u32)) -> Uncovered {
+        Uncovered { age: vec![u32::MAX; (size.0 * size.1) as usize], previous: None }
+    }
+
+    /// Age the pixels by a frame and restart those whose surface the previous frame did not
+    /// see: projected into the previous camera it falls outside the image, or the previous
+    /// depth buffer holds another depth there (more than 2% off; reversed Z, depth = clip z / w).
+    fn update(&mut self, r: &Renderer, gpu: &Gpu, camera: &Camera) -> Result<Vec<bool>> {
+        let (bytes, _) = r.read_texture(gpu, "gbuffer/depth").context("reading the depth")?;
+        let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
+        let view_proj = r.camera_setup(camera).view_proj;
+        let (w, h) = r.size();
+        let inverse = view_proj.inverse();
+        let uncovered = |i: usize, prev: &[f32], prev_vp: &Mat4| {
+            let d = depth[i];
+            if d <= 0.0 || !d.is_finite() {
+                return false;
+            }
+            let (x, y) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
+            let ndc = Vec4::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / h as f32 * 2.0, d, 1.0);
+            let p = inverse * ndc;
+            let c = *prev_vp * (p / p.w);
+            if c.w <= 0.0 {
+                return true;
+            }
+            let tx = ((c.x / c.w + 1.0) * 0.5 * w as f32).floor();
+            let ty = ((1.0 - c.y / c.w) * 0.5 * h as f32).floor();
+            if tx < 0.0 || ty < 0.0 || tx >= w as f32 || ty >= h as f32 {
+                return true;
+            }
+            let expected = c.z / c.w;
+            (prev[ty as usize * w as usize + tx as usize] - expected).abs() > 0.02 * expected
         };
-        for (age, rejected) in self.age.iter_mut().zip(rejected) {
-            *age = if rejected { 0 } else { age.saturating_add(1) };
+        if let Some((prev, prev_vp)) = &self.previous {
+            for (i, age) in self.age.iter_mut().enumerate() {
+                *age = if uncovered(i, prev, prev_vp) { 0 } else { age.saturating_add(1) };
+            }
         }
+        self.previous = Some((depth, view_proj));
         Ok(self.age.iter().map(|a| *a <= UNCOVERED_FRAMES).collect())
     }
 }
@@ -222,15 +237,14 @@ fn stream(
     let mut scores = Scores::default();
     let mut prev: Option<Image> = None;
     let mut last = vec![];
-    let mut uncovered = Uncovered { age: vec![u32::MAX; (s.size.0 * s.size.1) as usize] };
+    let mut uncovered = Uncovered::new(s.size);
     for (k, input) in s.inputs.iter().enumerate() {
         r.render(&s.gpu, input, settings, None)?;
         let ms: f64 = r.pass_times(&s.gpu)?.iter().map(|p| p.1).sum();
         let img = r.read_hdr(&s.gpu)?;
-        let tracked = (settings.denoiser == Denoiser::MARA && settings.matte.temporal)
-            || (settings.denoiser == Denoiser::SVGF && settings.svgf.temporal);
-        let mask =
-            if tracked { Some(uncovered.update(&r, &s.gpu, &settings.denoiser, k)?) } else { None };
+        // The raw stream is not scored on them.
+        let tracked = settings.denoiser != Denoiser::NONE;
+        let mask = if tracked { Some(uncovered.update(&r, &s.gpu, &input.camera)?) } else { None };
         scores.push(&img, prev.as_ref(), &references[k], ms, mask.as_deref())?;
         if k + 1 == s.inputs.len() {
             last.push(img.clone());
