@@ -101,7 +101,23 @@ fn a_cell_holds_the_mean_of_its_samples() {
     assert!(pixels > f0.cell.len() / 2, "{pixels} pixels have a cell");
     // A cell covers a few pixels: 8-pixel cells over a 48x27 view.
     assert!(cpu0.len() > 20 && cpu0.len() < pixels / 2, "{} cells", cpu0.len());
+    let centroids = f32s(&r.read_buffer(&gpu, "cache/centroids").unwrap());
     for (slot, (sum, n)) in &cpu0 {
+        // The mean squared luminance (in 1/1024 units, each luminance at most 16).
+        let l2 = f0
+            .cell
+            .iter()
+            .zip(&f0.matte)
+            .filter(|(s, _)| *s == slot)
+            .map(|(_, m)| {
+                let c = m.map(|v| v.clamp(0.0, 64.0) as f64);
+                let l = (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]).min(16.0);
+                l * l
+            })
+            .sum::<f64>()
+            / *n as f64;
+        let got = centroids[*slot as usize * 4 + 3] as f64;
+        assert!((got - l2).abs() <= 1.01 / 1024.0 + 1e-5 * l2, "cell {slot}: {got} against {l2}");
         let gpu_cell = f0.cells[*slot as usize];
         assert_eq!(gpu_cell[3], *n as f32, "cell {slot}'s samples");
         for k in 0..3 {

@@ -40,11 +40,14 @@ struct CacheParams {
 var<uniform> cache: CacheParams;
 var<storage, read_write> cache_keys: array<atomic<u32>>;
 // Per cell, CACHE_SUMS words: this frame's fixed-point sums of r, g, b, the number of samples,
-// and the sums of their positions in the cell (x, y, z in 1/1024 of its edge).
+// the sums of their positions in the cell (x, y, z in 1/1024 of its edge), and the sum of their
+// squared luminances (in 1/1024 of the displayed white squared, each at most 16 whites).
 var<storage, read_write> cache_sums: array<atomic<u32>>;
 // Per cell: the mean (rgb) and the samples it holds (a).
 var<storage, read_write> cache_cells: array<vec4f>;
-// Per cell: its samples' centroid, as a fraction of the cell from its lowest corner.
+// Per cell: its samples' centroid, as a fraction of the cell from its lowest corner (xyz), and
+// the mean of their squared luminances (w): with the mean's luminance, their spread, which a
+// denoiser that estimates variance from moments (SVGF) takes for a restarted pixel's.
 var<storage, read_write> cache_centroids: array<vec4f>;
 // Per cell: frames since its last sample.
 var<storage, read_write> cache_ages: array<u32>;
@@ -141,8 +144,13 @@ fn cache_add(s: u32, k: CellKey, p: vec3f, v: vec3f, u: vec3f) {
     if s == CACHE_NONE || !is_finite3(v) {
         return;
     }
-    let q = vec3u(clamp(v, vec3f(0.0), vec3f(cache.sample_clamp)) * cache.fixed_scale + u);
+    let c = clamp(v, vec3f(0.0), vec3f(cache.sample_clamp));
+    let q = vec3u(c * cache.fixed_scale + u);
     let at = vec3u(cell_fraction(k, p) * 1024.0 + 0.5);
+    // Luminance in displayed whites (fixed_scale = 4096 x exposure), at most 16, squared, in
+    // 1/1024 units: 2^18 a sample, as the light's.
+    let white = min(luminance(c) * cache.fixed_scale / 4096.0, 16.0);
+    let l2 = u32(white * white * 1024.0 + fract(u.x + u.y));
     let i = CACHE_SUMS * s;
     atomicAdd(&cache_sums[i], q.x);
     atomicAdd(&cache_sums[i + 1u], q.y);
@@ -151,4 +159,5 @@ fn cache_add(s: u32, k: CellKey, p: vec3f, v: vec3f, u: vec3f) {
     atomicAdd(&cache_sums[i + 4u], at.x);
     atomicAdd(&cache_sums[i + 5u], at.y);
     atomicAdd(&cache_sums[i + 6u], at.z);
+    atomicAdd(&cache_sums[i + 7u], l2);
 }

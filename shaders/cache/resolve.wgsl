@@ -31,12 +31,15 @@ fn resolve(@builtin(global_invocation_id) gid: vec3u) {
         f32(atomicLoad(&cache_sums[i + 5u])),
         f32(atomicLoad(&cache_sums[i + 6u])),
     ) / (1024.0 * f32(count));
+    // The mean squared luminance, back in radiance squared.
+    let to_radiance = 4096.0 / cache.fixed_scale;
+    let l2 = f32(atomicLoad(&cache_sums[i + 7u])) / (1024.0 * f32(count)) * to_radiance * to_radiance;
     let mean = sum / (cache.fixed_scale * f32(count));
     let old = cache_cells[s];
     let n = min(old.a + f32(count), max(cache.max_samples, 1.0));
     let w = min(f32(count) / n, 1.0);
     cache_cells[s] = vec4f(mix(old.rgb, mean, w), n);
-    cache_centroids[s] = vec4f(mix(cache_centroids[s].xyz, at, w), 0.0);
+    cache_centroids[s] = mix(cache_centroids[s], vec4f(at, l2), w);
     cache_ages[s] = 0u;
     for (var k = 0u; k < CACHE_SUMS; k++) {
         atomicStore(&cache_sums[i + k], 0u);

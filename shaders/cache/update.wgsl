@@ -15,6 +15,8 @@ var tr_matte: texture_2d<f32>;
 var prev_depth: texture_depth_2d;
 // rgb: the cell's mean; a: the frames' worth of samples it stands for (0: no cell).
 var out_prior: texture_storage_2d<rgba16float, write>;
+// The prior's mean squared luminance (0: no prior).
+var out_prior_m2: texture_storage_2d<r32float, write>;
 // The pixel's cell slot (CACHE_NONE: none; where the pixel was traced this frame, the slot its
 // sample went to), for the tests.
 var out_cell: texture_storage_2d<r32uint, write>;
@@ -42,8 +44,10 @@ fn cell_of(s: Surface) -> CellKey {
     return cell_key(s.p, s.ns, frame.cam_pos.xyz, pixel_spread());
 }
 
-// The last frame saw p: its depth buffer holds p's depth (within 2%) where p projects into it.
-// Reversed infinite Z: depth = near / view depth = clip z / clip w.
+// The last frame saw p: its depth buffer holds p's depth (within 2%) at one of the 3x3 texels
+// where p projects into it (both frames' depths were drawn with a sub-pixel jitter, which on a
+// grazing floor moves a texel's depth by more than 2%). Reversed infinite Z: depth = near / view
+// depth = clip z / clip w.
 fn seen_last_frame(p: vec3f) -> bool {
     let clip = frame.prev_view_proj * vec4f(p, 1.0);
     if clip.w <= 0.0 {
@@ -54,7 +58,13 @@ fn seen_last_frame(p: vec3f) -> bool {
         return false;
     }
     let expected = clip.z / clip.w;
-    return abs(textureLoad(prev_depth, t, 0) - expected) <= 0.02 * expected;
+    for (var k = 0; k < 9; k++) {
+        let q = clamp(t + vec2i(k % 3 - 1, k / 3 - 1), vec2i(0), vec2i(frame.size) - 1);
+        if abs(textureLoad(prev_depth, q, 0) - expected) <= 0.02 * expected {
+            return true;
+        }
+    }
+    return false;
 }
 
 // Cell k's centroid (slot s) is in sight of surface s0: a shadow ray between the two, each end
@@ -85,6 +95,7 @@ fn gather(@builtin(global_invocation_id) gid: vec3u) {
     }
     let ids = textureLoad(gb_ids, px, 0).xy;
     var prior = vec4f(0.0);
+    var m2 = 0.0;
     var slot = CACHE_NONE;
     if ids.y != NO_HIT {
         let ray = primary_ray(px, 0u);
@@ -95,6 +106,7 @@ fn gather(@builtin(global_invocation_id) gid: vec3u) {
             if slot != CACHE_NONE && !seen_last_frame(cs.s.p) && centroid_in_sight(key, slot, cs.s) {
                 let c = cache_cells[slot];
                 prior = vec4f(c.rgb, min(c.a, cache.prior_frames));
+                m2 = cache_centroids[slot].w;
             }
             if traced_now(px) {
                 var rng = rng_init(px.y * frame.size.x + px.x, frame.index, params.seed ^ 0x63616368u);
@@ -104,7 +116,9 @@ fn gather(@builtin(global_invocation_id) gid: vec3u) {
             }
         }
     }
-    textureStore(out_prior, px, select(vec4f(0.0), prior, is_finite3(prior.rgb)));
+    let finite = is_finite3(prior.rgb) && is_finite3(vec3f(m2));
+    textureStore(out_prior, px, select(vec4f(0.0), prior, finite));
+    textureStore(out_prior_m2, px, vec4f(select(0.0, m2, finite), 0.0, 0.0, 0.0));
     textureStore(out_cell, px, vec4u(slot, 0u, 0u, 0u));
 }
 

@@ -57,13 +57,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     var i = integrate(current, hist, mom, reprojected);
     // A history that restarts here starts from the radiance cache's prior where there is one
-    // (passes/cache.rs), as `prior.a` samples of the cell's mean beside this one; the moments
-    // keep this sample's (the spread of the pixel's own samples).
+    // (passes/cache.rs), as `prior.a` samples of the cell's mean beside this one, and its moments
+    // from the cell's samples' (their luminance's mean and mean square): a history of 1 + a
+    // frames takes its variance from the moments, and one sample's would be 0.
     if !reprojected && sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
         let prior = cache_prior_at(p);
         if prior.a > 0.0 {
             let w = 1.0 / (1.0 + prior.a);
-            i = Integrated(mix(prior.rgb, current, w), vec4f(i.moments.xy, 1.0 + prior.a, w));
+            let m = mix(vec2f(luminance(prior.rgb), cache_prior_m2_at(p)), i.moments.xy, w);
+            i = Integrated(mix(prior.rgb, current, w), vec4f(m, 1.0 + prior.a, w));
         }
     }
     textureStore(out_integrated, p, vec4f(half_safe(i.light), luminance(current)));

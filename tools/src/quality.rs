@@ -129,7 +129,8 @@ impl Uncovered {
 
     /// Age the pixels by a frame and restart those whose surface the previous frame did not
     /// see: projected into the previous camera it falls outside the image, or the previous
-    /// depth buffer holds another depth there (more than 2% off; reversed Z, depth = clip z / w).
+    /// depth buffer holds another depth at each of the 3x3 texels there (more than 2% off;
+    /// reversed Z, depth = clip z / w).
     fn update(&mut self, r: &Renderer, gpu: &Gpu, camera: &Camera) -> Result<Vec<bool>> {
         let (bytes, _) = r.read_texture(gpu, "gbuffer/depth").context("reading the depth")?;
         let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
@@ -148,13 +149,21 @@ impl Uncovered {
             if c.w <= 0.0 {
                 return true;
             }
-            let tx = ((c.x / c.w + 1.0) * 0.5 * w as f32).floor();
-            let ty = ((1.0 - c.y / c.w) * 0.5 * h as f32).floor();
-            if tx < 0.0 || ty < 0.0 || tx >= w as f32 || ty >= h as f32 {
+            let tx = ((c.x / c.w + 1.0) * 0.5 * w as f32).floor() as i64;
+            let ty = ((1.0 - c.y / c.w) * 0.5 * h as f32).floor() as i64;
+            if tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
                 return true;
             }
+            // The 3x3 texels around: both depth buffers were drawn with a sub-pixel jitter,
+            // which on a grazing floor moves a texel's depth by more than 2%.
             let expected = c.z / c.w;
-            (prev[ty as usize * w as usize + tx as usize] - expected).abs() > 0.02 * expected
+            let seen =
+                (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (tx + dx, ty + dy))).any(|(x, y)| {
+                    let inside = x >= 0 && y >= 0 && x < w as i64 && y < h as i64;
+                    inside
+                        && (prev[(y * w as i64 + x) as usize] - expected).abs() <= 0.02 * expected
+                });
+            !seen
         };
         if let Some((prev, prev_vp)) = &self.previous {
             for (i, age) in self.age.iter_mut().enumerate() {

@@ -269,7 +269,7 @@ impl Stages {
         let Some(ct) = t.cache.as_ref().filter(|_| plan.cache) else { return Ok(io) };
         let inputs = CacheInputs { scene, io: &io, targets: ct };
         self.cache.record(rec, plan.key, &inputs, &plan.settings.cache, plan.frame_index)?;
-        io.cache_prior = Some(&ct.prior.1);
+        io.cache_prior = Some((&ct.prior.1, &ct.prior_m2.1));
         Ok(io)
     }
 

@@ -17,8 +17,9 @@
 //! instead of from one sample. The table lives across resizes (its cells are in world space);
 //! it is cleared when the cache starts again after frames without it.
 //!
-//! Memory: [`CELL_BYTES`] per cell (65536 cells by default: 4.5 MiB), and 12 bytes per pixel
-//! (the prior, Rgba16Float, and the cell's slot, R32Uint, which the tests and the views read).
+//! Memory: [`CELL_BYTES`] per cell (65536 cells by default: 4.5 MiB), and 16 bytes per pixel
+//! (the prior, Rgba16Float; its samples' mean squared luminance, R32Float; the cell's slot,
+//! R32Uint, which the tests read).
 
 use super::io::FrameIo;
 use super::trace::SceneInputs;
@@ -32,9 +33,11 @@ pub const GATHER: &str = "cache/gather";
 pub const SECONDARY: &str = "cache/secondary";
 pub const RESOLVE: &str = "cache/resolve";
 pub const PRIOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const PRIOR_M2_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const CELL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
-/// A cell's bytes: its key (4), this frame's fixed-point sums of light and position and its
-/// count (32), its mean and sample count (16), its centroid (16) and its age (4).
+/// A cell's bytes: its key (4), this frame's fixed-point sums of light, position and squared
+/// luminance and its count (32), its mean and sample count (16), its centroid and mean squared
+/// luminance (16) and its age (4).
 pub const CELL_BYTES: u64 = 72;
 /// The slot `cache/cell` holds for a pixel without a cell (shaders/cache/cells.wgsl).
 pub const NO_CELL: u32 = u32::MAX;
@@ -126,6 +129,7 @@ impl CacheCells {
 /// The cache's per-pixel outputs, in the frame's targets (remade on resize).
 pub struct CacheTargets {
     pub prior: Tex,
+    pub prior_m2: Tex,
     pub cell: Tex,
     pub epoch: u64,
 }
@@ -139,6 +143,7 @@ impl CacheTargets {
             | wgpu::TextureUsages::COPY_SRC;
         CacheTargets {
             prior: mem.texture(d, "cache/prior", size, PRIOR_FORMAT, usage),
+            prior_m2: mem.texture(d, "cache/prior m2", size, PRIOR_M2_FORMAT, usage),
             cell: mem.texture(d, "cache/cell", size, CELL_FORMAT, usage),
             epoch,
         }
@@ -182,6 +187,7 @@ fn scene_bindings<'a>(i: &CacheInputs<'a>, cells: &'a CacheCells) -> Bindings<'a
         .texture("tr_matte", matte)
         .texture_opt("prev_depth", i.io.previous.map(|p| &p.depth.1))
         .texture("out_prior", &i.targets.prior.1)
+        .texture("out_prior_m2", &i.targets.prior_m2.1)
         .texture("out_cell", &i.targets.cell.1);
     cells.bindings(b)
 }

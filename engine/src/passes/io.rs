@@ -24,8 +24,9 @@ pub struct FrameIo<'a> {
     pub trace: &'a TraceTargets,
     /// With supersampling (k > 1), the guides' light after eq. (7): offered as the trace's.
     pub mixed: Option<&'a MixedLight>,
-    /// The radiance cache's prior per pixel (passes/cache.rs), where the cache ran this frame.
-    pub cache_prior: Option<&'a wgpu::TextureView>,
+    /// The radiance cache's prior per pixel and its samples' mean squared luminance
+    /// (passes/cache.rs), where the cache ran this frame.
+    pub cache_prior: Option<(&'a wgpu::TextureView, &'a wgpu::TextureView)>,
     /// The composite's linear HDR image, one vec4 per pixel.
     pub hdr: &'a wgpu::Buffer,
     /// Every per-pixel allocation of the frame, textures findable by label.
@@ -53,7 +54,8 @@ impl<'a> FrameIo<'a> {
             .texture("gb_object", g.view(Channel::Ids))
             .texture("tr_matte", &t.matte.1)
             .texture("tr_direct", &t.direct.1)
-            .texture_opt("cache_prior", self.cache_prior);
+            .texture_opt("cache_prior", self.cache_prior.map(|p| p.0))
+            .texture_opt("cache_prior_m2", self.cache_prior.map(|p| p.1));
         if let Some(gl) = &t.glossy {
             b = b
                 .texture("tr_glossy", &gl.light.1)

@@ -15,8 +15,11 @@ described! {
     pub struct CacheSettings / FIELDS {
         /// Keep the cache and give a pixel whose matte history restarts (uncovered by a move)
         /// its cell's mean as a prior worth up to `prior_frames` frames (Mara's and SVGF's
-        /// temporal stages). Off: no passes, no memory, a restarted pixel starts from its one
-        /// sample.
+        /// temporal stages). Off (the default): no passes, no memory, a restarted pixel starts
+        /// from its one sample. The level at 320x180, the 10 frames after a 2 m jump, FLIP of the
+        /// uncovered pixels: Mara 0.1514 off, 0.1388 on; SVGF 0.1480 off, 0.1487 on. Costs 80 of
+        /// 2181 ms a still frame at 640x360 on lavapipe (3.7%), and a shadow ray per uncovered
+        /// pixel.
         enabled: bool = false,
             ("cache.enabled", "cache", "", Bool);
         /// A cell's edge in pixels at its distance from the camera (rounded up to a power of two
@@ -24,8 +27,10 @@ described! {
         cell_pixels: f32 = 8.0,
             ("cache.cell_pixels", "cache", "pixels", Float(1.0, 32.0, 0.5));
         /// The most frames' worth of samples a prior stands for (a cell with fewer samples gives
-        /// fewer): the weight of the cell's blur against the pixel's own samples.
-        prior_frames: f32 = 16.0,
+        /// fewer): the weight of the cell's blur against the pixel's own samples. 4: the jump
+        /// of `enabled` 0.1388 (Mara) and 0.1487 (SVGF); 16: 0.1398 and 0.1555 (SVGF then takes
+        /// the cell's blocks for converged light and stops filtering them).
+        prior_frames: f32 = 4.0,
             ("cache.prior_frames", "cache", "frames", Float(0.0, 256.0, 1.0));
         /// One secondary sample per tile of this many pixels squared per frame: from the tile's
         /// surface to the one it sees, whose cell it fills (0: the cache takes only what the
