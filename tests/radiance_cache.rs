@@ -318,3 +318,27 @@ fn no_light_leaks_through_a_thin_wall_into_a_dark_room() {
     );
     assert_eq!(leaked, 0, "pixels of room B with light");
 }
+
+/// The cache switched on and off between frames, under Mara and SVGF: their temporal stages are
+/// made again for a frame that offers a prior and one that does not, and every image stays
+/// finite.
+#[test]
+fn the_cache_can_be_switched_between_frames() {
+    let size = (32, 18);
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, size).unwrap();
+    for (k, denoiser) in [Denoiser::MARA, Denoiser::SVGF].into_iter().enumerate() {
+        for on in [true, false, true, false] {
+            let s = FrameSettings {
+                denoiser: denoiser.clone(),
+                cache: CacheSettings { enabled: on, ..Default::default() },
+                ..Default::default()
+            };
+            let eye = DVec3::new(-3.0 + k as f64, 1.7, 4.0);
+            let camera = Camera::look_at(eye, eye + DVec3::new(0.5, -0.3, -3.0), 60.0);
+            r.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, &s, None).unwrap();
+            let img = r.read_hdr(&gpu).unwrap();
+            assert!(img.data.iter().all(|v| v.is_finite()), "{denoiser:?}, cache {on}");
+        }
+    }
+}
