@@ -150,12 +150,42 @@ impl CacheTargets {
     }
 }
 
+/// One of the cache's passes: its pipeline and bind groups.
+struct Pass {
+    label: &'static str,
+    pipeline: Reloadable<wgpu::ComputePipeline>,
+    groups: BindCache,
+}
+
+impl Pass {
+    fn new(label: &'static str, pipeline: Reloadable<wgpu::ComputePipeline>) -> Pass {
+        Pass { label, pipeline, groups: BindCache::default() }
+    }
+
+    /// Dispatch `groups` workgroups with what `offered` binds.
+    fn record(
+        &mut self,
+        rec: &mut Recorder,
+        key: BindKey,
+        offered: &Bindings,
+        groups: (u32, u32),
+    ) -> Result<()> {
+        let _scope = crate::profile::scope(self.label);
+        let p = &self.pipeline;
+        let device = &rec.gpu.device;
+        let g = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(device, offered))?;
+        let mut pass = rec.compute_pass(self.label);
+        pass.set_pipeline(p.get());
+        set_compute_groups(&mut pass, g);
+        pass.dispatch_workgroups(groups.0, groups.1, 1);
+        Ok(())
+    }
+}
+
 /// The gather and secondary programs (the trace's scene program with the cache's entries).
 struct Programs {
-    gather: Reloadable<wgpu::ComputePipeline>,
-    secondary: Reloadable<wgpu::ComputePipeline>,
-    gather_groups: BindCache,
-    secondary_groups: BindCache,
+    gather: Pass,
+    secondary: Pass,
 }
 
 /// The radiance cache stage: its table and its programs (made on first use).
@@ -164,7 +194,7 @@ pub struct RadianceCache {
     cells: Option<CacheCells>,
     /// Static and moving-shutter programs.
     programs: [Option<Programs>; 2],
-    resolve: Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>,
+    resolve: Option<Pass>,
     /// The frame the cache last ran in: a gap means its cells are stale.
     last_frame: Option<u32>,
     /// Bumped when the table is remade (its bind groups then are too).
@@ -261,40 +291,25 @@ impl RadianceCache {
         let moving = i.scene.moving as usize;
         let p = super::chain::made(&mut self.programs[moving], || {
             Ok(Programs {
-                gather: scene_program(gpu, i, cells, GATHER, "gather")?,
-                secondary: scene_program(gpu, i, cells, SECONDARY, "secondary")?,
-                gather_groups: BindCache::default(),
-                secondary_groups: BindCache::default(),
+                gather: Pass::new(GATHER, scene_program(gpu, i, cells, GATHER, "gather")?),
+                secondary: Pass::new(
+                    SECONDARY,
+                    scene_program(gpu, i, cells, SECONDARY, "secondary")?,
+                ),
             })
         })?;
         let size = i.io.size;
         let offered = scene_bindings(i, cells);
-        {
-            let _scope = crate::profile::scope(GATHER);
-            let g = p.gather_groups.get(key, p.gather.builds(), 1, 0, |_| {
-                p.gather.bind_groups(&gpu.device, &offered)
-            })?;
-            let mut pass = rec.compute_pass(GATHER);
-            pass.set_pipeline(p.gather.get());
-            set_compute_groups(&mut pass, g);
-            pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
-        }
+        p.gather.record(rec, key, &offered, (size.0.div_ceil(8), size.1.div_ceil(8)))?;
         let tile = settings.update_tile.min(64);
         if tile > 0 {
-            let _scope = crate::profile::scope(SECONDARY);
-            let g = p.secondary_groups.get(key, p.secondary.builds(), 1, 0, |_| {
-                p.secondary.bind_groups(&gpu.device, &offered)
-            })?;
-            let mut pass = rec.compute_pass(SECONDARY);
-            pass.set_pipeline(p.secondary.get());
-            set_compute_groups(&mut pass, g);
             let tiles = (size.0.div_ceil(tile), size.1.div_ceil(tile));
-            pass.dispatch_workgroups(tiles.0.div_ceil(8), tiles.1.div_ceil(8), 1);
+            p.secondary.record(rec, key, &offered, (tiles.0.div_ceil(8), tiles.1.div_ceil(8)))?;
         }
-        let (resolve, groups) = super::chain::made(&mut self.resolve, || {
+        let offered = cells.bindings(Bindings::new());
+        let resolve = super::chain::made(&mut self.resolve, || {
             let modules =
                 ["common/math.wgsl", "common/rng.wgsl", "cache/cells.wgsl", "cache/resolve.wgsl"];
-            let offered = cells.bindings(Bindings::new());
             let r = Reloadable::new(
                 gpu,
                 RESOLVE,
@@ -304,16 +319,9 @@ impl RadianceCache {
                 &offered,
                 |d, m, l| compute_pipeline(d, RESOLVE, m, l, "resolve"),
             )?;
-            Ok((r, BindCache::default()))
+            Ok(Pass::new(RESOLVE, r))
         })?;
-        let _scope = crate::profile::scope(RESOLVE);
-        let offered = cells.bindings(Bindings::new());
-        let g = groups
-            .get(key, resolve.builds(), 1, 0, |_| resolve.bind_groups(&gpu.device, &offered))?;
-        let mut pass = rec.compute_pass(RESOLVE);
-        pass.set_pipeline(resolve.get());
-        set_compute_groups(&mut pass, g);
-        pass.dispatch_workgroups((1u32 << cells.log2).div_ceil(RESOLVE_GROUP), 1, 1);
+        resolve.record(rec, key, &offered, ((1u32 << cells.log2).div_ceil(RESOLVE_GROUP), 1))?;
         Ok(())
     }
 
@@ -321,11 +329,11 @@ impl RadianceCache {
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
         let mut v: Vec<&mut dyn Reload> = vec![];
         for p in self.programs.iter_mut().flatten() {
-            v.push(&mut p.gather);
-            v.push(&mut p.secondary);
+            v.push(&mut p.gather.pipeline);
+            v.push(&mut p.secondary.pipeline);
         }
-        if let Some((r, _)) = self.resolve.as_mut() {
-            v.push(r);
+        if let Some(r) = self.resolve.as_mut() {
+            v.push(&mut r.pipeline);
         }
         v
     }
