@@ -112,8 +112,8 @@ pub const FRAME_VIEWS: &[ViewSpec] = &[
     v("trace/glossy hit distance", "trace/glossy", ViewMap::Distance),
     v("trace/virtual position", "trace/reflection", ViewMap::Position),
     v("trace/mirror direction", "trace/mirror", ViewMap::PackedDirection),
-    // The radiance cache's, where it runs: the prior a restarted pixel starts from, and the
-    // frames' worth of samples it stands for (white: 16).
+    // The radiance cache's, where it runs: the prior an uncovered pixel starts from, and the
+    // frames' worth of samples it stands for (white: 4, the default `cache.prior_frames`).
     v("cache/prior", "cache/prior", ViewMap::Light),
-    v("cache/prior frames", "cache/prior", ViewMap::Grey { channel: 3, divisor: 16.0 }),
+    v("cache/prior frames", "cache/prior", ViewMap::Grey { channel: 3, divisor: 4.0 }),
 ];
