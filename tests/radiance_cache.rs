@@ -9,7 +9,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::Gpu;
 use hush_engine::passes::cache::NO_CELL;
 use hush_engine::scene::{Camera, Scene, cuboid, load_gltf, quad};
-use hush_engine::settings::{CacheSettings, Denoiser, FrameSettings, TaaSettings};
+use hush_engine::settings::{CacheSettings, Denoiser, FrameSettings, TaaSettings, View};
 use hush_tests::gltf_writer::GltfWriter;
 use hush_tests::half;
 use serde_json::json;
@@ -196,6 +196,11 @@ fn an_uncovered_pixel_starts_from_its_cells_mean() {
     }
     println!("{checked} disoccluded pixels with a prior");
     assert!(checked > 50, "{checked} disoccluded pixels with a prior");
+    for view in ["cache/prior", "cache/prior frames"] {
+        let shown =
+            r.display_image(&gpu, &FrameSettings { view: View::named(view), ..s.clone() }).unwrap();
+        assert!(shown.pixels().any(|p| p.0[..3] != [0, 0, 0]), "the view {view} is black");
+    }
 }
 
 /// Two closed rooms side by side, one wall 2 cm thick between them at x = 0.37 .. 0.39 (not on

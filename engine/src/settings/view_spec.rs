@@ -70,6 +70,12 @@ impl ViewSpec {
         self.texture.starts_with("prefilter/")
     }
 
+    /// Views of the radiance cache's outputs (`cache/...`): black unless the cache runs and a
+    /// move uncovered pixels it holds light for.
+    pub fn needs_cache(&self) -> bool {
+        self.texture.starts_with("cache/")
+    }
+
     /// Views of buffers that exist only in scenes with a specular lobe: the glossy chain's
     /// (`glossy/...`), a denoiser's glossy signal (`name/glossy ...`) and the trace's glossy
     /// outputs.
