@@ -6,7 +6,7 @@
 use super::field::{Kind::*, described};
 use serde::{Deserialize, Serialize};
 
-/// The most cells the table may hold (2^22: 168 MiB at 40 bytes a cell).
+/// The most cells the table may hold (2^22: 288 MiB at 72 bytes a cell).
 pub const MAX_CELLS_LOG2: u32 = 22;
 
 described! {
@@ -43,7 +43,7 @@ described! {
         /// Frames a cell without a sample is kept before its slot is freed.
         max_age_frames: u32 = 64,
             ("cache.max_age_frames", "cache", "frames", Int(1, 100000));
-        /// Cells in the table, as a power of two (16: 65536 cells, 2.5 MiB).
+        /// Cells in the table, as a power of two (16: 65536 cells, 4.5 MiB at 72 bytes a cell).
         cells_log2: u32 = 16,
             ("cache.cells_log2", "cache", "", Int(10, MAX_CELLS_LOG2 as i64));
     }
