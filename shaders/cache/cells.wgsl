@@ -65,10 +65,6 @@ struct CellKey {
     corner: vec3i,
 }
 
-fn cell_hash(h: u32, v: u32) -> u32 {
-    return pcg_hash(h ^ v);
-}
-
 // The cell of a surface point p with normal n, its grid sized for a camera at `eye` whose pixels
 // subtend `spread` radians.
 fn cell_key(p: vec3f, n: vec3f, eye: vec3f, spread: f32) -> CellKey {
@@ -87,12 +83,12 @@ fn cell_key(p: vec3f, n: vec3f, eye: vec3f, spread: f32) -> CellKey {
     }
     let face = axis * 2u + select(0u, 1u, along < 0.0);
     let tag = u32(level + 64) | (face << 8u);
-    var h = cell_hash(0x9e3779b9u, tag);
-    var c = cell_hash(0x85ebca6bu, tag * 0x27d4eb2fu);
+    var h = pcg_hash(0x9e3779b9u ^ tag);
+    var c = pcg_hash(0x85ebca6bu ^ (tag * 0x27d4eb2fu));
     for (var i = 0u; i < 3u; i++) {
         let v = bitcast<u32>(q[i]);
-        h = cell_hash(h, v);
-        c = cell_hash(c, v * 0x165667b1u + i);
+        h = pcg_hash(h ^ v);
+        c = pcg_hash(c ^ (v * 0x165667b1u + i));
     }
     return CellKey(h, max(c, 1u), exp2(f32(level)), q);
 }

@@ -82,11 +82,6 @@ fn centroid_in_sight(k: CellKey, slot: u32, s0: Surface) -> bool {
     return traverse(a, d / len, len, true).tri == NO_HIT;
 }
 
-// The pixel was traced this frame (below one sample per pixel, one pixel of each tile is).
-fn traced_now(px: vec2u) -> bool {
-    return frame.period <= 1u || all(scheduled_pixel(px / schedule_tile()) == px);
-}
-
 @compute @workgroup_size(8, 8)
 fn gather(@builtin(global_invocation_id) gid: vec3u) {
     let px = gid.xy;
@@ -108,7 +103,7 @@ fn gather(@builtin(global_invocation_id) gid: vec3u) {
                 prior = vec4f(c.rgb, min(c.a, cache.prior_frames));
                 m2 = cache_centroids[slot].w;
             }
-            if traced_now(px) {
+            if traced_this_frame(px) {
                 var rng = rng_init(px.y * frame.size.x + px.x, frame.index, params.seed ^ 0x63616368u);
                 let u = vec3f(rand(&rng), rand(&rng), rand(&rng));
                 slot = cache_claim(key);
@@ -145,13 +140,7 @@ fn matte_light_at(s: Surface, rd: vec3f, cone_width: f32, rng: ptr<function, u32
             }
         }
     }
-    let wl = cosine_hemisphere(rand2(rng));
-    let wi = basis * wl;
-    if dot(wi, s.ng) > 0.0 {
-        let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), wl.z * INV_PI));
-        matte += trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone), rng).radiance;
-    }
-    return matte;
+    return matte + matte_path(basis, origin, s.ng, cone_width, nee_select, rng);
 }
 
 @compute @workgroup_size(8, 8)

@@ -73,7 +73,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // output is 32-bit for that). The store is under a uniform branch: lavapipe (Mesa 22.3)
     // crashes on a storage store under a branch that diverges on a float comparison.
     if level.feedback != 0u {
-        let feed = !missing && traced(p) && age < pp.feedback_samples;
+        let feed = !missing && traced_this_frame(vec2u(p)) && age < pp.feedback_samples;
         textureStore(out_history, p, vec4f(select(c.rgb, filtered, feed), 1.0));
     }
 }

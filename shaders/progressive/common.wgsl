@@ -37,12 +37,6 @@ var<uniform> pp: ProgressiveParams;
 // Linear depth, its screen-space gradient and the octahedral normal (progressive/features).
 var features: texture_2d<f32>;
 
-// Whether pixel p was traced this frame (realtime/frame.wgsl: scheduled_pixel).
-fn traced(p: vec2i) -> bool {
-    let q = vec2u(p);
-    return frame.period <= 1u || all(scheduled_pixel(q / schedule_tile()) == q);
-}
-
 // Dundr's luminance (§4.2: 0.299 R + 0.587 G + 0.114 B).
 fn luma(c: vec3f) -> f32 {
     return dot(c, vec3f(0.299, 0.587, 0.114));

@@ -17,7 +17,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !in_bounds(p) {
         return;
     }
-    let sampled = traced(p);
+    let sampled = traced_this_frame(vec2u(p));
     let current = half_safe(signal_input(p));
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);

@@ -1,6 +1,7 @@
-// The area lights of the real-time trace's next-event estimate (emissive triangles and the
-// environment; punctual lights are evaluated exhaustively into `direct`), shared by the trace
-// (realtime/trace.wgsl) and the radiance cache's secondary samples (cache/update.wgsl).
+// What the real-time trace's matte estimate is made of, shared by the trace
+// (realtime/trace.wgsl) and the radiance cache's secondary samples (cache/update.wgsl): the
+// area lights of its next-event estimate (emissive triangles and the environment; punctual
+// lights are evaluated exhaustively into `direct`) and its cosine-sampled matte path.
 
 fn area_groups() -> u32 {
     return select(0u, 1u, HAS_EMITTERS) + select(0u, 1u, HAS_ENV);
@@ -19,4 +20,17 @@ fn sample_area_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
     s.li *= f32(n);
     s.pdf /= f32(n);
     return s;
+}
+
+// One cosine-sampled matte path (Mara et al. 2017, eq. (6)) from `origin` on a surface with
+// shading frame `basis` and geometric normal ng; 0 where the direction falls below the
+// geometric surface. Cosine sampling cancels eq. (7)'s cos / pi: the throughput starts at 1.
+fn matte_path(basis: mat3x3f, origin: vec3f, ng: vec3f, cone_width: f32, nee_select: f32, rng: ptr<function, u32>) -> vec3f {
+    let wl = cosine_hemisphere(rand2(rng));
+    let wi = basis * wl;
+    if dot(wi, ng) <= 0.0 {
+        return vec3f(0.0);
+    }
+    let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), wl.z * INV_PI));
+    return trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone), rng).radiance;
 }

@@ -74,6 +74,11 @@ fn scheduled_pixel(t: vec2u) -> vec2u {
     return t * schedule_tile() + c;
 }
 
+// Whether pixel px was traced this frame (every pixel at one sample per pixel).
+fn traced_this_frame(px: vec2u) -> bool {
+    return frame.period <= 1u || all(scheduled_pixel(px / schedule_tile()) == px);
+}
+
 // A clip-space position in pixels of this frame's image (x right, y down): motion vectors
 // compare two of them.
 fn to_pixels(clip: vec4f) -> vec2f {

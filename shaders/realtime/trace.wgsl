@@ -116,14 +116,7 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
         }
 
         if has_matte {
-            // Cosine sampling cancels eq. (7)'s cos / pi: the path's throughput starts at 1.
-            let wl = cosine_hemisphere(rand2(rng));
-            let wi = basis * wl;
-            if dot(wi, s.ng) > 0.0 {
-                let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), wl.z * INV_PI));
-                let r = trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone), rng);
-                matte += r.radiance;
-            }
+            matte += matte_path(basis, origin, s.ng, cone_width, nee_select, rng);
         } else {
             // Keep the random sequence of the glossy path independent of the material.
             rand2(rng);

@@ -197,8 +197,6 @@ pub struct RadianceCache {
     resolve: Option<Pass>,
     /// The frame the cache last ran in: a gap means its cells are stale.
     last_frame: Option<u32>,
-    /// Bumped when the table is remade (its bind groups then are too).
-    generation: usize,
 }
 
 /// What the gather and secondary passes read and write.
@@ -257,7 +255,6 @@ impl RadianceCache {
         let remade = self.cells.as_ref().is_none_or(|c| c.log2 != log2);
         if remade {
             self.cells = Some(CacheCells::new(gpu, log2));
-            self.generation += 1;
             self.last_frame = None;
         }
         if let Some(c) = &self.cells {
@@ -286,7 +283,6 @@ impl RadianceCache {
             cells.clear(rec.enc);
         }
         self.last_frame = Some(index);
-        let key = BindKey { levels: self.generation, ..key };
         let gpu = rec.gpu;
         let moving = i.scene.moving as usize;
         let p = super::chain::made(&mut self.programs[moving], || {
