@@ -102,6 +102,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             hist = half_safe(load_taps(history, b, passing_weights(b, ok)).rgb);
             n = resampled_length(n, prev, gp.resampled_history_frames);
         }
+        n = rescaled_length(n - 1.0) + 1.0;
         own = select(0.0, 1.0, all(r.texel == p) && (!r.bilinear || all(prev == vec2f(p) + 0.5)));
         var clipped = hist;
         if gstage_on(GSTAGE_CLIPPING) && roughness < gp.clip_roughness {

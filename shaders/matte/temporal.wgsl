@@ -12,7 +12,8 @@
 // 1 / still_frames): the history is then a true mean and converges to the reference. The
 // reason texture carries n above its 8 flag bits. A history resampled
 // between texels (the surface moved on screen) is a little blurred each time, and counts as at
-// most resampled_history_frames, so that motion's blur fades within a few frames of a stop.
+// most resampled_history_frames, so that motion's blur fades within a few frames of a stop; so
+// does every history on the frame after a change of size (realtime/rescale.wgsl).
 
 var prev_depth: texture_depth_2d;
 var history: texture_2d<f32>;
@@ -77,6 +78,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         } else {
             reason |= REASON_NEIGHBOUR;
         }
+        n = rescaled_length(n - 1.0) + 1.0;
         var clamped = hist;
         if dn.clamp_sigma > 0.0 {
             // The current neighbourhood's mean and standard deviation: the paper's 3x3, plus 24

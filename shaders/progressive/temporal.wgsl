@@ -39,6 +39,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             mom = textureLoad(moments, p, 0);
             found = mom.z >= 1.0;
         }
+        // After a change of size the history was resampled (realtime/rescale.wgsl).
+        mom.z = rescaled_length(mom.z);
     }
     var light = hist;
     if sampled {

@@ -29,9 +29,22 @@ struct Frame {
     period: u32,
     // Primary samples per pixel of the traced primaries (realtime/primaries.wgsl); 0: raster.
     primary_samples: u32,
+    // On the first frame after a change of size whose histories were resampled to it
+    // (realtime/rescale.wgsl): the most frames a history may count (0 on every other frame).
+    rescaled_frames: f32,
 }
 
 var<uniform> frame: Frame;
+
+// Frames `n` of a history as a temporal stage counts them: on the first frame after a change of
+// size, whose histories were resampled to it (blurred by the resampling), at most
+// frame.rescaled_frames, so that the new size's samples replace them within a few frames.
+fn rescaled_length(n: f32) -> f32 {
+    if frame.rescaled_frames > 0.0 {
+        return min(n, frame.rescaled_frames);
+    }
+    return n;
+}
 
 // Sub-1-spp tracing (Dundr et al. §5; engine/src/frame/schedule.rs, which documents and tests
 // it): with period N = 2^k the image is cut into 2^ceil(k/2) x 2^floor(k/2) tiles and each

@@ -89,7 +89,14 @@ struct Integrated {
     moments: vec4f,
 }
 
-fn integrate(current: vec3f, history: vec3f, moments: vec4f, reprojected: bool) -> Integrated {
+fn integrate(current: vec3f, history: vec3f, moments_in: vec4f, reprojected: bool) -> Integrated {
+    // After a change of size the history was resampled (realtime/rescale.wgsl): it counts as
+    // at most frame.rescaled_frames, and its light's variance as that many frames' mean.
+    var moments = moments_in;
+    let h_cap = rescaled_length(moments.z);
+    if h_cap < moments.z {
+        moments = vec4f(moments.xy, h_cap, max(moments.w, 1.0 / h_cap));
+    }
     let l = luminance(current);
     let now = vec2f(l, l * l);
     if !reprojected {

@@ -155,6 +155,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let weight_floor = select(dn.taa_alpha, min(dn.taa_alpha, 1.0 / max(dn.taa_still_frames, 1.0)), settled);
         // A negative length marks a history last resampled or clamped.
         var n_prev = select(texel.a, 1.0, texel.a != texel.a);
+        // After a change of size every history was resampled (realtime/rescale.wgsl): TAA's
+        // counts as one resampled between texels.
+        if frame.rescaled_frames > 0.0 {
+            n_prev = -abs(n_prev);
+        }
         if n_prev < 0.0 {
             n_prev = -n_prev;
             if settled && dn.taa_resampled_frames > 0.0 {

@@ -105,6 +105,11 @@ pub struct Renderer {
     /// Deforming meshes posed on the GPU (None: the scene has none, or they are posed on the
     /// CPU).
     posing: Option<crate::gpu::posing::GpuPosing>,
+    /// The targets of the last size rendered, after a resize and until the next frame
+    /// resamples their histories into the new ones (passes/rescale.rs).
+    rescale_from: Option<Targets>,
+    /// What the last resampling carried across a change of size.
+    last_rescale: crate::passes::rescale::Rescaled,
 }
 
 impl PreparedScene {
@@ -195,6 +200,7 @@ impl Renderer {
             primaries: Primaries::default(),
             prefilter: Prefilter::default(),
             cache: RadianceCache::default(),
+            rescale: Default::default(),
         };
         let mut r = Renderer {
             scene,
@@ -208,6 +214,8 @@ impl Renderer {
             timer: GpuTimer::new(gpu, TIMED_PASSES),
             async_timings: false,
             posing: None,
+            rescale_from: None,
+            last_rescale: Default::default(),
         };
         r.set_gpu_posing(gpu, true)?;
         log::info!("{}", r.report());
@@ -287,18 +295,33 @@ impl Renderer {
         self.targets.memory.total_bytes() as f64 / (w as f64 * h as f64)
     }
 
+    /// Render at `size` from the next frame on. Where `FrameSettings::resample_history_frames`
+    /// is above 0 (the default) and a denoiser runs, that frame resamples every history to the
+    /// new size (passes/rescale.rs); else the histories restart.
     pub fn resize(&mut self, gpu: &Gpu, size: (u32, u32)) -> Result<()> {
         check_size(size)?;
         if size == self.targets.size {
             return Ok(());
         }
         let t = &self.targets;
-        self.targets =
+        let new =
             Targets::new(gpu, size, self.prepared.features.glossy, t.epoch + 1, t.generation + 1);
-        // The frame count goes on (jitter sequences, seeds); everything about the last frame's
-        // pixels is gone.
-        self.history = FrameHistory { frame_index: self.history.frame_index, ..Default::default() };
+        let old = std::mem::replace(&mut self.targets, new);
+        // Resized again before a frame: the histories are still the first size's.
+        if self.rescale_from.as_ref().is_none_or(|r| r.size == size) {
+            self.rescale_from = (old.size != size).then_some(old);
+        }
+        // The accumulation restarts (its buffer is new); the cameras stay until the next frame
+        // decides whether its histories are resampled.
+        let h = &mut self.history;
+        (h.accumulated, h.accumulated_state) = (0, None);
         Ok(())
+    }
+
+    /// What the last resampling of the histories carried across a change of size: the labels
+    /// of the textures resampled, and of those no pass could write.
+    pub fn last_rescale(&self) -> &crate::passes::rescale::Rescaled {
+        &self.last_rescale
     }
 
     /// Near plane: 2^-14 of the scene's extent (reversed Z keeps depth precise far beyond it).

@@ -31,6 +31,10 @@ pub struct FrameParams {
     /// Primary samples per pixel k of the traced primaries (realtime/primaries.wgsl), where a
     /// thin lens makes the primary hit random; 0: the raster's G-buffer.
     pub primary_samples: u32,
+    /// On the first frame after a change of size whose histories were resampled to it
+    /// (passes/rescale.rs): the most frames a history may count; 0 on every other frame.
+    pub rescaled_frames: f32,
+    pub _pad: [u32; 3],
 }
 
 impl FrameParams {
@@ -71,6 +75,8 @@ impl FrameParams {
             },
             period: if accumulated > 0 { 1 } else { settings.sample_fraction.period() },
             primary_samples: 0,
+            rescaled_frames: 0.0,
+            _pad: [0; 3],
         }
     }
 }

@@ -62,6 +62,14 @@ impl Renderer {
         let _setup = crate::profile::scope("upload");
         self.update_accumulation(gpu, input, settings);
         let denoiser = self.denoiser_for(gpu, settings)?;
+        // After a resize: the histories are resampled to the new size where the settings ask
+        // for it and a denoiser keeps them, else every one restarts.
+        let resample = settings.resample_history_frames > 0.0 && denoiser.is_some();
+        if self.rescale_from.is_some() && !resample {
+            self.rescale_from = None;
+            let h = &mut self.history;
+            *h = super::FrameHistory { frame_index: h.frame_index, ..Default::default() };
+        }
         if denoiser.is_some() {
             let t = &mut self.targets;
             if self.stages.taa.allocate(gpu, &mut t.memory, t.size, t.epoch) {
@@ -293,6 +301,9 @@ impl Renderer {
             representative,
         );
         fp.primary_samples = primary_samples;
+        if self.rescale_from.is_some() {
+            fp.rescaled_frames = settings.resample_history_frames;
+        }
         let trace_view = TraceView {
             camera: input.camera,
             width: size.0,

@@ -13,6 +13,7 @@ use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
 use crate::passes::prefilter::Prefilter;
 use crate::passes::primaries::Primaries;
+use crate::passes::rescale::Rescale;
 use crate::passes::supersample::Supersample;
 use crate::passes::taa::TaaStage;
 use crate::passes::trace::{self, SceneInputs, TraceInputs, TracePass};
@@ -32,6 +33,7 @@ pub(super) struct Stages {
     pub primaries: Primaries,
     pub prefilter: Prefilter,
     pub cache: RadianceCache,
+    pub rescale: Rescale,
 }
 
 /// What the next frame needs of the ones before it.
@@ -61,6 +63,8 @@ impl Renderer {
         // "Renderer>::record_frame".
         puffin::profile_scope!("Renderer::record_frame");
         let plan = self.plan(gpu, input, settings, target)?;
+        // Kept until the frame is submitted: its textures are read by the resampling.
+        let rescale_from = self.rescale_from.take();
         let encode = crate::profile::scope("encode");
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let moving = self.prepared.shutter_moves();
@@ -72,12 +76,17 @@ impl Renderer {
             denoisers,
             timer,
             posing,
+            last_rescale,
             ..
         } = self;
         if let Some(t) = timer.as_mut() {
             t.begin_frame();
         }
         let mut rec = Recorder::new(gpu, &mut enc, timer.as_mut());
+        if let Some(old) = rescale_from.as_ref() {
+            let from = (&old.memory, old.previous.as_ref());
+            *last_rescale = s.rescale.record(&mut rec, from, (&t.memory, t.previous.as_ref()))?;
+        }
         if let Some(p) = posing.as_mut() {
             p.record(&mut rec, gpu_scene);
         }
@@ -100,6 +109,7 @@ impl Renderer {
         }
         drop(encode);
         self.submit(gpu, enc, &plan);
+        drop(rescale_from);
         Ok(())
     }
 

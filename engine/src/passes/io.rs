@@ -99,9 +99,12 @@ pub struct PreviousGBuffer {
 
 impl PreviousGBuffer {
     pub fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> PreviousGBuffer {
+        // RENDER_ATTACHMENT: a change of size draws the old one's nearest texels into it
+        // (passes/rescale.rs).
         let usage = wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_DST
-            | wgpu::TextureUsages::COPY_SRC;
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::RENDER_ATTACHMENT;
         PreviousGBuffer {
             depth: mem.texture(
                 device,

@@ -15,6 +15,7 @@ pub mod io;
 pub mod matte;
 pub mod prefilter;
 pub mod primaries;
+pub mod rescale;
 pub mod schedule;
 pub mod supersample;
 pub mod taa;

@@ -98,6 +98,13 @@ const FRAME_FIELDS: &[Field] = &[
         "Ray cones choose each texture's mip level after the primary hit: an indirect ray reads the mean of its footprint, not one texel (less noise, same converged image).",
     ),
     f(
+        "resample_history_frames",
+        "frame/rescale",
+        "frames",
+        Float(0.0, 1024.0, 1.0),
+        "A change of size (resolution scale, window) resamples the histories to the new size, each then counting as at most this many frames; 0 restarts them.",
+    ),
+    f(
         "sample_fraction",
         "trace",
         "",

@@ -93,6 +93,13 @@ pub struct FrameSettings {
     /// Costs a triangle's texture-coordinate area at each textured secondary hit. Off reads the
     /// finest level everywhere.
     pub texture_lod: bool,
+    /// A change of the frame's size (the governor's resolution scale, a window resize)
+    /// resamples every history to the new size (passes/rescale.rs) instead of restarting it,
+    /// and each temporal stage then counts it as at most this many frames: a still view keeps
+    /// what it had accumulated, and the new size's samples replace its blur (more: a better
+    /// first frame after the change, a longer-lived blur). Costs one pass per history texture
+    /// on the frame after the change. 0: every history restarts from one sample.
+    pub resample_history_frames: f32,
     /// The settings of denoisers an application registered, by their section's name: `[name]`
     /// in a preset, `name.field` in a field path ([`registry::Section`]).
     #[serde(flatten)]
@@ -146,6 +153,7 @@ impl FrameSettings {
             cache: CacheSettings::default(),
             paths_per_pixel: 1,
             texture_lod: true,
+            resample_history_frames: 4.0,
             samples_per_pixel: 1,
             sample_fraction: SampleFraction::ONE,
             primary_samples: DEFAULT_PRIMARY_SAMPLES,

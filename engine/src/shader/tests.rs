@@ -104,6 +104,17 @@ fn all_programs() -> Vec<Program> {
         ];
         v.push(compose("realtime/display.wgsl", "", &display).unwrap());
     }
+    for (format, main) in [
+        ("rgba32float", "realtime/rescale_float.wgsl"),
+        ("r32float", "realtime/rescale_float.wgsl"),
+        ("r32uint", "realtime/rescale_uint.wgsl"),
+        ("rg32uint", "realtime/rescale_uint.wgsl"),
+    ] {
+        let prelude = format!("alias Dst = texture_storage_2d<{format}, write>;\n");
+        v.push(compose(main, &prelude, &["realtime/rescale.wgsl", main]).unwrap());
+    }
+    let gbuffer = ["realtime/rescale.wgsl", "realtime/rescale_gbuffer.wgsl"];
+    v.push(compose("realtime/rescale_gbuffer.wgsl", "", &gbuffer).unwrap());
     for motion in [
         "realtime/motion_static.wgsl",
         "realtime/motion_objects.wgsl",
