@@ -242,6 +242,7 @@ impl Running {
         }
         g.target_ms = p.governor.target_ms;
         g.still_ratio = p.governor.still_ratio;
+        g.keeps_history = p.settings.resample_history_frames > 0.0;
         g.pinned_scale = p.governor.pin_scale.then_some(p.resolution_scale);
         g.pinned_fraction = p.governor.pin_fraction.then_some(p.settings.sample_fraction);
         g.fractions_allowed =

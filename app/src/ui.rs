@@ -121,7 +121,7 @@ impl Panel {
                     .text("still view: x target")
                     .suffix("x"),
             )
-            .on_hover_text("While the camera stands still the samples accumulate, so the governor picks the sample fraction that traces the most samples per second, letting a frame take up to this multiple of the target: a larger one converges sooner, and a move waits longer for the frame in flight. 1 holds the target.");
+            .on_hover_text("While the camera stands still the samples accumulate, so the governor picks the sample fraction that traces the most samples per second, letting a frame take up to this multiple of the target, and (where the histories are resampled across a change of size) raises the resolution a step each time the pixels have gathered 4 samples: a larger multiple converges sooner and sharper, and a move waits longer for the frame in flight. 1 holds the target.");
             ui.horizontal(|ui| {
                 ui.checkbox(&mut g.pin_scale, "pin scale");
                 ui.checkbox(&mut g.pin_fraction, "pin sample fraction");

@@ -268,6 +268,7 @@ fn governed(
     g.min_scale = min_scale;
     g.pinned_fraction = pinned;
     g.fractions_allowed = r.fills_untraced_pixels(gpu, settings)?;
+    g.keeps_history = settings.resample_history_frames > 0.0;
     let mut rows = vec![];
     let mut last_camera = None;
     for (k, input) in inputs.enumerate() {

@@ -73,6 +73,10 @@ pub struct TimeToQualityArgs {
     pub seed: u32,
     #[arg(long)]
     pub out_dir: PathBuf,
+    /// Settings every run starts from (TOML, as the viewer saves); each --run's denoiser
+    /// replaces the preset's
+    #[arg(long)]
+    pub preset: Option<PathBuf>,
     #[command(flatten)]
     pub load: crate::cli::LoadArgs,
 }
@@ -192,7 +196,7 @@ pub fn run(a: TimeToQualityArgs) -> Result<()> {
         a.scenarios.iter().map(|s| Scenario::parse(s)).collect::<Result<_>>()?;
     // Before any reference is rendered: a misspelt denoiser is a clear error at once.
     for r in &runs {
-        preset_settings(None, Some(&r.denoiser), &[], None)
+        preset_settings(a.preset.as_deref(), Some(&r.denoiser), &[], None)
             .with_context(|| format!("--run {:?}", r.label))?;
     }
     if !(a.seconds > 0.0 && a.seconds <= 600.0 && a.lead_in >= 0.0 && a.lead_in <= 600.0) {
@@ -298,7 +302,7 @@ fn follow(
     view: &Camera,
     reference: &Image,
 ) -> Result<Curve> {
-    let base = preset_settings(None, Some(&run.denoiser), &[], None)
+    let base = preset_settings(a.preset.as_deref(), Some(&run.denoiser), &[], None)
         .with_context(|| format!("--run {:?}", run.label))?;
     let (samples_per_pixel, sample_fraction) = match run.spp {
         None => (1, SampleFraction::ONE),
@@ -324,6 +328,7 @@ fn follow(
         Some(t) => {
             let mut g = Governor::new(t);
             g.fractions_allowed = renderer.fills_untraced_pixels(gpu, &settings)?;
+            g.keeps_history = settings.resample_history_frames > 0.0;
             g.pinned_fraction = run.spp.map(|_| sample_fraction);
             g
         }
