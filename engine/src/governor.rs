@@ -333,13 +333,22 @@ impl Governor {
         let want = fits(self, budget).unwrap_or(smallest);
         let cur = self.choice();
         self.limit_ms = budget;
-        // Without resampled histories a young still view may still rise as a moving one does
-        // (below); with them, still_rise decides every rise.
-        let young_rise = want.scale > cur.scale && self.scale_frames < YOUNG_FRAMES;
-        if !moving && self.still() && (self.keeps_history || !young_rise) {
+        // Rise after RISE_FRAMES frames that would fit the larger scale with room; on a still
+        // view without resampled histories only while the history at this scale is young: a
+        // rise restarts every history, which on a settled view trades converged light for a
+        // noisy image (time-to-quality, level 320x180: FLIP 0.156 -> 0.499 at a rise 0.84 s
+        // after a stop, back to 0.156 only after 3.6 s), while a scale chosen from the first
+        // frames (a shader compile) must not stay until the camera moves.
+        let rises = want.scale > cur.scale && {
+            let young = moving || (!self.keeps_history && self.scale_frames < YOUNG_FRAMES);
+            let roomy = young && fits(self, 0.8 * budget).is_some_and(|c| c.scale > cur.scale);
+            self.room_frames = if roomy { self.room_frames + 1 } else { 0 };
+            self.room_frames >= RISE_FRAMES
+        };
+        if !moving && self.still() && !rises {
             // A still view rises a step where its history comes along (resampled), else keeps
-            // its scale (a fall or a rise would restart every history), at the fraction that
-            // traces the most samples per second within the still limit.
+            // its scale, at the fraction that traces the most samples per second within the
+            // still limit.
             let limit = budget.max(self.still_ratio * self.target_ms);
             if let Some(rise) = self.still_rise(cur.scale, limit) {
                 self.room_frames = 0;
@@ -347,28 +356,16 @@ impl Governor {
                 return rise;
             }
             if let Some(fraction) = self.still_fraction(cur.scale, limit) {
-                self.room_frames = 0;
                 self.limit_ms = limit;
                 return Choice { scale: cur.scale, fraction };
             }
         }
-        if want.scale > cur.scale {
-            // Rise after RISE_FRAMES frames that would fit the larger scale with room, and on a
-            // still view only while the history at this scale is young: a rise restarts every
-            // history, which on a settled view trades converged light for a noisy image
-            // (time-to-quality, level 320x180: FLIP 0.156 -> 0.499 at a rise 0.84 s after a
-            // stop, back to 0.156 only after 3.6 s), while a scale chosen from the first
-            // frames (a shader compile) must not stay until the camera moves.
-            let roomy = (moving || self.scale_frames < YOUNG_FRAMES)
-                && fits(self, 0.8 * budget).is_some_and(|c| c.scale > cur.scale);
-            self.room_frames = if roomy { self.room_frames + 1 } else { 0 };
-            if self.room_frames < RISE_FRAMES {
-                let fraction = self
-                    .best_fraction(cur.scale, budget, floor(moving))
-                    .or_else(|| self.best_fraction(cur.scale, budget, u32::MAX))
-                    .unwrap_or(smallest.fraction);
-                return Choice { scale: cur.scale, fraction };
-            }
+        if want.scale > cur.scale && !rises {
+            let fraction = self
+                .best_fraction(cur.scale, budget, floor(moving))
+                .or_else(|| self.best_fraction(cur.scale, budget, u32::MAX))
+                .unwrap_or(smallest.fraction);
+            return Choice { scale: cur.scale, fraction };
         }
         self.room_frames = 0;
         want
@@ -511,20 +508,24 @@ mod tests {
 
     #[test]
     fn a_slow_first_frame_does_not_hold_a_still_view_at_a_small_scale() {
-        let mut g = Governor::new(100.0);
-        // The first frame compiles its shaders: 20 times its later cost.
-        let c = g.choice();
-        g.record(FrameCost {
-            wall_ms: 1200.0,
-            trace_ms: 0.0,
-            scaled_ms: 0.0,
-            choice: c,
-            moving: false,
-        });
-        assert!(g.choice().scale < 0.5);
-        // A step each STILL_RISE_SAMPLES frames: six steps from 0.25.
-        let frames = run(&mut g, 60.0, 0.0, 30, false);
-        assert_eq!(frames.last().unwrap().0.scale, 1.0, "{frames:?}");
+        for keeps_history in [true, false] {
+            let mut g = Governor::new(100.0);
+            g.keeps_history = keeps_history;
+            // The first frame compiles its shaders: 20 times its later cost.
+            let c = g.choice();
+            g.record(FrameCost {
+                wall_ms: 1200.0,
+                trace_ms: 0.0,
+                scaled_ms: 0.0,
+                choice: c,
+                moving: false,
+            });
+            assert!(g.choice().scale < 0.5);
+            // Resampled: a step each STILL_RISE_SAMPLES frames, six steps from 0.25. Restarted:
+            // the young scale rises at once after RISE_FRAMES frames with room.
+            let frames = run(&mut g, 60.0, 0.0, 30, false);
+            assert_eq!(frames.last().unwrap().0.scale, 1.0, "{keeps_history} {frames:?}");
+        }
     }
 
     #[test]
