@@ -70,10 +70,12 @@ fn cpu_rescale(old: &[f32], depth: &[f32], from: (u32, u32), to: (u32, u32)) -> 
     out
 }
 
-/// Mara, still camera, 12 frames at 64x36, then one at 96x54. The history half this frame did
-/// not write holds the old one resampled, as the CPU computes it; the last frame's depth, normal
-/// and ids came along, so the still view's surface pixels keep their history (a restart would
-/// mark every one disoccluded) with its length capped at resampled_history_frames.
+/// Mara, still camera, 12 frames at 64x36, then one at 96x54 (resized through 80x45 without a
+/// frame there). The history half this frame did not write holds the 64x36 one resampled, as
+/// the CPU computes it; the last frame's depth, normal and ids came along, so the still view's
+/// surface pixels keep their history (a restart would mark every one disoccluded) with its
+/// length capped at resample_history_frames. A round trip of sizes between two frames leaves
+/// the histories as they were.
 #[test]
 fn a_history_is_resampled_from_its_surface_and_kept() {
     let (from, to) = ((64, 36), (96, 54));
@@ -90,6 +92,14 @@ fn a_history_is_resampled_from_its_surface_and_kept() {
         u32s(&r.read_texture(&gpu, "matte/reason").unwrap().0).iter().map(|v| v >> 8).collect();
     assert!(lengths_before.iter().filter(|n| **n >= 12).count() > 1000, "the histories grew");
 
+    // Resized and back before a frame: the same targets, histories untouched.
+    r.resize(&gpu, to).unwrap();
+    r.resize(&gpu, from).unwrap();
+    let again: Vec<Vec<f32>> =
+        (0..2).map(|i| texture_f32(&gpu, &r, &format!("matte/history {i}"))).collect();
+    assert!(again == old, "a round trip of sizes changed the histories");
+    // Through a size never drawn: resampled from the last size drawn.
+    r.resize(&gpu, (80, 45)).unwrap();
     r.resize(&gpu, to).unwrap();
     r.render(&gpu, &input(), &s, None).unwrap();
     let done = r.last_rescale();

@@ -303,18 +303,24 @@ impl Renderer {
         if size == self.targets.size {
             return Ok(());
         }
-        let t = &self.targets;
-        let new =
-            Targets::new(gpu, size, self.prepared.features.glossy, t.epoch + 1, t.generation + 1);
-        let old = std::mem::replace(&mut self.targets, new);
-        // Resized again before a frame: the histories are still the first size's.
-        if self.rescale_from.as_ref().is_none_or(|r| r.size == size) {
-            self.rescale_from = (old.size != size).then_some(old);
-        }
         // The accumulation restarts (its buffer is new); the cameras stay until the next frame
         // decides whether its histories are resampled.
         let h = &mut self.history;
         (h.accumulated, h.accumulated_state) = (0, None);
+        // Back to the last size rendered before a frame ran at this one: its targets are whole.
+        if let Some(old) = self.rescale_from.take_if(|r| r.size == size) {
+            self.targets = old;
+            return Ok(());
+        }
+        let t = &self.targets;
+        let new =
+            Targets::new(gpu, size, self.prepared.features.glossy, t.epoch + 1, t.generation + 1);
+        let old = std::mem::replace(&mut self.targets, new);
+        // Resized again before a frame: the histories are still the last rendered size's, and
+        // the targets in between were never drawn.
+        if self.rescale_from.is_none() {
+            self.rescale_from = Some(old);
+        }
         Ok(())
     }
 
