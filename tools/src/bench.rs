@@ -40,6 +40,11 @@ pub struct BenchArgs {
     /// GPU's posing pass (the frame's CPU time then carries the pose, refit and upload).
     #[arg(long)]
     pub cpu_posing: bool,
+    /// Real-time mode: every frame changes the size, between WIDTHxHEIGHT and 7/8 of it, so
+    /// that each one resamples its histories to the new size (measures `frame/rescale`; the
+    /// other passes then run at the two sizes in turn).
+    #[arg(long)]
+    pub rescale: bool,
     /// Image size of the tracer benchmark.
     #[arg(long, default_value_t = 128)]
     pub width: u32,

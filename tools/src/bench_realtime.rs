@@ -105,6 +105,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             capture = Some(hush_engine::profile::Capture::start(a.frames as usize));
         }
         let input = FrameInput { camera, time: k as f64 / 60.0, shutter: None };
+        if a.rescale {
+            let shrunk = ((size.0 * 7 / 8).max(1), (size.1 * 7 / 8).max(1));
+            r.resize(&gpu, if k % 2 == 0 { size } else { shrunk })?;
+        }
         let start = Instant::now();
         {
             puffin::profile_scope!("frame");

@@ -85,7 +85,15 @@ impl Renderer {
         let mut rec = Recorder::new(gpu, &mut enc, timer.as_mut());
         if let Some(old) = rescale_from.as_ref() {
             let from = (&old.memory, old.previous.as_ref());
-            *last_rescale = s.rescale.record(&mut rec, from, (&t.memory, t.previous.as_ref()))?;
+            match s.rescale.record(&mut rec, from, (&t.memory, t.previous.as_ref())) {
+                Ok(done) => *last_rescale = done,
+                Err(e) => {
+                    // Nothing was resampled: the next frame must not read these targets as
+                    // histories.
+                    self.history.denoised_last = None;
+                    return Err(e);
+                }
+            }
         }
         if let Some(p) = posing.as_mut() {
             p.record(&mut rec, gpu_scene);
