@@ -129,8 +129,21 @@ pub fn render_pipeline(
     layout: &wgpu::PipelineLayout,
     depth_compare: wgpu::CompareFunction,
 ) -> wgpu::RenderPipeline {
+    let formats: Vec<wgpu::TextureFormat> = COLOR_FORMATS.iter().map(|(_, f)| *f).collect();
+    depth_pipeline(d, label, (module, layout), depth_compare, &formats)
+}
+
+/// A pipeline that writes colour targets of `formats` and a G-buffer depth (entry points
+/// `vs_main` and `fs_main`, both faces drawn), depth compared by `depth_compare`.
+pub fn depth_pipeline(
+    d: &wgpu::Device,
+    label: &str,
+    (module, layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
+    depth_compare: wgpu::CompareFunction,
+    formats: &[wgpu::TextureFormat],
+) -> wgpu::RenderPipeline {
     let targets: Vec<Option<wgpu::ColorTargetState>> =
-        COLOR_FORMATS.iter().map(|(_, f)| Some((*f).into())).collect();
+        formats.iter().map(|f| Some((*f).into())).collect();
     d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),

@@ -183,7 +183,16 @@ impl Rescale {
                 &["realtime/rescale.wgsl", "realtime/rescale_gbuffer.wgsl"],
                 wgpu::ShaderStages::FRAGMENT,
                 &offered,
-                move |d, module, layout| gbuffer_pipeline(d, module, layout, formats),
+                move |d, module, layout| {
+                    let always = wgpu::CompareFunction::Always;
+                    super::gbuffer::depth_pipeline(
+                        d,
+                        GBUFFER_LABEL,
+                        (module, layout),
+                        always,
+                        &formats,
+                    )
+                },
             )
         })?;
         let groups = pipeline.bind_groups(&gpu.device, &offered)?;
@@ -228,39 +237,4 @@ impl Rescale {
         }
         v
     }
-}
-
-fn gbuffer_pipeline(
-    d: &wgpu::Device,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::PipelineLayout,
-    [normal, ids]: [wgpu::TextureFormat; 2],
-) -> wgpu::RenderPipeline {
-    d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(GBUFFER_LABEL),
-        layout: Some(layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: super::gbuffer::DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(normal.into()), Some(ids.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
 }
