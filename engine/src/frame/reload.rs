@@ -25,6 +25,7 @@ impl Renderer {
         }
         v.extend(self.stages.prefilter.pipelines());
         v.extend(self.stages.cache.pipelines());
+        v.extend(self.stages.rescale.pipelines());
         for d in &mut self.denoisers {
             v.extend(d.denoiser.pipelines());
         }

@@ -129,7 +129,8 @@ impl Rescale {
                         wgpu::ShaderStages::COMPUTE,
                         &offered,
                         |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),
-                    )?;
+                    )
+                    .with_context(|| format!("making the resampling program for {wgsl}"))?;
                     e.insert(p)
                 }
             };
