@@ -14,9 +14,10 @@
 //! Written here rather than taken from a crate: it resamples the frame's own labelled textures
 //! with the frame's depth, which no general-purpose image crate sees (they run on the CPU).
 //!
-//! A resampled history is blurred by the resampling; the temporal stages count it as at most
-//! their `resampled_history_frames` (`frame.history_resampled`, realtime/frame.wgsl), so that the
-//! new size's samples replace it within a few frames.
+//! A resampled history is blurred by the resampling: on that frame the temporal stages count it
+//! as at most `FrameSettings::resample_history_frames` (`frame.rescaled_frames` and
+//! `rescaled_length` in realtime/frame.wgsl), and TAA as one history resampled between texels,
+//! so that the new size's samples replace it within a few frames.
 
 use super::io::PreviousGBuffer;
 use crate::gpu::{Bindings, GpuMemory, Recorder, set_compute_groups, set_render_groups};
