@@ -100,8 +100,9 @@ pub struct FrameSettings {
     /// first frame after the change, a longer-lived blur). The level scaled 2x after 24 still
     /// frames, relMSE of the first frame: Mara 0.064 (0.632 restarted), SVGF 0.052 (0.090); 16
     /// frames on, the progressive filter 0.028 against 0.025 restarted (the blur kept); a cap
-    /// of 8 is worse from frame 4 on. Costs one pass per history texture on the frame after the
-    /// change (0.8-0.95 ms on an H200 at 1280x720). 0: every history restarts from one sample.
+    /// of 8 is better only in SVGF's first two frames. Costs one pass per history texture on
+    /// the frame after the change (0.8-0.95 ms on an H200 at 1280x720). 0: every history
+    /// restarts from one sample.
     pub resample_history_frames: f32,
     /// The settings of denoisers an application registered, by their section's name: `[name]`
     /// in a preset, `name.field` in a field path ([`registry::Section`]).
