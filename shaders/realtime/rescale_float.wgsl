@@ -1,16 +1,9 @@
-// A float history at the new size (realtime/rescale.wgsl). The prelude aliases
-// `Dst`, a write-only storage texture of the history's format.
+// A float history at the new size (realtime/rescale.wgsl, entry point in rescale_main.wgsl):
+// bilinear over the old texels on the nearest one's surface.
 
 var old: texture_2d<f32>;
-var dst: Dst;
 
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
-    let size = textureDimensions(dst);
-    if any(gid.xy >= size) {
-        return;
-    }
-    let t = rescale_taps(vec2i(gid.xy), textureDimensions(old), size);
+fn rescale_texel(t: RescaleTaps) -> vec4f {
     var v = vec4f(0.0);
     for (var i = 0; i < 4; i++) {
         // Skipped, not multiplied by 0: a zero weight on a non-finite texel would still be NaN.
@@ -18,5 +11,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             v += t.w[i] * textureLoad(old, t.texel[i], 0);
         }
     }
-    textureStore(dst, vec2i(gid.xy), v);
+    return v;
 }

@@ -126,7 +126,7 @@ impl Rescale {
                         gpu,
                         LABEL,
                         &prelude,
-                        &["realtime/rescale.wgsl", main],
+                        &["realtime/rescale.wgsl", main, "realtime/rescale_main.wgsl"],
                         wgpu::ShaderStages::COMPUTE,
                         &offered,
                         |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),

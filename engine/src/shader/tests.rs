@@ -111,7 +111,8 @@ fn all_programs() -> Vec<Program> {
         ("rg32uint", "realtime/rescale_uint.wgsl"),
     ] {
         let prelude = format!("alias Dst = texture_storage_2d<{format}, write>;\n");
-        v.push(compose(main, &prelude, &["realtime/rescale.wgsl", main]).unwrap());
+        let m = ["realtime/rescale.wgsl", main, "realtime/rescale_main.wgsl"];
+        v.push(compose(main, &prelude, &m).unwrap());
     }
     let gbuffer = ["realtime/rescale.wgsl", "realtime/rescale_gbuffer.wgsl"];
     v.push(compose("realtime/rescale_gbuffer.wgsl", "", &gbuffer).unwrap());
