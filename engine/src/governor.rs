@@ -44,12 +44,11 @@ pub const RISE_FRAMES: u32 = 8;
 pub const YOUNG_FRAMES: u32 = 16;
 /// Samples per pixel a still view gathers at one scale before it rises a step (where the
 /// histories are resampled): as many as a resampled history counts by default
-/// (`resample_history_frames`). Time to quality on the level at 320x180 and 100 ms, FLIP 2 / 5 s
-/// after a stop and after a cut, mean of 3 runs: 4 samples 0.138 / 0.106 and 0.169 / 0.110; 2
-/// samples 0.143 / 0.105 and 0.178 / 0.118; 8 samples 0.134 / 0.108 and 0.181 / 0.120; rising
-/// straight to the largest scale with a fraction of 1/8 after 8 samples 0.131 / 0.099 and
-/// 0.190 / 0.120 (after 4: 0.151 / 0.126 and 0.200 / 0.141); histories restarted and the scale
-/// kept, as before, 0.155 / 0.140 and 0.290 / 0.125.
+/// (`resample_history_frames`). Fewer rise sooner onto blurrier carried histories, more hold
+/// the smaller scale longer. Time to quality on the level at 320x180 and 100 ms, FLIP 2 / 5 s:
+/// 0.135 / 0.105 after a stop and 0.169 / 0.110 after a cut (with the scale kept and histories
+/// restarted, 0.142 / 0.120 and 0.199 / 0.128; docs/decisions.md measures 2, 8 and a jump to
+/// the largest scale).
 pub const STILL_RISE_SAMPLES: f64 = 4.0;
 
 /// A frame over this multiple of its limit counts towards a lasting overload.

@@ -255,24 +255,6 @@ fn load_bilinear(t: texture_2d<f32>, at: vec2f) -> vec4f {
     return load_taps(t, b, b.w);
 }
 
-// The four texels a bilinear read at `at` blends, base + (0,0), (1,0), (0,1), (1,1), and their
-// weights in that order.
-struct BilinearTaps {
-    base: vec2i,
-    w: vec4f,
-}
-
-fn bilinear_taps(at: vec2f) -> BilinearTaps {
-    let f = at - 0.5;
-    let t = f - floor(f);
-    let s = 1.0 - t;
-    return BilinearTaps(vec2i(floor(f)), vec4f(s.x * s.y, t.x * s.y, s.x * t.y, t.x * t.y));
-}
-
-fn bilinear_tap(b: BilinearTaps, k: i32) -> vec2i {
-    return b.base + vec2i(k & 1, k >> 1);
-}
-
 // The taps of `b` read with weights `w` (which sum to 1), edges clamped.
 fn load_taps(t: texture_2d<f32>, b: BilinearTaps, w: vec4f) -> vec4f {
     let hi = vec2i(frame.size) - 1;

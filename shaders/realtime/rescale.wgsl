@@ -19,21 +19,16 @@ struct RescaleTaps {
 const RESCALE_DEPTH_TOLERANCE: f32 = 0.02;
 
 fn rescale_taps(p: vec2i, old_size: vec2u, new_size: vec2u) -> RescaleTaps {
-    // Old texel coordinates of the new texel's centre (old texel centres at integers).
-    let at = (vec2f(p) + 0.5) * vec2f(old_size) / vec2f(new_size) - 0.5;
-    let base = floor(at);
-    let f = at - base;
+    // The new texel's centre in the old texture's pixel coordinates (centres at +0.5).
+    let at = (vec2f(p) + 0.5) * vec2f(old_size) / vec2f(new_size);
+    let b = bilinear_taps(at);
     let hi = vec2i(old_size) - 1;
-    let b = vec2i(base);
     var t: RescaleTaps;
-    t.texel = array<vec2i, 4>(
-        clamp(b, vec2i(0), hi),
-        clamp(b + vec2i(1, 0), vec2i(0), hi),
-        clamp(b + vec2i(0, 1), vec2i(0), hi),
-        clamp(b + vec2i(1, 1), vec2i(0), hi),
-    );
-    t.w = vec4f((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-    t.nearest = clamp(vec2i(floor(at + 0.5)), vec2i(0), hi);
+    for (var k = 0; k < 4; k++) {
+        t.texel[k] = clamp(bilinear_tap(b, k), vec2i(0), hi);
+    }
+    t.w = b.w;
+    t.nearest = clamp(vec2i(floor(at)), vec2i(0), hi);
     if all(textureDimensions(old_depth) == old_size) {
         let ref_depth = textureLoad(old_depth, t.nearest, 0);
         for (var i = 0; i < 4; i++) {

@@ -258,7 +258,7 @@ pub fn modules(
     if glossy {
         m.push("realtime/glossy_in.wgsl");
     }
-    m.push("matte/common.wgsl");
+    m.extend(["common/bilinear.wgsl", "matte/common.wgsl"]);
     m.push(motion.module());
     m.extend(["progressive/common.wgsl", signal.module(), stage]);
     m

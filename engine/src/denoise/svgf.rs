@@ -229,7 +229,7 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
     if glossy {
         m.push("realtime/glossy_in.wgsl");
     }
-    m.push("matte/common.wgsl");
+    m.extend(["common/bilinear.wgsl", "matte/common.wgsl"]);
     if glossy {
         m.push("glossy/common.wgsl");
     }

@@ -181,6 +181,7 @@ pub fn modules(stage: &'static str, motion: crate::gpu::Motion) -> Vec<&'static 
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
         "realtime/glossy_in.wgsl",
+        "common/bilinear.wgsl",
         "matte/common.wgsl",
         "glossy/common.wgsl",
     ];

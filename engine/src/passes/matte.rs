@@ -250,6 +250,7 @@ fn modules(kind: Kind, motion: crate::gpu::Motion, prior: &'static str) -> Vec<&
         "common/math.wgsl",
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
+        "common/bilinear.wgsl",
         "matte/common.wgsl",
     ];
     m.push(motion.module());

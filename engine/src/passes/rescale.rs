@@ -126,7 +126,12 @@ impl Rescale {
                         gpu,
                         LABEL,
                         &prelude,
-                        &["realtime/rescale.wgsl", main, "realtime/rescale_main.wgsl"],
+                        &[
+                            "common/bilinear.wgsl",
+                            "realtime/rescale.wgsl",
+                            main,
+                            "realtime/rescale_main.wgsl",
+                        ],
                         wgpu::ShaderStages::COMPUTE,
                         &offered,
                         |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),
@@ -182,7 +187,7 @@ impl Rescale {
                 gpu,
                 GBUFFER_LABEL,
                 "",
-                &["realtime/rescale.wgsl", "realtime/rescale_gbuffer.wgsl"],
+                &["common/bilinear.wgsl", "realtime/rescale.wgsl", "realtime/rescale_gbuffer.wgsl"],
                 wgpu::ShaderStages::FRAGMENT,
                 &offered,
                 move |d, module, layout| {

@@ -176,6 +176,7 @@ fn modules((matte, glossy): (bool, bool), motion: crate::gpu::Motion) -> Vec<&'s
         "common/math.wgsl",
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
+        "common/bilinear.wgsl",
         "matte/common.wgsl",
     ];
     m.push(motion.module());

@@ -111,10 +111,12 @@ fn all_programs() -> Vec<Program> {
         ("rg32uint", "realtime/rescale_uint.wgsl"),
     ] {
         let prelude = format!("alias Dst = texture_storage_2d<{format}, write>;\n");
-        let m = ["realtime/rescale.wgsl", main, "realtime/rescale_main.wgsl"];
+        let m =
+            ["common/bilinear.wgsl", "realtime/rescale.wgsl", main, "realtime/rescale_main.wgsl"];
         v.push(compose(main, &prelude, &m).unwrap());
     }
-    let gbuffer = ["realtime/rescale.wgsl", "realtime/rescale_gbuffer.wgsl"];
+    let gbuffer =
+        ["common/bilinear.wgsl", "realtime/rescale.wgsl", "realtime/rescale_gbuffer.wgsl"];
     v.push(compose("realtime/rescale_gbuffer.wgsl", "", &gbuffer).unwrap());
     for motion in [
         "realtime/motion_static.wgsl",
@@ -141,6 +143,7 @@ fn all_programs() -> Vec<Program> {
                 "common/math.wgsl",
                 "realtime/frame.wgsl",
                 "realtime/gbuffer_in.wgsl",
+                "common/bilinear.wgsl",
                 "matte/common.wgsl",
                 motion,
             ];
