@@ -2,7 +2,9 @@
 // surface accumulated; a pixel not traced this frame keeps its light, age and moments as they
 // were (reprojected), and a pixel with neither a sample nor a history is missing (age 0).
 // The matte signal's pass also writes the features (linear depth and its gradient).
-// Outputs: integrated (rgb), moments (m1, m2, age).
+// Outputs: integrated (rgb), moments (m1, m2, age, frames): frames counts the frames since the
+// pixel's history last restarted, traced or not (TAA compares it with its own history's length
+// before it follows this light: taa/matte_moments.wgsl).
 
 var prev_depth: texture_depth_2d;
 var prev_normal: texture_2d<f32>;
@@ -41,7 +43,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         // After a change of size the history was resampled (realtime/rescale.wgsl).
         mom.z = rescaled_length(mom.z);
+        mom.w = rescaled_length(mom.w);
     }
+    // 2^24: counts stay whole numbers in f32.
+    let frames = select(1.0, min(mom.w + 1.0, 16777216.0), found);
     var light = hist;
     if sampled {
         let l = luma(current);
@@ -54,10 +59,12 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let r = max(a, 1.0 / age);
         light = select(current, mix(hist, current, r), found);
         let m = select(vec2f(l, l * l), mix(mom.xy, vec2f(l, l * l), r), found);
-        mom = vec4f(m, age, 0.0);
-    } else if !found {
+        mom = vec4f(m, age, frames);
+    } else if found {
+        mom.w = frames;
+    } else {
         mom = vec4f(0.0);
     }
     textureStore(out_integrated, p, vec4f(half_safe(light), 1.0));
-    textureStore(out_moments, p, vec4f(select(vec3f(0.0), mom.xyz, all(abs(mom.xyz) < vec3f(3.0e38))), 0.0));
+    textureStore(out_moments, p, select(vec4f(0.0), mom, all(abs(mom) < vec4f(3.0e38))));
 }

@@ -19,6 +19,7 @@ use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
+use crate::passes::taa::{MatteFollow, TaaFollow};
 use crate::settings::{
     FrameSettings, PROGRESSIVE_MAX_LEVELS, ProgressiveSettings, STILL_FRAMES_MAX,
 };
@@ -143,7 +144,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
         signals.insert(1, Signal::Glossy);
     }
     let res = Resources { pp, dn, levels, feedback, targets: None };
-    Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
+    Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals, taa_follow: false }))
 }
 
 /// One signal's textures: 96 bytes per pixel.
@@ -245,6 +246,8 @@ struct Progressive {
     res: Resources,
     stages: Option<Stages>,
     signals: Vec<Signal>,
+    /// This frame's `ProgressiveSettings::taa_follow`.
+    taa_follow: bool,
 }
 
 /// The modules of a program of `signal`'s `stage`.
@@ -385,6 +388,7 @@ impl Denoiser for Progressive {
 
     fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
         let gpu = rec.gpu;
+        self.taa_follow = cx.settings.progressive.taa_follow;
         let Progressive { scene, res, stages, .. } = self;
         let missing = "the progressive filter records before its textures exist";
         let p = &cx.settings.progressive;
@@ -420,6 +424,21 @@ impl Denoiser for Progressive {
             }
         }
         Ok(())
+    }
+
+    /// With `ProgressiveSettings::taa_follow`, TAA follows the matte light the filter shows, so
+    /// that a still view shows the latest accumulated and filtered light under TAA's averaged
+    /// material rather than TAA's mean of every frame shown, whose first frames (below one
+    /// sample per pixel, mostly filled in by the a-trous levels) are the blurriest.
+    fn taa_follow(&self, parity: Parity) -> TaaFollow<'_> {
+        let Some(t) = self.res.targets.as_ref().filter(|_| self.taa_follow) else {
+            return TaaFollow::default();
+        };
+        let Some((_, s)) = t.signals.iter().find(|(g, _)| *g == Signal::Matte) else {
+            return TaaFollow::default();
+        };
+        let (light, state) = (&s.output(t.levels.count).1, &s.moments.output(parity).1);
+        TaaFollow { matte: Some(MatteFollow { light, state, moments: true }), glossy: None }
     }
 
     fn output(&self, _parity: Parity) -> Denoised<'_> {

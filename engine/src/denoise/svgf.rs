@@ -17,7 +17,7 @@ use crate::passes::chain::ChainStage;
 use crate::passes::glossy::GlossyParams;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
-use crate::passes::taa::TaaFollow;
+use crate::passes::taa::{MatteFollow, TaaFollow};
 use crate::settings::{FrameSettings, SvgfSettings, svgf::STILL_FRAMES_MAX};
 use anyhow::{Context, Result};
 use bytemuck::{Pod, Zeroable};
@@ -611,7 +611,8 @@ impl Denoiser for Svgf {
     /// frame SVGF showed (whose first frames are the least converged).
     fn taa_follow(&self, _parity: Parity) -> TaaFollow<'_> {
         let Some(t) = &self.res.targets else { return TaaFollow::default() };
-        TaaFollow { matte: Some((&t.matte.out.1, &t.matte.state.1)), glossy: None }
+        let (light, state) = (&t.matte.out.1, &t.matte.state.1);
+        TaaFollow { matte: Some(MatteFollow { light, state, moments: false }), glossy: None }
     }
 
     fn output(&self, _parity: Parity) -> Denoised<'_> {

@@ -16,10 +16,21 @@ const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// What a denoiser offers TAA to follow (all this frame's, parity resolved).
 #[derive(Clone, Copy, Default)]
 pub struct TaaFollow<'a> {
-    /// The matte light before spatial filtering and its state (`matte/reason`'s format: REASON_*
-    /// flags in the low 8 bits, history length above).
-    pub matte: Option<(&'a wgpu::TextureView, &'a wgpu::TextureView)>,
+    /// The matte light to follow and its state.
+    pub matte: Option<MatteFollow<'a>>,
     pub glossy: Option<GlossyFollow<'a>>,
+}
+
+/// The matte light TAA may follow.
+#[derive(Clone, Copy)]
+pub struct MatteFollow<'a> {
+    /// The light the composite used (demodulated, before the matte factor).
+    pub light: &'a wgpu::TextureView,
+    /// Whether the pixel's history continues and its length: `matte/reason`'s format (REASON_*
+    /// flags in the low 8 bits, history length above; taa/matte.wgsl), or where `moments` is
+    /// set the progressive filter's moments texel (taa/matte_moments.wgsl).
+    pub state: &'a wgpu::TextureView,
+    pub moments: bool,
 }
 
 /// The glossy light TAA may follow (taa/glossy.wgsl).
@@ -68,8 +79,9 @@ impl TaaTargets {
 pub struct TaaStage {
     params: wgpu::Buffer,
     targets: Option<(u64, TaaTargets)>,
-    /// One program per (follows matte, follows glossy), made on first use.
-    programs: Vec<((bool, bool), ChainStage)>,
+    /// One program per (the matte state's form where it follows the matte light, follows
+    /// glossy), made on first use.
+    programs: Vec<((Option<bool>, bool), ChainStage)>,
     motion: crate::gpu::Motion,
 }
 
@@ -120,7 +132,7 @@ impl TaaStage {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let (_, t) = self.targets.as_ref().context("TAA records before its textures exist")?;
         let f = follow(parity);
-        let variant = (f.matte.is_some(), f.glossy.is_some());
+        let variant = (f.matte.map(|m| m.moments), f.glossy.is_some());
         let bindings = |p: Parity| taa_bindings(io, t, &self.params, &follow(p), p);
         let i = match self.programs.iter().position(|(v, _)| *v == variant) {
             Some(i) => i,
@@ -157,8 +169,9 @@ fn taa_bindings<'a>(
         .texture("out_residual", &t.residual.output(parity).1)
         .texture("glossy_factor_history", &t.glossy.history(parity).1)
         .texture("out_glossy_factor", &t.glossy.output(parity).1);
-    if let Some((light, state)) = follow.matte {
-        b = b.texture("matte_temporal", light).texture("matte_reason", state);
+    if let Some(m) = follow.matte {
+        let state = if m.moments { "matte_moments" } else { "matte_reason" };
+        b = b.texture("matte_temporal", m.light).texture(state, m.state);
     }
     if let Some(g) = follow.glossy {
         b = b
@@ -171,7 +184,7 @@ fn taa_bindings<'a>(
     b
 }
 
-fn modules((matte, glossy): (bool, bool), motion: crate::gpu::Motion) -> Vec<&'static str> {
+fn modules((matte, glossy): (Option<bool>, bool), motion: crate::gpu::Motion) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "realtime/frame.wgsl",
@@ -185,7 +198,11 @@ fn modules((matte, glossy): (bool, bool), motion: crate::gpu::Motion) -> Vec<&'s
     } else {
         ["taa/glossy_none.wgsl"].as_slice()
     });
-    m.push(if matte { "taa/matte.wgsl" } else { "taa/matte_none.wgsl" });
+    m.push(match matte {
+        Some(false) => "taa/matte.wgsl",
+        Some(true) => "taa/matte_moments.wgsl",
+        None => "taa/matte_none.wgsl",
+    });
     m.push("taa/taa.wgsl");
     m
 }

@@ -138,6 +138,7 @@ fn all_programs() -> Vec<Program> {
                 "taa/taa.wgsl",
             ],
             &["taa/glossy_none.wgsl", "taa/matte_none.wgsl", "taa/taa.wgsl"],
+            &["taa/glossy_none.wgsl", "taa/matte_moments.wgsl", "taa/taa.wgsl"],
         ] {
             let mut m = vec![
                 "common/math.wgsl",
