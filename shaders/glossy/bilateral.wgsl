@@ -85,6 +85,10 @@ fn bilateral_h(@builtin(global_invocation_id) gid: vec3u) {
         // reflection ends unblurred.
         let falloff = history_falloff(gp.sigma_full_frames, textureLoad(src, p, 0).a);
         sigma *= falloff * falloff;
+        // Out of focus the lens averages the light over the circle of confusion anyway
+        // (realtime/uncertainty.wgsl), and there a highlight comes as rare bright lens samples
+        // that a long history still shows as sparkles: that reach does not fall with it.
+        sigma = max(sigma, min(defocus_sigma(p), gp.max_sigma_px));
     }
     textureStore(dst, p, vec4f(half_safe(bilateral(p, vec2i(1, 0), sigma)), sigma));
 }

@@ -6,7 +6,10 @@
 // reflectance in the temporal stage, is multiplied back here. The filter's reach is bounded by
 // a Gaussian (§4.2.2 eq. (6); glossy/common.wgsl: glossy_sigma): Mara's 7 roughness^0.1 pixels,
 // shrunk by the secondary hit's ray differential below the roughness threshold, so that a
-// sharp reflection seen from afar is not blurred across the surface.
+// sharp reflection seen from afar is not blurred across the surface. Out of focus it reaches
+// at least the circle of confusion (realtime/uncertainty.wgsl: defocus_sigma), over which the
+// lens averages the light anyway: a defocused glossy surface's highlights come as rare bright
+// lens samples, and the roughness alone would keep them as sparkles.
 var features: texture_2d<f32>;
 
 fn signal_features(p: vec2i) -> Features {
@@ -25,7 +28,8 @@ fn signal_remodulation(p: vec2i) -> vec3f {
 
 fn signal_sigma(p: vec2i) -> f32 {
     let x = position_at(p);
-    return max(glossy_sigma(roughness_at(p), ray_differential(p, x)), 0.5);
+    let defocus = min(defocus_sigma(p), gp.max_sigma_px);
+    return max(max(glossy_sigma(roughness_at(p), ray_differential(p, x)), defocus), 0.5);
 }
 
 // Behind a mirror the glossy light is what a diffuse surface reflects (§4.1: the first non-

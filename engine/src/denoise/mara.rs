@@ -73,6 +73,11 @@ impl Denoiser for Mara {
                 params: &self.glossy_params,
                 glossy: g,
             };
+            // Made again when the pre-filter starts or stops offering its statistics.
+            if self.glossy.as_ref().is_some_and(|c| c.uncertain != io.feature_uncertainty.is_some())
+            {
+                self.glossy = None;
+            }
             let glossy = crate::passes::chain::made(&mut self.glossy, || {
                 GlossyChain::new(gpu, &inputs, motion).context("creating the glossy chain")
             })?;

@@ -249,6 +249,9 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
 struct SignalStages {
     /// The matte temporal reads the radiance cache's prior (made for a frame that offers one).
     prior: bool,
+    /// The glossy reach reads the pre-filter's feature uncertainty (made for a frame that
+    /// offers it).
+    uncertain: bool,
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
@@ -263,6 +266,7 @@ impl SignalStages {
         motion: crate::gpu::Motion,
         offered: &Bindings,
         prior: bool,
+        uncertainty: &'static str,
     ) -> Result<SignalStages> {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
@@ -285,7 +289,13 @@ impl SignalStages {
             ]
         };
         let stage = |label, file, b: &Bindings| {
-            ChainStage::new(gpu, label, &modules(file, glossy, motion), "main", b)
+            let mut m = modules(file, glossy, motion);
+            // The glossy light's reach (svgf/features_glossy.wgsl) takes the circle of
+            // confusion where the pre-filter measured one.
+            if glossy {
+                m.insert(m.len() - 1, uncertainty);
+            }
+            ChainStage::new(gpu, label, &m, "main", b)
         };
         // The matte history restarts from the radiance cache's prior where there is one.
         let mut temporal_modules = modules(temporal, glossy, motion);
@@ -294,6 +304,7 @@ impl SignalStages {
         }
         Ok(SignalStages {
             prior,
+            uncertain: uncertainty == "realtime/uncertainty.wgsl",
             temporal: ChainStage::new(gpu, labels[0], &temporal_modules, "main", offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
@@ -583,7 +594,8 @@ impl Denoiser for Svgf {
         let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
         let stages = |g, s| {
             let offered = res.offered(io, t, s);
-            SignalStages::new(gpu, g, scene.motion, &offered, io.cache_prior.is_some())
+            let (prior, uncertainty) = (io.cache_prior.is_some(), io.uncertainty_module());
+            SignalStages::new(gpu, g, scene.motion, &offered, prior, uncertainty)
                 .context("creating SVGF's stages")
         };
         let s = signal(false)?;
@@ -600,6 +612,10 @@ impl Denoiser for Svgf {
                 motion_stages(gpu, res, io, m, scene.motion)
             })?;
             res.record_motion(rec, io, cx, m, st)?;
+            // Made again when the pre-filter starts or stops offering its statistics.
+            if glossy.as_ref().is_some_and(|g| g.uncertain != io.feature_uncertainty.is_some()) {
+                *glossy = None;
+            }
             let st = crate::passes::chain::made(glossy, || stages(true, s))?;
             res.record_stages(rec, io, cx, s, st)?;
         }

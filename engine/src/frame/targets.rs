@@ -80,6 +80,7 @@ impl Targets {
             trace: &self.trace,
             mixed: None,
             cache_prior: None,
+            feature_uncertainty: None,
             hdr: &self.hdr,
             memory: &self.memory,
         }

@@ -198,6 +198,9 @@ pub fn modules(stage: &'static str, motion: crate::gpu::Motion) -> Vec<&'static 
 
 pub struct GlossyChain {
     stages: Vec<(Kind, ChainStage)>,
+    /// The bilateral reads the pre-filter's feature uncertainty (made for a frame that offers
+    /// it).
+    pub uncertain: bool,
 }
 
 impl GlossyChain {
@@ -209,18 +212,16 @@ impl GlossyChain {
     pub fn new(gpu: &Gpu, i: &GlossyInputs, motion: crate::gpu::Motion) -> Result<GlossyChain> {
         let mut stages = vec![];
         for (kind, label, file, entry) in STAGES {
-            stages.push((
-                kind,
-                ChainStage::new(
-                    gpu,
-                    label,
-                    &modules(file, motion),
-                    entry,
-                    &bindings(kind, i, Parity::default()),
-                )?,
-            ));
+            let mut m = modules(file, motion);
+            // The bilateral's sigma takes the circle of confusion where the pre-filter measured
+            // one (glossy/bilateral.wgsl: sigma_at).
+            if matches!(kind, Kind::BilateralH | Kind::BilateralV) {
+                m.insert(m.len() - 1, i.io.uncertainty_module());
+            }
+            let offered = bindings(kind, i, Parity::default());
+            stages.push((kind, ChainStage::new(gpu, label, &m, entry, &offered)?));
         }
-        Ok(GlossyChain { stages })
+        Ok(GlossyChain { stages, uncertain: i.io.feature_uncertainty.is_some() })
     }
 
     /// Record the chain. The prefilter runs only when the clip uses it.

@@ -27,6 +27,10 @@ pub struct FrameIo<'a> {
     /// The radiance cache's prior per pixel and its samples' mean squared luminance
     /// (passes/cache.rs), where the cache ran this frame.
     pub cache_prior: Option<(&'a wgpu::TextureView, &'a wgpu::TextureView)>,
+    /// The pre-filter's per-pixel statistics (`prefilter/view`: z the world positions' spread
+    /// in pixels), where it ran this frame: offered as `gb_uncertainty`
+    /// (realtime/uncertainty.wgsl; [`FrameIo::uncertainty_module`]).
+    pub feature_uncertainty: Option<&'a wgpu::TextureView>,
     /// The composite's linear HDR image, one vec4 per pixel.
     pub hdr: &'a wgpu::Buffer,
     /// Every per-pixel allocation of the frame, textures findable by label.
@@ -34,6 +38,16 @@ pub struct FrameIo<'a> {
 }
 
 impl<'a> FrameIo<'a> {
+    /// The module that gives a stage `defocus_sigma`: realtime/uncertainty.wgsl where the frame
+    /// offers the pre-filter's statistics, else realtime/uncertainty_none.wgsl (no binding).
+    pub fn uncertainty_module(&self) -> &'static str {
+        if self.feature_uncertainty.is_some() {
+            "realtime/uncertainty.wgsl"
+        } else {
+            "realtime/uncertainty_none.wgsl"
+        }
+    }
+
     /// The frame's resources by WGSL name: `frame`, the G-buffer (`gb_*`, realtime/gbuffer_in.wgsl),
     /// the trace's light (`tr_*`, raw; a stage that filters offers its own `tr_matte` on top),
     /// object motion, the radiance cache's prior (`cache_prior`), and the previous depth, normal and object ids where they exist.
@@ -55,7 +69,8 @@ impl<'a> FrameIo<'a> {
             .texture("tr_matte", &t.matte.1)
             .texture("tr_direct", &t.direct.1)
             .texture_opt("cache_prior", self.cache_prior.map(|p| p.0))
-            .texture_opt("cache_prior_m2", self.cache_prior.map(|p| p.1));
+            .texture_opt("cache_prior_m2", self.cache_prior.map(|p| p.1))
+            .texture_opt("gb_uncertainty", self.feature_uncertainty);
         if let Some(gl) = &t.glossy {
             b = b
                 .texture("tr_glossy", &gl.light.1)

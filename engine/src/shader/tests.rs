@@ -159,7 +159,17 @@ fn all_programs() -> Vec<Program> {
             "glossy/temporal.wgsl",
             "glossy/bilateral.wgsl",
         ] {
-            v.push(compose(stage, "", &crate::passes::glossy::modules(stage, animated)).unwrap());
+            let m = crate::passes::glossy::modules(stage, animated);
+            if stage == "glossy/bilateral.wgsl" {
+                // With the pre-filter's feature uncertainty, and without.
+                for u in ["realtime/uncertainty.wgsl", "realtime/uncertainty_none.wgsl"] {
+                    let mut m = m.clone();
+                    m.insert(m.len() - 1, u);
+                    v.push(compose(stage, "", &m).unwrap());
+                }
+            } else {
+                v.push(compose(stage, "", &m).unwrap());
+            }
         }
     }
     for animated in MOTIONS {
@@ -180,6 +190,13 @@ fn all_programs() -> Vec<Program> {
                     with_prior.push("cache/prior.wgsl");
                     v.push(compose(stage, "", &with_prior).unwrap());
                     m.push("cache/prior_none.wgsl");
+                }
+                if glossy && !stage.starts_with("svgf/temporal") {
+                    // With the pre-filter's feature uncertainty, and without.
+                    let mut with = m.clone();
+                    with.insert(with.len() - 1, "realtime/uncertainty.wgsl");
+                    v.push(compose(stage, "", &with).unwrap());
+                    m.insert(m.len() - 1, "realtime/uncertainty_none.wgsl");
                 }
                 v.push(compose(stage, "", &m).unwrap());
             }
