@@ -487,3 +487,108 @@ fn prefiltered_gbuffer_is_closer_to_the_converged_one() {
     assert!(focus_count > 500, "only {focus_count} in-focus pixels");
     assert!(fn_focus <= 1.1 * rn_focus, "in-focus normal MSE {rn_focus} -> {fn_focus}");
 }
+
+/// A final filter driven by the features' uncertainty: with a thin lens the pre-filter passes on
+/// each pixel's world-position spread (`prefilter/view` z, pixels at the surface), and the
+/// glossy filters then reach at least the circle of confusion it measures, spread / sqrt(2) per
+/// axis, at most MAX_GLOSSY_SIGMA_PX (realtime/uncertainty.wgsl): Mara's glossy bilateral
+/// (glossy/bilateral.wgsl; its sigma in `glossy/scratch` alpha) and SVGF's glossy a-trous and
+/// regression (svgf/features_glossy.wgsl; the reach in the fourth word of `svgf/glossy taps`).
+/// Against a CPU computation from the read-back textures (cornell_dof at 128x128 with a 1 m
+/// aperture, so that the back of the room is defocused past every roughness's own sigma):
+/// - every surface pixel's sigma is at least that reach;
+/// - where the reach exceeds the largest sigma the roughness gives (GlossySettings::sigma_px
+///   with no ray differential: 8 px at roughness 1), the sigma equals it;
+/// - without the pre-filter no sigma exceeds the roughness's.
+///
+/// Tolerance: Mara's sigma and the spread are stored as half floats (2^-11 relative), the sigma
+/// after an f32 product.
+#[test]
+fn the_glossy_reach_takes_the_pre_filters_circle_of_confusion() {
+    use hush_engine::frame::{FrameInput, Renderer};
+    use hush_engine::scene::load_gltf;
+    use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MAX_GLOSSY_SIGMA_PX};
+    let scene = load_gltf(&hush_tests::oracle("cornell_dof").join("cornell_dof.gltf")).unwrap();
+    let size = (128u32, 128u32);
+    let pixels = (size.0 * size.1) as usize;
+    let mut camera = scene.camera_or_default();
+    camera.lens.as_mut().expect("cornell_dof has a thin lens").aperture_radius = 1.0;
+    let glossy = GlossySettings::default();
+    // The largest sigma any roughness gives (no ray differential shrinks it).
+    let roughness_sigma = |r: f32| glossy.sigma_px(r, 0.0);
+    let run = |denoiser: Denoiser, prefilter: bool| {
+        let svgf = denoiser == Denoiser::SVGF;
+        let settings =
+            FrameSettings { denoiser, primary_samples: 4, prefilter, ..Default::default() };
+        let (gpu, mut r) =
+            Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, size).unwrap();
+        r.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, &settings, None).unwrap();
+        let halves = |label: &str, channel: usize| -> Vec<f32> {
+            r.read_texture(&gpu, label)
+                .map(|t| {
+                    (0..pixels).map(|i| hush_tests::half(&t.0[i * 8 + channel * 2..])).collect()
+                })
+                .unwrap_or_default()
+        };
+        let sigma: Vec<f32> = if svgf {
+            let taps = r.read_buffer(&gpu, "svgf/glossy taps").unwrap();
+            bytemuck::cast_slice::<u8, f32>(&taps).chunks(4).map(|t| t[3]).collect()
+        } else {
+            halves("glossy/scratch", 3)
+        };
+        let spread = halves("prefilter/view", 2);
+        let roughness: Vec<f32> = r.read_texture(&gpu, "gbuffer/specular").unwrap().0[..pixels * 4]
+            .chunks(4)
+            .map(|t| t[3] as f32 / 255.0)
+            .collect();
+        // A pixel whose first lens sample missed has no surface (its other samples may hit).
+        let surface: Vec<bool> = r.read_texture(&gpu, "gbuffer/ids").unwrap().0[..pixels * 8]
+            .chunks(8)
+            .map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]) != u32::MAX)
+            .collect();
+        (sigma, spread, roughness, surface)
+    };
+    let tolerance = 2.0 / 2048.0;
+    for denoiser in [Denoiser::MARA, Denoiser::SVGF] {
+        let (sigma, spread, roughness, surface) = run(denoiser.clone(), true);
+        let (mut checked, mut dominated, mut worst) = (0usize, 0usize, 0.0f32);
+        for i in 0..pixels {
+            if !surface[i] || spread[i] <= 0.0 {
+                continue;
+            }
+            checked += 1;
+            let reach = (spread[i] * std::f32::consts::FRAC_1_SQRT_2).min(MAX_GLOSSY_SIGMA_PX);
+            assert!(
+                sigma[i] >= reach * (1.0 - tolerance),
+                "{denoiser:?}, pixel {i}: sigma {} below the circle of confusion's {reach}",
+                sigma[i]
+            );
+            if reach > roughness_sigma(roughness[i]) * (1.0 + tolerance) {
+                dominated += 1;
+                worst = worst.max((sigma[i] / reach - 1.0).abs());
+                assert!(
+                    (sigma[i] - reach).abs() <= reach * tolerance,
+                    "{denoiser:?}, pixel {i}: sigma {} where the circle of confusion gives {reach}",
+                    sigma[i]
+                );
+            }
+        }
+        println!(
+            "{denoiser:?}: {checked} surface pixels with a spread; {dominated} where the circle of confusion sets the glossy sigma (largest relative difference {worst:.5})"
+        );
+        assert!(
+            dominated > 1000,
+            "{denoiser:?}: only {dominated} pixels defocused past their roughness's sigma"
+        );
+        let (sigma, spread, roughness, surface) = run(denoiser.clone(), false);
+        assert!(spread.is_empty(), "the pre-filter's statistics exist without it");
+        for i in (0..pixels).filter(|&i| surface[i]) {
+            assert!(
+                sigma[i] <= roughness_sigma(roughness[i]) * (1.0 + tolerance),
+                "{denoiser:?}, pixel {i}: sigma {} past the roughness's {} without the pre-filter",
+                sigma[i],
+                roughness_sigma(roughness[i])
+            );
+        }
+    }
+}
