@@ -24,7 +24,8 @@ pub struct TaaFollow<'a> {
 /// The matte light TAA may follow.
 #[derive(Clone, Copy)]
 pub struct MatteFollow<'a> {
-    /// The light the composite used (demodulated, before the matte factor).
+    /// The light TAA follows, before the matte factor: Mara's matte temporal output (before
+    /// its spatial stages), SVGF's and the progressive filter's shown light.
     pub light: &'a wgpu::TextureView,
     /// Whether the pixel's history continues and its length: `matte/reason`'s format (REASON_*
     /// flags in the low 8 bits, history length above; taa/matte.wgsl), or where `moments` is
