@@ -133,7 +133,9 @@ fn progressive(period: u32, p: ProgressiveSettings) -> FrameSettings {
 /// At 1/4 spp with a still camera: after every frame, a pixel the schedule skipped holds
 /// exactly (bit for bit) the accumulated light and moments it held before; a traced one holds
 /// the CPU's r = max(a, 1/age) update of them with the trace's sample (within 1e-5 relative:
-/// f32 moments and light), on 99% of the surface pixels (measured: all of them).
+/// f32 moments and light), on 99% of the surface pixels (measured: all of them). Either way
+/// the moments' fourth channel counts the frames since the pixel's first sample, this one
+/// included (what TAA compares with its own history's length before it follows the light).
 #[test]
 fn missing_samples_leave_history_and_moments_unchanged() {
     let (gpu, mut r) =
@@ -154,6 +156,8 @@ fn missing_samples_leave_history_and_moments_unchanged() {
     let n = (SIZE.0 * SIZE.1) as usize;
     // Per pixel: light, m1, m2, age.
     let mut cpu = vec![([0f64; 3], 0f64, 0f64, 0f64); n];
+    // Per pixel: the frame of its first sample.
+    let mut first = vec![None; n];
     let (mut before_m, mut before_h): (Vec<u8>, Vec<u8>) = (vec![], vec![]);
     let (mut checked, mut agree) = (0u32, 0u32);
     for frame in 0..10u32 {
@@ -175,6 +179,7 @@ fn missing_samples_leave_history_and_moments_unchanged() {
                 let traced = scheduled_pixel(x / tw, y / th, frame, 4) == (x, y);
                 let c = &mut cpu[i];
                 if traced {
+                    first[i] = first[i].or(Some(frame));
                     let v = [0, 1, 2].map(|k| half(&sample[i * 8 + k * 2..]) as f64);
                     let l = luma(v);
                     c.3 += 1.0;
@@ -187,17 +192,20 @@ fn missing_samples_leave_history_and_moments_unchanged() {
                     continue;
                 }
                 checked += 1;
-                let ok = if traced {
-                    let close = |a: f64, b: f64, rel: f64| (a - b).abs() <= rel * b.abs().max(1e-3);
-                    let g = [0, 1, 2].map(|k| f32_at(&history, i * 4 + k) as f64);
-                    f32_at(&moments, i * 4 + 2) as f64 == c.3
-                        && close(f32_at(&moments, i * 4) as f64, c.1, 1e-5)
-                        && close(f32_at(&moments, i * 4 + 1) as f64, c.2, 1e-5)
-                        && (0..3).all(|k| close(g[k], c.0[k], 1e-5))
-                } else {
-                    moments[i * 16..i * 16 + 16] == before_m[i * 16..i * 16 + 16]
-                        && history[i * 16..i * 16 + 16] == before_h[i * 16..i * 16 + 16]
-                };
+                let frames = first[i].map_or(0.0, |f| (frame - f + 1) as f32);
+                let ok = f32_at(&moments, i * 4 + 3) == frames
+                    && if traced {
+                        let close =
+                            |a: f64, b: f64, rel: f64| (a - b).abs() <= rel * b.abs().max(1e-3);
+                        let g = [0, 1, 2].map(|k| f32_at(&history, i * 4 + k) as f64);
+                        f32_at(&moments, i * 4 + 2) as f64 == c.3
+                            && close(f32_at(&moments, i * 4) as f64, c.1, 1e-5)
+                            && close(f32_at(&moments, i * 4 + 1) as f64, c.2, 1e-5)
+                            && (0..3).all(|k| close(g[k], c.0[k], 1e-5))
+                    } else {
+                        moments[i * 16..i * 16 + 12] == before_m[i * 16..i * 16 + 12]
+                            && history[i * 16..i * 16 + 16] == before_h[i * 16..i * 16 + 16]
+                    };
                 // The CPU's light drifts from the f32 history it does not round: resync.
                 if ok {
                     agree += 1;
