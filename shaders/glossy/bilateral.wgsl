@@ -88,9 +88,9 @@ fn bilateral_h(@builtin(global_invocation_id) gid: vec3u) {
         // Out of focus the lens averages the light over the circle of confusion anyway
         // (realtime/uncertainty.wgsl), and there a highlight comes as rare bright lens samples
         // that a long history still shows as sparkles: in a still view that reach does not fall
-        // with it (cornell_dof, 60 frames: relMSE 0.02240 -> 0.01572). While the camera moves it
-        // is not taken: the defocused box's highlight then spread past its extent (a slide of
-        // 30 frames at 128x128: relMSE 0.04722 -> 0.05416).
+        // with it (cornell_dof, 60 frames: relMSE 0.02240 -> 0.01572). While the camera or
+        // anything in view moves it is not taken: the defocused box's highlight then spread past
+        // its extent (a slide of 30 frames at 128x128: relMSE 0.04722 -> 0.05416).
         if dn.static_view != 0u {
             sigma = max(sigma, min(defocus_sigma(p), gp.max_sigma_px));
         }
