@@ -266,7 +266,7 @@ impl SignalStages {
         motion: crate::gpu::Motion,
         offered: &Bindings,
         prior: bool,
-        uncertainty: &'static str,
+        uncertain: bool,
     ) -> Result<SignalStages> {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
@@ -293,7 +293,7 @@ impl SignalStages {
             // The glossy light's reach (svgf/features_glossy.wgsl) takes the circle of
             // confusion where the pre-filter measured one.
             if glossy {
-                m.insert(m.len() - 1, uncertainty);
+                m.insert(m.len() - 1, crate::passes::io::uncertainty_module(uncertain));
             }
             ChainStage::new(gpu, label, &m, "main", b)
         };
@@ -304,7 +304,7 @@ impl SignalStages {
         }
         Ok(SignalStages {
             prior,
-            uncertain: uncertainty == "realtime/uncertainty.wgsl",
+            uncertain,
             temporal: ChainStage::new(gpu, labels[0], &temporal_modules, "main", offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
@@ -594,8 +594,8 @@ impl Denoiser for Svgf {
         let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
         let stages = |g, s| {
             let offered = res.offered(io, t, s);
-            let (prior, uncertainty) = (io.cache_prior.is_some(), io.uncertainty_module());
-            SignalStages::new(gpu, g, scene.motion, &offered, prior, uncertainty)
+            let (prior, uncertain) = (io.cache_prior.is_some(), io.feature_uncertainty.is_some());
+            SignalStages::new(gpu, g, scene.motion, &offered, prior, uncertain)
                 .context("creating SVGF's stages")
         };
         let s = signal(false)?;

@@ -101,9 +101,8 @@ impl Renderer {
         let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
         let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace };
         let mut io = t.io(&u.frame, gpu_scene);
-        if plan.traced && plan.prefilter {
-            io.feature_uncertainty = t.prefilter.as_ref().map(|pf| &pf.view.1);
-        }
+        io.feature_uncertainty =
+            t.prefilter.as_ref().filter(|_| plan.prefilter).map(|pf| &pf.view.1);
         // primaries [-> pre-filter] -> trace [-> mix] [-> radiance cache] -> denoise -> composite [-> resolve] -> TAA
         // -> display; then this frame's G-buffer becomes the next one's previous.
         s.record_primaries(&mut rec, &plan, scene, t)?;

@@ -6,6 +6,13 @@ use super::gbuffer::{Channel, GBufferTargets};
 use super::trace::TraceTargets;
 use crate::gpu::{Bindings, GpuMemory};
 
+/// The module that gives a stage `defocus_sigma`: realtime/uncertainty.wgsl where the frame
+/// offers the pre-filter's statistics (`uncertain`), else realtime/uncertainty_none.wgsl (no
+/// binding).
+pub fn uncertainty_module(uncertain: bool) -> &'static str {
+    if uncertain { "realtime/uncertainty.wgsl" } else { "realtime/uncertainty_none.wgsl" }
+}
+
 /// What the frame offers a stage (all borrowed from the frame for one recording).
 #[derive(Clone, Copy)]
 pub struct FrameIo<'a> {
@@ -38,14 +45,9 @@ pub struct FrameIo<'a> {
 }
 
 impl<'a> FrameIo<'a> {
-    /// The module that gives a stage `defocus_sigma`: realtime/uncertainty.wgsl where the frame
-    /// offers the pre-filter's statistics, else realtime/uncertainty_none.wgsl (no binding).
+    /// The module that gives a stage `defocus_sigma` ([`uncertainty_module`]).
     pub fn uncertainty_module(&self) -> &'static str {
-        if self.feature_uncertainty.is_some() {
-            "realtime/uncertainty.wgsl"
-        } else {
-            "realtime/uncertainty_none.wgsl"
-        }
+        uncertainty_module(self.feature_uncertainty.is_some())
     }
 
     /// The frame's resources by WGSL name: `frame`, the G-buffer (`gb_*`, realtime/gbuffer_in.wgsl),
