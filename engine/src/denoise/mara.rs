@@ -8,7 +8,7 @@ use crate::gpu::{Gpu, GpuMemory, Parity, Recorder};
 use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
-use crate::passes::taa::{GlossyFollow, MatteFollow, TaaFollow};
+use crate::passes::taa::{GlossyFollow, MatteFollow, MatteState, TaaFollow};
 use anyhow::{Context, Result};
 
 pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
@@ -98,7 +98,11 @@ impl Denoiser for Mara {
     fn taa_follow(&self, parity: Parity) -> TaaFollow<'_> {
         let Some((m, g)) = &self.targets else { return TaaFollow::default() };
         TaaFollow {
-            matte: Some(MatteFollow { light: &m.temporal.1, state: &m.reason.1, moments: false }),
+            matte: Some(MatteFollow {
+                light: &m.temporal.1,
+                state: &m.reason.1,
+                form: MatteState::Reason,
+            }),
             // What the glossy temporal wrote this frame, and what it read.
             glossy: g.as_ref().map(|g| GlossyFollow {
                 denoised: &g.denoised.1,

@@ -23,7 +23,7 @@ pub use crate::gpu::{BindKey, Bindings, Gpu, GpuMemory, Parity, PingPong, Record
 pub use crate::passes::chain::{ChainStage, made};
 pub use crate::passes::io::{FrameIo, PreviousGBuffer};
 pub use crate::passes::matte::ChainView;
-pub use crate::passes::taa::{GlossyFollow, TaaFollow};
+pub use crate::passes::taa::{GlossyFollow, MatteFollow, MatteState, TaaFollow};
 pub use crate::settings::FrameSettings;
 pub use crate::settings::{
     DenoiserInfo, Field, Kind, Off, Section, Stage, ViewMap, ViewSpec, disable_stage, fields,

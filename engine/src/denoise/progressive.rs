@@ -19,7 +19,7 @@ use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
-use crate::passes::taa::{MatteFollow, TaaFollow};
+use crate::passes::taa::{MatteFollow, MatteState, TaaFollow};
 use crate::settings::{
     FrameSettings, PROGRESSIVE_MAX_LEVELS, ProgressiveSettings, STILL_FRAMES_MAX,
 };
@@ -438,7 +438,10 @@ impl Denoiser for Progressive {
             return TaaFollow::default();
         };
         let (light, state) = (&s.output(t.levels.count).1, &s.moments.output(parity).1);
-        TaaFollow { matte: Some(MatteFollow { light, state, moments: true }), glossy: None }
+        TaaFollow {
+            matte: Some(MatteFollow { light, state, form: MatteState::Moments }),
+            glossy: None,
+        }
     }
 
     fn output(&self, _parity: Parity) -> Denoised<'_> {

@@ -17,7 +17,7 @@ use crate::passes::chain::ChainStage;
 use crate::passes::glossy::GlossyParams;
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
-use crate::passes::taa::{MatteFollow, TaaFollow};
+use crate::passes::taa::{MatteFollow, MatteState, TaaFollow};
 use crate::settings::{FrameSettings, SvgfSettings, svgf::STILL_FRAMES_MAX};
 use anyhow::{Context, Result};
 use bytemuck::{Pod, Zeroable};
@@ -628,7 +628,10 @@ impl Denoiser for Svgf {
     fn taa_follow(&self, _parity: Parity) -> TaaFollow<'_> {
         let Some(t) = &self.res.targets else { return TaaFollow::default() };
         let (light, state) = (&t.matte.out.1, &t.matte.state.1);
-        TaaFollow { matte: Some(MatteFollow { light, state, moments: false }), glossy: None }
+        TaaFollow {
+            matte: Some(MatteFollow { light, state, form: MatteState::Reason }),
+            glossy: None,
+        }
     }
 
     fn output(&self, _parity: Parity) -> Denoised<'_> {

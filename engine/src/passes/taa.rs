@@ -27,11 +27,20 @@ pub struct MatteFollow<'a> {
     /// The light TAA follows, before the matte factor: Mara's matte temporal output (before
     /// its spatial stages), SVGF's and the progressive filter's shown light.
     pub light: &'a wgpu::TextureView,
-    /// Whether the pixel's history continues and its length: `matte/reason`'s format (REASON_*
-    /// flags in the low 8 bits, history length above; taa/matte.wgsl), or where `moments` is
-    /// set the progressive filter's moments texel (taa/matte_moments.wgsl).
+    /// Whether the pixel's history continues, and its length, in the form `form` names.
     pub state: &'a wgpu::TextureView,
-    pub moments: bool,
+    pub form: MatteState,
+}
+
+/// The form of a followed matte light's state texture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MatteState {
+    /// `matte/reason`'s: REASON_* flags in the low 8 bits, the history length above
+    /// (taa/matte.wgsl).
+    Reason,
+    /// The progressive filter's moments texel, the frames since the history restarted in w
+    /// (taa/matte_moments.wgsl).
+    Moments,
 }
 
 /// The glossy light TAA may follow (taa/glossy.wgsl).
@@ -82,7 +91,7 @@ pub struct TaaStage {
     targets: Option<(u64, TaaTargets)>,
     /// One program per (the matte state's form where it follows the matte light, follows
     /// glossy), made on first use.
-    programs: Vec<((Option<bool>, bool), ChainStage)>,
+    programs: Vec<((Option<MatteState>, bool), ChainStage)>,
     motion: crate::gpu::Motion,
 }
 
@@ -133,7 +142,7 @@ impl TaaStage {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let (_, t) = self.targets.as_ref().context("TAA records before its textures exist")?;
         let f = follow(parity);
-        let variant = (f.matte.map(|m| m.moments), f.glossy.is_some());
+        let variant = (f.matte.map(|m| m.form), f.glossy.is_some());
         let bindings = |p: Parity| taa_bindings(io, t, &self.params, &follow(p), p);
         let i = match self.programs.iter().position(|(v, _)| *v == variant) {
             Some(i) => i,
@@ -171,7 +180,10 @@ fn taa_bindings<'a>(
         .texture("glossy_factor_history", &t.glossy.history(parity).1)
         .texture("out_glossy_factor", &t.glossy.output(parity).1);
     if let Some(m) = follow.matte {
-        let state = if m.moments { "matte_moments" } else { "matte_reason" };
+        let state = match m.form {
+            MatteState::Reason => "matte_reason",
+            MatteState::Moments => "matte_moments",
+        };
         b = b.texture("matte_temporal", m.light).texture(state, m.state);
     }
     if let Some(g) = follow.glossy {
@@ -185,7 +197,10 @@ fn taa_bindings<'a>(
     b
 }
 
-fn modules((matte, glossy): (Option<bool>, bool), motion: crate::gpu::Motion) -> Vec<&'static str> {
+fn modules(
+    (matte, glossy): (Option<MatteState>, bool),
+    motion: crate::gpu::Motion,
+) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "realtime/frame.wgsl",
@@ -200,8 +215,8 @@ fn modules((matte, glossy): (Option<bool>, bool), motion: crate::gpu::Motion) ->
         ["taa/glossy_none.wgsl"].as_slice()
     });
     m.push(match matte {
-        Some(false) => "taa/matte.wgsl",
-        Some(true) => "taa/matte_moments.wgsl",
+        Some(MatteState::Reason) => "taa/matte.wgsl",
+        Some(MatteState::Moments) => "taa/matte_moments.wgsl",
         None => "taa/matte_none.wgsl",
     });
     m.push("taa/taa.wgsl");
