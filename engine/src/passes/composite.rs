@@ -12,6 +12,9 @@ use anyhow::Result;
 
 pub const COMPOSITE: &str = "composite";
 pub const DISPLAY: &str = "display";
+/// The remodulation of the light bound as `tr_*` (the composite's, and the still-view mean's of
+/// the trace's own light).
+pub const REMODULATE: &str = "realtime/remodulate.wgsl";
 
 /// What the composite and the display bind beside the frame's I/O.
 pub struct FrameBuffers<'a> {
@@ -41,15 +44,16 @@ fn inputs<'a>(b: &FrameBuffers<'a>, hdr: &'a wgpu::Buffer) -> Bindings<'a> {
     s.buffer("hdr", hdr).buffer("accumulation", b.accumulation).buffer("display", b.display)
 }
 
-fn modules(glossy: bool, last: &'static str) -> Vec<&'static str> {
-    vec![
+fn modules(glossy: bool, last: &[&'static str]) -> Vec<&'static str> {
+    let mut m = vec![
         "common/math.wgsl",
         "common/rng.wgsl",
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
         if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" },
-        last,
-    ]
+    ];
+    m.extend_from_slice(last);
+    m
 }
 
 pub struct CompositePass {
@@ -59,7 +63,8 @@ pub struct CompositePass {
 
 impl CompositePass {
     pub fn new(gpu: &Gpu, b: &FrameBuffers) -> Result<CompositePass> {
-        let modules = modules(b.io.trace.glossy.is_some(), "realtime/composite.wgsl");
+        let modules =
+            modules(b.io.trace.glossy.is_some(), &[REMODULATE, "realtime/composite.wgsl"]);
         let pipeline = Reloadable::new(
             gpu,
             COMPOSITE,
@@ -135,7 +140,7 @@ impl DisplayPass {
         let offered = inputs(b, b.shown)
             .texture("view_float", &zero_float.1)
             .texture("view_uint", &zero_uint.1);
-        let modules = modules(b.io.trace.glossy.is_some(), "realtime/display.wgsl");
+        let modules = modules(b.io.trace.glossy.is_some(), &["realtime/display.wgsl"]);
         let pipeline = Reloadable::new(
             gpu,
             DISPLAY,

@@ -91,6 +91,7 @@ fn all_programs() -> Vec<Program> {
             "realtime/frame.wgsl",
             "realtime/gbuffer_in.wgsl",
             glossy,
+            "realtime/remodulate.wgsl",
             "realtime/composite.wgsl",
         ];
         v.push(compose("realtime/composite.wgsl", "", &m).unwrap());
