@@ -19,6 +19,7 @@ use crate::denoise::Denoiser;
 use crate::gpu::{BindKey, Gpu, GpuRequirements, GpuScene, GpuTimer, Instancing, PreparedScene};
 use crate::passes::cache::RadianceCache;
 use crate::passes::composite::CompositePass;
+use crate::passes::converge::ConvergeStage;
 use crate::passes::gbuffer::{self, GBufferPass};
 use crate::passes::prefilter::Prefilter;
 use crate::passes::primaries::Primaries;
@@ -190,12 +191,14 @@ impl Renderer {
         let composite = CompositePass::new(gpu, &u.shown(&targets, &io, None))
             .context("creating the composite pass")?;
         let taa = TaaStage::new(gpu, &mut uniforms.memory, prepared.features.motion());
+        let converge = ConvergeStage::new(gpu, &mut uniforms.memory);
         let stages = Stages {
             gbuffer,
             trace,
             composite,
             display: None,
             taa,
+            converge,
             supersample: Supersample::new(),
             primaries: Primaries::default(),
             prefilter: Prefilter::default(),
@@ -271,6 +274,7 @@ impl Renderer {
         self.prepared.repack_lighting(&self.scene);
         self.gpu_scene.update_lighting(gpu, &self.prepared);
         self.history.accumulated_state = None;
+        self.history.converge_state = None;
         true
     }
 
@@ -306,7 +310,7 @@ impl Renderer {
         // The accumulation restarts (its buffer is new); the cameras stay until the next frame
         // decides whether its histories are resampled.
         let h = &mut self.history;
-        (h.accumulated, h.accumulated_state) = (0, None);
+        (h.accumulated, h.accumulated_state, h.converge_state) = (0, None, None);
         // Back to the last size rendered before a frame ran at this one: its targets are whole.
         if let Some(old) = self.rescale_from.take_if(|r| r.size == size) {
             self.targets = old;

@@ -4,6 +4,7 @@
 use super::{DisplayTarget, FrameInput, FrameParams, MadeDenoiser, Renderer, halton_jitter};
 use crate::denoise::DenoiserScene;
 use crate::gpu::{BindKey, Gpu, Parity};
+use crate::passes::converge::ConvergeParams;
 use crate::passes::matte::ChainView;
 use crate::passes::reference::{TraceView, make_params};
 use crate::settings::{FrameSettings, MAX_PRIMARY_SAMPLES, MAX_SAMPLES_PER_PIXEL};
@@ -38,6 +39,8 @@ pub(super) struct FramePlan<'s> {
     /// Frames rendered before this one (wraps), and its parity.
     pub frame_index: u32,
     pub parity: Parity,
+    /// The still-view mean's parameters where it runs (passes/converge.rs).
+    pub converge: Option<ConvergeParams>,
 }
 
 impl Renderer {
@@ -109,6 +112,7 @@ impl Renderer {
                 && h.prev_jittered.is_some(),
             static_view: !moved && h.prev_view_proj == Some(cam.view_proj),
         };
+        let converge = self.converge_plan(gpu, input, settings, (denoiser, samples), &view);
         let denoised = denoiser.is_some();
         self.upload(gpu, input, settings, (&cam, jittered, jitter), denoised, primary_samples);
         self.history.denoised_last = denoiser;
@@ -131,6 +135,43 @@ impl Renderer {
             output_key: self.bind_key(denoiser),
             frame_index: self.history.frame_index,
             parity: Parity::of_frame(self.history.frame_index),
+            converge,
+        })
+    }
+
+    /// The still-view mean's parameters where it runs this frame: a denoiser ran (TAA's image is
+    /// there to move), the stage is on, and every pixel is one sample (k > 1 mixes samples into
+    /// guides the mean cannot remodulate). It continues last frame's mean while the view stands
+    /// still with the same camera, settings and size; anything else restarts it.
+    fn converge_plan(
+        &mut self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        (denoiser, samples): (Option<usize>, u32),
+        view: &ChainView,
+    ) -> Option<ConvergeParams> {
+        let taa = &settings.taa;
+        if denoiser.is_none() || taa.converge_sigmas <= 0.0 || samples != 1 {
+            self.history.converge_state = None;
+            return None;
+        }
+        let state = (input.camera, input.shutter.map(|s| s.camera), settings.clone());
+        let h = &mut self.history;
+        let continues = view.history_valid
+            && view.static_view
+            && self.rescale_from.is_none()
+            && h.converge_state.as_ref() == Some(&state);
+        h.converge_state = Some(state);
+        let t = &mut self.targets;
+        if self.stages.converge.allocate(gpu, &mut t.memory, t.size, t.epoch) {
+            t.generation += 1;
+        }
+        Some(ConvergeParams {
+            continues: continues as u32,
+            bias_sigmas: taa.converge_sigmas.clamp(0.0, 1024.0),
+            min_samples: taa.converge_min_samples.clamp(2.0, 1.0e9),
+            _pad: 0.0,
         })
     }
 

@@ -8,6 +8,7 @@ use crate::denoise::{Denoiser, FrameContext};
 use crate::gpu::{BindKey, Gpu, Recorder};
 use crate::passes::cache::{CacheInputs, RadianceCache};
 use crate::passes::composite::{self, CompositePass, DisplayPass, FrameBuffers};
+use crate::passes::converge::ConvergeStage;
 use crate::passes::gbuffer::{self, GBufferPass};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
@@ -29,6 +30,7 @@ pub(super) struct Stages {
     /// Made for the first display target's format.
     pub display: Option<DisplayPass>,
     pub taa: TaaStage,
+    pub converge: ConvergeStage,
     pub supersample: Supersample,
     pub primaries: Primaries,
     pub prefilter: Prefilter,
@@ -49,7 +51,12 @@ pub(super) struct FrameHistory {
     pub frame_index: u32,
     pub accumulated: u32,
     pub accumulated_state: Option<(FrameInput, FrameSettings)>,
+    /// What the still-view mean was taken with: the camera, the shutter's camera and the
+    /// settings (None: it restarts).
+    pub converge_state: Option<ConvergeState>,
 }
+
+pub(super) type ConvergeState = (crate::scene::Camera, Option<crate::scene::Camera>, FrameSettings);
 
 impl Renderer {
     pub(super) fn record_frame(
@@ -104,7 +111,7 @@ impl Renderer {
         io.feature_uncertainty =
             t.prefilter.as_ref().filter(|_| plan.prefilter).map(|pf| &pf.view.1);
         // primaries [-> pre-filter] -> trace [-> mix] [-> radiance cache] -> denoise -> composite [-> resolve] -> TAA
-        // -> display; then this frame's G-buffer becomes the next one's previous.
+        // [-> still-view mean] -> display; then this frame's G-buffer becomes the next one's previous.
         s.record_primaries(&mut rec, &plan, scene, t)?;
         s.record_trace(&mut rec, &plan, &trace, t.size)?;
         let io = s.record_mix(&mut rec, &plan, &trace, t, io)?;
@@ -113,6 +120,7 @@ impl Renderer {
         s.record_composite(&mut rec, &plan, &io, denoiser, u.shown(t, &io, None))?;
         s.record_resolve(&mut rec, &plan, &io, t)?;
         s.record_taa(&mut rec, &plan, &io, denoiser)?;
+        s.record_converge(&mut rec, &plan, &io)?;
         s.record_display(&mut rec, &plan, (&io, u, t), target)?;
         if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
             p.record_copy(rec.enc, &t.gbuffer, t.size);
@@ -164,7 +172,8 @@ impl Renderer {
             let (t, u) = (&self.targets, &self.uniforms);
             let io = t.io(&u.frame, &self.gpu_scene);
             let denoised = self.history.denoised_last;
-            let fb = u.shown(t, &io, self.stages.taa.output().filter(|_| denoised.is_some()));
+            let after_taa = after_taa(&self.stages.taa, &self.stages.converge);
+            let fb = u.shown(t, &io, after_taa.filter(|_| denoised.is_some()));
             let (view, view_key) = t.view_texture(settings);
             let key = BindKey { view: view_key, ..self.bind_key(denoised) };
             if let Some(d) = self.stages.display.as_mut() {
@@ -204,6 +213,14 @@ impl Renderer {
         gpu.queue.write_buffer(&u.display, 0, bytemuck::cast_slice(&options));
         Ok(())
     }
+}
+
+/// The image after TAA (and the still-view mean where it ran), once TAA ran.
+pub(super) fn after_taa<'a>(
+    taa: &'a TaaStage,
+    converge: &'a ConvergeStage,
+) -> Option<&'a wgpu::Buffer> {
+    converge.output().or(taa.output())
 }
 
 /// The denoiser the plan chose, recorded on the frame's I/O.
@@ -339,6 +356,22 @@ impl Stages {
         self.taa.record(rec, plan.output_key, io, |p| d.taa_follow(p), &dp, plan.parity)
     }
 
+    /// In a still view, TAA's image moved towards the mean of the pixel's samples
+    /// (passes/converge.rs).
+    fn record_converge(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        io: &FrameIo,
+    ) -> Result<()> {
+        let (Some(params), Some(taa)) = (plan.converge, self.taa.output()) else {
+            self.converge.skip();
+            return Ok(());
+        };
+        let _pass = crate::profile::scope(crate::passes::converge::LABEL);
+        self.converge.record(rec, plan.output_key, io, taa, &params, plan.parity)
+    }
+
     /// The image after TAA when a denoiser ran, else the composite's, tone-mapped (or the
     /// debug view) into `target`.
     fn record_display(
@@ -350,7 +383,8 @@ impl Stages {
     ) -> Result<()> {
         let (Some(target), Some(d)) = (target, self.display.as_mut()) else { return Ok(()) };
         let _pass = crate::profile::scope(composite::DISPLAY);
-        let shown = u.shown(t, io, self.taa.output().filter(|_| plan.denoiser.is_some()));
+        let after_taa = after_taa(&self.taa, &self.converge);
+        let shown = u.shown(t, io, after_taa.filter(|_| plan.denoiser.is_some()));
         let (view, view_key) = t.view_texture(plan.settings);
         d.record(rec, BindKey { view: view_key, ..plan.output_key }, &shown, view, target.view)
     }

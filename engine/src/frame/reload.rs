@@ -18,6 +18,7 @@ impl Renderer {
             v.push(&mut d.pipeline);
         }
         v.extend(self.stages.taa.pipelines());
+        v.extend(self.stages.converge.pipelines());
         v.extend(self.stages.supersample.pipelines());
         v.extend(self.stages.primaries.pipelines());
         if let Some((p, _)) = self.stages.trace.moving.as_mut() {
@@ -40,6 +41,10 @@ impl Renderer {
             if p.modules().iter().any(|m| changed.contains(m)) {
                 out.push(p.reload(gpu));
             }
+        }
+        // The still-view mean holds samples of the shaders before.
+        if !out.is_empty() {
+            self.history.converge_state = None;
         }
         out
     }

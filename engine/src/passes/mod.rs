@@ -9,6 +9,7 @@ pub use reference::{Accumulation, ReferenceTracer, TraceView};
 pub mod cache;
 pub mod chain;
 pub mod composite;
+pub mod converge;
 pub mod gbuffer;
 pub mod glossy;
 pub mod io;

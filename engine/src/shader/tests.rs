@@ -105,6 +105,12 @@ fn all_programs() -> Vec<Program> {
         ];
         v.push(compose("realtime/display.wgsl", "", &display).unwrap());
     }
+    for glossy in [false, true] {
+        for mean in [true, false] {
+            let m = crate::passes::converge::modules(glossy, mean);
+            v.push(compose(m[m.len() - 1], "", &m).unwrap());
+        }
+    }
     for (format, main) in [
         ("rgba32float", "realtime/rescale_float.wgsl"),
         ("r32float", "realtime/rescale_float.wgsl"),
@@ -469,6 +475,11 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(offs[7] as usize, offset_of!(FrameParams, jitter));
     assert_eq!(offs[11] as usize, offset_of!(FrameParams, accumulated));
     assert_eq!(offs[12] as usize, offset_of!(FrameParams, paths));
+    let converge = programs.iter().find(|p| p.label == "taa/converge.wgsl").unwrap();
+    let (size, offs) = wgsl_layout(converge, "ConvergeParams");
+    use crate::passes::converge::ConvergeParams;
+    assert_eq!(size as usize, size_of::<ConvergeParams>());
+    assert_eq!(offs[2] as usize, offset_of!(ConvergeParams, min_samples));
     let taa = programs.iter().find(|p| p.label == "taa/taa.wgsl").unwrap();
     let (size, offs) = wgsl_layout(taa, "DenoiseParams");
     use crate::passes::matte::DenoiseParams;

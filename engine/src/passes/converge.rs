@@ -1,0 +1,180 @@
+//! `converge`: the still-view mean after TAA (shaders/taa/converge*.wgsl). While the view stands
+//! still it keeps each pixel's plain mean of its own samples (the trace's light remodulated, as
+//! the accumulate mode sums it), and shows TAA's image moved towards that mean where the two
+//! differ by more than the mean's noise. A denoiser's bias that outlives its noise (the
+//! product of averaged material and light at a pixel whose jittered samples fall on two
+//! surfaces) then fades as the samples grow, and a still image ends at the mean of every
+//! sample. Its settings are [`crate::settings::TaaSettings::converge_sigmas`] and
+//! `converge_min_samples`; its output, `converge/shown`, is then the image shown.
+//!
+//! Per pixel: 40 bytes of history (the mean and count, the mean square) and 16 for the image
+//! shown, allocated only while the stage is on.
+
+use super::chain::ChainStage;
+use super::io::FrameIo;
+use crate::gpu::{Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
+use anyhow::{Context, Result};
+
+pub const MEAN: &str = "converge/mean";
+pub const LABEL: &str = "converge";
+
+/// Mirrors `ConvergeParams` (shaders/taa/converge_common.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ConvergeParams {
+    /// 1 when the mean continues last frame's.
+    pub continues: u32,
+    pub bias_sigmas: f32,
+    pub min_samples: f32,
+    pub _pad: f32,
+}
+
+struct ConvergeTargets {
+    /// Mean of the samples (rgb) and their count (a).
+    mean: PingPong<Tex>,
+    /// Mean of the samples' squared length.
+    m2: PingPong<Tex>,
+    shown: wgpu::Buffer,
+}
+
+impl ConvergeTargets {
+    fn new(device: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32)) -> ConvergeTargets {
+        let rw = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let mut pair = |l: &str, f| {
+            PingPong::new(|i| mem.texture(device, &format!("converge/{l} {i}"), size, f, rw))
+        };
+        let mean = pair("mean", wgpu::TextureFormat::Rgba32Float);
+        let m2 = pair("m2", wgpu::TextureFormat::R32Float);
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let shown = mem.buffer(device, "converge/shown", size.0 as u64 * size.1 as u64 * 16, usage);
+        ConvergeTargets { mean, m2, shown }
+    }
+}
+
+/// The stage's two passes, made on first use (they depend on whether the scene has glossy
+/// light).
+struct Programs {
+    mean: ChainStage,
+    shown: ChainStage,
+}
+
+pub struct ConvergeStage {
+    params: wgpu::Buffer,
+    targets: Option<(u64, ConvergeTargets)>,
+    programs: Option<Programs>,
+    /// Whether the last frame recorded ran the stage (its image is then the one shown).
+    ran: bool,
+}
+
+impl ConvergeStage {
+    pub fn new(gpu: &Gpu, memory: &mut GpuMemory) -> ConvergeStage {
+        let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let params =
+            memory.buffer(&gpu.device, "converge/params", size_of::<ConvergeParams>() as u64, u);
+        ConvergeStage { params, targets: None, programs: None, ran: false }
+    }
+
+    pub fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
+        self.programs.iter_mut().flat_map(|p| {
+            [&mut p.mean.pipeline as &mut dyn crate::shader::Reload, &mut p.shown.pipeline]
+        })
+    }
+
+    /// Make the textures for the frame targets of `epoch` (once per size); true if it did.
+    pub fn allocate(
+        &mut self,
+        gpu: &Gpu,
+        memory: &mut GpuMemory,
+        size: (u32, u32),
+        epoch: u64,
+    ) -> bool {
+        if self.targets.as_ref().is_some_and(|(e, _)| *e == epoch) {
+            return false;
+        }
+        self.targets = Some((epoch, ConvergeTargets::new(&gpu.device, memory, size)));
+        true
+    }
+
+    /// The image shown after this stage, if the last frame ran it.
+    pub fn output(&self) -> Option<&wgpu::Buffer> {
+        self.targets.as_ref().filter(|_| self.ran).map(|(_, t)| &t.shown)
+    }
+
+    /// Note that this frame does not run the stage (TAA's image is shown).
+    pub fn skip(&mut self) {
+        self.ran = false;
+    }
+
+    /// Record the mean's update and the image shown, from `taa_image` (TAA's output).
+    pub fn record(
+        &mut self,
+        rec: &mut Recorder,
+        key: crate::gpu::BindKey,
+        io: &FrameIo,
+        taa_image: &wgpu::Buffer,
+        params: &ConvergeParams,
+        parity: Parity,
+    ) -> Result<()> {
+        self.ran = false;
+        let gpu = rec.gpu;
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        let (_, t) = self
+            .targets
+            .as_ref()
+            .context("the still-view mean records before its textures exist")?;
+        let cv = &self.params;
+        let mean_bindings = |p: Parity| {
+            io.bindings()
+                .buffer("cv", cv)
+                .texture("mean_history", &t.mean.history(p).1)
+                .texture("m2_history", &t.m2.history(p).1)
+                .texture("out_mean", &t.mean.output(p).1)
+                .texture("out_m2", &t.m2.output(p).1)
+        };
+        let shown_bindings = |p: Parity| {
+            io.bindings()
+                .buffer("cv", cv)
+                .texture("mean", &t.mean.output(p).1)
+                .texture("m2", &t.m2.output(p).1)
+                .buffer("taa_image", taa_image)
+                .buffer("shown", &t.shown)
+        };
+        let programs = match self.programs.as_mut() {
+            Some(p) => p,
+            None => {
+                let glossy = io.trace.glossy.is_some();
+                let offered = mean_bindings(Parity::default());
+                let mean = ChainStage::new(gpu, MEAN, &modules(glossy, true), "main", &offered)?;
+                let offered = shown_bindings(Parity::default());
+                let shown = ChainStage::new(gpu, LABEL, &modules(glossy, false), "main", &offered)?;
+                self.programs.insert(Programs { mean, shown })
+            }
+        };
+        programs.mean.record(rec, key, parity, io.size, mean_bindings)?;
+        programs.shown.record(rec, key, parity, io.size, shown_bindings)?;
+        self.ran = true;
+        Ok(())
+    }
+}
+
+/// The modules of the mean's pass (`mean`) or of the image shown, with the scene's glossy light
+/// or without.
+pub fn modules(glossy: bool, mean: bool) -> Vec<&'static str> {
+    let mut m = vec![
+        "common/math.wgsl",
+        "common/rng.wgsl",
+        "realtime/frame.wgsl",
+        "realtime/gbuffer_in.wgsl",
+        if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" },
+        "taa/converge_common.wgsl",
+    ];
+    m.extend(match mean {
+        true => [super::composite::REMODULATE, "taa/converge_mean.wgsl"].as_slice(),
+        false => ["taa/converge.wgsl"].as_slice(),
+    });
+    m
+}
