@@ -98,7 +98,8 @@ fn the_image_shown_is_the_minimum_error_blend_of_taa_and_the_mean() {
 }
 
 /// The mean continues only while the camera and the settings stand: a moved camera, a changed
-/// setting and the stage's own first frame each restart it at one sample.
+/// setting of the samples and another denoiser each restart it at one sample; the display's
+/// exposure does not.
 #[test]
 fn the_still_view_mean_restarts_when_the_view_or_the_settings_change() {
     let (gpu, mut r, input) = cornell();
@@ -119,6 +120,8 @@ fn the_still_view_mean_restarts_when_the_view_or_the_settings_change() {
     moved.camera.world.w_axis.x += 0.01;
     assert_eq!(run(&mut r, &moved, &s, 1), 1.0, "the camera moved");
     assert_eq!(run(&mut r, &moved, &s, 4), 5.0, "it stands again");
+    let brighter = FrameSettings { exposure_ev: 1.0, ..s.clone() };
+    assert_eq!(run(&mut r, &moved, &brighter, 1), 6.0, "the exposure is the display's");
     let deeper = FrameSettings { max_depth: s.max_depth + 1, ..s.clone() };
     assert_eq!(run(&mut r, &moved, &deeper, 2), 2.0, "a setting changed");
     let other = FrameSettings { denoiser: Denoiser::SVGF, ..deeper.clone() };

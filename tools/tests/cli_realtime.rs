@@ -102,6 +102,8 @@ fn realtime_bench_reports_every_pass() {
             "glossy/bilateral_v",
             "composite",
             "taa",
+            "converge/mean",
+            "converge",
             "display",
         ]
     );

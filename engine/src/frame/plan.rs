@@ -142,7 +142,8 @@ impl Renderer {
     /// The still-view mean's parameters where it runs this frame: a denoiser ran (TAA's image is
     /// there to move), the stage is on, and every pixel is one sample (k > 1 mixes samples into
     /// guides the mean cannot remodulate). It continues last frame's mean while the view stands
-    /// still with the same camera, settings and size; anything else restarts it.
+    /// still with the same camera, settings and size; anything else restarts it, but for the
+    /// settings that do not change a pixel's samples.
     fn converge_plan(
         &mut self,
         gpu: &Gpu,
@@ -156,7 +157,15 @@ impl Renderer {
             self.history.converge_state = None;
             return None;
         }
-        let state = (input.camera, input.shutter.map(|s| s.camera), settings.clone());
+        // What decides the samples: not which pixels a frame traces (the governor's fraction),
+        // nor the display's exposure and view.
+        let samples_from = FrameSettings {
+            sample_fraction: Default::default(),
+            exposure_ev: 0.0,
+            view: Default::default(),
+            ..settings.clone()
+        };
+        let state = (input.camera, input.shutter.map(|s| s.camera), samples_from);
         let h = &mut self.history;
         let continues = view.history_valid
             && view.static_view

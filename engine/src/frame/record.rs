@@ -368,7 +368,6 @@ impl Stages {
             self.converge.skip();
             return Ok(());
         };
-        let _pass = crate::profile::scope(crate::passes::converge::LABEL);
         self.converge.record(rec, plan.output_key, io, taa, &params, plan.parity)
     }
 
