@@ -8,7 +8,7 @@
 //! `converge_min_samples`; its output, `converge/shown`, is then the image shown.
 //!
 //! Per pixel: 40 bytes of history (the mean and count, the mean square) and 16 for the image
-//! shown, allocated only while the stage is on.
+//! shown, allocated on the stage's first frame at a size (never where it stays off).
 
 use super::chain::ChainStage;
 use super::io::FrameIo;
