@@ -16,6 +16,20 @@ pub fn made<T>(slot: &mut Option<T>, make: impl FnOnce() -> Result<T>) -> Result
     }
 }
 
+/// Per-pixel targets in `slot` made for the frame targets of `epoch` (once per size): `make`
+/// runs where the slot holds none or another epoch's. True if it did.
+pub fn made_for_epoch<T>(
+    slot: &mut Option<(u64, T)>,
+    epoch: u64,
+    make: impl FnOnce() -> T,
+) -> bool {
+    if slot.as_ref().is_some_and(|(e, _)| *e == epoch) {
+        return false;
+    }
+    *slot = Some((epoch, make()));
+    true
+}
+
 pub struct ChainStage {
     pub label: &'static str,
     pub pipeline: Reloadable<wgpu::ComputePipeline>,

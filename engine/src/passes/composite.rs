@@ -44,7 +44,9 @@ fn inputs<'a>(b: &FrameBuffers<'a>, hdr: &'a wgpu::Buffer) -> Bindings<'a> {
     s.buffer("hdr", hdr).buffer("accumulation", b.accumulation).buffer("display", b.display)
 }
 
-fn modules(glossy: bool, last: &[&'static str]) -> Vec<&'static str> {
+/// The modules every stage that reads the G-buffer and the trace's light through the frame's
+/// bindings starts with, then `last`.
+pub fn modules(glossy: bool, last: &[&'static str]) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "common/rng.wgsl",

@@ -92,11 +92,8 @@ impl ConvergeStage {
         size: (u32, u32),
         epoch: u64,
     ) -> bool {
-        if self.targets.as_ref().is_some_and(|(e, _)| *e == epoch) {
-            return false;
-        }
-        self.targets = Some((epoch, ConvergeTargets::new(&gpu.device, memory, size)));
-        true
+        let make = || ConvergeTargets::new(&gpu.device, memory, size);
+        super::chain::made_for_epoch(&mut self.targets, epoch, make)
     }
 
     /// The image shown after this stage, if the last frame ran it.
@@ -164,17 +161,8 @@ impl ConvergeStage {
 /// The modules of the mean's pass (`mean`) or of the image shown, with the scene's glossy light
 /// or without.
 pub fn modules(glossy: bool, mean: bool) -> Vec<&'static str> {
-    let mut m = vec![
-        "common/math.wgsl",
-        "common/rng.wgsl",
-        "realtime/frame.wgsl",
-        "realtime/gbuffer_in.wgsl",
-        if glossy { "realtime/glossy_in.wgsl" } else { "realtime/glossy_in_none.wgsl" },
-        "taa/converge_common.wgsl",
-    ];
-    m.extend(match mean {
-        true => [super::composite::REMODULATE, "taa/converge_mean.wgsl"].as_slice(),
-        false => ["taa/converge.wgsl"].as_slice(),
-    });
-    m
+    const MEAN_PASS: [&str; 3] =
+        ["taa/converge_common.wgsl", super::composite::REMODULATE, "taa/converge_mean.wgsl"];
+    const SHOWN_PASS: [&str; 2] = ["taa/converge_common.wgsl", "taa/converge.wgsl"];
+    super::composite::modules(glossy, if mean { &MEAN_PASS } else { &SHOWN_PASS })
 }

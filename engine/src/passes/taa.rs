@@ -114,11 +114,8 @@ impl TaaStage {
         size: (u32, u32),
         epoch: u64,
     ) -> bool {
-        if self.targets.as_ref().is_some_and(|(e, _)| *e == epoch) {
-            return false;
-        }
-        self.targets = Some((epoch, TaaTargets::new(&gpu.device, memory, size)));
-        true
+        let make = || TaaTargets::new(&gpu.device, memory, size);
+        super::chain::made_for_epoch(&mut self.targets, epoch, make)
     }
 
     /// The image after TAA (once it ran).
