@@ -1,7 +1,8 @@
 // The still-view mean: each pixel's running mean of its own samples (the trace's light
 // remodulated, realtime/remodulate.wgsl) since the view settled, with the count in alpha, and
-// the mean of their squared length (the sum of the channels' second moments). This is what the accumulate mode sums, over TAA's jitter: the
-// box-filtered pixel. A pixel not traced this frame (sub-1-spp) keeps its mean.
+// the mean of their squared length (the sum of the channels' second moments). This is what the
+// accumulate mode sums, over TAA's jitter: the box-filtered pixel. A pixel not traced this frame
+// (sub-1-spp) keeps its mean.
 
 var mean_history: texture_2d<f32>;
 var m2_history: texture_2d<f32>;
