@@ -167,10 +167,9 @@ impl Renderer {
         };
         let state = (input.camera, input.shutter.map(|s| s.camera), samples_from);
         let h = &mut self.history;
-        let continues = view.history_valid
-            && view.static_view
-            && self.rescale_from.is_none()
-            && h.converge_state.as_ref() == Some(&state);
+        // A resize cleared the state (Renderer::resize).
+        let continues =
+            view.history_valid && view.static_view && h.converge_state.as_ref() == Some(&state);
         h.converge_state = Some(state);
         let t = &mut self.targets;
         if self.stages.converge.allocate(gpu, &mut t.memory, t.size, t.epoch) {

@@ -10,7 +10,7 @@
 //! Per pixel: 40 bytes of history (the mean and count, the mean square) and 16 for the image
 //! shown, allocated on the stage's first frame at a size (never where it stays off).
 
-use super::chain::ChainStage;
+use super::chain::{ChainStage, made};
 use super::io::FrameIo;
 use crate::gpu::{Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use anyhow::{Context, Result};
@@ -140,17 +140,14 @@ impl ConvergeStage {
                 .buffer("taa_image", taa_image)
                 .buffer("shown", &t.shown)
         };
-        let programs = match self.programs.as_mut() {
-            Some(p) => p,
-            None => {
-                let glossy = io.trace.glossy.is_some();
-                let offered = mean_bindings(Parity::default());
-                let mean = ChainStage::new(gpu, MEAN, &modules(glossy, true), "main", &offered)?;
-                let offered = shown_bindings(Parity::default());
-                let shown = ChainStage::new(gpu, LABEL, &modules(glossy, false), "main", &offered)?;
-                self.programs.insert(Programs { mean, shown })
-            }
-        };
+        let programs = made(&mut self.programs, || {
+            let glossy = io.trace.glossy.is_some();
+            let offered = mean_bindings(Parity::default());
+            let mean = ChainStage::new(gpu, MEAN, &modules(glossy, true), "main", &offered)?;
+            let offered = shown_bindings(Parity::default());
+            let shown = ChainStage::new(gpu, LABEL, &modules(glossy, false), "main", &offered)?;
+            Ok(Programs { mean, shown })
+        })?;
         programs.mean.record(rec, key, parity, io.size, mean_bindings)?;
         programs.shown.record(rec, key, parity, io.size, shown_bindings)?;
         self.ran = true;
