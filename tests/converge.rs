@@ -127,3 +127,16 @@ fn the_still_view_mean_restarts_when_the_view_or_the_settings_change() {
     let other = FrameSettings { denoiser: Denoiser::SVGF, ..deeper.clone() };
     assert_eq!(run(&mut r, &moved, &other, 3), 3.0, "another denoiser");
 }
+
+/// `--disable converge` (the quality tool's ablations, `reflections --disable`) turns the stage
+/// off and leaves TAA on.
+#[test]
+fn the_still_view_mean_is_a_stage_disable_switches_off() {
+    use hush_engine::settings::{CONVERGE_STAGE, disable_stage, stage_names};
+    assert!(stage_names().contains(&CONVERGE_STAGE));
+    let mut s = settings(2.0);
+    assert!(disable_stage(&mut s, CONVERGE_STAGE));
+    assert_eq!(s.taa.converge_sigmas, 0.0);
+    assert!(s.taa.enabled);
+    assert_eq!(s.taa.converge_min_samples, 4.0);
+}

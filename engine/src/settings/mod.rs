@@ -222,10 +222,18 @@ pub fn denoiser_names() -> Vec<&'static str> {
 /// TAA's `--disable` name: TAA runs after any denoiser.
 pub const TAA_STAGE: &str = TaaSettings::STAGE;
 
-/// Every stage `--disable` accepts: each denoiser's, then TAA's.
+/// The still-view mean's `--disable` name (`passes/converge.rs`): it runs after TAA.
+pub const CONVERGE_STAGE: &str = "converge";
+
+/// Every stage `--disable` accepts: each denoiser's, then TAA's and the still-view mean's.
 pub fn stages() -> Vec<Stage> {
     let taa = Stage { name: TAA_STAGE, path: "taa.enabled", off: Off::False };
-    registry::denoisers().iter().flat_map(|d| d.stages.iter().copied()).chain([taa]).collect()
+    let converge = Stage { name: CONVERGE_STAGE, path: "taa.converge_sigmas", off: Off::Zero };
+    registry::denoisers()
+        .iter()
+        .flat_map(|d| d.stages.iter().copied())
+        .chain([taa, converge])
+        .collect()
 }
 
 /// Every stage name `--disable` accepts.
