@@ -186,6 +186,15 @@ fn nonfinite_input_never_reaches_history_or_screen() {
             };
             assert_eq!(bad, 0, "{name} holds {bad} NaN/Inf values with {m:?}");
         }
+        // The glossy term TAA's history holds (TaaSettings::moving_glossy).
+        for name in ["taa/glossy term 0", "taa/glossy term 1"] {
+            let bytes = r.read_buffer(&gpu, name).unwrap();
+            let bad = bytes
+                .chunks_exact(4)
+                .filter(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite())
+                .count();
+            assert_eq!(bad, 0, "{name} holds {bad} NaN/Inf values with {m:?}");
+        }
     }
 }
 

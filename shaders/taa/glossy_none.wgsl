@@ -8,3 +8,7 @@ fn taa_glossy(p: vec2i, f_s: vec3f) -> TaaGlossy {
 fn taa_glossy_previous(p: vec2i) -> vec3f {
     return vec3f(0.0);
 }
+
+fn taa_glossy_term(p: vec2i, f_s: vec3f) -> vec3f {
+    return vec3f(0.0);
+}

@@ -38,6 +38,13 @@
 // term goes back into the residual (last frame's light is its temporal output there, still in
 // its history); where the matte chain does, or the pixel is not settled, TAA keeps its own
 // average and re-sets the residual so that the two agree.
+//
+// A pixel that moves takes the glossy term out of its history and this frame's in
+// (TaaSettings::moving_glossy): the history moved with the surface, the reflection on it moves
+// its own way, and the denoiser's glossy light followed the reflection. The term each texel was
+// last blended with is kept beside the history; both are read bilinearly, so where the texels
+// were written while moving the difference is exactly the history of the rest of the composite
+// (after a still frame it is off by TAA's average of the glossy term less the last frame's).
 
 var<storage, read> hdr: array<vec4f>;
 var history: texture_2d<f32>;
@@ -52,12 +59,16 @@ var out_residual: texture_storage_2d<rgba32float, write>;
 // Average of the glossy factor F(w_s) x the mirror demodulation (MatteSettings::taa_current_glossy).
 var glossy_factor_history: texture_2d<f32>;
 var out_glossy_factor: texture_storage_2d<rgba32float, write>;
+// The glossy term of the composite each history texel was last blended with
+// (TaaSettings::moving_glossy): rgb per pixel, row-major.
+var<storage, read> glossy_term_history: array<f32>;
+var<storage, read_write> out_glossy_term: array<f32>;
 
 // What TAA follows of the denoiser's matte light: taa/matte.wgsl where the denoiser offers it
 // (the matte temporal's output and its reason flags and history length), taa/matte_none.wgsl
-// where it does not. This pixel's glossy term as TAA follows it: taa/glossy.wgsl, or
-// taa/glossy_none.wgsl in a scene without glossy buffers or a denoiser that offers no glossy
-// light to follow.
+// where it does not. This pixel's glossy term as TAA follows it: taa/glossy.wgsl;
+// taa/glossy_shown.wgsl for a denoiser that shows glossy light but offers none to follow (the
+// term alone); taa/glossy_none.wgsl in a scene without glossy buffers.
 struct TaaGlossy {
     // What the composite multiplies the glossy chain's light by: F(w_s) x the demodulation.
     factor: vec3f,
@@ -95,6 +106,20 @@ fn pixel_factors(px: vec2u) -> array<vec3f, 2> {
     return array<vec3f, 2>(f_s, matte_factor(g, f_s));
 }
 
+// The history's glossy term read bilinearly at `at`, edges clamped (as load_bilinear reads the
+// history).
+fn glossy_term_bilinear(at: vec2f) -> vec3f {
+    let b = bilinear_taps(at);
+    let hi = vec2i(frame.size) - 1;
+    var sum = vec3f(0.0);
+    for (var k = 0; k < 4; k++) {
+        let q = clamp(bilinear_tap(b, k), vec2i(0), hi);
+        let j = 3u * (u32(q.y) * frame.size.x + u32(q.x));
+        sum += b.w[k] * vec3f(glossy_term_history[j], glossy_term_history[j + 1u], glossy_term_history[j + 2u]);
+    }
+    return sum;
+}
+
 fn hdr_at(p: vec2i) -> vec3f {
     let q = clamp(p, vec2i(0), vec2i(frame.size) - 1);
     return half_safe(hdr[u32(q.y) * frame.size.x + u32(q.x)].rgb);
@@ -111,6 +136,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let m_k = factors[1];
     let light_k = half_safe(taa_matte_light(p));
     let gl = taa_glossy(p, factors[0]);
+    let glossy_term = taa_glossy_term(p, factors[0]);
     let matte_reason_k = taa_matte_state(p);
     // The matte light of this pixel continues last frame's: a surface whose history is this
     // pixel's own texel.
@@ -136,9 +162,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             }
         }
         let texel = load_bilinear(history, prev);
-        let hist = half_safe(texel.rgb);
-        let y = to_ycocg(hist);
+        var hist = half_safe(texel.rgb);
         let still = dot(prev - vec2f(p) - 0.5, prev - vec2f(p) - 0.5) < 1e-4;
+        // After a change of size the history was resampled but the terms were not.
+        if dn.taa_moving_glossy != 0u && !still && frame.rescaled_frames <= 0.0 {
+            // The history's glossy term moved with the surface; the reflection moves its own way,
+            // and the denoiser's glossy light followed it there.
+            hist = half_safe(hist - glossy_term_bilinear(prev) + glossy_term);
+        }
+        let y = to_ycocg(hist);
         // In a static view (no camera or object motion) the history shows what the pixel shows,
         // and the clamp can only take from it: a feature thinner than a pixel (a highlight on a
         // stair nosing, a lantern's lit glass) lies between the jittered samples of most frames,
@@ -218,6 +250,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     textureStore(out_glossy_factor, p, vec4f(glossy, 0.0));
     textureStore(out_residual, p, vec4f(residual, f32(chains)));
     let i = u32(p.y) * frame.size.x + u32(p.x);
+    out_glossy_term[3u * i] = glossy_term.x;
+    out_glossy_term[3u * i + 1u] = glossy_term.y;
+    out_glossy_term[3u * i + 2u] = glossy_term.z;
     var shown = result;
     if shown_weight < 1.0 {
         shown = half_safe(mix(half_safe(final_image[i].rgb), result, shown_weight));

@@ -353,7 +353,8 @@ impl Stages {
         let Some(d) = denoiser else { return Ok(()) };
         let s = plan.settings;
         let dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, plan.frame_index, &plan.view);
-        self.taa.record(rec, plan.output_key, io, |p| d.taa_follow(p), &dp, plan.parity)
+        let follow = |p| (d.taa_follow(p), d.output(p).glossy);
+        self.taa.record(rec, plan.output_key, io, follow, &dp, plan.parity)
     }
 
     /// In a still view, TAA's image moved towards the mean of the pixel's samples

@@ -73,7 +73,9 @@ pub struct DenoiseParams {
     pub still_normal_min_cos: f32,
     /// [`MatteSettings::tap_sigma_fraction`].
     pub tap_sigma: f32,
-    pub _pad: [f32; 2],
+    /// [`TaaSettings::moving_glossy`].
+    pub taa_moving_glossy: u32,
+    pub _pad: [f32; 1],
 }
 
 /// What the chains need to know of this frame's camera and the previous one's.
@@ -141,7 +143,8 @@ impl DenoiseParams {
             edge_stop_full_frames: s.edge_stop_full_frames.clamp(0.0, STILL_FRAMES_MAX),
             still_normal_min_cos: normal_test_cos(s.still_normal_degrees),
             tap_sigma: s.tap_sigma_fraction.clamp(0.0, 4.0),
-            _pad: [0.0; 2],
+            taa_moving_glossy: taa.moving_glossy as u32,
+            _pad: [0.0; 1],
         }
     }
 }

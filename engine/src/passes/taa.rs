@@ -58,12 +58,16 @@ pub struct GlossyFollow<'a> {
 }
 
 /// TAA's per-pixel textures: its history (with its length), the averaged matte and glossy
-/// factors and residual it follows the chains with, and the image shown. 144 bytes per pixel.
+/// factors and residual it follows the chains with, the glossy term its history holds, and the
+/// image shown. 168 bytes per pixel.
 struct TaaTargets {
     history: PingPong<Tex>,
     material: PingPong<Tex>,
     residual: PingPong<Tex>,
     glossy: PingPong<Tex>,
+    /// Three floats a pixel in storage buffers: a fifth storage texture would pass WebGPU's
+    /// default limit of four per stage, and unpacking half floats needs a shader capability.
+    glossy_term: PingPong<wgpu::Buffer>,
     final_image: wgpu::Buffer,
 }
 
@@ -80,18 +84,32 @@ impl TaaTargets {
         let usage = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
             | wgpu::BufferUsages::COPY_DST;
-        let final_image =
-            mem.buffer(device, "taa/final", size.0 as u64 * size.1 as u64 * 16, usage);
-        TaaTargets { history, material, residual, glossy, final_image }
+        let pixels = size.0 as u64 * size.1 as u64;
+        let glossy_term = PingPong::new(|i| {
+            mem.buffer(device, &format!("taa/glossy term {i}"), pixels * 12, usage)
+        });
+        let final_image = mem.buffer(device, "taa/final", pixels * 16, usage);
+        TaaTargets { history, material, residual, glossy, glossy_term, final_image }
     }
+}
+
+/// What TAA reads of the denoiser's glossy light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum GlossyInput {
+    /// None shown (a scene without glossy buffers): the glossy term is zero.
+    None,
+    /// The light the composite showed, for the glossy term (`TaaSettings::moving_glossy`).
+    Shown,
+    /// That and the chain's temporal light to follow ([`GlossyFollow`]).
+    Follow,
 }
 
 pub struct TaaStage {
     params: wgpu::Buffer,
     targets: Option<(u64, TaaTargets)>,
-    /// One program per (the matte state's form where it follows the matte light, follows
-    /// glossy), made on first use.
-    programs: Vec<((Option<MatteState>, bool), ChainStage)>,
+    /// One program per (the matte state's form where it follows the matte light, what it reads
+    /// of the glossy light), made on first use.
+    programs: Vec<((Option<MatteState>, GlossyInput), ChainStage)>,
     motion: crate::gpu::Motion,
 }
 
@@ -125,22 +143,31 @@ impl TaaStage {
 
     /// Record TAA of `io.hdr`; `params` as the denoisers write them (its `taa*` and `stages`).
     /// `key` changes whenever a bound resource may have (scene, targets, denoiser).
-    /// `follow(p)`: what TAA follows at history parity p.
+    /// `follow(p)`: what TAA follows at history parity p, and the glossy light the composite
+    /// showed.
     pub fn record<'a>(
         &mut self,
         rec: &mut Recorder,
         key: crate::gpu::BindKey,
         io: &FrameIo<'a>,
-        follow: impl Fn(Parity) -> TaaFollow<'a>,
+        follow: impl Fn(Parity) -> (TaaFollow<'a>, Option<&'a wgpu::TextureView>),
         params: &DenoiseParams,
         parity: Parity,
     ) -> Result<()> {
         let gpu = rec.gpu;
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let (_, t) = self.targets.as_ref().context("TAA records before its textures exist")?;
-        let f = follow(parity);
-        let variant = (f.matte.map(|m| m.form), f.glossy.is_some());
-        let bindings = |p: Parity| taa_bindings(io, t, &self.params, &follow(p), p);
+        let (f, shown) = follow(parity);
+        let glossy = match (f.glossy.is_some(), shown.is_some()) {
+            (true, _) => GlossyInput::Follow,
+            (false, true) => GlossyInput::Shown,
+            (false, false) => GlossyInput::None,
+        };
+        let variant = (f.matte.map(|m| m.form), glossy);
+        let bindings = |p: Parity| {
+            let (f, shown) = follow(p);
+            taa_bindings(io, t, &self.params, &f, shown, p)
+        };
         let i = match self.programs.iter().position(|(v, _)| *v == variant) {
             Some(i) => i,
             None => {
@@ -161,6 +188,7 @@ fn taa_bindings<'a>(
     t: &'a TaaTargets,
     params: &'a wgpu::Buffer,
     follow: &TaaFollow<'a>,
+    shown_glossy: Option<&'a wgpu::TextureView>,
     parity: Parity,
 ) -> Bindings<'a> {
     let mut b = io
@@ -175,7 +203,9 @@ fn taa_bindings<'a>(
         .texture("residual_history", &t.residual.history(parity).1)
         .texture("out_residual", &t.residual.output(parity).1)
         .texture("glossy_factor_history", &t.glossy.history(parity).1)
-        .texture("out_glossy_factor", &t.glossy.output(parity).1);
+        .texture("out_glossy_factor", &t.glossy.output(parity).1)
+        .buffer("glossy_term_history", t.glossy_term.history(parity))
+        .buffer("out_glossy_term", t.glossy_term.output(parity));
     if let Some(m) = follow.matte {
         let state = match m.form {
             MatteState::Reason => "matte_reason",
@@ -190,12 +220,14 @@ fn taa_bindings<'a>(
             .texture("glossy_previous", g.previous)
             .texture("glossy_info", g.info)
             .buffer("gp", g.params);
+    } else if let Some(shown) = shown_glossy {
+        b = b.texture("tr_glossy", shown);
     }
     b
 }
 
 fn modules(
-    (matte, glossy): (Option<MatteState>, bool),
+    (matte, glossy): (Option<MatteState>, GlossyInput),
     motion: crate::gpu::Motion,
 ) -> Vec<&'static str> {
     let mut m = vec![
@@ -206,10 +238,12 @@ fn modules(
         "matte/common.wgsl",
     ];
     m.push(motion.module());
-    m.extend(if glossy {
-        ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice()
-    } else {
-        ["taa/glossy_none.wgsl"].as_slice()
+    m.extend(match glossy {
+        GlossyInput::Follow => {
+            ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice()
+        }
+        GlossyInput::Shown => ["realtime/glossy_in.wgsl", "taa/glossy_shown.wgsl"].as_slice(),
+        GlossyInput::None => ["taa/glossy_none.wgsl"].as_slice(),
     });
     m.push(match matte {
         Some(MatteState::Reason) => "taa/matte.wgsl",

@@ -225,14 +225,15 @@ pub const TAA_STAGE: &str = TaaSettings::STAGE;
 /// The still-view mean's `--disable` name (`passes/converge.rs`): it runs after TAA.
 pub const CONVERGE_STAGE: &str = "converge";
 
-/// Every stage `--disable` accepts: each denoiser's, then TAA's and the still-view mean's.
+/// Every stage `--disable` accepts: each denoiser's, then TAA's (and its glossy term under
+/// motion) and the still-view mean's.
 pub fn stages() -> Vec<Stage> {
     let taa = Stage { name: TAA_STAGE, path: "taa.enabled", off: Off::False };
     let converge = Stage { name: CONVERGE_STAGE, path: "taa.converge_sigmas", off: Off::Zero };
     registry::denoisers()
         .iter()
         .flat_map(|d| d.stages.iter().copied())
-        .chain([taa, converge])
+        .chain([taa, Stage::switch("taa.moving_glossy"), converge])
         .collect()
 }
 

@@ -146,6 +146,12 @@ fn all_programs() -> Vec<Program> {
             ],
             &["taa/glossy_none.wgsl", "taa/matte_none.wgsl", "taa/taa.wgsl"],
             &["taa/glossy_none.wgsl", "taa/matte_moments.wgsl", "taa/taa.wgsl"],
+            &[
+                "realtime/glossy_in.wgsl",
+                "taa/glossy_shown.wgsl",
+                "taa/matte_moments.wgsl",
+                "taa/taa.wgsl",
+            ],
         ] {
             let mut m = vec![
                 "common/math.wgsl",
@@ -486,6 +492,7 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(size as usize, size_of::<DenoiseParams>());
     assert_eq!(offs[2] as usize, offset_of!(DenoiseParams, stages));
     assert_eq!(offs[17] as usize, offset_of!(DenoiseParams, history_valid));
+    assert_eq!(offs[35] as usize, offset_of!(DenoiseParams, taa_moving_glossy));
     let temporal = programs.iter().find(|p| p.label == "glossy/temporal.wgsl").unwrap();
     let (size, offs) = wgsl_layout(temporal, "GlossyParams");
     use crate::passes::glossy::GlossyParams;
