@@ -88,7 +88,7 @@ fn strafe_error(s: &FrameSettings, refs: &[(Image, Vec<bool>)]) -> (f64, f64) {
 
 /// FLIP on the reflective pixels (roughness under 0.4, as `hush-cli reflections` masks them)
 /// of frames 8-19 of a strafe at 128x72, against 32 accumulated frames of each. Measured: Mara
-/// 0.1043 with, 0.1154 without (0.90x); SVGF 0.1047 and 0.1206 (0.87x). The frames are the
+/// 0.1041 with, 0.1154 without (0.90x); SVGF 0.1052 and 0.1206 (0.87x). The frames are the
 /// same samples in both runs (a frame's seed is its index), so the bound, 0.95x, leaves room for
 /// a driver's rounding, not for noise. The trade, printed beside: the mean relative luminance
 /// error, which counts noise that FLIP does not see: SVGF 0.156 against 0.187, Mara 0.169

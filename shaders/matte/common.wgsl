@@ -78,7 +78,7 @@ struct DenoiseParams {
     // The sparse bilateral's taps weigh by a Gaussian of their distance whose sigma is this
     // fraction of the disk's radius (0: none; MatteSettings::tap_sigma_fraction).
     tap_sigma: f32,
-    // TAA: while anything moves, the history's glossy term is replaced by this frame's
+    // TAA: where a pixel moves, the history's glossy term is replaced by this frame's
     // (TaaSettings::moving_glossy).
     taa_moving_glossy: u32,
 }

@@ -32,7 +32,7 @@ described! {
         /// composite shows now: the denoiser carried it along the reflection's motion, TAA's
         /// history moves with the surface, and reflections move over their surfaces. Default on:
         /// `hush-cli reflections` strafe, reflective / ghost-region FLIP Mara 0.1168 / 0.2211 ->
-        /// 0.0980 / 0.1942, SVGF 0.1153 / 0.2244 -> 0.0927 / 0.1925; the glossy term is no longer
+        /// 0.0977 / 0.1941, SVGF 0.1153 / 0.2244 -> 0.0933 / 0.1923; the glossy term is no longer
         /// averaged by TAA while it moves, so Mara's relative error there rises 6%. Still pixels
         /// are unchanged. 24 bytes per pixel.
         moving_glossy: bool = true,
