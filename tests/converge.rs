@@ -128,8 +128,7 @@ fn the_still_view_mean_restarts_when_the_view_or_the_settings_change() {
     assert_eq!(run(&mut r, &moved, &other, 3), 3.0, "another denoiser");
 }
 
-/// `--disable converge` (the quality tool's ablations, `reflections --disable`) turns the stage
-/// off and leaves TAA on.
+/// `--disable converge` (`render`, `reflections`) turns the stage off and leaves TAA on.
 #[test]
 fn the_still_view_mean_is_a_stage_disable_switches_off() {
     use hush_engine::settings::{CONVERGE_STAGE, disable_stage, stage_names};

@@ -15,11 +15,6 @@ fn taa_glossy(p: vec2i, f_s: vec3f) -> TaaGlossy {
     return TaaGlossy(f_s * demodulation(p), half_safe(t.rgb), info.w == 1.0, info.z);
 }
 
-// The composite's glossy term at this pixel: the denoiser's glossy light times F(w_s).
-fn taa_glossy_term(p: vec2i, f_s: vec3f) -> vec3f {
-    return half_safe(glossy_light(p) * f_s);
-}
-
 // The light TAA followed at this pixel last frame (the glossy temporal's output there).
 fn taa_glossy_previous(p: vec2i) -> vec3f {
     return half_safe(textureLoad(glossy_previous, p, 0).rgb);

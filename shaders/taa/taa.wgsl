@@ -66,9 +66,9 @@ var<storage, read_write> out_glossy_term: array<f32>;
 
 // What TAA follows of the denoiser's matte light: taa/matte.wgsl where the denoiser offers it
 // (the matte temporal's output and its reason flags and history length), taa/matte_none.wgsl
-// where it does not. This pixel's glossy term as TAA follows it: taa/glossy.wgsl;
-// taa/glossy_shown.wgsl for a denoiser that shows glossy light but offers none to follow (the
-// term alone); taa/glossy_none.wgsl in a scene without glossy buffers.
+// where it does not. This pixel's glossy term as TAA follows it: taa/glossy.wgsl, or
+// taa/glossy_none.wgsl where the denoiser offers none to follow; taa/glossy_term.wgsl gives the
+// composite's glossy term either way (TaaSettings::moving_glossy).
 struct TaaGlossy {
     // What the composite multiplies the glossy chain's light by: F(w_s) x the demodulation.
     factor: vec3f,

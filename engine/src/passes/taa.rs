@@ -242,9 +242,10 @@ fn modules(
         GlossyInput::Follow => {
             ["realtime/glossy_in.wgsl", "glossy/common.wgsl", "taa/glossy.wgsl"].as_slice()
         }
-        GlossyInput::Shown => ["realtime/glossy_in.wgsl", "taa/glossy_shown.wgsl"].as_slice(),
-        GlossyInput::None => ["taa/glossy_none.wgsl"].as_slice(),
+        GlossyInput::Shown => ["realtime/glossy_in.wgsl", "taa/glossy_none.wgsl"].as_slice(),
+        GlossyInput::None => ["realtime/glossy_in_none.wgsl", "taa/glossy_none.wgsl"].as_slice(),
     });
+    m.push("taa/glossy_term.wgsl");
     m.push(match matte {
         Some(MatteState::Reason) => "taa/matte.wgsl",
         Some(MatteState::Moments) => "taa/matte_moments.wgsl",
