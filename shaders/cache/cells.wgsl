@@ -35,17 +35,26 @@ struct CacheParams {
     // Fixed-point units per unit of radiance, and the clamp of one sample (radiance).
     fixed_scale: f32,
     sample_clamp: f32,
+    // The samples a cell must hold before a path may end in it (0: none does;
+    // cache/path_end.wgsl).
+    path_end_samples: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 var<uniform> cache: CacheParams;
 var<storage, read_write> cache_keys: array<atomic<u32>>;
 // Per cell, CACHE_SUMS words: this frame's fixed-point sums of r, g, b, the number of samples,
-// the sums of their positions in the cell (x, y, z in 1/1024 of its edge), and the sum of their
-// squared luminances (in 1/1024 of the displayed white squared, each at most 16 whites).
+// the sums of their positions in the cell (x, y, z in 1/1024 of its edge) weighted by their
+// light, the sum of their squared luminances (in 1/1024 of the displayed white squared, each at
+// most 16 whites), and the sum of the light weights (light_weight).
 var<storage, read_write> cache_sums: array<atomic<u32>>;
 // Per cell: the mean (rgb) and the samples it holds (a).
 var<storage, read_write> cache_cells: array<vec4f>;
-// Per cell: its samples' centroid, as a fraction of the cell from its lowest corner (xyz), and
+// Per cell: its samples' centroid weighted by their light (light_weight), as a fraction of the
+// cell from its lowest corner (xyz): where the light it holds came from, which a cell that
+// straddles a wall keeps on its lit side however many dark samples the other side adds; and
 // the mean of their squared luminances (w): with the mean's luminance, their spread, which a
 // denoiser that estimates variance from moments (SVGF) takes for a restarted pixel's.
 var<storage, read_write> cache_centroids: array<vec4f>;
@@ -54,7 +63,7 @@ var<storage, read_write> cache_ages: array<u32>;
 
 const CACHE_PROBES: u32 = 8u;
 const CACHE_NONE: u32 = 0xffffffffu;
-const CACHE_SUMS: u32 = 8u;
+const CACHE_SUMS: u32 = 9u;
 
 struct CellKey {
     // Where its probe sequence starts, and its identity in the table (never 0: empty).
@@ -147,13 +156,22 @@ fn cache_add(s: u32, k: CellKey, p: vec3f, v: vec3f, u: vec3f) {
     // 1/1024 units: 2^18 a sample, as the light's.
     let white = min(luminance(c) * cache.fixed_scale / 4096.0, 16.0);
     let l2 = u32(white * white * 1024.0 + fract(u.x + u.y));
+    let w = light_weight(white);
     let i = CACHE_SUMS * s;
     atomicAdd(&cache_sums[i], q.x);
     atomicAdd(&cache_sums[i + 1u], q.y);
     atomicAdd(&cache_sums[i + 2u], q.z);
     atomicAdd(&cache_sums[i + 3u], 1u);
-    atomicAdd(&cache_sums[i + 4u], at.x);
-    atomicAdd(&cache_sums[i + 5u], at.y);
-    atomicAdd(&cache_sums[i + 6u], at.z);
+    atomicAdd(&cache_sums[i + 4u], at.x * w);
+    atomicAdd(&cache_sums[i + 5u], at.y * w);
+    atomicAdd(&cache_sums[i + 6u], at.z * w);
     atomicAdd(&cache_sums[i + 7u], l2);
+    atomicAdd(&cache_sums[i + 8u], w);
+}
+
+// A sample's weight in its cell's centroid, from its luminance in displayed whites (at most
+// 16): 1 for a black sample, 257 at 16 whites, so that the centroid follows the light (at most
+// 2^18 units of position a sample, as the light's sums).
+fn light_weight(white: f32) -> u32 {
+    return 1u + u32(clamp(white, 0.0, 16.0) * 16.0);
 }

@@ -67,21 +67,6 @@ fn seen_last_frame(p: vec3f) -> bool {
     return false;
 }
 
-// Cell k's centroid (slot s) is in sight of surface s0: a shadow ray between the two, each end
-// lifted off the surface along its normal by a quarter cell, so that neither grazes the
-// surface they share (a floor) nor cuts a curved one's chord.
-fn centroid_in_sight(k: CellKey, slot: u32, s0: Surface) -> bool {
-    let lift = s0.ns * (0.25 * k.size);
-    let a = s0.p + lift;
-    let b = (vec3f(k.corner) + cache_centroids[slot].xyz) * k.size + lift;
-    let d = b - a;
-    let len = length(d);
-    if len <= 1e-6 * k.size {
-        return true;
-    }
-    return traverse(a, d / len, len, true).tri == NO_HIT;
-}
-
 @compute @workgroup_size(8, 8)
 fn gather(@builtin(global_invocation_id) gid: vec3u) {
     let px = gid.xy;

@@ -93,10 +93,15 @@ struct PathState {
     // the throughput by it, so that refraction's radiance scaling 1 / eta^2 does not end paths
     // inside glass that will regain it on the way out.
     eta2: f32,
+    // The segment count from which a vertex may end the path with the light the radiance cache
+    // holds for it (`path_end`; NEVER_CACHED: no vertex does).
+    cache_from: i32,
 }
 
+const NEVER_CACHED: i32 = 0x7fffffff;
+
 fn path_begin(start: PathStart) -> PathState {
-    return PathState(start.ro, start.rd, start.beta, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false, start.cone, 1.0);
+    return PathState(start.ro, start.rd, start.beta, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false, start.cone, 1.0, NEVER_CACHED);
 }
 
 fn path_result(st: PathState) -> PathResult {
@@ -183,6 +188,15 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     let frame = onb(s.ns);
     let wo = to_local(frame, -rd);
     let origin = offset_ray(s.p, s.ng, eps);
+    if segments >= (*st).cache_from && wo.z > 0.0 {
+        // The rest of the path from the cache (cache/path_end.wgsl; common/path_end_none.wgsl
+        // never ends one).
+        let end = path_end(s, bsdf, wo, frame, origin);
+        if end.a > 0.0 {
+            (*st).radiance += beta * end.rgb;
+            return;
+        }
+    }
     // Rays that go through (glass) start on the surface's far side.
     let origin_through = offset_ray(s.p, -s.ng, eps);
     let transmits = bsdf.transmission > 0.0;

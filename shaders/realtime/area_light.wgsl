@@ -32,5 +32,16 @@ fn matte_path(basis: mat3x3f, origin: vec3f, ng: vec3f, cone_width: f32, nee_sel
         return vec3f(0.0);
     }
     let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), wl.z * INV_PI));
-    return trace_path(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone), rng).radiance;
+    var st = path_begin(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone));
+    // Where the frame keeps a radiance cache, the path may end at its first vertex with the
+    // cell's light (cache/path_end.wgsl): the matte light integrates over that vertex, which
+    // hides the cell's blocks. The glossy path never does: a mirror would show them.
+    st.cache_from = 2;
+    loop {
+        if st.done {
+            break;
+        }
+        path_step(&st, rng);
+    }
+    return st.radiance;
 }

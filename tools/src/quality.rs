@@ -307,12 +307,14 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
     let s = Setup { gpu, scene, size, inputs };
 
-    // References: one accumulation per distinct (camera, time).
+    // References: one accumulation per distinct (camera, time), with the path length of the
+    // runs they score (a preset's, else the scene's).
+    let max_depth = crate::cli::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
     let mut refr = renderer(&s)?;
     let acc = FrameSettings {
         accumulate: true,
         seed: a.seed.wrapping_add(7919),
-        max_depth: s.scene.max_depth,
+        max_depth,
         ..Default::default()
     };
     let mut references: Vec<Image> = vec![];
@@ -361,7 +363,6 @@ pub fn run(a: QualityArgs) -> Result<()> {
         flips64.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &f| (l.min(f), h.max(f)));
     drop(accumulator);
 
-    let max_depth = crate::cli::path_length(None, a.preset.as_deref(), s.scene.max_depth)?;
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
     let (den, last) = stream(&s, &base, &references)?;
     let (raw, last_raw) =

@@ -106,14 +106,24 @@ impl Renderer {
             p.record(&mut rec, gpu_scene);
         }
         let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
-        let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace };
+        let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace, cache: None };
         let mut io = t.io(&u.frame, gpu_scene);
         io.feature_uncertainty =
             t.prefilter.as_ref().filter(|_| plan.prefilter).map(|pf| &pf.view.1);
         // primaries [-> pre-filter] -> trace [-> mix] [-> radiance cache] -> denoise -> composite [-> resolve] -> TAA
         // [-> still-view mean] -> display; then this frame's G-buffer becomes the next one's previous.
         s.record_primaries(&mut rec, &plan, scene, t)?;
-        s.record_trace(&mut rec, &plan, &trace, t.size)?;
+        {
+            let _pass = crate::profile::scope(trace::LABEL);
+            // Matte paths end in the radiance cache where it ran the frame before, and where their
+            // length is unlimited (shaders/cache/path_end.wgsl).
+            let ends = plan.cache
+                && plan.settings.cache.path_end_samples > 0.0
+                && plan.settings.max_depth < 0;
+            let cache = s.cache.live_cells(plan.frame_index).filter(|_| ends);
+            let inputs = TraceInputs { cache, ..trace };
+            s.trace.record(&mut rec, plan.key, &inputs, t.size, plan.period)?;
+        }
         let io = s.record_mix(&mut rec, &plan, &trace, t, io)?;
         let io = s.record_cache(&mut rec, &plan, scene, t, io)?;
         let denoiser = record_denoiser(&mut rec, &plan, denoisers, &io)?;
@@ -264,17 +274,6 @@ impl Stages {
             edges = Some(&pf.features);
         }
         self.primaries.record_resolve(rec, plan.key, scene.frame, (p, edges), &t.gbuffer)
-    }
-
-    fn record_trace(
-        &mut self,
-        rec: &mut Recorder,
-        plan: &FramePlan,
-        inputs: &TraceInputs,
-        size: (u32, u32),
-    ) -> Result<()> {
-        let _pass = crate::profile::scope(trace::LABEL);
-        self.trace.record(rec, plan.key, inputs, size, plan.period)
     }
 
     /// With k > 1 samples per pixel, the extra samples mixed into their guides (Voorhuis §5,

@@ -9,11 +9,8 @@ impl Renderer {
     /// Every pipeline of the frame that exists now (denoisers, TAA and the display are made on
     /// first use).
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
-        let mut v: Vec<&mut dyn Reload> = vec![
-            &mut self.stages.gbuffer.pipeline,
-            &mut self.stages.trace.pipeline,
-            &mut self.stages.composite.pipeline,
-        ];
+        let mut v: Vec<&mut dyn Reload> =
+            vec![&mut self.stages.gbuffer.pipeline, &mut self.stages.composite.pipeline];
         if let Some(d) = self.stages.display.as_mut() {
             v.push(&mut d.pipeline);
         }
@@ -21,9 +18,7 @@ impl Renderer {
         v.extend(self.stages.converge.pipelines());
         v.extend(self.stages.supersample.pipelines());
         v.extend(self.stages.primaries.pipelines());
-        if let Some((p, _)) = self.stages.trace.moving.as_mut() {
-            v.push(p);
-        }
+        v.extend(self.stages.trace.pipelines());
         v.extend(self.stages.prefilter.pipelines());
         v.extend(self.stages.cache.pipelines());
         v.extend(self.stages.rescale.pipelines());

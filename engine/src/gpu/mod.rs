@@ -20,5 +20,5 @@ pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use pack::TEXTURE_BUDGET_BYTES;
 pub use prepare::{EnvKind, Instancing, Motion, PreparedScene, SceneFeatures};
 pub use record::Recorder;
-pub use scene::GpuScene;
+pub use scene::{GpuScene, PATH_END_NONE};
 pub use timestamps::GpuTimer;

@@ -4,6 +4,10 @@ use super::prepare::{Draw, EnvKind, PreparedScene, SceneFeatures};
 use super::{Bindings, Gpu, GpuMemory, GpuRequirements};
 use crate::accel::BvhKind;
 
+/// The shading modules' `path_end` that never ends a path (common/path.wgsl); a program with a
+/// radiance cache puts cache/path_end.wgsl in its place.
+pub const PATH_END_NONE: &str = "common/path_end_none.wgsl";
+
 pub struct GpuScene {
     pub features: SceneFeatures,
     pub bvh_kind: BvhKind,
@@ -398,6 +402,7 @@ impl GpuScene {
     }
 
     /// Program modules that match this scene's features, for a program that shades.
+    /// Paths never end in a radiance cache there ([`PATH_END_NONE`]).
     pub fn shading_modules(&self) -> Vec<&'static str> {
         self.shading_modules_for(false)
     }
@@ -426,6 +431,8 @@ impl GpuScene {
             "common/params.wgsl",
             "common/camera.wgsl",
             "common/path.wgsl",
+            // Programs with a radiance cache swap in cache/path_end.wgsl.
+            PATH_END_NONE,
         ]);
         m.extend(self.material_modules());
         m.push(if f.punctual_lights { "common/lights.wgsl" } else { "common/lights_none.wgsl" });

@@ -17,7 +17,7 @@
 //! instead of from one sample. The table lives across resizes (its cells are in world space);
 //! it is cleared when the cache starts again after frames without it.
 //!
-//! Memory: [`CELL_BYTES`] per cell (65536 cells by default: 4.5 MiB), and 16 bytes per pixel
+//! Memory: [`CELL_BYTES`] per cell (65536 cells by default: 4.75 MiB), and 16 bytes per pixel
 //! (the prior, Rgba16Float; its samples' mean squared luminance, R32Float; the cell's slot,
 //! R32Uint, which the tests read).
 
@@ -35,10 +35,10 @@ pub const RESOLVE: &str = "cache/resolve";
 pub const PRIOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const PRIOR_M2_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const CELL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
-/// A cell's bytes: its key (4), this frame's fixed-point sums of light, position and squared
-/// luminance and its count (32), its mean and sample count (16), its centroid and mean squared
-/// luminance (16) and its age (4).
-pub const CELL_BYTES: u64 = 72;
+/// A cell's bytes: its key (4), this frame's fixed-point sums of light, light-weighted position,
+/// squared luminance and light weight and its count (36), its mean and sample count (16), its
+/// centroid and mean squared luminance (16) and its age (4).
+pub const CELL_BYTES: u64 = 76;
 /// The slot `cache/cell` holds for a pixel without a cell (shaders/cache/cells.wgsl).
 pub const NO_CELL: u32 = u32::MAX;
 /// Fixed-point units per unit of displayed white, and the clamp of one sample in displayed
@@ -59,6 +59,8 @@ pub struct CacheParams {
     pub update_tile: u32,
     pub fixed_scale: f32,
     pub sample_clamp: f32,
+    pub path_end_samples: f32,
+    pub pad: [f32; 3],
 }
 
 impl CacheParams {
@@ -75,6 +77,8 @@ impl CacheParams {
             update_tile: s.update_tile.min(64),
             fixed_scale: FIXED_PER_WHITE * exposure,
             sample_clamp: CLAMP_WHITES / exposure,
+            path_end_samples: s.path_end_samples.clamp(0.0, 65536.0),
+            pad: [0.0; 3],
         }
     }
 }
@@ -103,14 +107,15 @@ impl CacheCells {
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let params = memory.buffer(d, "cache/params", size_of::<CacheParams>() as u64, uniform);
         let keys = memory.buffer(d, "cache/keys", n * 4, storage);
-        let sums = memory.buffer(d, "cache/sums", n * 32, storage);
+        let sums = memory.buffer(d, "cache/sums", n * 36, storage);
         let cells = memory.buffer(d, "cache/cells", n * 16, storage);
         let centroids = memory.buffer(d, "cache/centroids", n * 16, storage);
         let ages = memory.buffer(d, "cache/ages", n * 4, storage);
         CacheCells { log2, params, keys, sums, cells, centroids, ages, memory }
     }
 
-    fn bindings<'a>(&'a self, b: Bindings<'a>) -> Bindings<'a> {
+    /// The table's buffers by the names shaders/cache/cells.wgsl declares.
+    pub fn bindings<'a>(&'a self, b: Bindings<'a>) -> Bindings<'a> {
         b.buffer("cache", &self.params)
             .buffer("cache_keys", &self.keys)
             .buffer("cache_sums", &self.sums)
@@ -228,12 +233,11 @@ fn scene_program(
     entry: &'static str,
 ) -> Result<Reloadable<wgpu::ComputePipeline>> {
     let scene = i.scene.scene;
-    let mut modules = scene.shading_modules_for(i.scene.moving);
+    let mut modules = with_path_ends(scene.shading_modules_for(i.scene.moving));
     modules.extend([
         "realtime/frame.wgsl",
         "realtime/lens.wgsl",
         "realtime/area_light.wgsl",
-        "cache/cells.wgsl",
         "cache/update.wgsl",
     ]);
     Reloadable::new(
@@ -267,6 +271,13 @@ impl RadianceCache {
     /// The table's buffers, once made.
     pub fn cells(&self) -> Option<&CacheCells> {
         self.cells.as_ref()
+    }
+
+    /// The table as frame `index` may read it before the cache records (the trace's path
+    /// ends): only where the cache ran in the frame before, since a gap leaves stale cells,
+    /// which the cache clears when it records.
+    pub fn live_cells(&self, index: u32) -> Option<&CacheCells> {
+        self.cells.as_ref().filter(|_| self.last_frame == Some(index.wrapping_sub(1)))
     }
 
     /// Record gather, secondary and resolve for frame `index`.
@@ -333,6 +344,14 @@ impl RadianceCache {
         }
         v
     }
+}
+
+/// Shading modules whose paths may end in the cache: cache/path_end.wgsl (with the cells it
+/// reads) in the place of [`crate::gpu::PATH_END_NONE`].
+pub fn with_path_ends(mut modules: Vec<&'static str>) -> Vec<&'static str> {
+    modules.retain(|m| *m != crate::gpu::PATH_END_NONE);
+    modules.extend(["cache/cells.wgsl", "cache/path_end.wgsl"]);
+    modules
 }
 
 /// The module a denoiser's temporal stage reads the prior from: cache/prior.wgsl where the frame

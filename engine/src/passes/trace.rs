@@ -52,21 +52,23 @@ impl TraceTargets {
     }
 }
 
+/// The trace's programs, made on first use: static or moving shutter (motion blur), and with
+/// or without matte paths that end in the radiance cache (shaders/cache/path_end.wgsl).
+#[derive(Default)]
 pub struct TracePass {
-    pub pipeline: crate::shader::Reloadable<wgpu::ComputePipeline>,
-    groups: BindCache,
-    /// The program for frames whose objects move during the shutter (motion blur), made on
-    /// first use.
-    pub moving: Option<(crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>,
+    programs: [Option<(crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>; 4],
 }
 
 fn program(
     gpu: &Gpu,
-    scene: &GpuScene,
-    offered: &Bindings,
+    inputs: &TraceInputs,
     moving: bool,
 ) -> Result<crate::shader::Reloadable<wgpu::ComputePipeline>> {
+    let scene = inputs.scene.scene;
     let mut modules = scene.shading_modules_for(moving);
+    if inputs.cache.is_some() {
+        modules = super::cache::with_path_ends(modules);
+    }
     modules.push("realtime/frame.wgsl");
     modules.push("realtime/lens.wgsl");
     modules.push("realtime/area_light.wgsl");
@@ -82,7 +84,7 @@ fn program(
         &scene.prelude(),
         &modules,
         wgpu::ShaderStages::COMPUTE,
-        offered,
+        &inputs.bindings(),
         |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),
     )
 }
@@ -104,18 +106,24 @@ impl<'a> SceneInputs<'a> {
     }
 }
 
-/// What the trace reads and writes: the scene, the G-buffer and its own outputs.
+/// What the trace reads and writes: the scene, the G-buffer and its own outputs, and the
+/// radiance cache's table where matte paths may end in it.
 #[derive(Clone, Copy)]
 pub struct TraceInputs<'a> {
     pub scene: SceneInputs<'a>,
     pub g: &'a GBufferTargets,
     pub t: &'a TraceTargets,
+    pub cache: Option<&'a super::cache::CacheCells>,
 }
 
 impl<'a> TraceInputs<'a> {
     /// What the trace (and the supersampling's samples pass, which shades as it does) binds.
     pub fn bindings(&self) -> Bindings<'a> {
-        bindings(self.scene, self.g, self.t)
+        let b = bindings(self.scene, self.g, self.t);
+        match self.cache {
+            Some(c) => c.bindings(b),
+            None => b,
+        }
     }
 }
 
@@ -136,9 +144,12 @@ fn bindings<'a>(s: SceneInputs<'a>, g: &'a GBufferTargets, t: &'a TraceTargets) 
 }
 
 impl TracePass {
+    /// The pass with its common program (static shutter, no cache) made now, so that a scene
+    /// the trace cannot compile fails here.
     pub fn new(gpu: &Gpu, inputs: &TraceInputs) -> Result<TracePass> {
-        let pipeline = program(gpu, inputs.scene.scene, &inputs.bindings(), false)?;
-        Ok(TracePass { pipeline, groups: BindCache::default(), moving: None })
+        let mut pass = TracePass::default();
+        pass.programs[0] = Some((program(gpu, inputs, false)?, BindCache::default()));
+        Ok(pass)
     }
 
     /// `key`: bind groups are rebuilt when it changes. `period`: 1 / f, the frames between two
@@ -153,14 +164,11 @@ impl TracePass {
     ) -> Result<()> {
         use crate::shader::Reload;
         let moving = inputs.scene.moving;
-        if moving && self.moving.is_none() {
-            let p = program(rec.gpu, inputs.scene.scene, &inputs.bindings(), true)?;
-            self.moving = Some((p, BindCache::default()));
+        let slot = &mut self.programs[moving as usize + 2 * inputs.cache.is_some() as usize];
+        if slot.is_none() {
+            *slot = Some((program(rec.gpu, inputs, moving)?, BindCache::default()));
         }
-        let (p, cache) = match self.moving.as_mut().filter(|_| moving) {
-            Some((p, c)) => (&*p, c),
-            None => (&self.pipeline, &mut self.groups),
-        };
+        let Some((p, cache)) = slot.as_mut() else { unreachable!("made above") };
         let groups = cache
             .get(key, p.builds(), 1, 0, |_| p.bind_groups(&rec.gpu.device, &inputs.bindings()))?;
         let mut pass = rec.compute_pass(LABEL);
@@ -174,5 +182,14 @@ impl TracePass {
             1,
         );
         Ok(())
+    }
+
+    /// Its pipelines, for hot reload.
+    pub fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
+        let mut v: Vec<&mut dyn crate::shader::Reload> = vec![];
+        for (p, _) in self.programs.iter_mut().flatten() {
+            v.push(p);
+        }
+        v
     }
 }

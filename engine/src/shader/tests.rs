@@ -301,6 +301,7 @@ fn all_programs() -> Vec<Program> {
                 "common/params.wgsl",
                 "common/camera.wgsl",
                 "common/path.wgsl",
+                "common/path_end_none.wgsl",
             ];
             m.extend(set.iter());
             let prelude = format!(
@@ -328,20 +329,24 @@ fn all_programs() -> Vec<Program> {
                 "realtime/primaries.wgsl",
             ]);
             v.push(compose(&format!("primaries {bvh} {i}"), &prelude, &primaries).unwrap());
-            let mut cache = m.clone();
+            // Paths that may end in the radiance cache (passes/cache.rs, with_path_ends).
+            let mut cache = crate::passes::cache::with_path_ends(m.clone());
             m.extend([
                 "realtime/frame.wgsl",
                 "realtime/lens.wgsl",
                 "realtime/area_light.wgsl",
                 glossy,
-                "realtime/trace.wgsl",
             ]);
+            let mut cached_trace = crate::passes::cache::with_path_ends(m.clone());
+            cached_trace.push("realtime/trace.wgsl");
+            let name = format!("realtime trace with the cache {bvh} {i}");
+            v.push(compose(&name, &prelude, &cached_trace).unwrap());
+            m.push("realtime/trace.wgsl");
             v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
             cache.extend([
                 "realtime/frame.wgsl",
                 "realtime/lens.wgsl",
                 "realtime/area_light.wgsl",
-                "cache/cells.wgsl",
                 "cache/update.wgsl",
             ]);
             v.push(compose(&format!("cache update {bvh} {i}"), &prelude, &cache).unwrap());

@@ -1,0 +1,71 @@
+// Paths that end in the radiance cache (engine/src/passes/cache.rs; SHaRC's main use): at a
+// vertex where common/path.wgsl allows it (the matte path's first, realtime/area_light.wgsl),
+// the rest of the path is the light the vertex's cell holds, where the cell has gathered
+// `path_end_samples` samples and its centroid is in sight of the vertex (the leak test of the
+// pixels' prior). The cells' light is that of every bounce: the matte light of the pixels and
+// secondary samples fills them, and those end their own paths in the cache, so the bounces add
+// up over frames. Hence only where the path length is unlimited (max_depth < 0): under a limit
+// the cells would carry light from past it (a white room lit from its ceiling, 64x48, frames
+// 8-31: +9% over paths that stop at 6 segments; tests/radiance_cache.rs).
+
+// Cell k's centroid (slot s) is in sight of surface s0: a shadow ray between the two, each end
+// lifted off the surface along its normal by a quarter cell, so that neither grazes the
+// surface they share (a floor) nor cuts a curved one's chord.
+fn centroid_in_sight(k: CellKey, slot: u32, s0: Surface) -> bool {
+    let lift = s0.ns * (0.25 * k.size);
+    let a = s0.p + lift;
+    let b = (vec3f(k.corner) + cache_centroids[slot].xyz) * k.size + lift;
+    let d = b - a;
+    let len = length(d);
+    if len <= 1e-6 * k.size {
+        return true;
+    }
+    return traverse(a, d / len, len, true).tri == NO_HIT;
+}
+
+// The light leaving surface s towards wo (local to `basis`) from the cache and the punctual
+// lights (a: 1), or nothing (a: 0) where the path must go on: a delta or transmitting lobe, a
+// glossy lobe that outweighs the matte one (the cell's light is a cosine-weighted mean, a
+// sharp lobe would reflect its blocks), no cell, too few samples, or a cell behind a wall.
+fn path_end(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> vec4f {
+    if params.max_depth >= 0 || cache.path_end_samples <= 0.0 || b.delta || b.transmission > 0.0 {
+        return vec4f(0.0);
+    }
+    let f = fresnel(b, wo.z);
+    let matte = matte_weight(b, wo.z);
+    if max3(matte) <= max3(f) {
+        return vec4f(0.0);
+    }
+    let key = cell_key(s.p, s.ns, frame.cam_pos.xyz, pixel_spread());
+    let slot = cache_find(key);
+    if slot == CACHE_NONE {
+        return vec4f(0.0);
+    }
+    let c = cache_cells[slot];
+    if !(c.a >= cache.path_end_samples) || !is_finite3(c.rgb) || !centroid_in_sight(key, slot, s) {
+        return vec4f(0.0);
+    }
+    // The cell's matte light is the incoming light of the area lights, the environment and the
+    // bounces, cos / pi weighted (eq. (9) without the material): the matte lobe reflects it by
+    // its weight, and the glossy lobe, in light that varies little across it, by about F.
+    var l = c.rgb * (matte + f);
+    // Punctual lights are not in the cells (the trace keeps them in `direct`): each is
+    // evaluated here with its shadow ray, as realtime/trace.wgsl's `shade` does.
+    let eps = params.cam_pos.w;
+    for (var i = 0u; i < params.num_lights; i++) {
+        let ls = sample_punctual(i, s.p);
+        let wi = to_local(basis, ls.wi);
+        if max3(ls.li) <= 0.0 || wi.z <= 0.0 || dot(ls.wi, s.ng) <= 0.0 {
+            continue;
+        }
+        let e = bsdf_eval(b, wo, wi);
+        if max3(e.f_cos) <= 0.0 {
+            continue;
+        }
+        let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+        if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
+            l += e.f_cos * ls.li;
+        }
+    }
+    return vec4f(l, 1.0);
+}
