@@ -38,7 +38,9 @@ struct CacheParams {
     // The samples a cell must hold before a path may end in it (0: none does;
     // cache/path_end.wgsl).
     path_end_samples: f32,
-    pad0: f32,
+    // The largest relative standard error of a cell's mean (from its samples' spread and count)
+    // at which a path may end in it.
+    path_end_error: f32,
     pad1: f32,
     pad2: f32,
 }

@@ -1,8 +1,8 @@
 // Paths that end in the radiance cache (engine/src/passes/cache.rs; SHaRC's main use): at a
 // vertex where common/path.wgsl allows it (the matte path's first, realtime/area_light.wgsl),
 // the rest of the path is the light the vertex's cell holds, where the cell has gathered
-// `path_end_samples` samples and its centroid is in sight of the vertex (the leak test of the
-// pixels' prior). The cells' light is that of every bounce: the matte light of the pixels and
+// `path_end_samples` samples, its mean is known to within `path_end_error` and its centroid is
+// in sight of the vertex (the leak test of the pixels' prior). The cells' light is that of every bounce: the matte light of the pixels and
 // secondary samples fills them, and those end their own paths in the cache, so the bounces add
 // up over frames. Hence only where the path length is unlimited (max_depth < 0): under a limit
 // the cells would carry light from past it (a white room lit from its ceiling, 64x48, frames
@@ -21,6 +21,17 @@ fn centroid_in_sight(k: CellKey, slot: u32, s0: Surface) -> bool {
         return true;
     }
     return traverse(a, d / len, len, true).tri == NO_HIT;
+}
+
+// Whether cell c's mean is known to within `path_end_error` (relative standard error): its
+// samples' variance, from their mean squared luminance m2, over their count. A firefly among a
+// cell's first samples raises its mean for every path that ends there, a blob the denoisers
+// cannot average away since it is the same in every frame; it raises m2 more, so the cell waits.
+fn known_well(c: vec4f, m2: f32) -> bool {
+    let l = luminance(c.rgb);
+    let spread = max(m2 - l * l, 0.0);
+    let e = cache.path_end_error;
+    return spread <= e * e * l * l * c.a;
 }
 
 // The light leaving surface s towards wo (local to `basis`) from the cache and the punctual
@@ -42,7 +53,7 @@ fn path_end(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> ve
         return vec4f(0.0);
     }
     let c = cache_cells[slot];
-    if !(c.a >= cache.path_end_samples) || !is_finite3(c.rgb) || !centroid_in_sight(key, slot, s) {
+    if !(c.a >= cache.path_end_samples) || !is_finite3(c.rgb) || !known_well(c, cache_centroids[slot].w) || !centroid_in_sight(key, slot, s) {
         return vec4f(0.0);
     }
     // The cell's matte light is the incoming light of the area lights, the environment and the

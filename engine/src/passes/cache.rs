@@ -60,7 +60,8 @@ pub struct CacheParams {
     pub fixed_scale: f32,
     pub sample_clamp: f32,
     pub path_end_samples: f32,
-    pub pad: [f32; 3],
+    pub path_end_error: f32,
+    pub pad: [f32; 2],
 }
 
 impl CacheParams {
@@ -78,7 +79,8 @@ impl CacheParams {
             fixed_scale: FIXED_PER_WHITE * exposure,
             sample_clamp: CLAMP_WHITES / exposure,
             path_end_samples: s.path_end_samples.clamp(0.0, 65536.0),
-            pad: [0.0; 3],
+            path_end_error: s.path_end_error.clamp(0.0, 100.0),
+            pad: [0.0; 2],
         }
     }
 }

@@ -50,6 +50,12 @@ described! {
         /// cell and the lag of its mean.
         path_end_samples: f32 = 16.0,
             ("cache.path_end_samples", "cache", "samples", Float(0.0, 65536.0, 1.0));
+        /// A path ends in a cell only where the cell's mean is known to within this relative
+        /// standard error (its samples' spread over their count): a firefly among a cell's
+        /// first samples would brighten every path that ends there, in every frame, a blob no
+        /// denoiser removes.
+        path_end_error: f32 = 0.1,
+            ("cache.path_end_error", "cache", "", Float(0.0, 100.0, 0.01));
         /// Cells in the table, as a power of two (16: 65536 cells, 4.75 MiB at 76 bytes a cell).
         cells_log2: u32 = 16,
             ("cache.cells_log2", "cache", "", Int(10, MAX_CELLS_LOG2 as i64));
