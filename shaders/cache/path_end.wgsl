@@ -1,8 +1,9 @@
 // Paths that end in the radiance cache (engine/src/passes/cache.rs; SHaRC's main use): at a
-// vertex where common/path.wgsl allows it (the matte path's first, realtime/area_light.wgsl),
-// the rest of the path is the light the vertex's cell holds, where the cell has gathered
-// `path_end_samples` samples, its mean is known to within `path_end_error` and its centroid is
-// in sight of the vertex (the leak test of the pixels' prior). The cells' light is that of every bounce: the matte light of the pixels and
+// vertex where common/path.wgsl allows it (from the matte path's first on,
+// realtime/area_light.wgsl), the rest of the path is the light the vertex's cell holds, where
+// the cell has gathered `path_end_samples` samples, its mean is known to within
+// `path_end_error` and its centroid is in sight of the vertex (the leak test of the pixels'
+// prior). The cells' light is that of every bounce: the matte light of the pixels and
 // secondary samples fills them, and those end their own paths in the cache, so the bounces add
 // up over frames. Hence only where the path length is unlimited (max_depth < 0): under a limit
 // the cells would carry light from past it (a white room lit from its ceiling, 64x48, frames

@@ -1,7 +1,8 @@
 // The radiance cache's resolve (engine/src/passes/cache.rs), one thread per slot, after the
 // frame's samples are in: each cell's mean takes this frame's samples in as a running mean of
 // up to max_samples samples (then an exponential one, so that a change of light fades in), and
-// the samples' light-weighted centroid as the running mean of the light; a cell with no sample for max_age frames frees its slot.
+// the samples' light-weighted centroid as the running mean of the light; a cell with no sample
+// for max_age frames frees its slot.
 
 @compute @workgroup_size(256)
 fn resolve(@builtin(global_invocation_id) gid: vec3u) {

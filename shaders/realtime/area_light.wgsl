@@ -33,9 +33,9 @@ fn matte_path(basis: mat3x3f, origin: vec3f, ng: vec3f, cone_width: f32, nee_sel
     }
     let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), wl.z * INV_PI));
     var st = path_begin(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone));
-    // Where the frame keeps a radiance cache, the path may end at its first vertex with the
-    // cell's light (cache/path_end.wgsl): the matte light integrates over that vertex, which
-    // hides the cell's blocks. The glossy path never does: a mirror would show them.
+    // Where the frame keeps a radiance cache, the path may end at any of its vertices with the
+    // vertex's cell's light (cache/path_end.wgsl): the matte light integrates over the vertices,
+    // which hides the cells' blocks. The glossy path never does: a mirror would show them.
     st.cache_from = 2;
     loop {
         if st.done {

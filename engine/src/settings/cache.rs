@@ -55,7 +55,8 @@ described! {
         /// A path ends in a cell only where the cell's mean is known to within this relative
         /// standard error (its samples' spread over their count): a firefly among a cell's
         /// first samples would brighten every path that ends there, in every frame, a blob no
-        /// denoiser removes.
+        /// denoiser removes. Lower waits longer for a cell: at 0.02 the level's matte light
+        /// (160x90, 30 frames, 8 pixels read) came out as with no path ends.
         path_end_error: f32 = 0.1,
             ("cache.path_end_error", "cache", "", Float(0.0, 100.0, 0.01));
         /// Cells in the table, as a power of two (16: 65536 cells, 4.75 MiB at 76 bytes a cell).
