@@ -61,23 +61,7 @@ fn path_end(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> ve
     // bounces, cos / pi weighted (eq. (9) without the material): the matte lobe reflects it by
     // its weight, and the glossy lobe, in light that varies little across it, by about F.
     var l = c.rgb * (matte + f);
-    // Punctual lights are not in the cells (the trace keeps them in `direct`): each is
-    // evaluated here with its shadow ray, as realtime/trace.wgsl's `shade` does.
-    let eps = params.cam_pos.w;
-    for (var i = 0u; i < params.num_lights; i++) {
-        let ls = sample_punctual(i, s.p);
-        let wi = to_local(basis, ls.wi);
-        if max3(ls.li) <= 0.0 || wi.z <= 0.0 || dot(ls.wi, s.ng) <= 0.0 {
-            continue;
-        }
-        let e = bsdf_eval(b, wo, wi);
-        if max3(e.f_cos) <= 0.0 {
-            continue;
-        }
-        let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-        if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
-            l += e.f_cos * ls.li;
-        }
-    }
+    // Punctual lights are not in the cells (the trace keeps them in `direct`).
+    l += punctual_light(s, b, wo, basis, origin);
     return vec4f(l, 1.0);
 }

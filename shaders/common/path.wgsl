@@ -27,6 +27,30 @@ fn sample_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
     return s;
 }
 
+// Every punctual light at surface s (BSDF b, outgoing direction wo in the frame `basis`), each
+// with its shadow ray from `origin`: at one sample they carry no noise (the real-time trace's
+// `direct`, and a path that ends in the radiance cache).
+fn punctual_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> vec3f {
+    let eps = params.cam_pos.w;
+    var l = vec3f(0.0);
+    for (var i = 0u; i < params.num_lights; i++) {
+        let ls = sample_punctual(i, s.p);
+        let wi = to_local(basis, ls.wi);
+        if max3(ls.li) <= 0.0 || wi.z <= 0.0 || dot(ls.wi, s.ng) <= 0.0 {
+            continue;
+        }
+        let e = bsdf_eval(b, wo, wi);
+        if max3(e.f_cos) <= 0.0 {
+            continue;
+        }
+        let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+        if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
+            l += e.f_cos * ls.li;
+        }
+    }
+    return l;
+}
+
 fn depth_ok(segments: i32) -> bool {
     return params.max_depth < 0 || segments <= params.max_depth;
 }

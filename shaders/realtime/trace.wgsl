@@ -76,21 +76,7 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
         return Shaded(matte, direct, glossy, glossy_t, hit_reflectance, hit_normal, mirror, glossy_t, s.ns, false);
     }
 
-    for (var i = 0u; i < params.num_lights; i++) {
-        let ls = sample_punctual(i, s.p);
-        let wi = to_local(basis, ls.wi);
-        if max3(ls.li) <= 0.0 || wi.z <= 0.0 || dot(ls.wi, s.ng) <= 0.0 {
-            continue;
-        }
-        let e = bsdf_eval(bsdf, wo, wi);
-        if max3(e.f_cos) <= 0.0 {
-            continue;
-        }
-        let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-        if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
-            direct += e.f_cos * ls.li;
-        }
-    }
+    direct = punctual_light(s, bsdf, wo, basis, origin);
 
     // `frame.paths` independent samples of the area lights and of each path, averaged.
     let paths = max(frame.paths, 1u);
