@@ -32,6 +32,13 @@ fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
+/// The pixels of the last frame with a reflective surface: specular F0 above 0, roughness under
+/// 0.4 (the glossy chains' roughness threshold).
+fn reflective(gpu: &Gpu, r: &Renderer) -> Vec<bool> {
+    let (spec, _) = r.read_texture(gpu, "gbuffer/specular").unwrap();
+    spec.chunks_exact(4).map(|s| s[..3].iter().any(|&f| f > 0) && s[3] < ROUGHNESS_MAX).collect()
+}
+
 fn renderer() -> (Gpu, Renderer, Camera) {
     let scene = hush_engine::scene::reflection_scene(true);
     let camera = scene.camera_or_default();
@@ -51,12 +58,7 @@ fn references() -> Vec<(Image, Vec<bool>)> {
             for _ in 0..32 {
                 r.render(&gpu, &input, &acc, None).unwrap();
             }
-            let (spec, _) = r.read_texture(&gpu, "gbuffer/specular").unwrap();
-            let mirror = spec
-                .chunks_exact(4)
-                .map(|s| s[..3].iter().any(|&f| f > 0) && s[3] < ROUGHNESS_MAX)
-                .collect();
-            (r.read_hdr(&gpu).unwrap(), mirror)
+            (r.read_hdr(&gpu).unwrap(), reflective(&gpu, &r))
         })
         .collect()
 }
@@ -164,15 +166,12 @@ impl OldReflection {
             r.read_hdr(&gpu).unwrap()
         };
         let (before, after) = (at(JUMP_TIMES.0), at(JUMP_TIMES.1));
-        let (spec, _) = r.read_texture(&gpu, "gbuffer/specular").unwrap();
-        let changed: Vec<bool> = spec
-            .chunks_exact(4)
+        let changed: Vec<bool> = reflective(&gpu, &r)
+            .into_iter()
             .zip(before.data.iter().zip(&after.data))
-            .map(|(s, (b, a))| {
+            .map(|(m, (b, a))| {
                 let (yb, ya) = (luminance(*b), luminance(*a));
-                s[3] < ROUGHNESS_MAX
-                    && s[..3].iter().any(|&f| f > 0)
-                    && (yb - ya).abs() > 0.3 * ya.max(0.05)
+                m && (yb - ya).abs() > 0.3 * ya.max(0.05)
             })
             .collect();
         let n = changed.iter().filter(|&&c| c).count();

@@ -44,8 +44,8 @@ fn resolve(@builtin(global_invocation_id) gid: vec3u) {
     cache_cells[s] = vec4f(mix(old.rgb, mean, w), n);
     // The centroid of the old samples and this frame's, each weighed by its light: the old ones'
     // mean weight a sample is taken from their mean's luminance.
-    let per_white = 4096.0 / cache.fixed_scale;
-    let w_old = (1.0 - w) * f32(select(light_weight(luminance(old.rgb) / per_white), 0u, old.a <= 0.0));
+    // (to_radiance is a displayed white in radiance.)
+    let w_old = (1.0 - w) * f32(select(light_weight(luminance(old.rgb) / to_radiance), 0u, old.a <= 0.0));
     let w_new = w * weights / f32(count);
     let c = cache_centroids[s];
     cache_centroids[s] = vec4f(mix(c.xyz, at, w_new / max(w_old + w_new, 1e-30)), mix(c.w, l2, w));
