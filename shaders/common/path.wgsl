@@ -27,25 +27,38 @@ fn sample_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
     return s;
 }
 
-// Every punctual light at surface s (BSDF b, outgoing direction wo in the frame `basis`), each
-// with its shadow ray from `origin`: at one sample they carry no noise (the real-time trace's
-// `direct`, and a path that ends in the radiance cache).
-fn punctual_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> vec3f {
+// A shadow ray from o along d up to tmax (none where tmax is 0), and the light it brings where
+// nothing blocks it.
+struct ShadowRay {
+    o: vec3f,
+    d: vec3f,
+    tmax: f32,
+    light: vec3f,
+}
+
+// Punctual light i at surface s (BSDF b, outgoing direction wo in the frame `basis`) with its
+// shadow ray from `origin`; no light where it cannot reach the surface's lobe.
+fn punctual_ray(i: u32, s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> ShadowRay {
     let eps = params.cam_pos.w;
+    let ls = sample_punctual(i, s.p);
+    let wi = to_local(basis, ls.wi);
+    let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+    var r = ShadowRay(origin, ls.wi, tmax, vec3f(0.0));
+    if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
+        r.light = bsdf_eval(b, wo, wi).f_cos * ls.li;
+    }
+    return r;
+}
+
+// Every punctual light at surface s, each with its shadow ray: at one sample they carry no
+// noise (the real-time trace's `direct`; a path that ends in the radiance cache casts the same
+// rays through its own loop, cache/path_end.wgsl).
+fn punctual_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> vec3f {
     var l = vec3f(0.0);
     for (var i = 0u; i < params.num_lights; i++) {
-        let ls = sample_punctual(i, s.p);
-        let wi = to_local(basis, ls.wi);
-        if max3(ls.li) <= 0.0 || wi.z <= 0.0 || dot(ls.wi, s.ng) <= 0.0 {
-            continue;
-        }
-        let e = bsdf_eval(b, wo, wi);
-        if max3(e.f_cos) <= 0.0 {
-            continue;
-        }
-        let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-        if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
-            l += e.f_cos * ls.li;
+        let r = punctual_ray(i, s, b, wo, basis, origin);
+        if max3(r.light) > 0.0 && traverse(r.o, r.d, r.tmax, true).tri == NO_HIT {
+            l += r.light;
         }
     }
     return l;
