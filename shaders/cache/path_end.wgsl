@@ -41,53 +41,99 @@ fn known_well(c: vec4f, m2: f32) -> bool {
     return spread <= e * e * l * l * c.a;
 }
 
-// The light leaving surface s towards wo (local to `basis`) from the cache and the punctual
-// lights (a: 1), or nothing (a: 0) where the path must go on: a delta or transmitting lobe, a
-// glossy lobe that outweighs the matte one (the cell's light is a cosine-weighted mean, a
-// sharp lobe would reflect its blocks), no cell, too few samples, or a cell behind a wall.
-fn path_end(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> vec4f {
+// Where a path may end: the light of the rest of the path but the punctual lights', and the
+// ray that must be clear for it to count.
+struct PathEnd {
+    ok: bool,
+    light: vec3f,
+    sight: ShadowRay,
+}
+
+// Where the path may end at surface s (towards wo, local to its shading frame): the light
+// leaving it from the cache, and the ray to its cell's centroid that must be clear. None where
+// the path must go on: a delta or transmitting lobe, a glossy lobe that outweighs the matte one
+// (the cell's light is a cosine-weighted mean, a sharp lobe would reflect its blocks), no cell,
+// too few samples, or a mean not yet known well.
+fn path_end(s: Surface, b: Bsdf, wo: vec3f) -> PathEnd {
+    var end = PathEnd(false, vec3f(0.0), ShadowRay(s.p, wo, 0.0, vec3f(0.0)));
     if params.max_depth >= 0 || cache.path_end_samples <= 0.0 || b.delta || b.transmission > 0.0 {
-        return vec4f(0.0);
+        return end;
     }
     let f = fresnel(b, wo.z);
     let matte = matte_weight(b, wo.z);
     if max3(matte) <= max3(f) {
-        return vec4f(0.0);
+        return end;
     }
     let key = cell_key(s.p, s.ns, frame.cam_pos.xyz, pixel_spread());
     let slot = cache_find(key);
     if slot == CACHE_NONE {
-        return vec4f(0.0);
+        return end;
     }
     let c = cache_cells[slot];
     if !(c.a >= cache.path_end_samples) || !is_finite3(c.rgb) || !known_well(c, cache_centroids[slot].w) {
-        return vec4f(0.0);
+        return end;
     }
     // The cell's matte light is the incoming light of the area lights, the environment and the
     // bounces, cos / pi weighted (eq. (9) without the material): the matte lobe reflects it by
     // its weight, and the glossy lobe, in light that varies little across it, by about F.
-    var l = c.rgb * (matte + f);
-    // Ray 0 tests the centroid's sight (centroid_in_sight); the others are the punctual lights'
-    // shadow rays (punctual_light), which are not in the cells (the trace keeps them in
-    // `direct`). One call of traverse for all: the GPU's compiler inlines each call, and the
-    // path's loop already holds two; with these as two more calls the living room's real-time
-    // trace took 2.8x as long on an H200 (640x360, 16.7 against 5.9 ms), with one more 1.15x.
-    for (var i = 0u; i <= params.num_lights; i++) {
+    end.ok = true;
+    end.light = c.rgb * (matte + f);
+    end.sight = centroid_ray(key, slot, s);
+    return end;
+}
+
+// A path vertex's light (common/path.wgsl's `vertex_light`): where the path may end here
+// (may_end: from the matte path's first vertex on) and `path_end` allows it, the cell's light
+// plus the punctual lights', which the cells do not hold (the trace keeps them in `direct`),
+// where the sight ray to the cell's centroid is clear; otherwise next_event's light sample.
+// All of these rays are cast through one call of traverse: the GPU's compiler inlines each
+// call, and lanes of a group at different calls take turns. On an H200 (Mara, unlimited path
+// length, 1280x720), with a call each for the sight ray and the punctual lights beside the
+// light sample's, the living room's trace took 64.6 ms against 20.6 without path ends; with
+// one call for the end's rays beside the light sample's 24.4 ms; with this one 21.8 ms. A
+// frame without the cache keeps next_event's own call (common/path_end_none.wgsl): through
+// this loop the level's trace took 5% longer there.
+fn vertex_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, beta: vec3f, may_end: bool, rng: ptr<function, u32>) -> VertexLight {
+    var end = PathEnd(false, vec3f(0.0), ShadowRay(s.p, wo, 0.0, vec3f(0.0)));
+    if may_end {
+        end = path_end(s, b, wo);
+    }
+    var ending = end.ok;
+    var light_sample = light_groups() > 0u && (max3(b.albedo) > 0.0 || !b.delta);
+    // The next of the end's rays: 0 the sight ray, k > 0 punctual light k - 1.
+    var k = 0u;
+    var light = select(vec3f(0.0), end.light, ending);
+    loop {
         var r: ShadowRay;
-        if i == 0u {
-            r = centroid_ray(key, slot, s);
-        } else {
-            r = punctual_ray(i - 1u, s, b, wo, basis, origin);
-            if max3(r.light) <= 0.0 {
-                continue;
+        let sight = ending && k == 0u;
+        if ending {
+            if k > params.num_lights {
+                break;
             }
+            if sight {
+                r = end.sight;
+            } else {
+                r = punctual_ray(k - 1u, s, b, wo, basis, origin);
+            }
+            k++;
+        } else if light_sample {
+            light_sample = false;
+            r = light_sample_ray(s, b, wo, basis, origin, rng);
+        } else {
+            break;
         }
-        let blocked = r.tmax > 0.0 && traverse(r.o, r.d, r.tmax, true).tri != NO_HIT;
-        if !blocked {
-            l += r.light;
-        } else if i == 0u {
-            return vec4f(0.0);
+        if !sight && max3(r.light) <= 0.0 {
+            continue;
+        }
+        if r.tmax > 0.0 && traverse(r.o, r.d, r.tmax, true).tri != NO_HIT {
+            if sight {
+                // A hidden centroid: the cell may hold light from behind a wall; the path goes on.
+                ending = false;
+                light = vec3f(0.0);
+            }
+        } else {
+            light += r.light;
         }
     }
-    return vec4f(l, 1.0);
+    return VertexLight(beta * light, ending);
 }

@@ -36,6 +36,13 @@ struct ShadowRay {
     light: vec3f,
 }
 
+// What a path vertex adds before the path goes on (`vertex_light`): the light sample's
+// light, times the throughput; or, where the path ends there, all of the rest of the path's.
+struct VertexLight {
+    light: vec3f,
+    ended: bool,
+}
+
 // Punctual light i at surface s (BSDF b, outgoing direction wo in the frame `basis`) with its
 // shadow ray from `origin`; no light where it cannot reach the surface's lobe.
 fn punctual_ray(i: u32, s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f) -> ShadowRay {
@@ -62,6 +69,58 @@ fn punctual_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f)
         }
     }
     return l;
+}
+
+// Next-event estimation at surface s (BSDF b, outgoing direction wo in the frame `basis`): one
+// light sample with its shadow ray from `origin` (from the far side where it goes through a
+// transmitting surface), weighed by the power heuristic against BSDF sampling, times the
+// throughput beta. Skipped when the glossy lobe is a pure mirror and there is no matte lobe:
+// no light sample can land in a delta lobe.
+fn next_event(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, beta: vec3f, rng: ptr<function, u32>) -> vec3f {
+    let eps = params.cam_pos.w;
+    let matte_present = max3(b.albedo) > 0.0;
+    if light_groups() == 0u || (!matte_present && b.delta) {
+        return vec3f(0.0);
+    }
+    let ls = sample_light(s.p, rng);
+    let wi_l = to_local(basis, ls.wi);
+    let through = b.transmission > 0.0 && wi_l.z < 0.0 && dot(ls.wi, s.ng) < 0.0;
+    if max3(ls.li) > 0.0 && ((wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0) || through) {
+        let e = bsdf_eval(b, wo, wi_l);
+        if max3(e.f_cos) > 0.0 {
+            let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+            let origin_through = offset_ray(s.p, -s.ng, eps);
+            let blocked = traverse(select(origin, origin_through, through), ls.wi, tmax, true).tri != NO_HIT;
+            if !blocked {
+                var w = 1.0;
+                if ls.pdf > 0.0 {
+                    w = power_heuristic(ls.pdf, e.pdf);
+                }
+                return beta * e.f_cos * ls.li * w;
+            }
+        }
+    }
+    return vec3f(0.0);
+}
+
+// next_event's light sample as a ray for a caller that casts it among others
+// (cache/path_end.wgsl), its light without the throughput.
+fn light_sample_ray(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, rng: ptr<function, u32>) -> ShadowRay {
+    let eps = params.cam_pos.w;
+    let ls = sample_light(s.p, rng);
+    let wi = to_local(basis, ls.wi);
+    let through = b.transmission > 0.0 && wi.z < 0.0 && dot(ls.wi, s.ng) < 0.0;
+    let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
+    var r = ShadowRay(select(origin, offset_ray(s.p, -s.ng, eps), through), ls.wi, tmax, vec3f(0.0));
+    if max3(ls.li) > 0.0 && ((wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0) || through) {
+        let e = bsdf_eval(b, wo, wi);
+        var w = 1.0;
+        if ls.pdf > 0.0 {
+            w = power_heuristic(ls.pdf, e.pdf);
+        }
+        r.light = e.f_cos * ls.li * w;
+    }
+    return r;
 }
 
 fn depth_ok(segments: i32) -> bool {
@@ -225,41 +284,16 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     let frame = onb(s.ns);
     let wo = to_local(frame, -rd);
     let origin = offset_ray(s.p, s.ng, eps);
-    if segments >= (*st).cache_from && wo.z > 0.0 {
-        // The rest of the path from the cache (cache/path_end.wgsl; common/path_end_none.wgsl
-        // never ends one).
-        let end = path_end(s, bsdf, wo, frame, origin);
-        if end.a > 0.0 {
-            (*st).radiance += beta * end.rgb;
-            return;
-        }
+    // The light sample, or where the path may end in the radiance cache here, the rest of the
+    // path from the cache (common/path_end_none.wgsl never ends one; cache/path_end.wgsl).
+    let v = vertex_light(s, bsdf, wo, frame, origin, beta, segments >= (*st).cache_from && wo.z > 0.0, rng);
+    (*st).radiance += v.light;
+    if v.ended {
+        return;
     }
     // Rays that go through (glass) start on the surface's far side.
     let origin_through = offset_ray(s.p, -s.ng, eps);
     let transmits = bsdf.transmission > 0.0;
-
-    // Next-event estimation (skipped when the glossy lobe is a pure mirror and there is no
-    // matte lobe: no light sample can land in a delta lobe).
-    let matte_present = max3(bsdf.albedo) > 0.0;
-    if light_groups() > 0u && (matte_present || !bsdf.delta) {
-        let ls = sample_light(s.p, rng);
-        let wi_l = to_local(frame, ls.wi);
-        let through = transmits && wi_l.z < 0.0 && dot(ls.wi, s.ng) < 0.0;
-        if max3(ls.li) > 0.0 && ((wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0) || through) {
-            let e = bsdf_eval(bsdf, wo, wi_l);
-            if max3(e.f_cos) > 0.0 {
-                let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-                let blocked = traverse(select(origin, origin_through, through), ls.wi, tmax, true).tri != NO_HIT;
-                if !blocked {
-                    var w = 1.0;
-                    if ls.pdf > 0.0 {
-                        w = power_heuristic(ls.pdf, e.pdf);
-                    }
-                    (*st).radiance += beta * e.f_cos * ls.li * w;
-                }
-            }
-        }
-    }
 
     // Continue the path by sampling the BSDF.
     let u_lobe = rand(rng);

@@ -49,7 +49,7 @@ described! {
         /// over frames: less noise for the blur of a cell and the lag of its mean. A white room's
         /// matte light: variance 0.32x, mean -0.6%; the level's, living room's and staircase's
         /// still FLIP at 160 wide: -4.4% / -0.6% / +1.1% (Mara); the trace costs 9-10% more on
-        /// lavapipe, 18-21% more on an H200 at 1280x720 (docs/decisions.md).
+        /// lavapipe, 6-10% more on an H200 at 1280x720 (docs/decisions.md).
         path_end_samples: f32 = 16.0,
             ("cache.path_end_samples", "cache", "samples", Float(0.0, 65536.0, 1.0));
         /// A path ends in a cell only where the cell's mean is known to within this relative
