@@ -56,6 +56,10 @@ pub struct ReflectionsArgs {
     /// The denoiser measured: `mara` (its glossy chain) or `svgf` (its glossy signal).
     #[arg(long, default_value = Denoiser::MARA.name())]
     pub denoiser: String,
+    /// Start every configuration from this preset's settings (TOML, as the viewer saves);
+    /// `--denoiser` and `--disable` then apply.
+    #[arg(long)]
+    pub preset: Option<PathBuf>,
     /// Stages to switch off in every configuration (see `render --disable`), for ablations.
     #[arg(long, value_delimiter = ',')]
     pub disable: Vec<String>,
@@ -153,7 +157,8 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
     let size = image_size(&scene, Some(a.width), a.height);
     let prepared = PreparedScene::new(&scene, bvh_kind(&None)?)?;
     let gpu = Gpu::headless(&prepared.realtime_requirements(size))?;
-    let base = crate::cli::denoiser_settings(&a.denoiser, &a.disable, "diamond")?;
+    let base =
+        crate::cli::preset_settings(a.preset.as_deref(), Some(&a.denoiser), &a.disable, None)?;
     let svgf = base.denoiser == Denoiser::SVGF;
     if !svgf && base.denoiser != Denoiser::MARA {
         let (m, s) = (Denoiser::MARA.name(), Denoiser::SVGF.name());
