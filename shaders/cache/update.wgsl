@@ -119,8 +119,8 @@ fn matte_light_at(s: Surface, rd: vec3f, cone_width: f32, rng: ptr<function, u32
         let ls = sample_area_light(s.p, rng);
         let wi = to_local(basis, ls.wi);
         if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
-            let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-            if traverse(origin, ls.wi, tmax, true).tri == NO_HIT {
+            let leg = shadow_leg(origin, s.p, ls.wi, ls.dist, eps);
+            if traverse(origin, leg.dir, leg.tmax, true).tri == NO_HIT {
                 matte += ls.li * (wi.z * INV_PI) * power_heuristic(ls.pdf, wi.z * INV_PI);
             }
         }

@@ -49,8 +49,8 @@ fn punctual_ray(i: u32, s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: 
     let eps = params.cam_pos.w;
     let ls = sample_punctual(i, s.p);
     let wi = to_local(basis, ls.wi);
-    let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-    var r = ShadowRay(origin, ls.wi, tmax, vec3f(0.0));
+    let leg = shadow_leg(origin, s.p, ls.wi, ls.dist, eps);
+    var r = ShadowRay(origin, leg.dir, leg.tmax, vec3f(0.0));
     if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
         r.light = bsdf_eval(b, wo, wi).f_cos * ls.li;
     }
@@ -88,9 +88,9 @@ fn next_event(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, bet
     if max3(ls.li) > 0.0 && ((wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0) || through) {
         let e = bsdf_eval(b, wo, wi_l);
         if max3(e.f_cos) > 0.0 {
-            let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-            let origin_through = offset_ray(s.p, -s.ng, eps);
-            let blocked = traverse(select(origin, origin_through, through), ls.wi, tmax, true).tri != NO_HIT;
+            let start = select(origin, offset_ray(s.p, -s.ng, eps), through);
+            let leg = shadow_leg(start, s.p, ls.wi, ls.dist, eps);
+            let blocked = traverse(start, leg.dir, leg.tmax, true).tri != NO_HIT;
             if !blocked {
                 var w = 1.0;
                 if ls.pdf > 0.0 {
@@ -110,8 +110,9 @@ fn light_sample_ray(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3
     let ls = sample_light(s.p, rng);
     let wi = to_local(basis, ls.wi);
     let through = b.transmission > 0.0 && wi.z < 0.0 && dot(ls.wi, s.ng) < 0.0;
-    let tmax = select(INF, ls.dist * (1.0 - 1e-4) - eps, ls.dist < INF);
-    var r = ShadowRay(select(origin, offset_ray(s.p, -s.ng, eps), through), ls.wi, tmax, vec3f(0.0));
+    let start = select(origin, offset_ray(s.p, -s.ng, eps), through);
+    let leg = shadow_leg(start, s.p, ls.wi, ls.dist, eps);
+    var r = ShadowRay(start, leg.dir, leg.tmax, vec3f(0.0));
     if max3(ls.li) > 0.0 && ((wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0) || through) {
         let e = bsdf_eval(b, wo, wi);
         var w = 1.0;
