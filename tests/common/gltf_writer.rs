@@ -227,3 +227,26 @@ pub fn edited_copy(src_gltf: &Path, name: &str, edit: impl FnOnce(&mut Value)) -
     std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
     p
 }
+
+/// A white (0.7) Lambertian floor, 20 m square at y = 0, under a square emitter facing down
+/// (centre, half size, radiance), seen straight down from `eye` (vertical field of view 1 rad,
+/// square): a scene whose light is all direct, as the floor sees nothing but the emitter.
+pub fn floor_under_light(
+    name: &str,
+    light: (glam::Vec3, f32, f32),
+    eye: [f32; 3],
+) -> hush_engine::scene::Scene {
+    use glam::Vec3;
+    use hush_engine::scene::quad;
+    let mut g = GltfWriter::default();
+    let white = g.lambert([0.7; 3]);
+    let lamp = g.emitter(light.2);
+    let floor = quad(Vec3::ZERO, Vec3::Z * 10.0, Vec3::X * 10.0, 0);
+    let emitter = quad(light.0, Vec3::X * light.1, Vec3::Z * light.1, 0);
+    for (mesh, material) in [(floor, white), (emitter, lamp)] {
+        let m = g.engine_mesh(&mesh, material);
+        g.node(json!({"mesh": m}));
+    }
+    g.camera(eye, [eye[0], 0.0, eye[2] + 0.001], 1.0);
+    hush_engine::scene::load_gltf(&g.write(name)).unwrap()
+}
