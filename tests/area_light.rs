@@ -1,8 +1,8 @@
 //! A small area light low over a large floor lights it as the integral of its radiance says:
-//! the reference tracer against a CPU quadrature over the emitter. A light sample's shadow ray
-//! once ran from the lifted surface point along the direction from the unlifted one, a line
-//! that crosses the emitter's plane before its end where the emitter lies low over the surface:
-//! the emitter's own triangle then shadowed the sample.
+//! the reference tracer and the real-time trace against a CPU quadrature over the emitter. A
+//! light sample's shadow ray once ran from the lifted surface point along the direction from
+//! the unlifted one, a line that crosses the emitter's plane before its end where the emitter
+//! lies low over the surface: the emitter's own triangle then shadowed the sample.
 
 use glam::DVec3;
 use hush_engine::quality::luminance;
