@@ -66,11 +66,11 @@ fn denoised(denoiser: Denoiser) -> FrameSettings {
 /// largest departure in any band: evenly lit, Mara 0.20%, SVGF 0.22%; lit from one side, Mara
 /// 0.48%, SVGF 0.70% (both in the band at the image's edge nearest the light, where the filters
 /// reach inwards only, over a falling light); SVGF without its luminance edge-stop (sigma_l 64)
-/// and regression, 2.3%. The progressive filter is not held to it: its
-/// luminance weight's epsilon is absolute, as Dundr's (0.05, here 0.025 after 128 samples), and
-/// this floor's light is 0.006 to 0.075, so it blurs across the gradient: 38% too bright in the
-/// darkest band; what it shows, after TAA and the still-view mean, departs by 0.97%
-/// (docs/decisions.md).
+/// and regression, 2.3%. The progressive filter is not held to it: its luminance weight's
+/// epsilon is an amount of displayed light, as Dundr's (0.05, here 0.025 after 128 samples),
+/// and this floor's light is 0.006 to 0.075 at the default exposure, so it blurs across the
+/// gradient: 38% too bright in the darkest band (8% shown at +3.5 EV); what it shows, after TAA
+/// and the still-view mean, departs by 0.97% (docs/decisions.md).
 #[test]
 fn mara_and_svgf_keep_the_mean_of_an_even_light_and_of_a_gradient() {
     for (name, scene) in [("even", even()), ("from one side", from_one_side())] {

@@ -66,10 +66,13 @@ fn dundr_weight(fc: vec2f, nc: vec3f, lc: f32, variance: f32, epsilon: f32, fq: 
     if fc.y < 0.1 * fc.x {
         w_d = exp(-abs(fc.x - fq.x) / (abs(pp.sigma_d * fc.y * offset) + 0.005 * fc.x));
     }
-    // §4.4.3
+    // §4.4.3, in displayed units (the light times the frame's exposure, its variance times the
+    // exposure squared): epsilon is an amount of light on the screen, so a scene lit far below
+    // the display's white, shown brighter, is not blurred across its gradients the more for it.
     var w_l = 1.0;
     if lc >= 0.0 {
-        w_l = exp(-abs(lc - lq) / (pp.sigma_l * variance + epsilon));
+        let k = frame.exposure;
+        w_l = exp(-abs(lc - lq) / (pp.sigma_l * variance * k + epsilon / k));
     }
     return w_n * w_d * w_l;
 }
