@@ -104,7 +104,9 @@ fn next_event(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, bet
 }
 
 // next_event's light sample as a ray for a caller that casts it among others
-// (cache/path_end.wgsl), its light without the throughput.
+// (cache/path_end.wgsl), its light without the throughput. next_event keeps its own code,
+// which leaves before setting up the ray where the sample brings no light, for every frame
+// without the cache.
 fn light_sample_ray(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, rng: ptr<function, u32>) -> ShadowRay {
     let eps = params.cam_pos.w;
     let ls = sample_light(s.p, rng);
