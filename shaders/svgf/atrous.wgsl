@@ -1,5 +1,6 @@
 // SVGF §4.3: one level of the edge-avoiding a-trous wavelet filter (Dammertz et al. 2010):
-// the 5x5 B3-spline kernel h with taps 2^level pixels apart, weighted by eq. (3)-(5)
+// the 5x5 B3-spline kernel h (or a 3x3 one, sv.kernel_radius) with taps 2^level pixels apart,
+// weighted by eq. (3)-(5)
 // (common.wgsl: edge_weight) with the luminance bandwidth sigma_l sqrt(g3x3(var)) of the
 // pixel's variance blurred by a 3x3 Gaussian; Voorhuis eq. (8) widens it for young histories.
 // The signal may bound the reach with a Gaussian of its own (signal_sigma: the glossy light's).
@@ -17,7 +18,16 @@ var dst: texture_storage_2d<rgba16float, write>;
 var out_history: texture_storage_2d<rgba32float, write>;
 var<uniform> level: Level;
 
-const KERNEL = array<f32, 3>(0.375, 0.25, 0.0625);
+const KERNEL_5 = array<f32, 3>(0.375, 0.25, 0.0625);
+const KERNEL_3 = array<f32, 2>(0.5, 0.25);
+
+// The kernel's weight along one axis at d taps from the centre.
+fn kernel(d: i32) -> f32 {
+    if sv.kernel_radius >= 2u {
+        return KERNEL_5[d];
+    }
+    return KERNEL_3[d];
+}
 
 // The 3x3 Gaussian of the variance around p (SVGF's prefilter of eq. (5)).
 fn blurred_variance(p: vec2i) -> f32 {
@@ -48,7 +58,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let samples = 1.0 / max(textureLoad(moments, p, 0).w, 1e-6);
     let settled = sv.settled_samples > 0.0 && samples >= sv.settled_samples && level.index >= sv.settled_levels;
     if has_surface(p) && !settled {
-        // The pixel's own features come unpacked (exact normal); its 24 taps' from the record.
+        // The pixel's own features come unpacked (exact normal); its taps' from the record.
         let fc = signal_features(p);
         let lc = luminance(c.rgb);
         var sigma_l = sv.sigma_l;
@@ -59,11 +69,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         let phi_l = sigma_l * sqrt(max(blurred_variance(p), 0.0));
         let sigma = signal_sigma(p);
-        var sum = c.rgb * (KERNEL[0] * KERNEL[0]);
-        var sum_var = c.a * (KERNEL[0] * KERNEL[0] * KERNEL[0] * KERNEL[0]);
-        var wsum = KERNEL[0] * KERNEL[0];
-        for (var dy = -2; dy <= 2; dy++) {
-            for (var dx = -2; dx <= 2; dx++) {
+        let k0 = kernel(0);
+        var sum = c.rgb * (k0 * k0);
+        var sum_var = c.a * (k0 * k0 * k0 * k0);
+        var wsum = k0 * k0;
+        let r = i32(sv.kernel_radius);
+        for (var dy = -r; dy <= r; dy++) {
+            for (var dx = -r; dx <= r; dx++) {
                 let q = p + vec2i(dx, dy) * level.step;
                 if (dx == 0 && dy == 0) || !in_bounds(q) {
                     continue;
@@ -75,7 +87,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 let t = textureLoad(src, q, 0);
                 let offset = f32(level.step) * length(vec2f(f32(dx), f32(dy)));
                 let spatial = exp(-0.5 * offset * offset / (sigma * sigma));
-                let w = KERNEL[abs(dx)] * KERNEL[abs(dy)] * spatial * edge_weight(fc, fq, offset, lc, luminance(t.rgb), phi_l);
+                let w = kernel(abs(dx)) * kernel(abs(dy)) * spatial * edge_weight(fc, fq, offset, lc, luminance(t.rgb), phi_l);
                 sum += w * t.rgb;
                 sum_var += w * w * t.a;
                 wsum += w;

@@ -25,8 +25,9 @@ struct SvgfParams {
     regression_order: f32,
     // Past this many samples' worth the intervals narrow as sqrt(this / samples) (0: never).
     regression_full_samples: f32,
-    _pad1: u32,
-    _pad2: u32,
+    // The a-trous kernel's radius in taps: 2, SVGF's 5x5 B3 spline; 1, a 3x3 kernel.
+    kernel_radius: u32,
+    _pad: u32,
 }
 
 // Per dispatch: which a-trous level (step 2^level pixels), whether it writes the history.

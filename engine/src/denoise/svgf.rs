@@ -56,7 +56,8 @@ pub struct SvgfParams {
     pub regression_samples: f32,
     pub regression_order: f32,
     pub regression_full_samples: f32,
-    pub _pad: [u32; 2],
+    pub kernel_radius: u32,
+    pub _pad: u32,
 }
 
 impl SvgfParams {
@@ -76,7 +77,8 @@ impl SvgfParams {
             regression_samples: s.regression_samples.max(1.0),
             regression_order: s.regression_order.min(2) as f32,
             regression_full_samples: s.regression_full_samples.clamp(0.0, STILL_FRAMES_MAX),
-            _pad: [0; 2],
+            kernel_radius: if s.kernel_5x5 { 2 } else { 1 },
+            _pad: 0,
         }
     }
 }

@@ -73,10 +73,17 @@ described! {
         /// off, those pixels use the temporal moments as they are.
         spatial_variance: bool = true,
             ("svgf.spatial_variance", "svgf/variance", "", Bool);
-        /// Levels of the edge-avoiding a-trous wavelet filter (5x5 kernel, step 2^i; SVGF: 5).
-        /// The first level's output is the next frame's history. 0: no spatial filter.
+        /// Levels of the edge-avoiding a-trous wavelet filter (step 2^i; SVGF: 5). The first
+        /// level's output is the next frame's history. 0: no spatial filter.
         levels: u32 = 5,
             ("svgf.levels", "svgf/atrous", "levels", Int(0, MAX_LEVELS as i64));
+        /// SVGF's 5x5 B3-spline a-trous kernel (24 taps a level); off, a 3x3 kernel (1/4, 1/2,
+        /// 1/4 per axis, 8 taps) that reaches half as far. Off by default: on lavapipe it
+        /// halves the a-trous passes (level 640x360: 595 -> 336 ms, SVGF's share of the frame
+        /// 39.2% -> 31.3%) and the still views measured came out the same or better
+        /// (docs/decisions.md).
+        kernel_5x5: bool = false,
+            ("svgf.kernel_5x5", "svgf/atrous", "", Bool);
         /// Where the light accumulated at least this many samples' worth (1 / the sum of the squared
         /// integration weights: a still view's long mean, not a moving pixel's 0.2 average of about
         /// 9), only the first `settled_levels` levels filter it: the wide levels' blur then costs
@@ -174,6 +181,7 @@ impl SvgfSettings {
             settled_samples: 0.0,
             variance_of_mean: false,
             filtered_history: true,
+            kernel_5x5: true,
             ..Default::default()
         }
     }

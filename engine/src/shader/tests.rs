@@ -518,6 +518,7 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(offs[8] as usize, offset_of!(SvgfParams, settled_levels));
     assert_eq!(offs[12] as usize, offset_of!(SvgfParams, regression_order));
     assert_eq!(offs[13] as usize, offset_of!(SvgfParams, regression_full_samples));
+    assert_eq!(offs[14] as usize, offset_of!(SvgfParams, kernel_radius));
     assert_eq!(wgsl_layout(atrous, "Level").0, 16);
     let resolve = programs.iter().find(|p| p.label == "cache/resolve.wgsl").unwrap();
     use crate::passes::cache::CacheParams;
