@@ -86,13 +86,9 @@ fn path_end(s: Surface, b: Bsdf, wo: vec3f) -> PathEnd {
 // (may_end: from the matte path's first vertex on) and `path_end` allows it, the cell's light
 // plus the punctual lights', which the cells do not hold (the trace keeps them in `direct`),
 // where the sight ray to the cell's centroid is clear; otherwise next_event's light sample.
-// All of these rays are cast through one call of traverse: the GPU's compiler inlines each
-// call, and lanes of a group at different calls take turns. On an H200 (Mara, unlimited path
-// length, 1280x720), with a call each for the sight ray and the punctual lights beside the
-// light sample's, the living room's trace took 64.6 ms against 20.6 without path ends; with
-// one call for the end's rays beside the light sample's 24.4 ms; with this one 21.8 ms. A
-// frame without the cache keeps next_event's own call (common/path_end_none.wgsl): through
-// this loop the level's trace took 5% longer there.
+// All of these rays go through one call of traverse: the GPU's compiler inlines each call, and
+// lanes of a group at different calls take turns (H200, living room, 1280x720, unlimited
+// length: trace 21.8 ms with path ends, 20.6 without; docs/decisions.md).
 fn vertex_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, beta: vec3f, may_end: bool, rng: ptr<function, u32>) -> VertexLight {
     var end = PathEnd(false, vec3f(0.0), ShadowRay(s.p, wo, 0.0, vec3f(0.0)));
     if may_end {

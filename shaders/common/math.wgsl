@@ -43,11 +43,9 @@ fn offset_ray(p: vec3f, n: vec3f, eps: f32) -> vec3f {
 
 // A shadow ray's direction and length from `origin` (p lifted off its surface by offset_ray) to
 // the light point p + wi x dist, stopping short of it (dist INF: a direction, kept as it is).
-// Aimed from the lifted origin, not along wi: that line runs beside p's, lifted off the
-// surface, and where an emitter lies low over the surface it crosses the emitter's plane
-// before its end, so that the emitter's own triangle shadowed its sample (a 40 cm light 60 cm
-// over a 20 m floor lost nearly all of its light past 35 degrees from overhead;
-// tests/filter_bias.rs).
+// Aimed from the lifted origin: a line along wi from there runs beside the true one and, where
+// an emitter lies low over the surface, crosses the emitter's plane before its end, so that
+// the emitter's own triangle would shadow its sample (tests/area_light.rs).
 struct ShadowLeg {
     dir: vec3f,
     tmax: f32,

@@ -1,8 +1,8 @@
 // SVGF §4.3: one level of the edge-avoiding a-trous wavelet filter (Dammertz et al. 2010):
 // the 5x5 B3-spline kernel h (or a 3x3 one, sv.kernel_radius) with taps 2^level pixels apart,
-// weighted by eq. (3)-(5)
-// (common.wgsl: edge_weight) with the luminance bandwidth sigma_l sqrt(g3x3(var)) of the
-// pixel's variance blurred by a 3x3 Gaussian; Voorhuis eq. (8) widens it for young histories.
+// weighted by eq. (3)-(5) (common.wgsl: edge_weight) with the luminance bandwidth
+// sigma_l sqrt(g3x3(var)) of the pixel's variance blurred by a 3x3 Gaussian; Voorhuis eq. (8)
+// widens it for young histories.
 // The signal may bound the reach with a Gaussian of its own (signal_sigma: the glossy light's).
 // Light accumulated from many samples runs only the first levels (SvgfSettings::settled_samples).
 // The variance is filtered with the squared weights (eq. (6)) unless Voorhuis §6 turns that off,

@@ -43,8 +43,8 @@ described! {
             ("progressive.sigma_l", "progressive/atrous", "", Float(0.0, 64.0, 0.1));
         /// epsilon of the luminance weight (Dundr: 0.01 to 0.1), in displayed light (the light
         /// times the exposure): a dim scene shown brighter is not blurred across its gradients
-        /// the more for its dimness (a floor lit 0.006 to 0.075 at +3.5 EV, 128 still frames:
-        /// the darkest band 8% too bright, 38% at 0 EV or with epsilon in the light's own units).
+        /// the more for its dimness (a floor lit 0.006 to 0.075, 128 still frames: the darkest
+        /// band 8% too bright shown at +3.5 EV, 38% at 0 EV).
         epsilon_l: f32 = 0.05,
             ("progressive.epsilon_l", "progressive/atrous", "", Float(0.0, 1.0, 0.005));
         /// In a still view `epsilon_l` falls as this / (samples accumulated) past this many
