@@ -49,14 +49,15 @@ struct PathEnd {
     sight: ShadowRay,
 }
 
-// Where the path may end at surface s (towards wo, local to its shading frame): the light
+// Where the path may end at surface s (towards wo, local to its shading frame; may_end: the
+// path allows it at this vertex): the light
 // leaving it from the cache, and the ray to its cell's centroid that must be clear. None where
 // the path must go on: a delta or transmitting lobe, a glossy lobe that outweighs the matte one
 // (the cell's light is a cosine-weighted mean, a sharp lobe would reflect its blocks), no cell,
 // too few samples, or a mean not yet known well.
-fn path_end(s: Surface, b: Bsdf, wo: vec3f) -> PathEnd {
+fn path_end(s: Surface, b: Bsdf, wo: vec3f, may_end: bool) -> PathEnd {
     var end = PathEnd(false, vec3f(0.0), ShadowRay(s.p, wo, 0.0, vec3f(0.0)));
-    if params.max_depth >= 0 || cache.path_end_samples <= 0.0 || b.delta || b.transmission > 0.0 {
+    if !may_end || params.max_depth >= 0 || cache.path_end_samples <= 0.0 || b.delta || b.transmission > 0.0 {
         return end;
     }
     let f = fresnel(b, wo.z);
@@ -90,10 +91,7 @@ fn path_end(s: Surface, b: Bsdf, wo: vec3f) -> PathEnd {
 // lanes of a group at different calls take turns (H200, living room, 1280x720, unlimited
 // length: trace 21.8 ms with path ends, 20.6 without; docs/decisions.md).
 fn vertex_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, beta: vec3f, may_end: bool, rng: ptr<function, u32>) -> VertexLight {
-    var end = PathEnd(false, vec3f(0.0), ShadowRay(s.p, wo, 0.0, vec3f(0.0)));
-    if may_end {
-        end = path_end(s, b, wo);
-    }
+    let end = path_end(s, b, wo, may_end);
     var ending = end.ok;
     var light_sample = light_groups() > 0u && (max3(b.albedo) > 0.0 || !b.delta);
     // The next of the end's rays: 0 the sight ray, k > 0 punctual light k - 1.
