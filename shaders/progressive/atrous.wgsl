@@ -32,7 +32,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let nc = oct_decode(f.zw);
     let lc = select(luma(c.rgb), -1.0, missing);
     let age = textureLoad(moments, p, 0).z;
-    let epsilon = luminance_epsilon(age);
+    // The luminance weight in displayed light (the light times the exposure, its variance times
+    // the exposure squared), here in the light's own units: epsilon is an amount of light on
+    // the screen, so a scene lit far below the display's white, shown brighter, is not blurred
+    // across its gradients the more for its dimness.
+    let k = frame.exposure;
+    let epsilon = luminance_epsilon(age) / k;
+    let variance = max(c.a, 0.0) * k;
     var sum = vec3f(0.0);
     var sum_var = 0.0;
     var wsum = 0.0;
@@ -56,7 +62,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             let nq = oct_decode(g.zw);
             let h = 0.25 * select(0.5, 1.0, dx == 0) * select(0.5, 1.0, dy == 0);
             let offset = f32(level.step) * length(vec2f(f32(dx), f32(dy)));
-            let w = h * dundr_weight(fc, nc, lc, max(c.a, 0.0), epsilon, fq, nq, luma(t.rgb), offset);
+            let w = h * dundr_weight(fc, nc, lc, variance, epsilon, fq, nq, luma(t.rgb), offset);
             sum += w * t.rgb;
             sum_var += w * w * t.a;
             wsum += w;

@@ -47,7 +47,7 @@ fn luma(c: vec3f) -> f32 {
 // The luminance weight's epsilon at a pixel whose light accumulated `age` samples: epsilon_l,
 // and in a still view past epsilon_full_samples epsilon_l x epsilon_full_samples / age. The
 // variance term beside it is the variance of the mean, which falls as 1 / age; a fixed epsilon
-// (Dundr's 0.01 to 0.1, in absolute luminance) outlasts it and keeps the 61-pixel filter
+// (Dundr's 0.01 to 0.1, in displayed luminance) outlasts it and keeps the 61-pixel filter
 // blurring a converged view's shading.
 fn luminance_epsilon(age: f32) -> f32 {
     if dn.static_view == 0u || pp.epsilon_full_samples <= 0.0 {
@@ -66,13 +66,10 @@ fn dundr_weight(fc: vec2f, nc: vec3f, lc: f32, variance: f32, epsilon: f32, fq: 
     if fc.y < 0.1 * fc.x {
         w_d = exp(-abs(fc.x - fq.x) / (abs(pp.sigma_d * fc.y * offset) + 0.005 * fc.x));
     }
-    // §4.4.3, in displayed units (the light times the frame's exposure, its variance times the
-    // exposure squared): epsilon is an amount of light on the screen, so a scene lit far below
-    // the display's white, shown brighter, is not blurred across its gradients the more for it.
+    // §4.4.3
     var w_l = 1.0;
     if lc >= 0.0 {
-        let k = frame.exposure;
-        w_l = exp(-abs(lc - lq) / (pp.sigma_l * variance * k + epsilon / k));
+        w_l = exp(-abs(lc - lq) / (pp.sigma_l * variance + epsilon));
     }
     return w_n * w_d * w_l;
 }
