@@ -12,11 +12,11 @@ use crate::cli::preset_settings;
 use crate::cli::{bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::{Mat4, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::quality::{
-    Image, compare, compare_with_flip_map, luminance, region_mean, save_flip_heatmap,
+    Image, compare, compare_with_flip_map, flip_over, luminance, region_mean, save_flip_heatmap,
 };
 use hush_engine::scene::{Camera, CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings};
@@ -236,17 +236,19 @@ pub fn new_renderer(gpu: &Gpu, scene: &Scene, size: (u32, u32)) -> Result<Render
     Renderer::new(gpu, scene.clone(), prepared, size)
 }
 
-/// Render the stream with `settings`, scoring every frame against `references`.
+/// Render the stream with `settings`, scoring every frame against `references`. Returns the
+/// scores, the last frame, and the last frame's uncovered pixels (white) where it has any.
 fn stream(
     s: &Setup,
     settings: &FrameSettings,
     references: &[Image],
-) -> Result<(Scores, Vec<Image>)> {
+) -> Result<(Scores, Vec<Image>, Option<Image>)> {
     let mut r = renderer(s)?;
     let mut scores = Scores::default();
     let mut prev: Option<Image> = None;
     let mut last = vec![];
     let mut uncovered = Uncovered::new(s.size);
+    let mut last_mask = None;
     for (k, input) in s.inputs.iter().enumerate() {
         r.render(&s.gpu, input, settings, None)?;
         let ms: f64 = r.pass_times(&s.gpu)?.iter().map(|p| p.1).sum();
@@ -257,10 +259,14 @@ fn stream(
         scores.push(&img, prev.as_ref(), &references[k], ms, mask.as_deref())?;
         if k + 1 == s.inputs.len() {
             last.push(img.clone());
+            if let Some(m) = mask.as_deref().filter(|m| m.iter().any(|u| *u)) {
+                let data = m.iter().map(|u| Vec3::splat(if *u { 1.0 } else { 0.0 })).collect();
+                last_mask = Some(Image { width: img.width, height: img.height, data });
+            }
         }
         prev = Some(img);
     }
-    Ok((scores, last))
+    Ok((scores, last, last_mask))
 }
 
 pub fn run(a: QualityArgs) -> Result<()> {
@@ -364,8 +370,12 @@ pub fn run(a: QualityArgs) -> Result<()> {
     drop(accumulator);
 
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
-    let (den, last) = stream(&s, &base, &references)?;
-    let (raw, last_raw) =
+    let (den, last, last_mask) = stream(&s, &base, &references)?;
+    if let Some(m) = &last_mask {
+        // Which pixels the uncovered column scored in the last frame.
+        m.save(&a.out_dir.join("last_uncovered.png"))?;
+    }
+    let (raw, last_raw, _) =
         stream(&s, &FrameSettings { denoiser: Denoiser::NONE, ..base.clone() }, &references)?;
     if let (Some(d), Some(r), Some(f)) = (last.first(), last_raw.first(), references.last()) {
         // The last frame as seen and in linear HDR, and where FLIP sees the error (denoised and
@@ -405,6 +415,17 @@ pub fn run(a: QualityArgs) -> Result<()> {
         den.flip.len(),
         flips64.len()
     );
+    if let (Some(m), Some(r)) = (&last_mask, references.last()) {
+        // The same pixels of the yardstick: how far 64 samples get where the region lies
+        // (silhouettes and a room's far openings score high at any sample count).
+        let region: Vec<bool> = m.data.iter().map(|v| v.x > 0.5).collect();
+        if let Some((f64_region, n)) = flip_over(&accumulated64, r, &region) {
+            let den_region = den.uncovered_flip.last().copied().unwrap_or(f64::NAN);
+            println!(
+                "  its uncovered pixels ({n}): denoised FLIP {den_region:.4}; 64 accumulated frames (first seed): FLIP {f64_region:.4}"
+            );
+        }
+    }
     let per_seed: Vec<String> = flips64.iter().map(|f| format!("{f:.5}")).collect();
     std::fs::write(
         a.out_dir.join("accumulated64_flip.txt"),
@@ -439,7 +460,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
         for stage in own.iter().map(|s| s.name).chain([taa]) {
             let mut settings = base.clone();
             hush_engine::settings::disable_stage(&mut settings, stage);
-            let (sc, _) = stream(&s, &settings, &references)?;
+            let (sc, _, _) = stream(&s, &settings, &references)?;
             row(stage, &sc)?;
         }
     }
