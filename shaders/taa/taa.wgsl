@@ -138,12 +138,12 @@ fn on_silhouette(p: vec2i, z: f32) -> bool {
 }
 
 // The bilinear read of the history at `prev` for the pixel p; no weight where the pixel moved
-// and none of the taps showed its surface, unless it lies on a silhouette. A still pixel reads
-// its own texel untested: nothing moved that could have uncovered it. On a moving silhouette
-// the jittered sample of one frame often hits the other surface than the last frame's texels
-// did; restarting there made every moving edge alias (the level's strafe: FLIP 0.0941 against
-// 0.0917, temporal error +14%), and reweighting each tap, as the denoisers do, took the edge's
-// blend out of the history (0.0980). An edge's history is the blend TAA exists to keep.
+// and none of the taps showed its surface, unless it lies on a silhouette. A pixel that did not
+// move on screen reads its own texel untested (what an object uncovers as it moves off a still
+// background is left to the clamp). On a moving silhouette the jittered sample of one frame
+// often hits the other surface than last frame's texels did, and the edge's history is the
+// blend TAA exists to keep, so every tap is read there (docs/decisions.md: "Uncovered
+// surfaces").
 fn history_taps(p: vec2i, prev: vec2f, still: bool) -> BilinearTaps {
     var b = bilinear_taps(prev);
     if still || !has_surface(p) {
