@@ -223,15 +223,21 @@ struct Reprojection {
 }
 
 fn previous_distance(depth: texture_depth_2d, normals: texture_2d<f32>, t: vec2i, expected: vec3f, s: SurfaceFrame, min_cos: f32) -> f32 {
+    // min_cos <= -1 passes every normal: skip the fetch (the matte default).
+    if in_bounds(t) && min_cos > -1.0 && dot(oct_decode(textureLoad(normals, t, 0).xy), s.n) < min_cos {
+        return -1.0;
+    }
+    return previous_plane_distance(depth, t, expected, s);
+}
+
+// previous_distance without the normal test: eq. (11)'s distance from the expected point to
+// the previous depth buffer's point at texel t, in footprints (-1: none there).
+fn previous_plane_distance(depth: texture_depth_2d, t: vec2i, expected: vec3f, s: SurfaceFrame) -> f32 {
     if !in_bounds(t) {
         return -1.0;
     }
     let d = textureLoad(depth, t, 0);
     if d <= 0.0 {
-        return -1.0;
-    }
-    // min_cos <= -1 passes every normal: skip the fetch (the matte default).
-    if min_cos > -1.0 && dot(oct_decode(textureLoad(normals, t, 0).xy), s.n) < min_cos {
         return -1.0;
     }
     let delta = world_from_depth(dn.prev_inv_view_proj, t, d) - expected;

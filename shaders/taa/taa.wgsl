@@ -4,8 +4,8 @@
 // now (not in a static view, where nothing can ghost); then blended with weight taa_alpha for
 // the current frame. Without a history (first frame, off screen, no surface) the current
 // colour is used as is. Nor is there where a pixel that moved finds its surface at none of the
-// bilinear taps' previous depths and normals (eq. (11) of Mara et al., as the denoisers' temporal
-// stages test theirs) and lies off any silhouette: a surface the move uncovered (a window's
+// bilinear taps' previous depths (eq. (11) of Mara et al., as the denoisers' temporal stages
+// test theirs) and lies off any silhouette: a surface the move uncovered (a window's
 // reveal after a step sideways) otherwise took 90% of its first frame from the wall that hid it,
 // clamped into a 3x3 box whose noisy light spans both.
 //
@@ -52,7 +52,6 @@
 
 var<storage, read> hdr: array<vec4f>;
 var prev_depth: texture_depth_2d;
-var prev_normal: texture_2d<f32>;
 var history: texture_2d<f32>;
 var out_history: texture_storage_2d<rgba32float, write>;
 var<storage, read_write> final_image: array<vec4f>;
@@ -152,8 +151,14 @@ fn history_taps(p: vec2i, prev: vec2f, still: bool) -> BilinearTaps {
     let x = position_at(p);
     let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
     let s = surface_frame(p, x);
-    let ok = surface_taps(prev_depth, prev_normal, b, expected, s, dn.reprojection_min_cos);
-    if !any(ok & (b.w > vec4f(0.0))) && !on_silhouette(p, linear_depth(x)) {
+    // Depth alone (the previous normals would be a 17th sampled texture where the vertices
+    // move, over WebGPU's default limit of 16 per stage).
+    var shown = false;
+    for (var k = 0; k < 4; k++) {
+        let d = previous_plane_distance(prev_depth, bilinear_tap(b, k), expected, s);
+        shown = shown || (b.w[k] > 0.0 && d >= 0.0 && d <= dn.d1_px);
+    }
+    if !shown && !on_silhouette(p, linear_depth(x)) {
         b.w = vec4f(0.0);
     }
     return b;

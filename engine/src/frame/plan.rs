@@ -78,6 +78,8 @@ impl Renderer {
             if self.stages.taa.allocate(gpu, &mut t.memory, t.size, t.epoch) {
                 t.generation += 1;
             }
+            // TAA's test of what a move uncovered reads the previous depth.
+            t.ensure_previous(gpu);
         }
         let (samples, period) = self.sampling(gpu, settings, denoiser)?;
         let (traced, primary_samples, prefilter) = self.primaries(gpu, input, settings, samples)?;
