@@ -237,12 +237,12 @@ pub fn new_renderer(gpu: &Gpu, scene: &Scene, size: (u32, u32)) -> Result<Render
 }
 
 /// Render the stream with `settings`, scoring every frame against `references`. Returns the
-/// scores, the last frame, and the last frame's uncovered pixels (white) where it has any.
+/// scores, the last frame, and the last frame's uncovered pixels where it has any.
 fn stream(
     s: &Setup,
     settings: &FrameSettings,
     references: &[Image],
-) -> Result<(Scores, Vec<Image>, Option<Image>)> {
+) -> Result<(Scores, Vec<Image>, Option<Vec<bool>>)> {
     let mut r = renderer(s)?;
     let mut scores = Scores::default();
     let mut prev: Option<Image> = None;
@@ -259,10 +259,7 @@ fn stream(
         scores.push(&img, prev.as_ref(), &references[k], ms, mask.as_deref())?;
         if k + 1 == s.inputs.len() {
             last.push(img.clone());
-            if let Some(m) = mask.as_deref().filter(|m| m.iter().any(|u| *u)) {
-                let data = m.iter().map(|u| Vec3::splat(if *u { 1.0 } else { 0.0 })).collect();
-                last_mask = Some(Image { width: img.width, height: img.height, data });
-            }
+            last_mask = mask.clone().filter(|m| m.iter().any(|u| *u));
         }
         prev = Some(img);
     }
@@ -372,8 +369,10 @@ pub fn run(a: QualityArgs) -> Result<()> {
     let base = FrameSettings { seed: a.seed, max_depth, ..chains };
     let (den, last, last_mask) = stream(&s, &base, &references)?;
     if let Some(m) = &last_mask {
-        // Which pixels the uncovered column scored in the last frame.
-        m.save(&a.out_dir.join("last_uncovered.png"))?;
+        // Which pixels the uncovered column scored in the last frame, white.
+        let data = m.iter().map(|u| Vec3::splat(if *u { 1.0 } else { 0.0 })).collect();
+        let img = Image { width: size.0, height: size.1, data };
+        img.save(&a.out_dir.join("last_uncovered.png"))?;
     }
     let (raw, last_raw, _) =
         stream(&s, &FrameSettings { denoiser: Denoiser::NONE, ..base.clone() }, &references)?;
@@ -418,8 +417,7 @@ pub fn run(a: QualityArgs) -> Result<()> {
     if let (Some(m), Some(r)) = (&last_mask, references.last()) {
         // The same pixels of the yardstick: how far 64 samples get where the region lies
         // (silhouettes and a room's far openings score high at any sample count).
-        let region: Vec<bool> = m.data.iter().map(|v| v.x > 0.5).collect();
-        if let Some((f64_region, n)) = flip_over(&accumulated64, r, &region) {
+        if let Some((f64_region, n)) = flip_over(&accumulated64, r, m) {
             let den_region = den.uncovered_flip.last().copied().unwrap_or(f64::NAN);
             println!(
                 "  its uncovered pixels ({n}): denoised FLIP {den_region:.4}; 64 accumulated frames (first seed): FLIP {f64_region:.4}"
