@@ -2,7 +2,8 @@
 //! running mean of the matte samples that fell in it, as a CPU computation from the same samples
 //! gives it; a pixel reads its cell's mean from before its own sample; the matte temporal starts a
 //! restarted history from it; light does not leak through a thin wall into a dark room; and matte
-//! paths that end in the cache keep the light of paths that go on, with less noise.
+//! paths that end in the cache keep the light of paths that go on, with less noise, and never
+//! end in a cell they reached over a segment shorter than its diagonal.
 
 use glam::{DVec3, Vec3};
 use hush_engine::accel::BvhKind;
@@ -382,11 +383,12 @@ fn matte_moments(frames: &[Vec<[f32; 4]>]) -> Vec<(f64, f64)> {
 /// many times. With unlimited path length (max_depth -1) and paths ending in the cache
 /// (`path_end_samples`), frames 8-31 of a still view must keep the matte light of paths that go
 /// on (the mean over the image within 2%) with less noise (the mean of the pixels' variances
-/// over frames at most half). Measured: mean 1.1918 against 1.1989 (-0.6%), variance 0.1057
-/// against 0.3349 (0.32x: Russian roulette's long paths are what the cells replace). Under a
-/// path length limit paths must not end in the cache (its cells carry light from every
-/// bounce: +9% here at 6 segments, 1.1221 against 1.0288), so the trace's matte light is then
-/// the same with and without it.
+/// over frames at most half). Measured: mean 1.1910 against 1.1989 (-0.7%), variance 0.1532
+/// against 0.3349 (0.46x: Russian roulette's long paths are what the cells replace; at 64x48 a
+/// cell is about a metre wide, and the segments shorter than its diagonal go on). Under a path
+/// length limit paths must not end in the cache (its cells carry light from every bounce: +9%
+/// here at 6 segments, 1.1221 against 1.0288), so the trace's matte light is then the same with
+/// and without it.
 #[test]
 fn paths_that_end_in_the_cache_keep_the_light_with_less_noise() {
     let scene = two_rooms();
@@ -423,4 +425,68 @@ fn paths_that_end_in_the_cache_keep_the_light_with_less_noise() {
     assert!((mean_on / mean_off - 1.0).abs() <= 0.02, "mean {mean_on} against {mean_off}");
     assert!(var_on <= 0.5 * var_off, "variance {var_on} against {var_off}");
     assert!(run(16.0, 6) == run(0.0, 6), "paths ended in the cache under a length limit");
+}
+
+/// A closed white box 40 cm wide with a light under its lid, seen from its centre.
+fn small_box() -> Scene {
+    let mut g = GltfWriter::default();
+    let white = g.lambert([0.7; 3]);
+    let lamp = g.emitter(20.0);
+    let (h, t) = (0.2, 0.05);
+    let parts = [
+        // Floor, lid and four walls, 10 cm slabs whose inner faces bound the box.
+        (cuboid(Vec3::new(0.0, -h - t, 0.0), Vec3::new(h + 2.0 * t, t, h + 2.0 * t), 0), white),
+        (cuboid(Vec3::new(0.0, h + t, 0.0), Vec3::new(h + 2.0 * t, t, h + 2.0 * t), 0), white),
+        (cuboid(Vec3::new(-h - t, 0.0, 0.0), Vec3::new(t, h, h), 0), white),
+        (cuboid(Vec3::new(h + t, 0.0, 0.0), Vec3::new(t, h, h), 0), white),
+        (cuboid(Vec3::new(0.0, 0.0, -h - t), Vec3::new(h, h, t), 0), white),
+        (cuboid(Vec3::new(0.0, 0.0, h + t), Vec3::new(h, h, t), 0), white),
+        // The light, facing down (X x Z = -Y).
+        (quad(Vec3::new(0.0, h - 0.01, 0.0), Vec3::X * 0.05, Vec3::Z * 0.05, 0), lamp),
+    ];
+    for (mesh, material) in parts {
+        let m = g.engine_mesh(&mesh, material);
+        g.node(json!({"mesh": m}));
+    }
+    g.camera([0.0, 0.0, 0.0], [1.0, -0.2, 0.3], 1.0);
+    load_gltf(&g.write("small_box")).unwrap()
+}
+
+/// SHaRC's segment test (cache/path_end.wgsl): a path does not end at a vertex it reached over
+/// a segment no longer than the vertex's cell's diagonal, where the cell's mean stands for light
+/// that changes within it (a corner, the floor under a step). In a 40 cm box seen at 16x12 with
+/// 32-pixel cells every cell is at least 1 m wide (1.73 m across), and no segment in the box is
+/// longer than 0.7 m: no path may end, so the trace's matte light is the same as with path ends
+/// off, frame by frame. Without the test the cells (which fill within a frame here) ended the
+/// paths and the two differed from the first frames on. The two rooms above show that paths do
+/// end where their segments are long.
+#[test]
+fn paths_do_not_end_in_a_cell_they_reached_over_a_short_segment() {
+    let scene = small_box();
+    let size = (16, 12);
+    let input = FrameInput {
+        camera: Camera::look_at(DVec3::ZERO, DVec3::new(1.0, -0.2, 0.3), 60.0),
+        time: 0.0,
+        shutter: None,
+    };
+    let run = |path_end_samples: f32| {
+        let (gpu, mut r) = Renderer::headless(scene.clone(), BvhKind::DEFAULT, size).unwrap();
+        let mut s = settings(4);
+        s.cache.cell_pixels = 32.0;
+        s.cache.path_end_samples = path_end_samples;
+        s.max_depth = -1;
+        (0..12)
+            .map(|_| {
+                r.render(&gpu, &input, &s, None).unwrap();
+                halves(&r.read_texture(&gpu, "trace/matte").unwrap().0)
+            })
+            .collect::<Vec<_>>()
+    };
+    let (on, off) = (run(16.0), run(0.0));
+    let lit = off.iter().flatten().filter(|p| p[0] > 0.0).count();
+    assert!(lit > off.len() * 100, "{lit} lit matte samples over {} frames", off.len());
+    for (k, (a, b)) in on.iter().zip(&off).enumerate() {
+        let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+        assert_eq!(differ, 0, "frame {k}: pixels whose matte light differs with path ends on");
+    }
 }

@@ -50,12 +50,17 @@ struct PathEnd {
 }
 
 // Where the path may end at surface s (towards wo, local to its shading frame; may_end: the
-// path allows it at this vertex): the light
+// path allows it at this vertex; reach: the length of the segment that arrived here): the light
 // leaving it from the cache, and the ray to its cell's centroid that must be clear. None where
 // the path must go on: a delta or transmitting lobe, a glossy lobe that outweighs the matte one
-// (the cell's light is a cosine-weighted mean, a sharp lobe would reflect its blocks), no cell,
-// too few samples, or a mean not yet known well.
-fn path_end(s: Surface, b: Bsdf, wo: vec3f, may_end: bool) -> PathEnd {
+// (the cell's light is a cosine-weighted mean, a sharp lobe would reflect its blocks), a segment
+// no longer than the cell's diagonal, no cell, too few samples, or a mean not yet known well.
+//
+// The segment test is SHaRC's (its samples query a voxel only past sqrt(3) voxel edges): a short
+// segment reaches into a corner, under a step or a table, where the light changes within a
+// cell, and the cell's mean carries the open surface's light in there; a long one sees the cell
+// from afar, where its blur is smaller than the bounce's own.
+fn path_end(s: Surface, b: Bsdf, wo: vec3f, may_end: bool, reach: f32) -> PathEnd {
     var end = PathEnd(false, vec3f(0.0), ShadowRay(s.p, wo, 0.0, vec3f(0.0)));
     if !may_end || params.max_depth >= 0 || cache.path_end_samples <= 0.0 || b.delta || b.transmission > 0.0 {
         return end;
@@ -66,6 +71,9 @@ fn path_end(s: Surface, b: Bsdf, wo: vec3f, may_end: bool) -> PathEnd {
         return end;
     }
     let key = cell_key(s.p, s.ns, frame.cam_pos.xyz, pixel_spread());
+    if !(reach > 1.7320508 * key.size) {
+        return end;
+    }
     let slot = cache_find(key);
     if slot == CACHE_NONE {
         return end;
@@ -84,14 +92,15 @@ fn path_end(s: Surface, b: Bsdf, wo: vec3f, may_end: bool) -> PathEnd {
 }
 
 // A path vertex's light (common/path.wgsl's `vertex_light`): where the path may end here
-// (may_end: from the matte path's first vertex on) and `path_end` allows it, the cell's light
+// (may_end: from the matte path's first vertex on; reach: the length of the segment that
+// arrived) and `path_end` allows it, the cell's light
 // plus the punctual lights', which the cells do not hold (the trace keeps them in `direct`),
 // where the sight ray to the cell's centroid is clear; otherwise next_event's light sample.
 // All of these rays go through one call of traverse: the GPU's compiler inlines each call, and
 // lanes of a group at different calls take turns (H200, living room, 1280x720, unlimited
 // length: trace 21.8 ms with path ends, 20.6 without; docs/decisions.md).
-fn vertex_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, beta: vec3f, may_end: bool, rng: ptr<function, u32>) -> VertexLight {
-    let end = path_end(s, b, wo, may_end);
+fn vertex_light(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, beta: vec3f, may_end: bool, reach: f32, rng: ptr<function, u32>) -> VertexLight {
+    let end = path_end(s, b, wo, may_end, reach);
     var ending = end.ok;
     var light_sample = light_groups() > 0u && (max3(b.albedo) > 0.0 || !b.delta);
     // The next of the end's rays: 0 the sight ray, k > 0 punctual light k - 1.

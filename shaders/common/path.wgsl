@@ -289,7 +289,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     let origin = offset_ray(s.p, s.ng, eps);
     // The light sample, or where the path may end in the radiance cache here, the rest of the
     // path from the cache (common/path_end_none.wgsl never ends one; cache/path_end.wgsl).
-    let v = vertex_light(s, bsdf, wo, frame, origin, beta, segments >= (*st).cache_from && wo.z > 0.0, rng);
+    let v = vertex_light(s, bsdf, wo, frame, origin, beta, segments >= (*st).cache_from && wo.z > 0.0, hit.t, rng);
     (*st).radiance += v.light;
     if v.ended {
         return;
