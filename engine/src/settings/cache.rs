@@ -44,12 +44,14 @@ described! {
         max_age_frames: u32 = 64,
             ("cache.max_age_frames", "cache", "frames", Int(1, 100000));
         /// With an unlimited path length (`max_depth` -1) a matte path ends at a vertex with the
-        /// light of the vertex's cell, where the cell holds at least this many samples (0: paths
-        /// never end in the cache). The bounces after it then come from the cells, which fill
-        /// over frames: less noise for the blur of a cell and the lag of its mean. A white room's
-        /// matte light: variance 0.32x, mean -0.6%; the level's, living room's and staircase's
-        /// still FLIP at 160 wide: -4.4% / -0.6% / +1.1% (Mara); the trace costs 9-10% more on
-        /// lavapipe, 6-10% more on an H200 at 1280x720 (docs/decisions.md).
+        /// light of the vertex's cell, where the cell holds at least this many samples and the
+        /// segment that reached the vertex is longer than the cell's diagonal (0: paths never
+        /// end in the cache). The bounces after it then come from the cells, which fill over
+        /// frames: less noise for the blur of a cell and the lag of its mean. A white room's
+        /// matte light at 64x48: variance 0.46x, mean -0.7%; the level's, living room's and
+        /// staircase's still FLIP at 160 wide: -3.8% / -1.1% / -0.8% (SVGF), -4.3% / -0.8% /
+        /// -1.1% (Mara); the trace cost 9-10% more on lavapipe and 6-10% more on an H200 at
+        /// 1280x720, measured before the segment test (docs/decisions.md).
         path_end_samples: f32 = 16.0,
             ("cache.path_end_samples", "cache", "samples", Float(0.0, 65536.0, 1.0));
         /// A path ends in a cell only where the cell's mean is known to within this relative
