@@ -8,7 +8,9 @@ use hush_engine::quality::{Image, compare, flip_over};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MatteSettings, TaaSettings};
 use hush_tests::half;
-use hush_tests::reproject::{DepthFrame, Stepped, neighbours_3x3, stepped};
+use hush_tests::reproject::{
+    CameraStep, DepthFrame, Stepped, neighbours_3x3, step_camera, stepped,
+};
 
 const SIZE: (u32, u32) = (96, 54);
 
@@ -65,27 +67,11 @@ fn mara() -> FrameSettings {
 /// The level after 8 still frames at view() and one frame after a step sideways and forward
 /// (Mara): the depth buffer before the step and both frames' jittered inverse view-projections,
 /// for tests that find on the CPU which pixels the step uncovered.
-struct Step {
-    gpu: hush_engine::gpu::Gpu,
-    r: Renderer,
-    depth0: Vec<u8>,
-    inv0: glam::Mat4,
-    setup1: hush_engine::frame::CameraSetup,
-    inv1: glam::Mat4,
-}
-
-fn step() -> Step {
-    use hush_engine::frame::halton_jitter;
+fn step() -> (hush_engine::gpu::Gpu, Renderer, CameraStep) {
     let (gpu, mut r) = level();
-    let warm = 8;
-    frames(&mut r, &gpu, &mara(), view(), warm);
-    let (depth0, _) = r.read_texture(&gpu, "gbuffer/depth").unwrap();
     let moved = Camera::look_at(DVec3::new(-2.2, 1.7, 3.6), DVec3::new(-2.0, 1.2, -6.0), 60.0);
-    frames(&mut r, &gpu, &mara(), moved, 1);
-    let inv0 = r.camera_setup(&view()).jittered(halton_jitter(warm - 1), SIZE).inverse();
-    let setup1 = r.camera_setup(&moved);
-    let inv1 = setup1.jittered(halton_jitter(warm), SIZE).inverse();
-    Step { gpu, r, depth0, inv0, setup1, inv1 }
+    let step = step_camera(&mut r, &gpu, &mara(), (view(), moved), 8);
+    (gpu, r, step)
 }
 
 /// After 30 frames of a still camera (cornell_diffuse, 256²), the denoised frame is much closer
@@ -305,7 +291,7 @@ fn still_view_flickers_at_a_tenth_of_raw() {
 /// temporal output must be exactly this frame's sample.
 #[test]
 fn history_resets_on_disocclusion() {
-    let Step { gpu, r, depth0, inv0, setup1, inv1 } = step();
+    let (gpu, r, CameraStep { depth0, inv0, setup1, inv1 }) = step();
     let read = |n: &str| r.read_texture(&gpu, n).unwrap().0;
     let (depth1, reason, motion, temporal, input, normal) = (
         read("gbuffer/depth"),
@@ -353,7 +339,7 @@ fn history_resets_on_disocclusion() {
 /// 0.261, 0.215 after). Measured at 96x54: 172 such pixels, every one restarted (0 before).
 #[test]
 fn taa_restarts_where_a_move_uncovers_a_surface() {
-    let Step { gpu, r, depth0, inv0, setup1, inv1 } = step();
+    let (gpu, r, CameraStep { depth0, inv0, setup1, inv1 }) = step();
     let read = |n: &str| r.read_texture(&gpu, n).unwrap().0;
     let (depth1, motion, normal) =
         (read("gbuffer/depth"), read("gbuffer/motion"), read("gbuffer/normal"));

@@ -119,3 +119,36 @@ pub fn stepped<'a>(
         Some(Stepped { x, y, i, surface, prev })
     })
 }
+
+/// A camera step for the tests of what a move uncovers: the depth buffer `warm` still frames at
+/// `from` left, then one frame at `to`, and both frames' jittered inverse view-projections.
+pub struct CameraStep {
+    pub depth0: Vec<u8>,
+    pub inv0: Mat4,
+    pub setup1: CameraSetup,
+    pub inv1: Mat4,
+}
+
+/// Renders `warm` still frames at `from` and one at `to` with settings `s` (`warm` >= 1).
+pub fn step_camera(
+    r: &mut hush_engine::frame::Renderer,
+    gpu: &hush_engine::gpu::Gpu,
+    s: &hush_engine::settings::FrameSettings,
+    (from, to): (hush_engine::scene::Camera, hush_engine::scene::Camera),
+    warm: u32,
+) -> CameraStep {
+    use hush_engine::frame::{FrameInput, halton_jitter};
+    let size = r.size();
+    let render = |r: &mut hush_engine::frame::Renderer, camera| {
+        r.render(gpu, &FrameInput { camera, time: 0.0, shutter: None }, s, None).unwrap()
+    };
+    for _ in 0..warm {
+        render(r, from);
+    }
+    let (depth0, _) = r.read_texture(gpu, "gbuffer/depth").unwrap();
+    render(r, to);
+    let inv0 = r.camera_setup(&from).jittered(halton_jitter(warm - 1), size).inverse();
+    let setup1 = r.camera_setup(&to);
+    let inv1 = setup1.jittered(halton_jitter(warm), size).inverse();
+    CameraStep { depth0, inv0, setup1, inv1 }
+}
