@@ -538,7 +538,7 @@ fn the_glossy_reach_takes_the_pre_filters_circle_of_confusion() {
                 .unwrap_or_default()
         };
         let sigma: Vec<f32> = if svgf {
-            let taps = r.read_buffer(&gpu, "svgf/glossy taps").unwrap();
+            let taps = r.read_texture(&gpu, "svgf/glossy taps").unwrap().0;
             bytemuck::cast_slice::<u8, f32>(&taps).chunks(4).map(|t| t[3]).collect()
         } else {
             halves("glossy/scratch", 3)

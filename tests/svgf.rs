@@ -329,3 +329,35 @@ fn svgf_regression_keeps_a_flat_light() {
     println!("mean luminance: accumulated {mp:.5}, svgf {mf:.5}");
     assert!((mf / mp - 1.0).abs() < 0.002, "SVGF's mean {mf} against the accumulation's {mp}");
 }
+
+/// The a-trous kernel is a constant of its program (svgf/kernel_3x3.wgsl, kernel_5x5.wgsl), so
+/// switching `svgf.kernel_5x5` mid-stream must remake the stage: a fourth frame after the
+/// switch differs from the same stream without it (the level's view, 4 frames, before the
+/// regression engages), either way round. With the stage kept, the two streams are the same
+/// image to the bit (the renderer is deterministic).
+#[test]
+fn svgf_kernel_switch_mid_stream_takes_effect() {
+    let run = |kernels: [bool; 4]| -> Image {
+        let (gpu, mut r) = level();
+        for k in kernels {
+            let s = FrameSettings {
+                svgf: SvgfSettings { kernel_5x5: k, ..Default::default() },
+                ..svgf()
+            };
+            r.render(&gpu, &FrameInput { camera: view(), time: 0.0, shutter: None }, &s, None)
+                .unwrap();
+        }
+        r.read_hdr(&gpu).unwrap()
+    };
+    let largest_change = |a: &Image, b: &Image| {
+        a.data.iter().zip(&b.data).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0, f32::max)
+    };
+    for (switched, kept) in [
+        ([false, false, false, true], [false; 4]),
+        ([true, true, true, false], [true; 4]),
+    ] {
+        let change = largest_change(&run(switched), &run(kept));
+        println!("kernel 5x5 {switched:?} against {kept:?}: largest change {change:.5}");
+        assert!(change > 1e-3, "switching the kernel changed nothing ({change})");
+    }
+}

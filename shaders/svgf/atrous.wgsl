@@ -1,5 +1,5 @@
 // SVGF §4.3: one level of the edge-avoiding a-trous wavelet filter (Dammertz et al. 2010):
-// the 5x5 B3-spline kernel h (or a 3x3 one, sv.kernel_radius) with taps 2^level pixels apart,
+// the 5x5 B3-spline kernel h (or a 3x3 one: svgf/kernel_*.wgsl) with taps 2^level pixels apart,
 // weighted by eq. (3)-(5) (common.wgsl: edge_weight) with the luminance bandwidth
 // sigma_l sqrt(g3x3(var)) of the pixel's variance blurred by a 3x3 Gaussian; Voorhuis eq. (8)
 // widens it for young histories.
@@ -13,21 +13,10 @@ var src: texture_2d<f32>;
 var moments: texture_2d<f32>;
 // The signal's features as the variance stage packed them (z, dz, oct normal; dz < 0: no
 // surface), one record per pixel.
-var<storage, read> taps: array<vec4u>;
+var taps: texture_2d<u32>;
 var dst: texture_storage_2d<rgba16float, write>;
 var out_history: texture_storage_2d<rgba32float, write>;
 var<uniform> level: Level;
-
-const KERNEL_5 = array<f32, 3>(0.375, 0.25, 0.0625);
-const KERNEL_3 = array<f32, 2>(0.5, 0.25);
-
-// The kernel's weight along one axis at d taps from the centre.
-fn kernel(d: i32) -> f32 {
-    if sv.kernel_radius >= 2u {
-        return KERNEL_5[d];
-    }
-    return KERNEL_3[d];
-}
 
 // The 3x3 Gaussian of the variance around p (SVGF's prefilter of eq. (5)).
 fn blurred_variance(p: vec2i) -> f32 {
@@ -73,14 +62,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var sum = c.rgb * (k0 * k0);
         var sum_var = c.a * (k0 * k0 * k0 * k0);
         var wsum = k0 * k0;
-        let r = i32(sv.kernel_radius);
-        for (var dy = -r; dy <= r; dy++) {
-            for (var dx = -r; dx <= r; dx++) {
+        for (var dy = -KERNEL_RADIUS; dy <= KERNEL_RADIUS; dy++) {
+            for (var dx = -KERNEL_RADIUS; dx <= KERNEL_RADIUS; dx++) {
                 let q = p + vec2i(dx, dy) * level.step;
                 if (dx == 0 && dy == 0) || !in_bounds(q) {
                     continue;
                 }
-                let fq = tap_features(taps[tap_index(q)]);
+                let fq = tap_features(textureLoad(taps, q, 0));
                 if fq.dz < 0.0 {
                     continue;
                 }

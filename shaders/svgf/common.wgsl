@@ -25,9 +25,8 @@ struct SvgfParams {
     regression_order: f32,
     // Past this many samples' worth the intervals narrow as sqrt(this / samples) (0: never).
     regression_full_samples: f32,
-    // The a-trous kernel's radius in taps: 2, SVGF's 5x5 B3 spline; 1, a 3x3 kernel.
-    kernel_radius: u32,
-    _pad: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // Per dispatch: which a-trous level (step 2^level pixels), whether it writes the history.
@@ -129,11 +128,6 @@ fn steering_variance(sample_variance: f32, moments: vec4f) -> f32 {
         v *= clamp(moments.w, 0.0, 1.0);
     }
     return min(v, 65000.0);
-}
-
-// A pixel's record in a per-pixel storage buffer (row-major).
-fn tap_index(p: vec2i) -> u32 {
-    return u32(p.y) * frame.size.x + u32(p.x);
 }
 
 // A pixel's edge-stopping features as the variance stage packs them into its taps record

@@ -23,7 +23,7 @@ var src: texture_2d<f32>;
 // variance_of_mean).
 var light: texture_2d<f32>;
 var moments: texture_2d<f32>;
-var<storage, read> taps: array<vec4u>;
+var taps: texture_2d<u32>;
 var dst: texture_storage_2d<rgba16float, write>;
 
 // Windows 1..WINDOWS: radius 2^(k-1) (at most regression_radius); a window's new taps lie on a
@@ -186,7 +186,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let fc = signal_features(p);
     // The signal's reach bound, as the variance stage packed it: lavapipe (Mesa 22.3, LLVM 15)
     // aborts compiling the glossy program when this stage calls signal_sigma itself.
-    let reach = tap_reach(taps[tap_index(p)]);
+    let reach = tap_reach(textureLoad(taps, p, 0));
     let c = textureLoad(light, p, 0);
     // Past regression_full_samples the intervals narrow as sqrt(full / samples): at a fixed width
     // an accepted window's bias stays a fixed share of the noise, and relMSE a fixed multiple of
@@ -217,7 +217,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 if !in_bounds(q) {
                     continue;
                 }
-                let fq = tap_features(taps[tap_index(q)]);
+                let fq = tap_features(textureLoad(taps, q, 0));
                 if fq.dz < 0.0 {
                     continue;
                 }

@@ -4,14 +4,16 @@
 // neighbours' accumulated moments (Voorhuis §6), and the light is averaged with the same
 // weights. As Falcor's SVGFPass, the young variance is raised by 4 / h, since it is drawn from
 // few samples and underestimates. Output: dst (rgb, variance), and the signal's features packed
-// into one 16-byte record per pixel for the a-trous levels and the regression (out_taps: z, dz,
-// oct normal, the signal's reach bound signal_sigma; dz < 0 where there is no surface), so that each of their 25 taps loads the light and one record instead of four to seven
-// texels.
+// into one 16-byte texel per pixel for the a-trous levels and the regression (out_taps: z, dz,
+// oct normal, the signal's reach bound signal_sigma; dz < 0 where there is no surface), so that
+// each of their taps loads the light and one record instead of four to seven texels. The record
+// is an Rgba32Uint texture, not a storage buffer: a texel load is one 16-byte load per lane on a
+// CPU driver, a storage-buffer read at per-lane addresses a loop over the lanes (docs/decisions.md).
 
 var integrated: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
-var<storage, read_write> out_taps: array<vec4u>;
+var out_taps: texture_storage_2d<rgba32uint, write>;
 
 fn pack_taps(f: Features, reach: f32) -> vec4u {
     return vec4u(bitcast<u32>(f.z), bitcast<u32>(f.dz), pack2x16snorm(oct_encode(f.n)), bitcast<u32>(reach));
@@ -28,11 +30,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let h = m.z;
     if !has_surface(p) {
         textureStore(dst, p, vec4f(c.rgb, 0.0));
-        out_taps[tap_index(p)] = pack_taps(Features(0.0, -1.0, vec3f(0.0, 0.0, 1.0)), 0.0);
+        textureStore(out_taps, p, pack_taps(Features(0.0, -1.0, vec3f(0.0, 0.0, 1.0)), 0.0));
         return;
     }
     let fc = signal_features(p);
-    out_taps[tap_index(p)] = pack_taps(fc, signal_sigma(p));
+    textureStore(out_taps, p, pack_taps(fc, signal_sigma(p)));
     if h >= 4.0 || !sv_on(SV_SPATIAL_VARIANCE) {
         textureStore(dst, p, vec4f(c.rgb, steering_variance(m.y - m.x * m.x, m)));
         return;

@@ -56,8 +56,7 @@ pub struct SvgfParams {
     pub regression_samples: f32,
     pub regression_order: f32,
     pub regression_full_samples: f32,
-    pub kernel_radius: u32,
-    pub _pad: u32,
+    pub _pad: [u32; 2],
 }
 
 impl SvgfParams {
@@ -77,8 +76,7 @@ impl SvgfParams {
             regression_samples: s.regression_samples.max(1.0),
             regression_order: s.regression_order.min(2) as f32,
             regression_full_samples: s.regression_full_samples.clamp(0.0, STILL_FRAMES_MAX),
-            kernel_radius: if s.kernel_5x5 { 2 } else { 1 },
-            _pad: 0,
+            _pad: [0; 2],
         }
     }
 }
@@ -136,8 +134,10 @@ pub struct SignalTargets {
     /// The variance stage's output (rgb, variance): the first a-trous level's input.
     pub variance: Tex,
     /// The signal's edge-stopping features packed by the variance stage for the a-trous levels
-    /// (z, dz, oct normal: 16 bytes per pixel; one load per tap instead of four to seven).
-    pub taps: wgpu::Buffer,
+    /// (z, dz, oct normal, reach: 16 bytes per pixel; one load per tap instead of four to
+    /// seven). A texture rather than a storage buffer: on lavapipe a texel load is one load per
+    /// lane, a storage-buffer read at per-lane addresses a loop over the lanes.
+    pub taps: Tex,
     /// The a-trous levels' ping-pong (rgb, variance).
     pub ping: Tex,
     pub pong: Tex,
@@ -155,15 +155,9 @@ impl SignalTargets {
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::COPY_DST;
-        let taps = mem.buffer(
-            d,
-            &format!("svgf/{name} taps"),
-            size.0 as u64 * size.1 as u64 * 16,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        );
         let mut t = |label: &str, f| mem.texture(d, &format!("svgf/{name} {label}"), size, f, rw);
         SignalTargets {
-            taps,
+            taps: t("taps", wgpu::TextureFormat::Rgba32Uint),
             history: PingPong::new(|i| t(&format!("history {i}"), RGBA32F)),
             moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
             integrated: t("integrated", RGBA32F),
@@ -247,6 +241,12 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
     m
 }
 
+/// The module that gives the a-trous stage its kernel: the radius is a constant of the
+/// program so that its taps' loop unrolls (svgf/kernel_3x3.wgsl says what that saves).
+pub fn kernel_module(kernel_5x5: bool) -> &'static str {
+    if kernel_5x5 { "svgf/kernel_5x5.wgsl" } else { "svgf/kernel_3x3.wgsl" }
+}
+
 /// One signal's passes.
 struct SignalStages {
     /// The matte temporal reads the radiance cache's prior (made for a frame that offers one).
@@ -254,6 +254,8 @@ struct SignalStages {
     /// The glossy reach reads the pre-filter's feature uncertainty (made for a frame that
     /// offers it).
     uncertain: bool,
+    /// The a-trous kernel is SVGF's 5x5 (`svgf.kernel_5x5`; made for the setting's value).
+    kernel_5x5: bool,
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
@@ -269,6 +271,7 @@ impl SignalStages {
         offered: &Bindings,
         prior: bool,
         uncertain: bool,
+        kernel_5x5: bool,
     ) -> Result<SignalStages> {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
@@ -292,6 +295,9 @@ impl SignalStages {
         };
         let stage = |label, file, b: &Bindings| {
             let mut m = modules(file, glossy, motion);
+            if file == "svgf/atrous.wgsl" {
+                m.insert(m.len() - 1, kernel_module(kernel_5x5));
+            }
             // The glossy light's reach (svgf/features_glossy.wgsl) takes the circle of
             // confusion where the pre-filter measured one.
             if glossy {
@@ -307,6 +313,7 @@ impl SignalStages {
         Ok(SignalStages {
             prior,
             uncertain,
+            kernel_5x5,
             temporal: ChainStage::new(gpu, labels[0], &temporal_modules, "main", offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
@@ -418,7 +425,7 @@ impl Resources {
                 .texture("integrated", &s.integrated.1)
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.variance.1)
-                .buffer("out_taps", &s.taps),
+                .texture("out_taps", &s.taps.1),
             Pass::Atrous(level) => {
                 let src = match level {
                     0 => &s.variance,
@@ -428,7 +435,7 @@ impl Resources {
                 let dst = if level % 2 == 0 { &s.pong } else { &s.ping };
                 b.texture("src", &src.1)
                     .texture("dst", &dst.1)
-                    .buffer("taps", &s.taps)
+                    .texture("taps", &s.taps.1)
                     .texture("moments", &s.moments.output(parity).1)
                     .texture("out_history", &s.history.output(parity).1)
                     .buffer("level", &self.levels[level])
@@ -436,7 +443,7 @@ impl Resources {
             Pass::Regression(last) => b
                 .texture("src", &[&s.variance, &s.ping, &s.pong][last].1)
                 .texture("light", &s.variance.1)
-                .buffer("taps", &s.taps)
+                .texture("taps", &s.taps.1)
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.regressed.1),
             Pass::Final => b
@@ -594,12 +601,19 @@ impl Denoiser for Svgf {
         let t = res.targets.as_ref().context("SVGF records before its textures exist")?;
         res.write_params(gpu, io, cx, scene.extent);
         let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
+        let kernel_5x5 = cx.settings.svgf.kernel_5x5;
         let stages = |g, s| {
             let offered = res.offered(io, t, s);
             let (prior, uncertain) = (io.cache_prior.is_some(), io.feature_uncertainty.is_some());
-            SignalStages::new(gpu, g, scene.motion, &offered, prior, uncertain)
+            SignalStages::new(gpu, g, scene.motion, &offered, prior, uncertain, kernel_5x5)
                 .context("creating SVGF's stages")
         };
+        // Made again when the kernel changes.
+        for st in [&mut *matte, &mut *glossy] {
+            if st.as_ref().is_some_and(|st| st.kernel_5x5 != kernel_5x5) {
+                *st = None;
+            }
+        }
         let s = signal(false)?;
         // Made again when the radiance cache starts or stops offering its prior.
         if matte.as_ref().is_some_and(|m| m.prior != io.cache_prior.is_some()) {

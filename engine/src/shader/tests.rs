@@ -211,6 +211,16 @@ fn all_programs() -> Vec<Program> {
                     v.push(compose(stage, "", &with_prior).unwrap());
                     m.push("cache/prior_none.wgsl");
                 }
+                if stage == "svgf/atrous.wgsl" {
+                    // SVGF's 5x5 kernel; the 3x3 below.
+                    let mut with = m.clone();
+                    with.insert(with.len() - 1, crate::denoise::svgf::kernel_module(true));
+                    if glossy {
+                        with.insert(with.len() - 1, "realtime/uncertainty_none.wgsl");
+                    }
+                    v.push(compose(stage, "", &with).unwrap());
+                    m.insert(m.len() - 1, crate::denoise::svgf::kernel_module(false));
+                }
                 if glossy && !stage.starts_with("svgf/temporal") {
                     // With the pre-filter's feature uncertainty, and without.
                     let mut with = m.clone();
@@ -518,7 +528,6 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(offs[8] as usize, offset_of!(SvgfParams, settled_levels));
     assert_eq!(offs[12] as usize, offset_of!(SvgfParams, regression_order));
     assert_eq!(offs[13] as usize, offset_of!(SvgfParams, regression_full_samples));
-    assert_eq!(offs[14] as usize, offset_of!(SvgfParams, kernel_radius));
     assert_eq!(wgsl_layout(atrous, "Level").0, 16);
     let resolve = programs.iter().find(|p| p.label == "cache/resolve.wgsl").unwrap();
     use crate::passes::cache::CacheParams;
