@@ -51,54 +51,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 
 /// (motion found, iterations, distance) per pixel.
 fn run_diamond(gpu: &Gpu, size: (u32, u32), motion: Vec2, initial_step: u32) -> Vec<Vec4> {
-    use wgpu::util::DeviceExt;
-    let program = hush_engine::shader::compose(
-        "diamond test",
-        DIAMOND_TEST,
-        &["common/math.wgsl", "glossy/diamond.wgsl"],
-    )
-    .unwrap();
-    let module = program.create(&gpu.device).unwrap();
-    let d = &gpu.device;
-    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("diamond test"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
+    use hush_tests::compute::{Input, run_compute};
     let params: [u32; 8] =
         [motion.x.to_bits(), motion.y.to_bits(), size.0, size.1, initial_step, 64, 0, 0];
-    let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&params),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let n = (size.0 * size.1) as u64 * 16;
-    let out = d.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size: n,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() },
-        ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
-    }
-    gpu.queue.submit([enc.finish()]);
-    let bytes = hush_engine::gpu::readback_buffer(&gpu.device, &gpu.queue, &out, n).unwrap();
+    let bytes = run_compute(
+        gpu,
+        DIAMOND_TEST,
+        &["common/math.wgsl", "glossy/diamond.wgsl"],
+        &[Input::Uniform(bytemuck::cast_slice(&params))],
+        (size.0 * size.1) as u64 * 16,
+        (size.0.div_ceil(8), size.1.div_ceil(8)),
+    );
     bytemuck::cast_slice::<u8, [f32; 4]>(&bytes).iter().map(|v| Vec4::from_array(*v)).collect()
 }
 

@@ -352,10 +352,9 @@ fn svgf_kernel_switch_mid_stream_takes_effect() {
     let largest_change = |a: &Image, b: &Image| {
         a.data.iter().zip(&b.data).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0, f32::max)
     };
-    for (switched, kept) in [
-        ([false, false, false, true], [false; 4]),
-        ([true, true, true, false], [true; 4]),
-    ] {
+    for (switched, kept) in
+        [([false, false, false, true], [false; 4]), ([true, true, true, false], [true; 4])]
+    {
         let change = largest_change(&run(switched), &run(kept));
         println!("kernel 5x5 {switched:?} against {kept:?}: largest change {change:.5}");
         assert!(change > 1e-3, "switching the kernel changed nothing ({change})");

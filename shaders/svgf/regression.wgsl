@@ -38,136 +38,9 @@ const WINDOWS: i32 = 6;
 // smallest reach too falls with the variance and a still view converges.
 const NARROW_GAMMA: f32 = 3.0;
 
-// The weighted fit of L(q) over the basis phi(u, v), (u, v) = (q - p) / 32: (1), (1, u, v) or
-// (1, u, v, u^2, uv, v^2) for regression_order 0, 1, 2, summed window by window. The normal
-// matrix of the quadric basis holds only the 15 weighted moments sum w u^a v^b, a + b <= 4, so a
-// tap adds four vec4 FMAs instead of a 6x6 outer product, whose matrix, indexed by loop
-// counters, would live in local memory on GPUs and in per-lane stack slots on lavapipe (its
-// cost: docs/decisions.md). The right-hand sides b (rgb each, one per basis function), sum w^2
-// and sum w var give the estimate's variance.
-struct Sums {
-    // sum w (1, u, v, u^2), (uv, v^2, u^3, u^2 v), (u v^2, v^3, u^4, u^3 v), (u^2 v^2, u v^3, v^4, 0)
-    m0: vec4f,
-    m1: vec4f,
-    m2: vec4f,
-    m3: vec4f,
-    // sum w phi_i L, i = 0..5
-    b0: vec3f,
-    b1: vec3f,
-    b2: vec3f,
-    b3: vec3f,
-    b4: vec3f,
-    b5: vec3f,
-    w2: f32,
-    wvar: f32,
-}
-
+// The fit's sums and solve: svgf/fit.wgsl.
 fn unknowns() -> i32 {
     return array<i32, 3>(1, 3, 6)[min(u32(sv.regression_order), 2u)];
-}
-
-fn add_tap(s: ptr<function, Sums>, w: f32, u: f32, v: f32, l: vec3f, variance: f32) {
-    let uu = u * u;
-    let uv = u * v;
-    let vv = v * v;
-    (*s).m0 += w * vec4f(1.0, u, v, uu);
-    (*s).m1 += w * vec4f(uv, vv, uu * u, uu * v);
-    (*s).m2 += w * vec4f(u * vv, vv * v, uu * uu, uu * uv);
-    (*s).m3 += w * vec4f(uu * vv, uv * vv, vv * vv, 0.0);
-    let wl = w * l;
-    (*s).b0 += wl;
-    (*s).b1 += u * wl;
-    (*s).b2 += v * wl;
-    (*s).b3 += uu * wl;
-    (*s).b4 += uv * wl;
-    (*s).b5 += vv * wl;
-    (*s).w2 += w * w;
-    (*s).wvar += w * variance;
-}
-
-// The fit at the pixel (beta_0, rgb) and (A^-1)_00, by the Cholesky factors of the ridge-
-// regularised matrix: in a window symmetric about the pixel the first-order beta_0 is the
-// weighted mean; in one cut by an edge the slopes take out what the mean's off-centre centroid
-// would add, and the second order the curvature of a falloff.
-struct Fit {
-    beta0: vec3f,
-    inv00: f32,
-    ok: bool,
-}
-
-fn solve(s: Sums) -> Fit {
-    let n = unknowns();
-    // The lower triangle of the 6x6 normal matrix from the moments. Basis functions past the
-    // order's n are decoupled (unit diagonal, no right-hand side), which leaves beta_0 that of
-    // the n x n system while every loop below keeps a constant trip count and unrolls into
-    // registers.
-    let m0 = s.m0;
-    let m1 = s.m1;
-    let m2 = s.m2;
-    let m3 = s.m3;
-    var a = array<f32, 36>(
-        m0.x, 0.0, 0.0, 0.0, 0.0, 0.0,
-        m0.y, m0.w, 0.0, 0.0, 0.0, 0.0,
-        m0.z, m1.x, m1.y, 0.0, 0.0, 0.0,
-        m0.w, m1.z, m1.w, m2.z, 0.0, 0.0,
-        m1.x, m1.w, m2.x, m2.w, m3.x, 0.0,
-        m1.y, m2.x, m2.y, m3.x, m3.y, m3.z,
-    );
-    var b = array<vec3f, 6>(s.b0, s.b1, s.b2, s.b3, s.b4, s.b5);
-    for (var i = 1; i < 6; i++) {
-        if i >= n {
-            for (var j = 0; j < i; j++) {
-                a[i * 6 + j] = 0.0;
-            }
-            a[i * 6 + i] = 1.0;
-            b[i] = vec3f(0.0);
-        }
-    }
-    var l: array<f32, 36>;
-    let ridge = 1e-3 * m0.x;
-    for (var i = 0; i < 6; i++) {
-        for (var j = 0; j <= i; j++) {
-            var sum = a[i * 6 + j];
-            if i == j && i > 0 {
-                sum += ridge;
-            }
-            for (var k = 0; k < j; k++) {
-                sum -= l[i * 6 + k] * l[j * 6 + k];
-            }
-            if i == j {
-                if !(sum > 1e-20) {
-                    return Fit(vec3f(0.0), 0.0, false);
-                }
-                l[i * 6 + i] = sqrt(sum);
-            } else {
-                l[i * 6 + j] = sum / l[j * 6 + j];
-            }
-        }
-    }
-    // Forward then back substitution, for the rgb right-hand side and for e_0.
-    var y: array<vec3f, 6>;
-    var e: array<f32, 6>;
-    for (var i = 0; i < 6; i++) {
-        var sy = b[i];
-        var se = select(0.0, 1.0, i == 0);
-        for (var k = 0; k < i; k++) {
-            sy -= l[i * 6 + k] * y[k];
-            se -= l[i * 6 + k] * e[k];
-        }
-        y[i] = sy / l[i * 6 + i];
-        e[i] = se / l[i * 6 + i];
-    }
-    for (var i = 5; i >= 0; i--) {
-        var sy = y[i];
-        var se = e[i];
-        for (var k = i + 1; k < 6; k++) {
-            sy -= l[k * 6 + i] * y[k];
-            se -= l[k * 6 + i] * e[k];
-        }
-        y[i] = sy / l[i * 6 + i];
-        e[i] = se / l[i * 6 + i];
-    }
-    return Fit(y[0], e[0], true);
 }
 
 @compute @workgroup_size(8, 8)
@@ -238,7 +111,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             lo = l0 - narrow_gamma * sqrt(var_pool);
             hi = l0 + narrow_gamma * sqrt(var_pool);
         }
-        let fit = solve(s);
+        let fit = solve(s, unknowns());
         if !fit.ok {
             continue;
         }

@@ -1,7 +1,8 @@
 //! Helpers shared by the GPU integration tests: paths to the oracle scenes (in the repository) and
 //! to `../shared`, rendering a scene with the reference tracer, a small glTF writer for synthetic
-//! scenes, and eq. (11)'s reprojection distance on the CPU.
+//! scenes, eq. (11)'s reprojection distance on the CPU, and one shader function run on the GPU.
 
+pub mod compute;
 pub mod gltf_writer;
 pub mod reproject;
 

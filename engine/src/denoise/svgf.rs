@@ -237,6 +237,9 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
     if !stage.starts_with("svgf/temporal") {
         m.push(if glossy { "svgf/features_glossy.wgsl" } else { "svgf/features_matte.wgsl" });
     }
+    if stage == "svgf/regression.wgsl" {
+        m.push("svgf/fit.wgsl");
+    }
     m.push(stage);
     m
 }
