@@ -79,8 +79,9 @@ described! {
             ("svgf.levels", "svgf/atrous", "levels", Int(0, MAX_LEVELS as i64));
         /// SVGF's 5x5 B3-spline a-trous kernel (24 taps a level); off, a 3x3 kernel (1/4, 1/2,
         /// 1/4 per axis, 8 taps) that reaches half as far. Off by default: on lavapipe it
-        /// halves the a-trous passes (level 640x360: 595 -> 336 ms, SVGF's share of the frame
-        /// 39.2% -> 31.3%; on an H200 at 1280x720 1.05 -> 0.58 ms) and the still views measured
+        /// halves the a-trous passes (level 640x360, matte + glossy, two runs: 864 / 816 ms with
+        /// the 5x5, 446 / 431 with the 3x3; SVGF's share of the frame 35.2 / 37.1% against
+        /// 32.6 / 29.1%; on an H200 at 1280x720 1.05 -> 0.58 ms) and the still views measured
         /// came out the same or better (docs/decisions.md).
         kernel_5x5: bool = false,
             ("svgf.kernel_5x5", "svgf/atrous", "", Bool);
