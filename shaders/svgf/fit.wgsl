@@ -62,17 +62,18 @@ struct Inverse3 {
 fn inverse3(a: mat3x3f) -> Inverse3 {
     let c0 = cross(a[1], a[2]);
     let det = dot(a[0], c0);
-    return Inverse3(transpose(mat3x3f(c0, cross(a[2], a[0]), cross(a[0], a[1]))) * (1.0 / det), det);
+    let cofactors = mat3x3f(c0, cross(a[2], a[0]), cross(a[0], a[1]));
+    return Inverse3(transpose(cofactors) * (1.0 / det), det);
 }
 
-// n unknowns. Only row 0 of A^-1 is needed: beta_0 = sum_i (A^-1)_0i b_i. A is split into 3x3 blocks over
-// (1, u, v) and (u^2, uv, v^2), A = [[P, Q], [Q^T, R]], and row 0 of its inverse is
-// [u^T + (Y h)^T, -h^T] with u = P^-1 e_0, Y = P^-1 Q, h = S^-1 Q^T u and the Schur complement
-// S = R - Q^T Y. Every quantity is a vec3 or mat3x3 in registers: a 6x6 Cholesky over private
-// arrays indexed by loop counters cost lavapipe (which indexes such arrays through a ladder over
-// their entries) half the stage (docs/decisions.md). A Gram matrix plus the ridge is positive
-// definite, so P and S are too; a determinant that is not positive is a fit lost to rounding
-// or non-finite input, and the window is skipped.
+// The fit with n unknowns. Only row 0 of A^-1 is needed: beta_0 = sum_i (A^-1)_0i b_i. A is split
+// into 3x3 blocks over (1, u, v) and (u^2, uv, v^2), A = [[P, Q], [Q^T, R]], and row 0 of its
+// inverse is [p0^T + (Y h)^T, -h^T] with p0 = P^-1 e_0, Y = P^-1 Q, h = S^-1 Q^T p0 and the Schur
+// complement S = R - Q^T Y. Every quantity is a vec3 or mat3x3 in registers: a 6x6 Cholesky over
+// private arrays indexed by loop counters cost lavapipe (which indexes such arrays through a
+// ladder over their entries) half the stage (docs/decisions.md). A Gram matrix plus the ridge is
+// positive definite, so P and S are too; a determinant that is not positive is a fit lost to
+// rounding or non-finite input, and the window is skipped.
 fn solve(s: Sums, n: i32) -> Fit {
     let fail = Fit(vec3f(0.0), 0.0, false);
     if n == 1 {
@@ -90,9 +91,9 @@ fn solve(s: Sums, n: i32) -> Fit {
     if !(p.det > 0.0) {
         return fail;
     }
-    let u = p.m[0];
+    let p0 = p.m[0];
     if n == 3 {
-        return Fit(u.x * s.b0 + u.y * s.b1 + u.z * s.b2, u.x, true);
+        return Fit(p0.x * s.b0 + p0.y * s.b1 + p0.z * s.b2, p0.x, true);
     }
     // Q's columns: (A_03, A_13, A_23), (A_04, ...), (A_05, ...).
     let q = mat3x3f(
@@ -111,8 +112,8 @@ fn solve(s: Sums, n: i32) -> Fit {
     if !(schur.det > 0.0) {
         return fail;
     }
-    let h = schur.m * (qt * u);
-    let k = u + y * h;
+    let h = schur.m * (qt * p0);
+    let k = p0 + y * h;
     let beta0 = k.x * s.b0 + k.y * s.b1 + k.z * s.b2 - (h.x * s.b3 + h.y * s.b4 + h.z * s.b5);
     return Fit(beta0, k.x, true);
 }
