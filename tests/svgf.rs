@@ -339,15 +339,16 @@ fn svgf_regression_keeps_a_flat_light() {
 fn svgf_kernel_switch_mid_stream_takes_effect() {
     let run = |kernels: [bool; 4]| -> Image {
         let (gpu, mut r) = level();
+        let with = |k| FrameSettings {
+            svgf: SvgfSettings { kernel_5x5: k, ..Default::default() },
+            ..svgf()
+        };
+        // Each frame in turn (its image read back), the last one returned.
+        let mut shown = None;
         for k in kernels {
-            let s = FrameSettings {
-                svgf: SvgfSettings { kernel_5x5: k, ..Default::default() },
-                ..svgf()
-            };
-            r.render(&gpu, &FrameInput { camera: view(), time: 0.0, shutter: None }, &s, None)
-                .unwrap();
+            shown = Some(frames(&mut r, &gpu, &with(k), view(), 1));
         }
-        r.read_hdr(&gpu).unwrap()
+        shown.unwrap()
     };
     let largest_change = |a: &Image, b: &Image| {
         a.data.iter().zip(&b.data).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0, f32::max)

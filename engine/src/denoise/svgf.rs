@@ -250,15 +250,31 @@ pub fn kernel_module(kernel_5x5: bool) -> &'static str {
     if kernel_5x5 { "svgf/kernel_5x5.wgsl" } else { "svgf/kernel_3x3.wgsl" }
 }
 
+/// What a signal's programs are made for; a frame that wants another variant makes them again.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct Variant {
+    /// The matte temporal reads the radiance cache's prior (a frame that offers one).
+    prior: bool,
+    /// The glossy reach reads the pre-filter's feature uncertainty (a frame that offers it).
+    uncertain: bool,
+    /// The a-trous kernel is SVGF's 5x5 (`svgf.kernel_5x5`).
+    kernel_5x5: bool,
+}
+
+impl Variant {
+    /// The variant signal `glossy` wants this frame: each signal reads only its own inputs.
+    fn wanted(glossy: bool, io: &FrameIo, s: &SvgfSettings) -> Variant {
+        Variant {
+            prior: !glossy && io.cache_prior.is_some(),
+            uncertain: glossy && io.feature_uncertainty.is_some(),
+            kernel_5x5: s.kernel_5x5,
+        }
+    }
+}
+
 /// One signal's passes.
 struct SignalStages {
-    /// The matte temporal reads the radiance cache's prior (made for a frame that offers one).
-    prior: bool,
-    /// The glossy reach reads the pre-filter's feature uncertainty (made for a frame that
-    /// offers it).
-    uncertain: bool,
-    /// The a-trous kernel is SVGF's 5x5 (`svgf.kernel_5x5`; made for the setting's value).
-    kernel_5x5: bool,
+    variant: Variant,
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
@@ -272,9 +288,7 @@ impl SignalStages {
         glossy: bool,
         motion: crate::gpu::Motion,
         offered: &Bindings,
-        prior: bool,
-        uncertain: bool,
-        kernel_5x5: bool,
+        variant: Variant,
     ) -> Result<SignalStages> {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
@@ -299,24 +313,23 @@ impl SignalStages {
         let stage = |label, file, b: &Bindings| {
             let mut m = modules(file, glossy, motion);
             if file == "svgf/atrous.wgsl" {
-                m.insert(m.len() - 1, kernel_module(kernel_5x5));
+                m.insert(m.len() - 1, kernel_module(variant.kernel_5x5));
             }
             // The glossy light's reach (svgf/features_glossy.wgsl) takes the circle of
             // confusion where the pre-filter measured one.
             if glossy {
-                m.insert(m.len() - 1, crate::passes::io::uncertainty_module(uncertain));
+                m.insert(m.len() - 1, crate::passes::io::uncertainty_module(variant.uncertain));
             }
             ChainStage::new(gpu, label, &m, "main", b)
         };
         // The matte history restarts from the radiance cache's prior where there is one.
         let mut temporal_modules = modules(temporal, glossy, motion);
         if !glossy {
+            let prior = variant.prior;
             temporal_modules.push(if prior { "cache/prior.wgsl" } else { "cache/prior_none.wgsl" });
         }
         Ok(SignalStages {
-            prior,
-            uncertain,
-            kernel_5x5,
+            variant,
             temporal: ChainStage::new(gpu, labels[0], &temporal_modules, "main", offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
@@ -604,24 +617,20 @@ impl Denoiser for Svgf {
         let t = res.targets.as_ref().context("SVGF records before its textures exist")?;
         res.write_params(gpu, io, cx, scene.extent);
         let signal = |g| t.signal(g).context("SVGF's glossy textures are missing");
-        let kernel_5x5 = cx.settings.svgf.kernel_5x5;
+        let wanted = |g| Variant::wanted(g, io, &cx.settings.svgf);
         let stages = |g, s| {
             let offered = res.offered(io, t, s);
-            let (prior, uncertain) = (io.cache_prior.is_some(), io.feature_uncertainty.is_some());
-            SignalStages::new(gpu, g, scene.motion, &offered, prior, uncertain, kernel_5x5)
+            SignalStages::new(gpu, g, scene.motion, &offered, wanted(g))
                 .context("creating SVGF's stages")
         };
-        // Made again when the kernel changes.
-        for st in [&mut *matte, &mut *glossy] {
-            if st.as_ref().is_some_and(|st| st.kernel_5x5 != kernel_5x5) {
+        // Made again when the radiance cache's prior, the pre-filter's statistics or the kernel
+        // come or go.
+        for (st, g) in [(&mut *matte, false), (&mut *glossy, true)] {
+            if st.as_ref().is_some_and(|st| st.variant != wanted(g)) {
                 *st = None;
             }
         }
         let s = signal(false)?;
-        // Made again when the radiance cache starts or stops offering its prior.
-        if matte.as_ref().is_some_and(|m| m.prior != io.cache_prior.is_some()) {
-            *matte = None;
-        }
         let st = crate::passes::chain::made(matte, || stages(false, s))?;
         res.record_stages(rec, io, cx, s, st)?;
         if scene.glossy {
@@ -631,10 +640,6 @@ impl Denoiser for Svgf {
                 motion_stages(gpu, res, io, m, scene.motion)
             })?;
             res.record_motion(rec, io, cx, m, st)?;
-            // Made again when the pre-filter starts or stops offering its statistics.
-            if glossy.as_ref().is_some_and(|g| g.uncertain != io.feature_uncertainty.is_some()) {
-                *glossy = None;
-            }
             let st = crate::passes::chain::made(glossy, || stages(true, s))?;
             res.record_stages(rec, io, cx, s, st)?;
         }
