@@ -452,3 +452,41 @@ fn glossy_history_follows_its_reflected_point() {
     assert!(rejected >= 5, "the hit test lowered only {rejected} glossy pixels' confidence");
     assert_eq!(stayed, 0, "{stayed} pixels lost confidence though their reflected point stayed");
 }
+
+/// The reflection motion's program has the brute-force search compiled in only while
+/// `glossy.reference_search_radius` asks for it (passes/glossy.rs: MotionProgram), so a change of
+/// the setting between frames must make the stage again, in Mara's glossy chain and in SVGF's
+/// glossy signal alike. The search view's fourth channel is the brute-force search's best
+/// distance: zero everywhere without it, and set on reflective pixels with it. With the stage
+/// kept, the frame after the switch would still show no brute-force distances.
+#[test]
+fn the_reference_search_comes_and_goes_with_its_setting() {
+    let size = (96u32, 54u32);
+    for (denoiser, search) in
+        [(Denoiser::MARA, "glossy/search"), (Denoiser::SVGF, "svgf/glossy search")]
+    {
+        let (gpu, mut r) =
+            Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size)
+                .unwrap();
+        let name = format!("{denoiser:?}");
+        let mut s = FrameSettings { denoiser, ..Default::default() };
+        s.glossy.reflection_mv = ReflectionMv::Diamond;
+        // The camera strafes, so that every frame after the first searches.
+        let mut measured = vec![];
+        for (i, radius) in [0u32, 0, 4, 4, 0].into_iter().enumerate() {
+            s.glossy.reference_search_radius = radius;
+            let input = FrameInput { camera: camera(0.05 * i as f64), time: 0.0, shutter: None };
+            r.render(&gpu, &input, &s, None).unwrap();
+            let (texels, _) = r.read_texture(&gpu, search).unwrap();
+            let with_distance = texels.chunks_exact(8).filter(|t| half(&t[6..8]) != 0.0).count();
+            measured.push(with_distance);
+        }
+        println!("{name}: pixels with a brute-force distance, frame by frame: {measured:?}");
+        assert_eq!(measured[1], 0, "{name}: a brute-force distance with the search off");
+        assert!(
+            measured[2] > 200 && measured[3] > 200,
+            "{name}: the brute-force search did not start with its setting: {measured:?}"
+        );
+        assert_eq!(measured[4], 0, "{name}: the brute-force search outlived its setting");
+    }
+}

@@ -11,8 +11,6 @@ struct GlossyParams {
     // Diamond search: first large-pattern step in pixels, most iterations.
     initial_step: u32,
     max_search_steps: u32,
-    // Brute-force search radius for measurements (0: off).
-    reference_radius: u32,
     roughness_threshold: f32,
     mirror_roughness: f32,
     clip_roughness: f32,
@@ -28,7 +26,8 @@ struct GlossyParams {
     // Distance that stands for a reflection that left the scene (a few scene extents).
     far: f32,
     max_sigma_px: f32,
-    // 1: the representative hits of glossy surfaces come from traced mirror rays.
+    // 1: the representative hits of glossy surfaces come from traced mirror rays (the reflected-hit
+    // test's; the motion search has it as a constant of its program, TRACED_HITS).
     representative_traced: u32,
     // The bilateral's sigma shrinks as 1 / sqrt(history length) beyond this many frames.
     sigma_full_frames: f32,

@@ -7,6 +7,9 @@
 //           brute-force search when it runs), z = best distance in reflected pixel footprints;
 //   hit:    xyz = representative hit (eq. 4), w = surface kind and secondary distance
 //           (encode_hit_w).
+// The program's prelude defines TRACED_HITS (GlossySettings::trace_representative_ray) and
+// REFERENCE_RADIUS (GlossySettings::reference_search_radius, 0: no brute-force search) as
+// constants (passes/glossy.rs: MotionProgram says why they are not uniforms).
 
 var prev_depth: texture_depth_2d;
 var prev_hit: texture_2d<f32>;
@@ -32,7 +35,7 @@ fn search_distance(q: vec2i, probe: Probe) -> f32 {
     }
     // Eq. (1) wherever the representative hit is a real hit: on mirrors, and on glossy surfaces
     // when the trace traced their representative ray; eq. (5) on sampled depths.
-    if probe.kind == HIT_MIRROR || gp.representative_traced != 0u {
+    if probe.kind == HIT_MIRROR || TRACED_HITS {
         return length(probe.h - ph.xyz);
     }
     let oq = world_from_depth(dn.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));
@@ -88,8 +91,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             mv = surface_mv;
         }
         search = vec4f(f32(r.steps), length(mv - virtual_mv), r.dist / reach, 0.0);
-        if gp.reference_radius > 0u {
-            let b = brute_force_search(p, i32(gp.reference_radius), probe);
+        if REFERENCE_RADIUS > 0 {
+            let b = brute_force_search(p, REFERENCE_RADIUS, probe);
             let ref_mv = select(mv, b.coord - (vec2f(p) + 0.5) + dn.jitter_shift, b.dist < INF);
             search.y = length(mv - ref_mv);
             // The reference's answer replaces the virtual one in zw.

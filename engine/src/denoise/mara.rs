@@ -5,7 +5,9 @@
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
 use crate::gpu::{Gpu, GpuMemory, Parity, Recorder};
-use crate::passes::glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams};
+use crate::passes::glossy::{
+    GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams, MotionProgram,
+};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
 use crate::passes::taa::{GlossyFollow, MatteFollow, MatteState, TaaFollow};
@@ -73,13 +75,16 @@ impl Denoiser for Mara {
                 params: &self.glossy_params,
                 glossy: g,
             };
-            // Made again when the pre-filter starts or stops offering its statistics.
-            if self.glossy.as_ref().is_some_and(|c| c.uncertain != io.feature_uncertainty.is_some())
-            {
+            // Made again when the pre-filter starts or stops offering its statistics, or the
+            // motion search's program constants change.
+            let program = MotionProgram::of(&s.glossy);
+            if self.glossy.as_ref().is_some_and(|c| {
+                c.uncertain != io.feature_uncertainty.is_some() || c.motion_program != program
+            }) {
                 self.glossy = None;
             }
             let glossy = crate::passes::chain::made(&mut self.glossy, || {
-                GlossyChain::new(gpu, &inputs, motion).context("creating the glossy chain")
+                GlossyChain::new(gpu, &inputs, motion, program).context("creating the glossy chain")
             })?;
             glossy.record(rec, cx.key, &inputs, cx.parity, &s.glossy)?;
         }

@@ -14,7 +14,7 @@
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
-use crate::passes::glossy::GlossyParams;
+use crate::passes::glossy::{GlossyParams, MotionProgram};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
 use crate::passes::taa::{MatteFollow, MatteState, TaaFollow};
@@ -352,6 +352,8 @@ impl SignalStages {
 }
 
 struct MotionStages {
+    /// What the motion stage's program was made for.
+    program: MotionProgram,
     motion: ChainStage,
     prefilter_h: ChainStage,
     prefilter_v: ChainStage,
@@ -588,17 +590,20 @@ fn motion_stages(
     io: &FrameIo,
     m: &MotionTargets,
     motion: crate::gpu::Motion,
+    program: MotionProgram,
 ) -> Result<MotionStages> {
     use crate::passes::glossy::modules;
     let p = Parity::default();
-    let stage = |label, file, entry, prefilter| {
+    let stage = |label, file, entry, prefilter, prelude: &str| {
         let offered = res.motion_bindings(io, m, prefilter, p);
-        ChainStage::new(gpu, label, &modules(file, motion), entry, &offered)
+        ChainStage::with_prelude(gpu, label, prelude, &modules(file, motion), entry, &offered)
     };
+    let search = program.prelude();
     Ok(MotionStages {
-        motion: stage("svgf/motion", "glossy/motion.wgsl", "main", None)?,
-        prefilter_h: stage("svgf/prefilter_h", "glossy/prefilter.wgsl", "pre_h", Some(false))?,
-        prefilter_v: stage("svgf/prefilter_v", "glossy/prefilter.wgsl", "pre_v", Some(true))?,
+        program,
+        motion: stage("svgf/motion", "glossy/motion.wgsl", "main", None, &search)?,
+        prefilter_h: stage("svgf/prefilter_h", "glossy/prefilter.wgsl", "pre_h", Some(false), "")?,
+        prefilter_v: stage("svgf/prefilter_v", "glossy/prefilter.wgsl", "pre_v", Some(true), "")?,
     })
 }
 
@@ -636,8 +641,12 @@ impl Denoiser for Svgf {
         if scene.glossy {
             let s = signal(true)?;
             let m = s.motion.context("SVGF's glossy motion textures are missing")?;
+            let program = MotionProgram::of(&cx.settings.glossy);
+            if motion.as_ref().is_some_and(|st| st.program != program) {
+                *motion = None;
+            }
             let st = crate::passes::chain::made(motion, || {
-                motion_stages(gpu, res, io, m, scene.motion)
+                motion_stages(gpu, res, io, m, scene.motion, program)
             })?;
             res.record_motion(rec, io, cx, m, st)?;
             let st = crate::passes::chain::made(glossy, || stages(true, s))?;

@@ -45,11 +45,23 @@ impl ChainStage {
         entry: &str,
         offered: &Bindings,
     ) -> Result<ChainStage> {
+        ChainStage::with_prelude(gpu, label, "", modules, entry, offered)
+    }
+
+    /// As [`ChainStage::new`], with `prelude` (constants of the program) before the modules.
+    pub fn with_prelude(
+        gpu: &Gpu,
+        label: &'static str,
+        prelude: &str,
+        modules: &[&'static str],
+        entry: &str,
+        offered: &Bindings,
+    ) -> Result<ChainStage> {
         let entry = entry.to_string();
         let pipeline = Reloadable::new(
             gpu,
             label,
-            "",
+            prelude,
             modules,
             wgpu::ShaderStages::COMPUTE,
             offered,

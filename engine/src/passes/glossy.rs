@@ -23,7 +23,6 @@ pub struct GlossyParams {
     pub mode: u32,
     pub initial_step: u32,
     pub max_search_steps: u32,
-    pub reference_radius: u32,
     pub roughness_threshold: f32,
     pub mirror_roughness: f32,
     pub clip_roughness: f32,
@@ -61,7 +60,6 @@ impl GlossyParams {
             },
             initial_step: s.initial_step.clamp(1, 64),
             max_search_steps: s.max_search_steps.clamp(1, 256),
-            reference_radius: s.reference_search_radius.min(256),
             roughness_threshold: s.roughness_threshold,
             mirror_roughness: s.mirror_roughness,
             clip_roughness: s.clip_roughness,
@@ -82,6 +80,39 @@ impl GlossyParams {
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
             still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
         }
+    }
+}
+
+/// What the reflection-motion program (shaders/glossy/motion.wgsl) is made for: two settings
+/// that are constants of its program (its prelude) rather than uniforms, and a frame whose
+/// settings want another makes the stage again. On lavapipe a branch on a uniform cost what its
+/// body costs whichever way it went, and both bodies are large: eq. (5)'s distance in each of the
+/// search's taps, and the brute-force search. The level at 640x360 (SVGF, 8 still frames, two
+/// interleaved runs each): the stage took 121 and 124 ms with them as uniforms, 43 and 48 ms as
+/// constants. Images are the same to the bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MotionProgram {
+    /// [`GlossySettings::trace_representative_ray`]: the search measures every lobe's distance by
+    /// eq. (1) between traced hits; off, glossy lobes by eq. (5).
+    pub traced_hits: bool,
+    /// [`GlossySettings::reference_search_radius`] (at most 256; 0: no brute-force search).
+    pub reference_radius: u32,
+}
+
+impl MotionProgram {
+    pub fn of(s: &GlossySettings) -> MotionProgram {
+        MotionProgram {
+            traced_hits: s.trace_representative_ray,
+            reference_radius: s.reference_search_radius.min(256),
+        }
+    }
+
+    /// The constants glossy/motion.wgsl reads.
+    pub fn prelude(self) -> String {
+        format!(
+            "const TRACED_HITS: bool = {};\nconst REFERENCE_RADIUS: i32 = {};\n",
+            self.traced_hits, self.reference_radius
+        )
     }
 }
 
@@ -198,6 +229,8 @@ pub fn modules(stage: &'static str, motion: crate::gpu::Motion) -> Vec<&'static 
 
 pub struct GlossyChain {
     stages: Vec<(Kind, ChainStage)>,
+    /// What the motion stage's program was made for.
+    pub motion_program: MotionProgram,
     /// The bilateral reads the pre-filter's feature uncertainty (made for a frame that offers
     /// it).
     pub uncertain: bool,
@@ -209,7 +242,12 @@ impl GlossyChain {
         self.stages.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 
-    pub fn new(gpu: &Gpu, i: &GlossyInputs, motion: crate::gpu::Motion) -> Result<GlossyChain> {
+    pub fn new(
+        gpu: &Gpu,
+        i: &GlossyInputs,
+        motion: crate::gpu::Motion,
+        motion_program: MotionProgram,
+    ) -> Result<GlossyChain> {
         let mut stages = vec![];
         for (kind, label, file, entry) in STAGES {
             let mut m = modules(file, motion);
@@ -218,10 +256,15 @@ impl GlossyChain {
             if matches!(kind, Kind::BilateralH | Kind::BilateralV) {
                 m.insert(m.len() - 1, i.io.uncertainty_module());
             }
+            let prelude = match kind {
+                Kind::Motion => motion_program.prelude(),
+                _ => String::new(),
+            };
             let offered = bindings(kind, i, Parity::default());
-            stages.push((kind, ChainStage::new(gpu, label, &m, entry, &offered)?));
+            stages
+                .push((kind, ChainStage::with_prelude(gpu, label, &prelude, &m, entry, &offered)?));
         }
-        Ok(GlossyChain { stages, uncertain: i.io.feature_uncertainty.is_some() })
+        Ok(GlossyChain { stages, motion_program, uncertain: i.io.feature_uncertainty.is_some() })
     }
 
     /// Record the chain. The prefilter runs only when the clip uses it.

@@ -180,6 +180,17 @@ fn all_programs() -> Vec<Program> {
             "glossy/bilateral.wgsl",
         ] {
             let m = crate::passes::glossy::modules(stage, animated);
+            if stage == "glossy/motion.wgsl" {
+                // Each of the search's program variants.
+                for traced_hits in [false, true] {
+                    for reference_radius in [0, 4] {
+                        let p =
+                            crate::passes::glossy::MotionProgram { traced_hits, reference_radius };
+                        v.push(compose(stage, &p.prelude(), &m).unwrap());
+                    }
+                }
+                continue;
+            }
             if stage == "glossy/bilateral.wgsl" {
                 // With the pre-filter's feature uncertainty, and without.
                 for u in ["realtime/uncertainty.wgsl", "realtime/uncertainty_none.wgsl"] {
@@ -519,8 +530,8 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     let (size, offs) = wgsl_layout(temporal, "GlossyParams");
     use crate::passes::glossy::GlossyParams;
     assert_eq!(size as usize, size_of::<GlossyParams>());
-    assert_eq!(offs[5] as usize, offset_of!(GlossyParams, roughness_threshold));
-    assert_eq!(offs[17] as usize, offset_of!(GlossyParams, max_sigma_px));
+    assert_eq!(offs[4] as usize, offset_of!(GlossyParams, roughness_threshold));
+    assert_eq!(offs[16] as usize, offset_of!(GlossyParams, max_sigma_px));
     let atrous = programs.iter().find(|p| p.label == "svgf/atrous.wgsl").unwrap();
     use crate::denoise::svgf::SvgfParams;
     let (size, offs) = wgsl_layout(atrous, "SvgfParams");
