@@ -1,7 +1,7 @@
 //! The glossy chain (Mara et al. 2017 §3.4 stages 8-10, Voorhuis §4): the diamond search on a
 //! synthetic motion, the virtual-position reprojection of a plane mirror against geometry, the
-//! surface reprojection's normal test, the reflected-hit test of glossy lobes, and the
-//! bilateral's sigma.
+//! surface reprojection's normal test, the reflected-hit test of glossy lobes, the bilateral's
+//! sigma, and the motion stage made again when its program's constants change.
 
 use glam::{DVec3, Vec2, Vec4};
 use hush_engine::accel::BvhKind;
