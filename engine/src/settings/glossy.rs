@@ -69,6 +69,8 @@ described! {
         /// search) the glossy sphere's vectors were 8.05 px off on average (42.6% within 1 px) with
         /// sampled depths, whose jumps between near and far geometry make eq. (5)'s minimum
         /// ambiguous, and 0.31 px (92.6%) with traced ones, for one closest-hit ray per such pixel.
+        /// A constant of the motion stage's program (a change makes it again): on lavapipe eq. (5)
+        /// cost every search tap even while unused (passes/glossy.rs: MotionProgram).
         trace_representative_ray: bool = true,
             ("glossy.trace_representative_ray", "glossy/motion", "", Bool);
         /// Stage switches. Without `temporal` nothing is reprojected (Voorhuis's "NoSpecReproj").
@@ -144,7 +146,8 @@ described! {
     }
     hidden {
         /// Measurements only: also run a brute-force search over a window of this radius (pixels)
-        /// and report the diamond search's distance to it in the search view (0: off).
+        /// and report the diamond search's distance to it in the search view (0: off). A constant
+        /// of the motion stage's program, which carries the search only while this is set.
         #[serde(skip)]
         reference_search_radius: u32 = 0;
     }
