@@ -57,10 +57,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             sigma_l *= 8.0 - min(7.0, reprojections);
         }
         let phi_l = sigma_l * sqrt(max(blurred_variance(p), 0.0));
-        // The reach bound as the variance stage packed it (exact: the f32's bits) rather than
-        // signal_sigma again at every level, which for the glossy light loads the neighbours' ray
-        // differentials (the level at 640x360 on lavapipe: glossy a-trous 209-242 ms, 262-281
-        // with signal_sigma here).
+        // The reach bound as the variance stage packed it (exact: the f32's bits), not
+        // signal_sigma at every level: for the glossy light that loads the neighbours' ray
+        // differentials, a sixth of the glossy a-trous on lavapipe (docs/decisions.md).
         let sigma = tap_reach(textureLoad(taps, p, 0));
         let k0 = kernel(0);
         var sum = c.rgb * (k0 * k0);

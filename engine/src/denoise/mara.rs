@@ -5,6 +5,7 @@
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
 use crate::gpu::{Gpu, GpuMemory, Parity, Recorder};
+use crate::passes::chain::made_for;
 use crate::passes::glossy::{
     GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams, MotionProgram,
 };
@@ -61,12 +62,12 @@ impl Denoiser for Mara {
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
         let motion = self.scene.motion;
         // Made again when the radiance cache starts or stops offering its prior.
-        if self.matte.as_ref().is_some_and(|c| c.prior != io.cache_prior.is_some()) {
-            self.matte = None;
-        }
-        let matte = crate::passes::chain::made(&mut self.matte, || {
-            MatteChain::new(gpu, &inputs, motion).context("creating the matte chain")
-        })?;
+        let prior = io.cache_prior.is_some();
+        let matte = made_for(
+            &mut self.matte,
+            |c| c.prior == prior,
+            || MatteChain::new(gpu, &inputs, motion).context("creating the matte chain"),
+        )?;
         matte.record(rec, cx.key, &inputs, cx.parity)?;
         if let Some(g) = g {
             let inputs = GlossyInputs {
@@ -77,15 +78,16 @@ impl Denoiser for Mara {
             };
             // Made again when the pre-filter starts or stops offering its statistics, or the
             // motion search's program constants change.
-            let program = MotionProgram::of(&s.glossy);
-            if self.glossy.as_ref().is_some_and(|c| {
-                c.uncertain != io.feature_uncertainty.is_some() || c.motion_program != program
-            }) {
-                self.glossy = None;
-            }
-            let glossy = crate::passes::chain::made(&mut self.glossy, || {
-                GlossyChain::new(gpu, &inputs, motion, program).context("creating the glossy chain")
-            })?;
+            let (uncertain, program) =
+                (io.feature_uncertainty.is_some(), MotionProgram::of(&s.glossy));
+            let glossy = made_for(
+                &mut self.glossy,
+                |c| c.uncertain == uncertain && c.motion_program == program,
+                || {
+                    GlossyChain::new(gpu, &inputs, motion, program)
+                        .context("creating the glossy chain")
+                },
+            )?;
             glossy.record(rec, cx.key, &inputs, cx.parity, &s.glossy)?;
         }
         Ok(())

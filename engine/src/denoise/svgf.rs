@@ -13,7 +13,7 @@
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
-use crate::passes::chain::ChainStage;
+use crate::passes::chain::{ChainStage, made_for};
 use crate::passes::glossy::{GlossyParams, MotionProgram};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
@@ -629,27 +629,22 @@ impl Denoiser for Svgf {
                 .context("creating SVGF's stages")
         };
         // Made again when the radiance cache's prior, the pre-filter's statistics or the kernel
-        // come or go.
-        for (st, g) in [(&mut *matte, false), (&mut *glossy, true)] {
-            if st.as_ref().is_some_and(|st| st.variant != wanted(g)) {
-                *st = None;
-            }
-        }
+        // come or go, and the motion search when its program's constants change.
+        let fits = |g| move |st: &SignalStages| st.variant == wanted(g);
         let s = signal(false)?;
-        let st = crate::passes::chain::made(matte, || stages(false, s))?;
+        let st = made_for(matte, fits(false), || stages(false, s))?;
         res.record_stages(rec, io, cx, s, st)?;
         if scene.glossy {
             let s = signal(true)?;
             let m = s.motion.context("SVGF's glossy motion textures are missing")?;
             let program = MotionProgram::of(&cx.settings.glossy);
-            if motion.as_ref().is_some_and(|st| st.program != program) {
-                *motion = None;
-            }
-            let st = crate::passes::chain::made(motion, || {
-                motion_stages(gpu, res, io, m, scene.motion, program)
-            })?;
+            let st = made_for(
+                motion,
+                |st| st.program == program,
+                || motion_stages(gpu, res, io, m, scene.motion, program),
+            )?;
             res.record_motion(rec, io, cx, m, st)?;
-            let st = crate::passes::chain::made(glossy, || stages(true, s))?;
+            let st = made_for(glossy, fits(true), || stages(true, s))?;
             res.record_stages(rec, io, cx, s, st)?;
         }
         Ok(())

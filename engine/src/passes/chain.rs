@@ -16,6 +16,20 @@ pub fn made<T>(slot: &mut Option<T>, make: impl FnOnce() -> Result<T>) -> Result
     }
 }
 
+/// As [`made`], where what the stages were made for can change between frames (an input the
+/// frame offers, or a setting that is a constant of their programs): the stages in `slot` are
+/// kept while `fits` says they suit this frame, and made again otherwise.
+pub fn made_for<T>(
+    slot: &mut Option<T>,
+    fits: impl FnOnce(&T) -> bool,
+    make: impl FnOnce() -> Result<T>,
+) -> Result<&mut T> {
+    if slot.as_ref().is_some_and(|t| !fits(t)) {
+        *slot = None;
+    }
+    made(slot, make)
+}
+
 /// Per-pixel targets in `slot` made for the frame targets of `epoch` (once per size): `make`
 /// runs where the slot holds none or another epoch's. True if it did.
 pub fn made_for_epoch<T>(
