@@ -167,6 +167,7 @@ impl Renderer {
         size: (u32, u32),
     ) -> Result<Renderer> {
         check_size(size)?;
+        gpu.check_realtime_formats()?;
         gpu.validated("creating the real-time frame", || Self::create(gpu, scene, prepared, size))
     }
 

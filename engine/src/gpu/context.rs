@@ -6,6 +6,20 @@ driver; on a machine without a GPU install the software Vulkan driver (on Debian
 `apt-get install mesa-vulkan-drivers`). WGPU_BACKEND (vulkan, metal, dx12, gl) and \
 WGPU_ADAPTER_NAME (a substring of the adapter's name) choose among several.";
 
+/// The formats the real-time frame's passes write as storage textures (`texture_storage_2d` in
+/// shaders/). A WebGPU-compliant adapter can write them all; wgpu's GL backend (what wgpu picks
+/// on a machine with Mesa's GL but no Vulkan driver) cannot write the two-channel ones, where the
+/// reference mode still runs.
+pub const REALTIME_STORAGE_FORMATS: [wgpu::TextureFormat; 7] = [
+    wgpu::TextureFormat::R32Float,
+    wgpu::TextureFormat::R32Uint,
+    wgpu::TextureFormat::Rg32Float,
+    wgpu::TextureFormat::Rg32Uint,
+    wgpu::TextureFormat::Rgba16Float,
+    wgpu::TextureFormat::Rgba32Float,
+    wgpu::TextureFormat::Rgba32Uint,
+];
+
 /// Features and limits a scene and its passes need. The device is created with exactly these,
 /// so a pass that would exceed them fails validation on every machine, not only on small GPUs.
 #[derive(Clone, Debug)]
@@ -216,6 +230,29 @@ impl Gpu {
         });
         let shaders = crate::shader::ShaderLibrary::from_env_or(None)?;
         Ok(Gpu { instance, adapter, device, queue, info, timestamps, shaders, lost })
+    }
+
+    /// An error naming the adapter and what it lacks when it cannot write every format of
+    /// [`REALTIME_STORAGE_FORMATS`], before any pass fails on one with a validation message.
+    pub fn check_realtime_formats(&self) -> Result<()> {
+        let storage = wgpu::TextureUsages::STORAGE_BINDING;
+        let missing: Vec<wgpu::TextureFormat> = REALTIME_STORAGE_FORMATS
+            .into_iter()
+            .filter(|f| {
+                !self.adapter.get_texture_format_features(*f).allowed_usages.contains(storage)
+            })
+            .collect();
+        if missing.is_empty() {
+            return Ok(());
+        }
+        Err(anyhow!(
+            "adapter {:?} ({:?} backend) cannot write the storage textures {missing:?} that the \
+             real-time frame needs (the reference mode runs on it). On a machine without a GPU \
+             install the software Vulkan driver (on Debian/Ubuntu: `apt-get install \
+             mesa-vulkan-drivers`); WGPU_BACKEND and WGPU_ADAPTER_NAME choose another adapter",
+            self.info.name,
+            self.info.backend
+        ))
     }
 
     /// Run `f` inside a validation error scope: what wgpu would only log becomes an error with

@@ -14,7 +14,7 @@ mod timestamps;
 pub use crate::shader::binding::{
     BindCache, BindKey, Bindings, Resource, set_compute_groups, set_render_groups,
 };
-pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP};
+pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP, REALTIME_STORAGE_FORMATS};
 pub use history::{Parity, PingPong, Tex};
 pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use pack::TEXTURE_BUDGET_BYTES;

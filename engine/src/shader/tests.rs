@@ -414,6 +414,34 @@ fn every_wgsl_file_is_embedded_and_used() {
 }
 
 #[test]
+fn every_storage_texture_format_is_checked_before_the_frame() {
+    use wgpu::TextureFormat as F;
+    let named = |w: &str| match w {
+        "r32float" => Some(F::R32Float),
+        "r32uint" => Some(F::R32Uint),
+        "rg32float" => Some(F::Rg32Float),
+        "rg32uint" => Some(F::Rg32Uint),
+        "rgba16float" => Some(F::Rgba16Float),
+        "rgba32float" => Some(F::Rgba32Float),
+        "rgba32uint" => Some(F::Rgba32Uint),
+        _ => None,
+    };
+    let mut seen = 0;
+    for (path, text) in SOURCES {
+        for part in text.split("texture_storage_2d<").skip(1) {
+            let w = part.split(|c: char| !c.is_ascii_alphanumeric()).next().unwrap();
+            let f = named(w).unwrap_or_else(|| panic!("{path}: storage format {w} has no entry"));
+            assert!(
+                crate::gpu::REALTIME_STORAGE_FORMATS.contains(&f),
+                "{path} writes {w}, which gpu::REALTIME_STORAGE_FORMATS does not check"
+            );
+            seen += 1;
+        }
+    }
+    assert!(seen > 50, "only {seen} storage textures found in shaders/");
+}
+
+#[test]
 fn errors_name_the_file_and_line() {
     let p = Program {
         label: "t".into(),
