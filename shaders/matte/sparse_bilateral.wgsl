@@ -1,6 +1,8 @@
 // The sparse cross-bilateral filter of stages (4) and (7): `dn.taps` taps in a disk, weighted by
 // plane distance and normals, and with edge_k > 0 also by luminance (stage 7's edge-stop, see
-// matte/bilateral.wgsl). Reads `filter_in`, the caller's input (for the edge-stop, its alpha
+// matte/bilateral.wgsl). Where the program's uncertainty module gives the features' variances
+// (stage 7 with the pre-filter) the plane and normal weights count them (common/
+// feature_weight.wgsl). Reads `filter_in`, the caller's input (for the edge-stop, its alpha
 // holds the guide's luminance), and for the edge-stop `reason_in`, the history length.
 
 // Standard deviation of the n-frame mean at p: the root mean square of the raw input minus the
@@ -48,6 +50,7 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         sigma_l = k * history_noise(p, xc, nc, fc, n) / 3.0 + 1e-6;
     }
     let lc = centre.a;
+    let vc = feature_variance(p);
     var sum = c;
     var wsum = 1.0;
     // Mara et al. §3.2's Gaussian over the disk, where it is on.
@@ -61,7 +64,14 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         }
         let tap = textureLoad(filter_in, q, 0);
         let t = tap.rgb;
-        var w = bilateral_weight(xc, nc, fc, position_at(q), oct_decode(textureLoad(gb_normal, q, 0).xy));
+        let xt = position_at(q);
+        let nt = oct_decode(textureLoad(gb_normal, q, 0).xy);
+        var w: f32;
+        if FEATURE_VARIANCE {
+            w = uncertain_bilateral_weight(xc, nc, fc, vc, xt, nt, feature_variance(q));
+        } else {
+            w = bilateral_weight(xc, nc, fc, xt, nt);
+        }
         if sigma_l > 0.0 {
             w *= exp(-abs(tap.a - lc) / sigma_l);
         }
@@ -70,4 +80,14 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         wsum += w;
     }
     return sum / wsum;
+}
+
+// bilateral_weight with the features' variances (vc, vt: the normal's and the view depth's
+// relative variance). The plane distance's variance is taken as the depth's: a defocused pixel's
+// samples scatter along the view ray about as far as its mean depth is uncertain.
+fn uncertain_bilateral_weight(xc: vec3f, nc: vec3f, fc: f32, vc: vec2f, xt: vec3f, nt: vec3f, vt: vec2f) -> f32 {
+    let zc = dot(xc - frame.cam_pos.xyz, frame.cam_fwd.xyz);
+    let zt = dot(xt - frame.cam_pos.xyz, frame.cam_fwd.xyz);
+    let plane = depth_distance(dot(nc, xt - xc), dn.plane_sigma_px * fc, vc.y * zc * zc, vt.y * zt * zt);
+    return normal_weight(dot(nc, nt), dn.normal_power, vc.x, vt.x) * exp(-plane * plane);
 }

@@ -7,8 +7,9 @@
 
 var<storage, read> pf_bandwidth: array<f32>;
 var<storage, read_write> pf_features: array<vec4u>;
-// Debug views: x the chosen bandwidth before smoothing, y after, z the world positions' spread
-// (RMS distance from their mean) in pixels, w the filtered normal's variance (dual buffers).
+// x the filtered view depth's relative variance (dual buffers), y the bandwidth after smoothing,
+// z the world positions' spread (RMS distance from their mean) in pixels, w the filtered
+// normal's variance (dual buffers): the later stages' `gb_uncertainty`.
 var pf_view: texture_storage_2d<rgba16float, write>;
 // xy the raw octahedral normal (the G-buffer holds the filtered one), z the filtered view
 // depth's relative variance (dual buffers), w unused.
@@ -136,6 +137,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let z = max(abs(normal_depth.w * inv), 1e-30);
         depth_variance = diff.w * diff.w / 4.0 / (z * z);
     }
-    textureStore(pf_view, c, vec4f(pf_bandwidth[ci], h, min(spread, 65000.0), min(variance, 65000.0)));
+    textureStore(pf_view, c, vec4f(min(depth_variance, 65000.0), h, min(spread, 65000.0), min(variance, 65000.0)));
     textureStore(pf_normals, c, vec4f(oct_of(raw_n.xyz), min(depth_variance, 65000.0), 0.0));
 }

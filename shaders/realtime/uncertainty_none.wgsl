@@ -5,3 +5,9 @@
 fn defocus_sigma(p: vec2i) -> f32 {
     return 0.0;
 }
+
+const FEATURE_VARIANCE: bool = false;
+
+fn feature_variance(p: vec2i) -> vec2f {
+    return vec2f(0.0);
+}

@@ -22,6 +22,11 @@ fn signal_features(p: vec2i) -> Features {
     return r;
 }
 
+// Behind a mirror the features are the reflected surface's, which the pre-filter did not see.
+fn signal_primary_features(p: vec2i) -> bool {
+    return !(sv_on(SV_MIRROR_FEATURES) && is_mirror(roughness_at(p)));
+}
+
 fn signal_remodulation(p: vec2i) -> vec3f {
     return demodulation(p);
 }

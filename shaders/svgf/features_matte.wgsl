@@ -7,6 +7,11 @@ fn signal_features(p: vec2i) -> Features {
     return Features(f.x, f.y, oct_decode(textureLoad(gb_normal, p, 0).xy));
 }
 
+// The features are the primary surface's, whose variances the pre-filter gives.
+fn signal_primary_features(p: vec2i) -> bool {
+    return true;
+}
+
 fn signal_remodulation(p: vec2i) -> vec3f {
     return vec3f(1.0);
 }

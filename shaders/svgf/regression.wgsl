@@ -4,8 +4,9 @@
 // Nemirovski 1997). Nested windows of radius 1, 2, 4, 8 and 16 pixels each give an estimate of
 // the light at the pixel, beta_0 of a weighted least-squares fit over the window's taps
 // (regression_order: a mean, a plane or a quadric in screen space; SVGF's depth and normal
-// edge-stops, eq. (3)-(4); the signal's reach Gaussian), with its standard deviation from the
-// taps' pooled variance of the accumulated light.
+// edge-stops, eq. (3)-(4), weighed against the features' own variances where the pre-filter
+// gives them (common/feature_weight.wgsl); the signal's reach Gaussian), with its standard
+// deviation from the taps' pooled variance of the accumulated light.
 //
 // The filter keeps widening while a window's interval [beta_0 - gamma sigma, beta_0 + gamma
 // sigma] still meets every smaller window's and the pixel's own, and shows the last estimate that
@@ -43,6 +44,19 @@ fn unknowns() -> i32 {
     return array<i32, 3>(1, 3, 6)[min(u32(sv.regression_order), 2u)];
 }
 
+// SVGF's depth and normal edge-stops of tap t, with the features' variances where the frame
+// has them (vc, vt: the normal's and the depth's relative variance, realtime/uncertainty.wgsl);
+// without, edge_weight's terms exactly.
+fn feature_weight(c: Features, t: Features, offset: f32, vc: vec2f, vt: vec2f) -> f32 {
+    if !FEATURE_VARIANCE {
+        return edge_weight(c, t, offset, 0.0, 0.0, 1.0);
+    }
+    let s = sv.sigma_z * max(c.dz, 1e-6) * offset + 1e-6;
+    let z2 = c.z * c.z;
+    let wz = depth_distance(c.z - t.z, s, vc.y * z2, vt.y * t.z * t.z);
+    return exp(-wz) * normal_weight(dot(c.n, t.n), sv.sigma_n, vc.x, vt.x);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     let p = vec2i(gid.xy);
@@ -57,6 +71,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let fc = signal_features(p);
+    // The variances are the primary surface's: none where the signal edge-stops on another.
+    let uncertain = signal_primary_features(p);
+    let vc = select(vec2f(0.0), feature_variance(p), uncertain);
     // The signal's reach bound, as the variance stage packed it: lavapipe (Mesa 22.3, LLVM 15)
     // aborts compiling the glossy program when this stage calls signal_sigma itself.
     let reach = tap_reach(textureLoad(taps, p, 0));
@@ -95,7 +112,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                     continue;
                 }
                 let offset = length(vec2f(f32(dx), f32(dy)));
-                let w = exp(-0.5 * offset * offset / (reach * reach)) * edge_weight(fc, fq, offset, 0.0, 0.0, 1.0);
+                let vq = select(vec2f(0.0), feature_variance(q), uncertain);
+                let w = exp(-0.5 * offset * offset / (reach * reach)) * feature_weight(fc, fq, offset, vc, vq);
                 if w > 1e-3 {
                     let t = textureLoad(light, q, 0);
                     add_tap(&s, w, f32(dx) / 32.0, f32(dy) / 32.0, t.rgb, max(t.a, 0.0));

@@ -61,11 +61,12 @@ impl Denoiser for Mara {
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
         let motion = self.scene.motion;
-        // Made again when the radiance cache starts or stops offering its prior.
-        let prior = io.cache_prior.is_some();
+        // Made again when the radiance cache starts or stops offering its prior, or the
+        // pre-filter its statistics.
+        let (prior, uncertain) = (io.cache_prior.is_some(), io.feature_uncertainty.is_some());
         let matte = made_for(
             &mut self.matte,
-            |c| c.prior == prior,
+            |c| c.prior == prior && c.uncertain == uncertain,
             || MatteChain::new(gpu, &inputs, motion).context("creating the matte chain"),
         )?;
         matte.record(rec, cx.key, &inputs, cx.parity)?;

@@ -238,10 +238,18 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
         m.push(if glossy { "svgf/features_glossy.wgsl" } else { "svgf/features_matte.wgsl" });
     }
     if stage == "svgf/regression.wgsl" {
-        m.push("svgf/fit.wgsl");
+        m.extend(["svgf/fit.wgsl", "common/feature_weight.wgsl"]);
     }
     m.push(stage);
     m
+}
+
+/// Whether a stage reads the pre-filter's feature uncertainty where the frame offers it (takes
+/// realtime/uncertainty.wgsl or uncertainty_none.wgsl before its own module): every glossy
+/// stage after the temporal one (the reach takes the circle of confusion) and both signals'
+/// regressions (their edge-stops weigh the features against their variances).
+pub fn reads_uncertainty(stage: &str, glossy: bool) -> bool {
+    (glossy && !stage.starts_with("svgf/temporal")) || stage == "svgf/regression.wgsl"
 }
 
 /// The module that gives the a-trous stage its kernel: the radius is a constant of the
@@ -255,7 +263,8 @@ pub fn kernel_module(kernel_5x5: bool) -> &'static str {
 struct Variant {
     /// The matte temporal reads the radiance cache's prior (a frame that offers one).
     prior: bool,
-    /// The glossy reach reads the pre-filter's feature uncertainty (a frame that offers it).
+    /// The glossy reach and the regressions read the pre-filter's feature uncertainty (a frame
+    /// that offers it).
     uncertain: bool,
     /// The a-trous kernel is SVGF's 5x5 (`svgf.kernel_5x5`).
     kernel_5x5: bool,
@@ -266,7 +275,7 @@ impl Variant {
     fn wanted(glossy: bool, io: &FrameIo, s: &SvgfSettings) -> Variant {
         Variant {
             prior: !glossy && io.cache_prior.is_some(),
-            uncertain: glossy && io.feature_uncertainty.is_some(),
+            uncertain: io.feature_uncertainty.is_some(),
             kernel_5x5: s.kernel_5x5,
         }
     }
@@ -316,8 +325,9 @@ impl SignalStages {
                 m.insert(m.len() - 1, kernel_module(variant.kernel_5x5));
             }
             // The glossy light's reach (svgf/features_glossy.wgsl) takes the circle of
-            // confusion where the pre-filter measured one.
-            if glossy {
+            // confusion where the pre-filter measured one, and the regressions weigh the
+            // features against their variances.
+            if reads_uncertainty(file, glossy) {
                 m.insert(m.len() - 1, crate::passes::io::uncertainty_module(variant.uncertain));
             }
             ChainStage::new(gpu, label, &m, "main", b)

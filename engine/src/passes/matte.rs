@@ -248,7 +248,15 @@ fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: Parity) -> Bindings<'a>
     }
 }
 
-fn modules(kind: Kind, motion: crate::gpu::Motion, prior: &'static str) -> Vec<&'static str> {
+/// `uncertainty`: the module that gives stage 7's edge-stops the features' variances
+/// (realtime/uncertainty.wgsl where the frame offers the pre-filter's, else
+/// realtime/uncertainty_none.wgsl); stage 4, in the history loop, takes none.
+fn modules(
+    kind: Kind,
+    motion: crate::gpu::Motion,
+    prior: &'static str,
+    uncertainty: &'static str,
+) -> Vec<&'static str> {
     let mut m = vec![
         "common/math.wgsl",
         "realtime/frame.wgsl",
@@ -259,12 +267,20 @@ fn modules(kind: Kind, motion: crate::gpu::Motion, prior: &'static str) -> Vec<&
     m.push(motion.module());
     m.extend(match kind {
         Kind::Temporal => vec![prior, "matte/temporal.wgsl"],
-        Kind::HistoryBilateral => {
-            vec!["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"]
-        }
+        Kind::HistoryBilateral => vec![
+            "realtime/uncertainty_none.wgsl",
+            "common/feature_weight.wgsl",
+            "matte/sparse_bilateral.wgsl",
+            "matte/history_bilateral.wgsl",
+        ],
         Kind::MinH | Kind::MinV => vec!["matte/disocclusion.wgsl"],
         Kind::Firefly => vec!["matte/firefly.wgsl"],
-        Kind::Bilateral => vec!["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"],
+        Kind::Bilateral => vec![
+            uncertainty,
+            "common/feature_weight.wgsl",
+            "matte/sparse_bilateral.wgsl",
+            "matte/bilateral.wgsl",
+        ],
     });
     m
 }
@@ -273,6 +289,9 @@ pub struct MatteChain {
     stages: Vec<(Kind, ChainStage)>,
     /// The temporal stage reads the radiance cache's prior (made for a frame that offers one).
     pub prior: bool,
+    /// Stage 7 weighs the features against the pre-filter's variances (made for a frame that
+    /// offers them).
+    pub uncertain: bool,
 }
 
 impl MatteChain {
@@ -295,13 +314,17 @@ impl MatteChain {
                 ChainStage::new(
                     gpu,
                     label,
-                    &modules(kind, motion, prior),
+                    &modules(kind, motion, prior, i.io.uncertainty_module()),
                     entry,
                     &bindings(kind, i, Parity::default()),
                 )?,
             ));
         }
-        Ok(MatteChain { stages, prior: i.io.cache_prior.is_some() })
+        Ok(MatteChain {
+            stages,
+            prior: i.io.cache_prior.is_some(),
+            uncertain: i.io.feature_uncertainty.is_some(),
+        })
     }
 
     /// Record stages 3-7.

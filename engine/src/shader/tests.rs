@@ -133,10 +133,26 @@ fn all_programs() -> Vec<Program> {
         for stage in [
             &["cache/prior_none.wgsl", "matte/temporal.wgsl"][..],
             &["cache/prior.wgsl", "matte/temporal.wgsl"],
-            &["matte/sparse_bilateral.wgsl", "matte/history_bilateral.wgsl"],
+            &[
+                "realtime/uncertainty_none.wgsl",
+                "common/feature_weight.wgsl",
+                "matte/sparse_bilateral.wgsl",
+                "matte/history_bilateral.wgsl",
+            ],
             &["matte/disocclusion.wgsl"],
             &["matte/firefly.wgsl"],
-            &["matte/sparse_bilateral.wgsl", "matte/bilateral.wgsl"],
+            &[
+                "realtime/uncertainty_none.wgsl",
+                "common/feature_weight.wgsl",
+                "matte/sparse_bilateral.wgsl",
+                "matte/bilateral.wgsl",
+            ],
+            &[
+                "realtime/uncertainty.wgsl",
+                "common/feature_weight.wgsl",
+                "matte/sparse_bilateral.wgsl",
+                "matte/bilateral.wgsl",
+            ],
             &[
                 "realtime/glossy_in.wgsl",
                 "glossy/common.wgsl",
@@ -232,7 +248,7 @@ fn all_programs() -> Vec<Program> {
                     v.push(compose(stage, "", &with).unwrap());
                     m.insert(m.len() - 1, crate::denoise::svgf::kernel_module(false));
                 }
-                if glossy && !stage.starts_with("svgf/temporal") {
+                if crate::denoise::svgf::reads_uncertainty(stage, glossy) {
                     // With the pre-filter's feature uncertainty, and without.
                     let mut with = m.clone();
                     with.insert(with.len() - 1, "realtime/uncertainty.wgsl");
