@@ -131,6 +131,10 @@ fn bindings<'a>(s: SceneInputs<'a>, g: &'a GBufferTargets, t: &'a TraceTargets) 
     let mut b = s
         .bindings()
         .texture("gb_ids", g.view(Channel::Ids))
+        .texture("tr_mean_normal", g.view(Channel::Normal))
+        .texture("tr_mean_base", g.view(Channel::BaseColor))
+        .texture("tr_mean_specular", g.view(Channel::Specular))
+        .texture("tr_mean_emission", g.view(Channel::Emission))
         .texture("out_matte", &t.matte.1)
         .texture("out_direct", &t.direct.1);
     if let Some(gl) = &t.glossy {

@@ -77,7 +77,8 @@ pub struct FrameSettings {
     /// Primary samples per pixel k where the camera has a thin lens (depth of field): the
     /// raster cannot draw a random primary hit, so `gbuffer/primaries` traces k lens rays per
     /// pixel and writes the mean of their features as the G-buffer (Moon et al. 2017 §4.2), and
-    /// the path continues from the first. More samples give less noisy features (and
+    /// the path continues from the first, its light scaled from the mean material to its own so
+    /// that a pixel whose samples hit two materials keeps its mean. More samples give less noisy features (and
     /// covariances for the pre-filter) at the cost of k closest-hit rays per pixel. The
     /// accumulate mode traces 1 (its mean over frames is then exact). No effect without a lens.
     pub primary_samples: u32,
