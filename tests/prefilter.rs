@@ -617,9 +617,10 @@ fn the_glossy_reach_takes_the_pre_filters_circle_of_confusion() {
 /// primary per frame: exact) at 128x128, the signed relative difference of the two means per
 /// 16x16 tile, averaged over the tiles below the top row: -0.03% (rms over the tiles 3.7%, the
 /// two runs' noise); scaled by the mean material alone, as before, -2.01% (rms 5.8%; the box's
-/// tiles 7-17% dark). The top row is left out: the ceiling tiles beside the light come out 20%
-/// darker with k = 4 than with k = 1 or the accumulation, with or without the scaling (an open
-/// question, docs/decisions.md). With about 3% of noise per tile the mean of 56 tiles has a
+/// tiles 7-17% dark). The top row is left out: without TAA the frame does not jitter, so each
+/// sample j sits at a fixed point of its pixel (the centre, then R2 steps from it) where the
+/// accumulate mode box-filters, and the ceiling's tiles beside the in-focus edge of the light
+/// differ by up to 20% for that alone. With about 3% of noise per tile the mean of 56 tiles has a
 /// standard error near 0.5%: asserted within 1.2%.
 #[test]
 fn defocused_edges_keep_the_mean_of_their_samples() {
