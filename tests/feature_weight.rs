@@ -6,6 +6,7 @@
 //! the noise is still stopped.
 
 use hush_engine::gpu::{Gpu, GpuRequirements};
+use hush_tests::Xorshift;
 use hush_tests::compute::{Input, run_compute};
 
 const WEIGHT_TEST: &str = r#"
@@ -52,18 +53,6 @@ fn cpu_normal(cos: f64, sigma_n: f64, vc: f64, vt: f64) -> f64 {
     (1.0 - d).max(0.0).powf(sigma_n)
 }
 
-/// xorshift32: the cases are the same on every run.
-struct Rng(u32);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 17;
-        self.0 ^= self.0 << 5;
-        (self.0 >> 8) as f32 / (1 << 24) as f32
-    }
-}
-
 fn run(cases: &[Case]) -> Vec<[f32; 2]> {
     let gpu = Gpu::headless(&GpuRequirements::default()).unwrap();
     let out = run_compute(
@@ -85,17 +74,19 @@ fn run(cases: &[Case]) -> Vec<[f32; 2]> {
 /// the value, which 1e-3 catches.
 #[test]
 fn feature_weights_match_a_cpu_computation() {
-    let mut rng = Rng(0x2545_f491);
+    // xorshift32: the cases are the same on every run.
+    let mut rng = Xorshift(0x2545_f491);
     let mut cases = vec![];
     for i in 0..512 {
-        let s = 0.01 + rng.next();
-        let dz = (rng.next() - 0.5) * 8.0 * s;
+        let s = 0.01 + rng.uniform();
+        let dz = (rng.uniform() - 0.5) * 8.0 * s;
         // A quarter of the cases have no variance at all (a pixel in focus).
-        let var = |r: &mut Rng| if i % 4 == 0 { 0.0 } else { (r.next() * 3.0 * dz).powi(2) };
+        let var =
+            |r: &mut Xorshift| if i % 4 == 0 { 0.0 } else { (r.uniform() * 3.0 * dz).powi(2) };
         let (vc, vt) = (var(&mut rng), var(&mut rng));
-        let cos = 1.0 - 2.0 * rng.next().powi(3);
+        let cos = 1.0 - 2.0 * rng.uniform().powi(3);
         let sigma_n = [1.0, 32.0, 128.0, 256.0][i % 4];
-        let nv = |r: &mut Rng| if i % 4 == 0 { 0.0 } else { 0.2 * r.next().powi(2) };
+        let nv = |r: &mut Xorshift| if i % 4 == 0 { 0.0 } else { 0.2 * r.uniform().powi(2) };
         let (nc, nt) = (nv(&mut rng), nv(&mut rng));
         cases.push(Case { depth: [dz, s, vc, vt], normal: [cos, sigma_n, nc, nt] });
     }
