@@ -136,3 +136,19 @@ fn oct_decode(e: vec2f) -> vec3f {
 fn half_safe(v: vec3f) -> vec3f {
     return select(vec3f(0.0), clamp(v, vec3f(-65000.0), vec3f(65000.0)), (v == v) & (abs(v) <= vec3f(3.0e38)));
 }
+
+// Schlick's Fresnel at the mirror direction (Mara et al. eq. (4) with w_h = n): F(w_s) for a
+// material of reflectance f0 at normal incidence and f90 at grazing, cos_o = n . w_o. The
+// composite's and the trace's (realtime/gbuffer_in.wgsl, realtime/trace.wgsl).
+fn schlick_mirror(f0: vec3f, f90: f32, cos_o: f32) -> vec3f {
+    let m = 1.0 - clamp(cos_o, 0.0, 1.0);
+    let m2 = m * m;
+    return f0 + (vec3f(f90) - f0) * (m2 * m2 * m);
+}
+
+// What the composite multiplies the matte light by: m (1 - F(w_s))^2 with m = base colour x
+// (1 - metallic), Mara et al. eq. (9) and (10).
+fn remodulated_matte(base: vec3f, metallic: f32, f_s: vec3f) -> vec3f {
+    let one_minus_f = vec3f(1.0) - f_s;
+    return base * (1.0 - metallic) * one_minus_f * one_minus_f;
+}

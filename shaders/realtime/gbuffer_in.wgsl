@@ -39,16 +39,12 @@ fn gbuffer_at(p: vec2i) -> GSample {
     return g;
 }
 
-// Schlick's Fresnel at the mirror direction (Mara et al. eq. (4) with w_h = n).
+// Schlick's Fresnel at the mirror direction of the G-buffer's material (realtime/frame.wgsl).
 fn fresnel_mirror(g: GSample, cos_o: f32) -> vec3f {
-    let m = 1.0 - clamp(cos_o, 0.0, 1.0);
-    let m2 = m * m;
-    return g.f0 + (vec3f(g.f90) - g.f0) * (m2 * m2 * m);
+    return schlick_mirror(g.f0, g.f90, cos_o);
 }
 
-// What the composite multiplies the matte light by: m (1 - F(w_s))^2 with m = base colour x
-// (1 - metallic), Mara et al. eq. (9) and (10).
+// What the composite multiplies the matte light by (realtime/frame.wgsl: remodulated_matte).
 fn matte_factor(g: GSample, f_s: vec3f) -> vec3f {
-    let one_minus_f = vec3f(1.0) - f_s;
-    return g.base * (1.0 - g.metallic) * one_minus_f * one_minus_f;
+    return remodulated_matte(g.base, g.metallic, f_s);
 }

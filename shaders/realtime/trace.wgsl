@@ -51,27 +51,24 @@ struct Shaded {
 
 // What the composite would multiply this sample's matte and glossy light by, were the pixel's
 // material this sample's alone: the G-buffer's fields as the traced primaries write them
-// (realtime/primaries.wgsl), with the composite's own formulas (realtime/remodulate.wgsl's
-// matte_factor and fresnel_mirror at camera_ray).
+// (realtime/primaries.wgsl), with the composite's own formulas (realtime/frame.wgsl's
+// schlick_mirror and remodulated_matte at camera_ray).
 struct Factors {
     matte: vec3f,
     glossy: vec3f,
 }
 
 fn composite_factors(n: vec3f, base: vec3f, metallic: f32, f0: vec3f, f90: f32, rd: vec3f) -> Factors {
-    let m = 1.0 - clamp(dot(n, -rd), 0.0, 1.0);
-    let m2 = m * m;
-    let f_s = f0 + (vec3f(f90) - f0) * (m2 * m2 * m);
-    let one_minus_f = vec3f(1.0) - f_s;
-    return Factors(base * (1.0 - metallic) * one_minus_f * one_minus_f, f_s);
+    let f_s = schlick_mirror(f0, f90, dot(n, -rd));
+    return Factors(remodulated_matte(base, metallic, f_s), f_s);
 }
 
 // With k > 1 traced primaries the G-buffer holds the mean of the k samples' materials, and the
 // composite multiplies sample 0's light by it; where the samples hit two surfaces (a defocused
 // edge, a blurred silhouette) the mean of (light x material) is not (sample 0's light) x (mean
-// material): cornell_dof's defocused metal box, whose pixels mix its metal with the lit wall
-// behind, came out 10-21% dark per 32x32 tile. So the light is written as sample 0's light x
-// its own factor / the mean's: the composite then gives sample 0's own radiance, whose mean over
+// material): a pixel mixing metal (F about 0.9, no matte albedo) with a lit wall would show the
+// metal's glossy light at about half. So the light is written as sample 0's light x its own
+// factor / the mean's: the composite then gives sample 0's own radiance, whose mean over
 // frames is the pixel's. The material's part of the ratio is at most k (sample 0 is one of the
 // k; the mean normal's Fresnel may move it a little), and the ratio is 0 where the mean factor
 // is (then so is sample 0's).
