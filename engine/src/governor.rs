@@ -30,7 +30,9 @@
 //! converged image it heads for is sharper. Without resampling, a change restarts every history,
 //! so the scale rises only after [`RISE_FRAMES`] frames in a row predicted under 80% of the
 //! target at the larger scale, and on a still view only within [`YOUNG_FRAMES`] frames of its
-//! last change. It falls at once when the prediction is over the frame's limit.
+//! last change. It falls at once when the prediction is over the frame's limit: while the
+//! camera moves to the choice that fits the target, in a still view to the largest scale, at
+//! or below its own, that fits the still limit.
 
 use crate::settings::SampleFraction;
 
@@ -354,9 +356,16 @@ impl Governor {
                 self.limit_ms = limit;
                 return rise;
             }
-            if let Some(fraction) = self.still_fraction(cur.scale, limit) {
+            // Where its scale no longer fits (a heavier view, a rise predicted too low), it
+            // steps down only as far as the still limit asks: the moving target's choice (the
+            // smallest scale, on lavapipe) would trade a settled view for a far smaller image.
+            let fitting = |s: f32| self.still_fraction(s, limit).map(|f| (s, f));
+            let at_most = |s: &f32| *s <= cur.scale + 1e-6;
+            if let Some((scale, fraction)) =
+                scales.iter().copied().filter(at_most).find_map(fitting)
+            {
                 self.limit_ms = limit;
-                return Choice { scale: cur.scale, fraction };
+                return Choice { scale, fraction };
             }
         }
         if want.scale > cur.scale && !rises {
@@ -582,6 +591,31 @@ mod tests {
         run(&mut g, 60.0, 300.0, 10, true);
         let still = run(&mut g, 60.0, 300.0, 60, false);
         assert!(still.iter().all(|(c, _)| c.scale == start), "{still:?}");
+    }
+
+    #[test]
+    fn a_still_view_that_outgrows_its_limit_steps_down_only_as_far_as_it_must() {
+        // Scale alone (Mara, SVGF): 360 ms a full frame, so a still view rises to full scale.
+        let mut g = Governor::new(100.0);
+        run(&mut g, 60.0, 300.0, 10, true);
+        let still = run(&mut g, 60.0, 300.0, 60, false);
+        assert_eq!(still.last().unwrap().0.scale, 1.0, "{still:?}");
+        // The view gets 60% heavier (576 ms at full scale, over the 500 ms still limit):
+        // 0.875 fits (441 ms). The moving target's choice would be 0.375 (81 ms).
+        let heavier = run(&mut g, 96.0, 480.0, 12, false);
+        let scales: Vec<f32> = heavier.iter().map(|(c, _)| c.scale).collect();
+        assert!(scales.iter().all(|&s| s >= 0.875), "{heavier:?}");
+        assert_eq!(*scales.last().unwrap(), 0.875, "{heavier:?}");
+        let mut after = heavier.iter().skip_while(|(c, _)| c.scale == 1.0);
+        assert!(after.all(|(_, t)| *t <= 500.0), "{heavier:?}");
+        // With sample fractions the still view keeps its scale and takes a smaller fraction.
+        let mut g = Governor::new(100.0);
+        g.fractions_allowed = true;
+        run(&mut g, 60.0, 300.0, 10, true);
+        run(&mut g, 60.0, 300.0, 60, false);
+        let heavier = run(&mut g, 96.0, 480.0, 12, false);
+        let (c, t) = *heavier.last().unwrap();
+        assert!(c.scale == 1.0 && t <= 500.0, "{heavier:?}");
     }
 
     #[test]
