@@ -196,6 +196,7 @@ fn register() {
                 stages: STAGES,
                 views: VIEWS,
                 fractions: false,
+                levels: None,
             },
             make: Some(make),
         })

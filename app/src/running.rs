@@ -2,7 +2,7 @@
 //! camera paths, presets and shader reloads.
 
 use super::*;
-use hush_engine::governor::FrameCost;
+use hush_engine::governor::{ALL_LEVELS, FrameCost};
 
 pub(crate) struct Running {
     pub(crate) window: Arc<Window>,
@@ -247,6 +247,7 @@ impl Running {
         g.pinned_fraction = p.governor.pin_fraction.then_some(p.settings.sample_fraction);
         g.fractions_allowed =
             self.renderer.fills_untraced_pixels(&self.gpu, &p.settings).unwrap_or(false);
+        g.filter_levels = hush_engine::settings::filter_levels(&p.settings).unwrap_or(0);
         let choice = match self.governed {
             Some((last, camera)) => {
                 let moving = camera != input.camera;
@@ -258,8 +259,12 @@ impl Running {
         p.settings.sample_fraction = choice.fraction;
         let predicted = g.predict(choice).map_or(String::new(), |t| format!(", about {t:.0} ms"));
         let still = if g.still() { " (still view: most samples per second)" } else { "" };
+        let levels = match hush_engine::settings::filter_levels(&p.settings) {
+            Some(l) if choice.levels < l => format!(", {} of {l} a-trous levels", choice.levels),
+            _ => String::new(),
+        };
         p.governor.choice =
-            format!("scale {:.3}, {} spp{predicted}{still}", choice.scale, choice.fraction);
+            format!("scale {:.3}, {} spp{levels}{predicted}{still}", choice.scale, choice.fraction);
         self.governed = Some((choice, input.camera));
     }
 
@@ -334,7 +339,16 @@ impl Running {
             // screen as an error until a reload or a settings change lets it through.
             let r = {
                 puffin::profile_scope!("render");
-                self.renderer.render(&self.gpu, &input, &self.panel.settings, Some(&target))
+                // The governor may run fewer of the filter's levels than the panel's (they stay
+                // the user's setting).
+                let mut capped = None;
+                if let Some((c, _)) = self.governed.filter(|(c, _)| c.levels != ALL_LEVELS) {
+                    let mut s = self.panel.settings.clone();
+                    hush_engine::settings::cap_filter_levels(&mut s, c.levels);
+                    capped = Some(s);
+                }
+                let settings = capped.as_ref().unwrap_or(&self.panel.settings);
+                self.renderer.render(&self.gpu, &input, settings, Some(&target))
             };
             if let Err(e) = r {
                 log::error!("{e:#}");

@@ -67,11 +67,20 @@ pub const SCALABLE_FLOOR: f64 = 0.25;
 /// 90 s from 0.186 to 0.076 (docs/decisions.md, "Fixed cost and still views").
 pub const STILL_RATIO: f64 = 5.0;
 
+/// What the a-trous levels' pass labels hold (`svgf/atrous_matte`, `progressive/atrous_direct`).
+pub const ATROUS: &str = "/atrous";
+
+/// [`Choice::levels`] that leaves the denoiser's a-trous levels as its settings have them.
+pub const ALL_LEVELS: u32 = u32::MAX;
+
 /// What the governor runs the next frame at.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Choice {
     pub scale: f32,
     pub fraction: SampleFraction,
+    /// At most this many of the denoiser's a-trous levels ([`ALL_LEVELS`]: as many as its
+    /// settings ask; [`crate::settings::cap_filter_levels`] applies it).
+    pub levels: u32,
 }
 
 impl FrameCost {
@@ -93,6 +102,7 @@ impl FrameCost {
             wall_ms,
             trace_ms: sum(&|l| l == trace),
             scaled_ms: sum(&|l| l != display),
+            filter_ms: sum(&|l| l.contains(ATROUS)),
             choice,
             moving,
         }
@@ -110,6 +120,8 @@ pub struct FrameCost {
     /// 0 when the device has no timestamps: then all of the frame is taken to scale with the
     /// pixels.
     pub scaled_ms: f64,
+    /// GPU time of the denoiser's a-trous levels, part of `scaled_ms` (ms).
+    pub filter_ms: f64,
     /// The choice the frame ran at.
     pub choice: Choice,
     /// The camera moved since the last frame.
@@ -117,12 +129,14 @@ pub struct FrameCost {
 }
 
 /// One frame's costs in the model's terms (ms): fixed, rest and trace per full-resolution
-/// frame at f = 1.
+/// frame at f = 1, and one a-trous level per full-resolution frame (part of rest where the
+/// frame ran none).
 #[derive(Clone, Copy, Debug)]
 struct Costs {
     fixed: f64,
     rest: f64,
     trace: f64,
+    level: f64,
 }
 
 #[derive(Clone, Debug)]
@@ -142,6 +156,11 @@ pub struct Governor {
     /// Whether the frame keeps its histories across a change of scale (resampled): a still
     /// view may then rise without losing what it has accumulated.
     pub keeps_history: bool,
+    /// The a-trous levels the denoiser's settings ask for (0: it has none to turn down,
+    /// [`crate::settings::filter_levels`]). Where no scale and fraction fits the frame's limit,
+    /// the governor runs fewer ([`Choice::levels`]), each level it drops taking the filter's
+    /// widest reach.
+    pub filter_levels: u32,
     /// Recent costs, oldest first.
     costs: Vec<Costs>,
     current: Choice,
@@ -169,8 +188,9 @@ impl Governor {
             pinned_fraction: None,
             fractions_allowed: false,
             keeps_history: true,
+            filter_levels: 0,
             costs: vec![],
-            current: Choice { scale: 1.0, fraction: SampleFraction::ONE },
+            current: Choice { scale: 1.0, fraction: SampleFraction::ONE, levels: ALL_LEVELS },
             limit_ms: target_ms,
             room_frames: 0,
             over_frames: 0,
@@ -186,6 +206,7 @@ impl Governor {
         Choice {
             scale: self.pinned_scale.unwrap_or(self.current.scale),
             fraction: self.pinned_fraction.unwrap_or(self.current.fraction),
+            levels: self.current.levels,
         }
     }
 
@@ -199,7 +220,13 @@ impl Governor {
     pub fn predict(&self, c: Choice) -> Option<f64> {
         let e = self.estimate()?;
         let area = (c.scale * c.scale) as f64;
-        Some(e.fixed + area * (e.rest + e.trace / c.fraction.period() as f64))
+        let levels = self.levels_run(c) as f64;
+        Some(e.fixed + area * (e.rest + e.level * levels + e.trace / c.fraction.period() as f64))
+    }
+
+    /// The a-trous levels a frame at `c` runs.
+    fn levels_run(&self, c: Choice) -> u32 {
+        c.levels.min(self.filter_levels)
     }
 
     /// Samples traced per pixel per second at `c` (its fraction over its predicted frame time).
@@ -217,10 +244,14 @@ impl Governor {
         let trace = finite_or(f.trace_ms, 0.0).clamp(0.0, scaled);
         // Without timestamps nothing is known of the fixed part: all of it scales.
         let fixed = if scaled > 0.0 { wall - scaled } else { 0.0 };
+        let levels = self.levels_run(f.choice);
+        let filter =
+            if levels > 0 { finite_or(f.filter_ms, 0.0).clamp(0.0, scaled - trace) } else { 0.0 };
         self.costs.push(Costs {
             fixed,
-            rest: (wall - fixed - trace) / area,
+            rest: (wall - fixed - trace - filter) / area,
             trace: trace * period / area,
+            level: filter / levels.max(1) as f64 / area,
         });
         if self.costs.len() > WINDOW {
             self.costs.remove(0);
@@ -238,7 +269,8 @@ impl Governor {
         self.scale_frames = if same_scale { self.scale_frames.saturating_add(1) } else { 1 };
         self.scale_samples = (if same_scale { self.scale_samples } else { 0.0 }) + 1.0 / period;
         self.still_frames = if f.moving { 0 } else { self.still_frames.saturating_add(1) };
-        self.current = self.pick(f.moving);
+        let pick = self.pick(f.moving);
+        self.current = self.levels_within(pick, self.limit_ms);
         self.choice()
     }
 
@@ -256,7 +288,22 @@ impl Governor {
             fixed: median(|c| c.fixed),
             rest: median(|c| c.rest),
             trace: median(|c| c.trace),
+            level: median(|c| c.level),
         })
+    }
+
+    /// `c` with all of the denoiser's a-trous levels, or where even the smallest image and
+    /// fraction would take longer than `limit` (the filter alone overruns it: a pinned scale,
+    /// a slow device), with the most levels that fit, down to [`min_levels`].
+    fn levels_within(&self, c: Choice, limit: f64) -> Choice {
+        let all = Choice { levels: ALL_LEVELS, ..c };
+        let least = min_levels(c.fraction);
+        if self.filter_levels <= least || self.predict(all).is_none_or(|t| t <= limit) {
+            return all;
+        }
+        let fits = |&levels: &u32| self.predict(Choice { levels, ..c }).is_some_and(|t| t <= limit);
+        let levels = (least..self.filter_levels).rev().find(fits).unwrap_or(least);
+        Choice { levels, ..c }
     }
 
     /// The frame time a moving camera's choice must fit: the target, or the fixed cost plus
@@ -284,7 +331,8 @@ impl Governor {
     /// The largest fraction at scale `s` predicted within `budget` ms, none below 1 / `floor`.
     fn best_fraction(&self, s: f32, budget: f64, floor: u32) -> Option<SampleFraction> {
         self.fractions().into_iter().filter(|f| f.period() <= floor).find(|&fraction| {
-            self.predict(Choice { scale: s, fraction }).is_some_and(|t| t <= budget)
+            self.predict(Choice { scale: s, fraction, levels: ALL_LEVELS })
+                .is_some_and(|t| t <= budget)
         })
     }
 
@@ -292,7 +340,9 @@ impl Governor {
     /// the still view's limit (None when none fits it).
     fn still_fraction(&self, scale: f32, limit: f64) -> Option<SampleFraction> {
         let rate = |f: SampleFraction| {
-            let t = self.predict(Choice { scale, fraction: f }).filter(|&t| t <= limit)?;
+            let t = self
+                .predict(Choice { scale, fraction: f, levels: ALL_LEVELS })
+                .filter(|&t| t <= limit)?;
             Some((f, 1.0 / (f.period() as f64 * t.max(1e-6))))
         };
         self.fractions()
@@ -311,7 +361,7 @@ impl Governor {
         }
         let next = self.scales().into_iter().rev().find(|&s| s > scale + 1e-6)?;
         let fraction = self.still_fraction(next, limit).filter(|f| f.period() <= floor(false))?;
-        Some(Choice { scale: next, fraction })
+        Some(Choice { scale: next, fraction, levels: ALL_LEVELS })
     }
 
     fn pick(&mut self, moving: bool) -> Choice {
@@ -321,7 +371,7 @@ impl Governor {
             for floor in [floor(moving), u32::MAX] {
                 for &s in &scales {
                     if let Some(fraction) = g.best_fraction(s, budget, floor) {
-                        return Some(Choice { scale: s, fraction });
+                        return Some(Choice { scale: s, fraction, levels: ALL_LEVELS });
                     }
                 }
             }
@@ -330,6 +380,7 @@ impl Governor {
         let smallest = Choice {
             scale: *scales.last().unwrap_or(&1.0),
             fraction: *self.fractions().last().unwrap_or(&SampleFraction::ONE),
+            levels: ALL_LEVELS,
         };
         let want = fits(self, budget).unwrap_or(smallest);
         let cur = self.choice();
@@ -365,7 +416,7 @@ impl Governor {
                 scales.iter().copied().filter(at_most).find_map(fitting)
             {
                 self.limit_ms = limit;
-                return Choice { scale, fraction };
+                return Choice { scale, fraction, levels: ALL_LEVELS };
             }
         }
         if want.scale > cur.scale && !rises {
@@ -373,7 +424,7 @@ impl Governor {
                 .best_fraction(cur.scale, budget, floor(moving))
                 .or_else(|| self.best_fraction(cur.scale, budget, u32::MAX))
                 .unwrap_or(smallest.fraction);
-            return Choice { scale: cur.scale, fraction };
+            return Choice { scale: cur.scale, fraction, levels: ALL_LEVELS };
         }
         self.room_frames = 0;
         want
@@ -387,6 +438,15 @@ impl Governor {
 /// 0.183 when free to go to 1/64).
 fn floor(moving: bool) -> u32 {
     if moving { 4 } else { 8 }
+}
+
+/// The fewest a-trous levels the governor runs at `fraction`: one, or where the frame traces a
+/// pixel of each tile (passes/schedule.rs), enough to reach across the tile's longer side
+/// (levels step 1 to 2^(L-1) pixels, so they reach 2^L - 1): fewer would leave the pixels far
+/// from this frame's samples to their history alone, and a fresh one black.
+pub fn min_levels(fraction: SampleFraction) -> u32 {
+    let (w, h) = crate::passes::schedule::tile(fraction.period());
+    (w.max(h) + 1).next_power_of_two().trailing_zeros().max(1)
 }
 
 fn finite_or(v: f64, or: f64) -> f64 {
@@ -405,18 +465,31 @@ mod tests {
         frames: usize,
         moving: bool,
     ) -> Vec<(Choice, f64)> {
+        run_filtered(g, (fixed, rest, 0.0, trace), frames, moving)
+    }
+
+    /// As [`run_fixed`], with a filter of `g.filter_levels` a-trous levels that each cost
+    /// `area * level` ms, of which a frame runs the choice's.
+    fn run_filtered(
+        g: &mut Governor,
+        (fixed, rest, level, trace): (f64, f64, f64, f64),
+        frames: usize,
+        moving: bool,
+    ) -> Vec<(Choice, f64)> {
         let mut out = vec![];
         for _ in 0..frames {
             let c = g.choice();
             let area = (c.scale * c.scale) as f64;
             let t = area * trace / c.fraction.period() as f64;
-            let scaled = area * rest + t;
+            let filter = area * level * c.levels.min(g.filter_levels) as f64;
+            let scaled = area * rest + filter + t;
             let wall = fixed + scaled;
             out.push((c, wall));
             g.record(FrameCost {
                 wall_ms: wall,
                 trace_ms: t,
                 scaled_ms: scaled,
+                filter_ms: filter,
                 choice: c,
                 moving,
             });
@@ -490,6 +563,7 @@ mod tests {
             wall_ms: 1000.0,
             trace_ms: 400.0,
             scaled_ms: 1000.0,
+            filter_ms: 0.0,
             choice: c,
             moving: false,
         });
@@ -525,6 +599,7 @@ mod tests {
                 wall_ms: 1200.0,
                 trace_ms: 0.0,
                 scaled_ms: 0.0,
+                filter_ms: 0.0,
                 choice: c,
                 moving: false,
             });
@@ -619,6 +694,43 @@ mod tests {
     }
 
     #[test]
+    fn filter_levels_are_turned_down_only_where_nothing_else_fits() {
+        // Scale pinned at 1, every pixel (SVGF): 40 ms of raster and the rest, 25 of trace and
+        // 10 a level of the filter's 5: 115 ms against a 100 ms target. Three levels fit (95).
+        let mut g = Governor::new(100.0);
+        (g.pinned_scale, g.filter_levels) = (Some(1.0), 5);
+        let frames = run_filtered(&mut g, (0.0, 40.0, 10.0, 25.0), 12, true);
+        let (c, t) = *frames.last().unwrap();
+        assert_eq!((c.scale, c.levels), (1.0, 3), "{frames:?}");
+        assert!(frames[1..].iter().all(|(_, t)| *t <= 100.0), "{frames:?}");
+        assert!(t > 90.0, "{c:?} {t}: no more levels were dropped than needed");
+        // A lighter load brings every level back.
+        let frames = run_filtered(&mut g, (0.0, 30.0, 10.0, 15.0), 6, true);
+        assert_eq!(frames.last().unwrap().0.levels, ALL_LEVELS, "{frames:?}");
+        // Where the scale is free, it is the scale that gives way (0.875: 88 ms).
+        let mut g = Governor::new(100.0);
+        g.filter_levels = 5;
+        let frames = run_filtered(&mut g, (0.0, 40.0, 10.0, 25.0), 12, true);
+        let (c, t) = *frames.last().unwrap();
+        assert!(c.levels == ALL_LEVELS && c.scale == 0.875 && t <= 100.0, "{frames:?}");
+        // Below one sample per pixel the levels keep reaching across the fraction's tile: at
+        // 1/16 (4x4 pixels) three (steps 1, 2 and 4) however far over the target.
+        let mut g = Governor::new(100.0);
+        g.pinned_scale = Some(1.0);
+        g.pinned_fraction = Some(SampleFraction::one_in(16).unwrap());
+        (g.fractions_allowed, g.filter_levels) = (true, 5);
+        let frames = run_filtered(&mut g, (0.0, 80.0, 10.0, 25.0), 12, true);
+        assert_eq!(frames.last().unwrap().0.levels, 3, "{frames:?}");
+        let reach = |f: u32| min_levels(SampleFraction::one_in(f).unwrap());
+        assert_eq!([1, 2, 4, 16, 64, 128].map(reach), [1, 2, 2, 3, 4, 5]);
+        // A still view's frames may take 5x the target: every level.
+        let mut g = Governor::new(100.0);
+        (g.pinned_scale, g.filter_levels) = (Some(1.0), 5);
+        let frames = run_filtered(&mut g, (0.0, 40.0, 10.0, 25.0), 12, false);
+        assert_eq!(frames.last().unwrap().0.levels, ALL_LEVELS, "{frames:?}");
+    }
+
+    #[test]
     fn pins_are_kept_and_bad_timings_do_not_break_it() {
         let mut g = Governor::new(100.0);
         g.fractions_allowed = true;
@@ -635,6 +747,7 @@ mod tests {
                 wall_ms: wall,
                 trace_ms: f64::NAN,
                 scaled_ms: f64::NAN,
+                filter_ms: 0.0,
                 choice: c,
                 moving: false,
             });
@@ -655,7 +768,8 @@ mod tests {
         run_fixed(&mut g, (40.0, 400.0, 2000.0), 10, true);
         // Its prediction holds for a choice it has not run: 40 + 0.25 (400 + 500) = 265 ms,
         // where a model that scales everything would say 0.25 x 4 x the frame it ran.
-        let c = Choice { scale: 0.5, fraction: SampleFraction::one_in(4).unwrap() };
+        let c =
+            Choice { scale: 0.5, fraction: SampleFraction::one_in(4).unwrap(), levels: ALL_LEVELS };
         let t = g.predict(c).unwrap();
         assert!((t - 265.0).abs() < 1e-6, "{t}");
         // The fixed part alone over the target: the frame still gets SCALABLE_FLOOR of it for
@@ -692,7 +806,7 @@ mod tests {
         assert!(rate_still > 13.0 * rate_moving, "{rate_still} against {rate_moving}");
         // No other fraction within the limit traces more.
         for f in SampleFraction::all() {
-            let o = Choice { scale: 0.25, fraction: f };
+            let o = Choice { scale: 0.25, fraction: f, levels: ALL_LEVELS };
             if g.predict(o).unwrap() <= STILL_RATIO * 100.0 {
                 assert!(g.samples_per_second(o).unwrap() <= rate_still, "{o:?}");
             }

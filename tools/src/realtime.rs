@@ -206,6 +206,9 @@ pub struct GovernedFrame {
     pub gpu_ms: f64,
     pub spp: f64,
     pub size: (u32, u32),
+    /// The denoiser's a-trous levels the frame ran (the governor may turn them down), where it
+    /// has them.
+    pub levels: Option<u32>,
 }
 
 /// Render one frame at the governor's choice (its scale of `full`, its sample fraction) and
@@ -226,7 +229,8 @@ pub fn governed_frame(
         (full.0 as f32 * c.scale).round().max(1.0) as u32,
         (full.1 as f32 * c.scale).round().max(1.0) as u32,
     );
-    let s = FrameSettings { sample_fraction: c.fraction, ..settings.clone() };
+    let mut s = FrameSettings { sample_fraction: c.fraction, ..settings.clone() };
+    hush_engine::settings::cap_filter_levels(&mut s, c.levels);
     let start = std::time::Instant::now();
     r.resize(gpu, size)?;
     r.render(gpu, input, &s, None)?;
@@ -240,6 +244,7 @@ pub fn governed_frame(
         gpu_ms: passes.iter().map(|p| p.1).sum(),
         spp: s.samples_per_pixel as f64 / c.fraction.period() as f64,
         size,
+        levels: hush_engine::settings::filter_levels(&s),
     })
 }
 
@@ -269,6 +274,7 @@ fn governed(
     g.pinned_fraction = pinned;
     g.fractions_allowed = r.fills_untraced_pixels(gpu, settings)?;
     g.keeps_history = settings.resample_history_frames > 0.0;
+    g.filter_levels = hush_engine::settings::filter_levels(settings).unwrap_or(0);
     let mut rows = vec![];
     let mut last_camera = None;
     for (k, input) in inputs.enumerate() {
@@ -278,10 +284,11 @@ fn governed(
         }
     }
     if let Some(dir) = out_dir {
-        let mut csv = String::from("frame,wall_ms,gpu_ms,spp,width,height\n");
+        let mut csv = String::from("frame,wall_ms,gpu_ms,spp,width,height,levels\n");
         for (k, f) in rows.iter().enumerate() {
+            let levels = f.levels.map_or(String::new(), |l| l.to_string());
             csv += &format!(
-                "{k},{:.3},{:.3},{},{},{}\n",
+                "{k},{:.3},{:.3},{},{},{},{levels}\n",
                 f.wall_ms, f.gpu_ms, f.spp, f.size.0, f.size.1
             );
         }

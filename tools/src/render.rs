@@ -62,9 +62,9 @@ pub struct RenderArgs {
     #[arg(long)]
     pub cpu_posing: bool,
     /// Real-time mode: hold this frame time (ms) with the governor, which picks the resolution
-    /// scale and (for denoisers that fill untraced pixels) the sample fraction each frame; with
-    /// --out-dir, writes frames.csv (frame, wall_ms, gpu_ms, spp, width, height). --spp pins the
-    /// fraction.
+    /// scale and (for denoisers that fill untraced pixels) the sample fraction each frame, and
+    /// where nothing else fits, fewer a-trous levels; with --out-dir, writes frames.csv (frame,
+    /// wall_ms, gpu_ms, spp, width, height, levels). --spp pins the fraction.
     #[arg(long)]
     pub target_ms: Option<f64>,
     /// Real-time mode with --target-ms: the smallest resolution scale per side (default 0.25).

@@ -329,6 +329,7 @@ fn follow(
             let mut g = Governor::new(t);
             g.fractions_allowed = renderer.fills_untraced_pixels(gpu, &settings)?;
             g.keeps_history = settings.resample_history_frames > 0.0;
+            g.filter_levels = hush_engine::settings::filter_levels(&settings).unwrap_or(0);
             g.pinned_fraction = run.spp.map(|_| sample_fraction);
             g
         }

@@ -63,4 +63,7 @@ pub struct DenoiserInfo {
     pub views: &'static [ViewSpec],
     /// It takes sample fractions below 1 (it fills the pixels a frame did not trace).
     pub fractions: bool,
+    /// Dotted path of its setting that counts the a-trous levels of its spatial filter, which
+    /// the frame-time governor may turn down where nothing else fits (`crate::governor`).
+    pub levels: Option<&'static str>,
 }

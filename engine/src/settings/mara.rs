@@ -30,6 +30,7 @@ pub const INFO: DenoiserInfo = DenoiserInfo {
     ],
     views: VIEWS,
     fractions: false,
+    levels: None,
 };
 
 /// The views of the Mara denoiser's chains (`crate::denoise::mara`), kept beside their settings

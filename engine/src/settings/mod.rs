@@ -261,3 +261,32 @@ pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
         Err(_) => false,
     }
 }
+
+/// The a-trous levels the chosen denoiser's settings ask for, where it declares them
+/// ([`DenoiserInfo::levels`]: SVGF, the progressive filter); None for Mara's chains and `none`.
+pub fn filter_levels(s: &FrameSettings) -> Option<u32> {
+    let info = registry::denoisers().into_iter().find(|d| d.name == s.denoiser.name())?;
+    let levels = get_field(&s.to_value(), info.levels?)?.as_u64()?;
+    u32::try_from(levels).ok()
+}
+
+/// The chosen denoiser's a-trous levels brought down to `cap` where they are more (the
+/// frame-time governor's [`crate::governor::Choice::levels`]); other settings and other
+/// denoisers are left as they are.
+pub fn cap_filter_levels(s: &mut FrameSettings, cap: u32) {
+    let Some(levels) = filter_levels(s) else { return };
+    if levels <= cap {
+        return;
+    }
+    let Some(info) = registry::denoisers().into_iter().find(|d| d.name == s.denoiser.name()) else {
+        return;
+    };
+    let mut v = s.to_value();
+    if let Some(field) = info.levels.and_then(|path| get_field_mut(&mut v, path)) {
+        *field = Value::from(cap);
+    }
+    // The cap is below a value the settings already held, so it is in range.
+    if let Ok(capped) = FrameSettings::from_value(&v) {
+        *s = capped;
+    }
+}

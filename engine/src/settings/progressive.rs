@@ -96,6 +96,7 @@ pub const INFO: DenoiserInfo = DenoiserInfo {
     ],
     views: VIEWS,
     fractions: true,
+    levels: Some("progressive.levels"),
 };
 
 /// The progressive filter's views (`crate::denoise::progressive`).

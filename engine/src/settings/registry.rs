@@ -23,6 +23,7 @@ pub const NONE: DenoiserInfo = DenoiserInfo {
     stages: &[],
     views: &[],
     fractions: true,
+    levels: None,
 };
 
 /// The denoisers built into Hush, in the order the viewer lists them.

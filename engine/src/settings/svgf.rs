@@ -249,6 +249,7 @@ pub const INFO: DenoiserInfo = DenoiserInfo {
     ],
     views: VIEWS,
     fractions: false,
+    levels: Some("svgf.levels"),
 };
 
 /// The views of SVGF (`crate::denoise::svgf`): every intermediate of both signals.
