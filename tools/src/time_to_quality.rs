@@ -382,15 +382,17 @@ fn follow(
 }
 
 fn write_outputs(a: &TimeToQualityArgs, curves: &[Curve], full: (u32, u32)) -> Result<()> {
-    let mut csv = String::from("run,scenario,frame,end_s,wall_ms,gpu_ms,spp,width,height,flip\n");
+    let mut csv =
+        String::from("run,scenario,frame,end_s,wall_ms,gpu_ms,spp,width,height,levels,flip\n");
     let mut at = String::from("run,scenario,seconds,flip\n");
     for c in curves {
         let (run, sc) = (&c.run.label, c.scenario.name());
-        writeln!(csv, "{run},{sc},-1,0,0,0,0,{},{},{:.5}", full.0, full.1, c.timeline.before)?;
+        writeln!(csv, "{run},{sc},-1,0,0,0,0,{},{},,{:.5}", full.0, full.1, c.timeline.before)?;
         for (k, (f, (end, flip))) in c.frames.iter().zip(&c.timeline.frames).enumerate() {
+            let levels = f.levels.map_or(String::new(), |l| l.to_string());
             writeln!(
                 csv,
-                "{run},{sc},{k},{end:.4},{:.3},{:.3},{},{},{},{flip:.5}",
+                "{run},{sc},{k},{end:.4},{:.3},{:.3},{},{},{},{levels},{flip:.5}",
                 f.wall_ms, f.gpu_ms, f.spp, f.size.0, f.size.1
             )?;
         }

@@ -389,7 +389,7 @@ fn governed_render_writes_frames_csv() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows[0], ["frame", "wall_ms", "gpu_ms", "spp", "width", "height"]);
+    assert_eq!(rows[0], ["frame", "wall_ms", "gpu_ms", "spp", "width", "height", "levels"]);
     assert_eq!(rows.len(), 9, "{csv}");
     for (k, r) in rows[1..].iter().enumerate() {
         assert_eq!(r[0], k.to_string());
@@ -401,7 +401,22 @@ fn governed_render_writes_frames_csv() {
     }
     // 1 ms cannot be met: from the second frame on, the smallest scale and fraction.
     let last = &rows[8];
-    assert_eq!((last[3], last[4], last[5]), ("0.0078125", "32", "18"), "{csv}");
+    assert_eq!((last[3], last[4], last[5], last[6]), ("0.0078125", "32", "18", ""), "{csv}");
+
+    // SVGF with its scale pinned: what cannot be met turns its a-trous levels down to one from
+    // the second frame on (the first has nothing to predict from).
+    let dir = temp_dir("governed-levels");
+    let o = hush_cli()
+        .args(["render", "level", "--mode", "realtime", "--target-ms", "1", "--frames", "3"])
+        .args(["--width", "32", "--height", "18", "--min-scale", "1", "--denoiser", "svgf"])
+        .arg("--out-dir")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    let levels: Vec<&str> = csv.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
+    assert_eq!(levels, ["5", "1", "1"], "{csv}");
 }
 
 #[test]
@@ -447,7 +462,7 @@ fn time_to_quality_follows_each_run_past_the_last_time() {
                 ends.windows(2).all(|w| w[1] >= w[0]) && *ends.last().unwrap() >= 0.4,
                 "{run} {sc}: {ends:?}"
             );
-            assert!(rows.iter().all(|r| r[9].parse::<f64>().unwrap().is_finite()), "{frames}");
+            assert!(rows.iter().all(|r| r[10].parse::<f64>().unwrap().is_finite()), "{frames}");
         }
     }
     assert!(
