@@ -1,12 +1,13 @@
 //! A frame-time governor: picks the resolution scale and the sample fraction (Dundr et al. §5)
-//! that hold a target frame time on whatever device runs, from the frames it has seen.
+//! that hold a target frame time on whatever device runs, from the frames it has seen, and
+//! where neither can, fewer of the denoiser's a-trous levels.
 //!
-//! Model: a frame at scale s (of each side) and fraction f costs
-//! `fixed + s^2 (rest + trace f)` ms, where `trace` is the trace pass's time per
-//! full-resolution frame at f = 1, `rest` the other passes that run at the frame's resolution
-//! (raster, denoiser), and `fixed` what no choice changes: the wall time outside those passes
-//! (the CPU's recording, the viewer's UI and present) and the display pass, which draws at the
-//! window's size. All three are re-estimated after every frame from its wall time and its
+//! Model: a frame at scale s (of each side), fraction f and L a-trous levels costs
+//! `fixed + s^2 (rest + level L + trace f)` ms, where `trace` is the trace pass's time per
+//! full-resolution frame at f = 1, `level` one a-trous level's, `rest` the other passes that run
+//! at the frame's resolution (raster, the rest of the denoiser), and `fixed` what no choice
+//! changes: the wall time outside those passes (the CPU's recording, the viewer's UI and
+//! present) and the display pass, which draws at the window's size. All four are re-estimated after every frame from its wall time and its
 //! passes' GPU times, and smoothed by the median of the last [`WINDOW`] frames: one slow frame
 //! (a hitch, a shader compile) moves nothing, a load that lasts (another program) is followed
 //! within three frames, and two frames in a row over [`OVER`] x the frame's limit (a cut to a
@@ -33,6 +34,10 @@
 //! last change. It falls at once when the prediction is over the frame's limit: while the
 //! camera moves to the choice that fits the target, in a still view to the largest scale, at
 //! or below its own, that fits the still limit.
+//!
+//! Levels: where even the smallest scale and fraction it may take overruns the frame's limit
+//! (a pinned scale, a device too slow for the smallest), it drops the filter's widest levels
+//! until the frame fits, down to [`min_levels`], and runs all of them again once they fit.
 
 use crate::settings::SampleFraction;
 
