@@ -259,8 +259,8 @@ impl Running {
         p.settings.sample_fraction = choice.fraction;
         let predicted = g.predict(choice).map_or(String::new(), |t| format!(", about {t:.0} ms"));
         let still = if g.still() { " (still view: most samples per second)" } else { "" };
-        let levels = match hush_engine::settings::filter_levels(&p.settings) {
-            Some(l) if choice.levels < l => format!(", {} of {l} a-trous levels", choice.levels),
+        let levels = match g.filter_levels {
+            l if choice.levels < l => format!(", {} of {l} a-trous levels", choice.levels),
             _ => String::new(),
         };
         p.governor.choice =

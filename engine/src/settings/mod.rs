@@ -265,28 +265,32 @@ pub fn disable_stage(s: &mut FrameSettings, name: &str) -> bool {
 /// The a-trous levels the chosen denoiser's settings ask for, where it declares them
 /// ([`DenoiserInfo::levels`]: SVGF, the progressive filter); None for Mara's chains and `none`.
 pub fn filter_levels(s: &FrameSettings) -> Option<u32> {
-    let info = registry::denoisers().into_iter().find(|d| d.name == s.denoiser.name())?;
-    let levels = get_field(&s.to_value(), info.levels?)?.as_u64()?;
-    u32::try_from(levels).ok()
+    levels_at(&s.to_value(), levels_path(s)?)
 }
 
 /// The chosen denoiser's a-trous levels brought down to `cap` where they are more (the
 /// frame-time governor's [`crate::governor::Choice::levels`]); other settings and other
 /// denoisers are left as they are.
 pub fn cap_filter_levels(s: &mut FrameSettings, cap: u32) {
-    let Some(levels) = filter_levels(s) else { return };
-    if levels <= cap {
+    let Some(path) = levels_path(s) else { return };
+    let mut v = s.to_value();
+    if levels_at(&v, path).is_none_or(|levels| levels <= cap) {
         return;
     }
-    let Some(info) = registry::denoisers().into_iter().find(|d| d.name == s.denoiser.name()) else {
-        return;
-    };
-    let mut v = s.to_value();
-    if let Some(field) = info.levels.and_then(|path| get_field_mut(&mut v, path)) {
+    if let Some(field) = get_field_mut(&mut v, path) {
         *field = Value::from(cap);
     }
     // The cap is below a value the settings already held, so it is in range.
     if let Ok(capped) = FrameSettings::from_value(&v) {
         *s = capped;
     }
+}
+
+/// The dotted path of the chosen denoiser's a-trous levels, where it has them.
+fn levels_path(s: &FrameSettings) -> Option<&'static str> {
+    registry::denoiser(s.denoiser.name()).ok()?.levels
+}
+
+fn levels_at(v: &Value, path: &str) -> Option<u32> {
+    u32::try_from(get_field(v, path)?.as_u64()?).ok()
 }
