@@ -9,10 +9,10 @@
 //   surface would have as a primary hit (the trace's area-light sample and matte path), added
 //   to that surface's cell. This fills cells of surfaces the camera does not see (behind a
 //   pillar, around a corner) before a move uncovers them.
+// `seen_last_frame` (realtime/seen.wgsl) decides which pixels the last frame did not see.
 
 var gb_ids: texture_2d<u32>;
 var tr_matte: texture_2d<f32>;
-var prev_depth: texture_depth_2d;
 // rgb: the cell's mean; a: the frames' worth of samples it stands for (0: no cell).
 var out_prior: texture_storage_2d<rgba16float, write>;
 // The prior's mean squared luminance (0: no prior).
@@ -42,29 +42,6 @@ fn cache_surface(hit: Hit, rd: vec3f) -> CacheSurface {
 
 fn cell_of(s: Surface) -> CellKey {
     return cell_key(s.p, s.ns, frame.cam_pos.xyz, pixel_spread());
-}
-
-// The last frame saw p: its depth buffer holds p's depth (within 2%) at one of the 3x3 texels
-// where p projects into it (both frames' depths were drawn with a sub-pixel jitter, which on a
-// grazing floor moves a texel's depth by more than 2%). Reversed infinite Z: depth = near / view
-// depth = clip z / clip w.
-fn seen_last_frame(p: vec3f) -> bool {
-    let clip = frame.prev_view_proj * vec4f(p, 1.0);
-    if clip.w <= 0.0 {
-        return false;
-    }
-    let t = vec2i(floor(to_pixels(clip)));
-    if any(t < vec2i(0)) || any(t >= vec2i(frame.size)) {
-        return false;
-    }
-    let expected = clip.z / clip.w;
-    for (var k = 0; k < 9; k++) {
-        let q = clamp(t + vec2i(k % 3 - 1, k / 3 - 1), vec2i(0), vec2i(frame.size) - 1);
-        if abs(textureLoad(prev_depth, q, 0) - expected) <= 0.02 * expected {
-            return true;
-        }
-    }
-    return false;
 }
 
 @compute @workgroup_size(8, 8)

@@ -104,14 +104,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         result = mix(clamped, current, new_frame_weight(c, n, dn.still_frames, still));
     }
-    // A history that restarts here (a surface a move uncovered) starts from the radiance
-    // cache's prior where there is one (passes/cache.rs): its cell's mean, weighed as the
-    // frames' worth of samples it holds, instead of this one sample.
+    // A history that restarts here (a surface a move uncovered) counts this frame's sample as
+    // the paths the trace averaged into it (more where it saw the surface uncovered), and
+    // starts from the radiance cache's prior where there is one (passes/cache.rs): its cell's
+    // mean, weighed as the frames' worth of samples it holds, instead of this one sample.
     if c <= 0.0 && dn.history_valid != 0u {
+        n = matte_paths(p);
         let prior = cache_prior_at(p);
         if prior.a > 0.0 {
-            result = mix(prior.rgb, current, 1.0 / (1.0 + prior.a));
-            n = 1.0 + prior.a;
+            result = mix(prior.rgb, current, n / (n + prior.a));
+            n += prior.a;
         }
     }
     textureStore(out_temporal, p, vec4f(half_safe(result), c));

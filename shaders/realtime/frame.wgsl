@@ -32,6 +32,9 @@ struct Frame {
     // On the first frame after a change of size whose histories were resampled to it
     // (realtime/rescale.wgsl): the most frames a history may count (0 on every other frame).
     rescaled_frames: f32,
+    // Paths per pixel where the surface was not on screen last frame (realtime/uncovered.wgsl;
+    // 0 where no frame before is there to test against).
+    uncovered_paths: u32,
 }
 
 var<uniform> frame: Frame;

@@ -12,6 +12,12 @@ var tr_direct: texture_2d<f32>;
 
 const NO_SURFACE: u32 = 0xffffffffu;
 
+// The paths the pixel's matte light averages (realtime/uncovered.wgsl: more where a move
+// uncovered the surface); 1 where the supersampling mixed it.
+fn matte_paths(p: vec2i) -> f32 {
+    return clamp(textureLoad(tr_matte, p, 0).a, 1.0, 64.0);
+}
+
 struct GSample {
     hit: bool,
     n: vec3f,

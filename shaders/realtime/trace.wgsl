@@ -27,8 +27,9 @@ var tr_mean_emission: texture_2d<f32>;
 var out_matte: texture_storage_2d<rgba16float, write>;
 var out_direct: texture_storage_2d<rgba16float, write>;
 
-fn write_all(px: vec2u, matte: vec3f, direct: vec3f) {
-    textureStore(out_matte, px, vec4f(half_safe(matte), 1.0));
+// The matte light's alpha: the paths its estimate averages (realtime/uncovered.wgsl).
+fn write_all(px: vec2u, matte: vec3f, direct: vec3f, paths: u32) {
+    textureStore(out_matte, px, vec4f(half_safe(matte), f32(paths)));
     textureStore(out_direct, px, vec4f(half_safe(direct), 1.0));
 }
 
@@ -98,8 +99,9 @@ fn safe_ratio(a: vec3f, b: vec3f) -> vec3f {
     return select(vec3f(0.0), a / max(b, vec3f(1e-20)), b > vec3f(0.0));
 }
 
-// One factored sample at the hit of camera ray direction rd.
-fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
+// One factored sample at the hit of camera ray direction rd, its area-light sample and paths
+// averaged over `path_count` independent ones.
+fn shade(rd: vec3f, hit: Hit, path_count: u32, rng: ptr<function, u32>) -> Shaded {
     let eps = params.cam_pos.w;
     let s = surface_at(hit, rd);
     let m = material(s.material);
@@ -109,7 +111,7 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
     let ms = material_at(m, s.tc);
     let bsdf = with_glass(material_bsdf(m, ms), m, ms, s.front);
     if bsdf.transmission > 0.0 {
-        return shade_glass(rd, hit, s, ms, rng);
+        return shade_glass(rd, hit, s, ms, path_count, rng);
     }
     let basis = onb(s.ns);
     let wo = to_local(basis, -rd);
@@ -133,8 +135,7 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
 
     direct = punctual_light(s, bsdf, wo, basis, origin);
 
-    // `frame.paths` independent samples of the area lights and of each path, averaged.
-    let paths = max(frame.paths, 1u);
+    let paths = max(path_count, 1u);
     for (var k = 0u; k < paths; k++) {
         let groups = area_groups();
         let nee_select = 1.0 / f32(max(groups, 1u));
@@ -209,9 +210,9 @@ fn shade(rd: vec3f, hit: Hit, rng: ptr<function, u32>) -> Shaded {
 // mode. A pixel has one motion vector: the refracted image is reprojected with the glass
 // surface (virtual distance 0), which is exact for a still camera and thin glass, and lags for
 // thick glass under motion.
-fn shade_glass(rd: vec3f, hit: Hit, s: Surface, ms: MaterialSample, rng: ptr<function, u32>) -> Shaded {
+fn shade_glass(rd: vec3f, hit: Hit, s: Surface, ms: MaterialSample, path_count: u32, rng: ptr<function, u32>) -> Shaded {
     let ro = s.p - rd * hit.t;
-    let paths = max(frame.paths, 1u);
+    let paths = max(path_count, 1u);
     var glossy = vec3f(0.0);
     for (var k = 0u; k < paths; k++) {
         glossy += trace_path(camera_path(ro, rd), rng).radiance;
@@ -240,17 +241,18 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let ids = textureLoad(gb_ids, px, 0).xy;
     if ids.y == NO_HIT {
         // Background: what the camera sees of the environment goes straight to the screen.
-        write_all(px, vec3f(0.0), env_radiance(rd));
+        write_all(px, vec3f(0.0), env_radiance(rd), 1u);
         write_glossy(px, vec3f(0.0), INF, rd, rd, vec3f(1.0), -rd, INF);
         return;
     }
     let hit = raster_hit(ro, rd, ids);
-    var sh = shade(rd, hit, &rng);
+    let paths = pixel_paths(ro + rd * hit.t);
+    var sh = shade(rd, hit, paths, &rng);
     if frame.primary_samples > 1u && !sh.backface {
         let r = own_over_mean(px, hit, rd);
         sh.matte *= r.matte;
         sh.glossy *= r.glossy;
     }
-    write_all(px, sh.matte, sh.direct);
+    write_all(px, sh.matte, sh.direct, paths);
     write_glossy(px, sh.glossy, sh.glossy_t, select(ro - frame.cam_pos.xyz + rd * hit.t, rd, sh.backface), sh.mirror, sh.hit_reflectance, sh.hit_normal, sh.representative_t);
 }

@@ -15,6 +15,24 @@ var out_integrated: texture_storage_2d<rgba32float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
 var out_features: texture_storage_2d<rg32float, write>;
 
+// The luminance variance of the matte light over the 3x3 pixels with a surface that averaged k
+// paths, as this one did (0 where fewer than two did).
+fn paths_variance(p: vec2i, k: f32) -> f32 {
+    var m = vec3f(0.0);
+    for (var j = 0; j < 9; j++) {
+        let q = p + vec2i(j % 3 - 1, j / 3 - 1);
+        if in_bounds(q) && has_surface(q) && matte_paths(q) == k {
+            let l = luminance(half_safe(matte_input(q)));
+            m += vec3f(1.0, l, l * l);
+        }
+    }
+    if m.x < 2.0 {
+        return 0.0;
+    }
+    let mean = m.y / m.x;
+    return max(m.z / m.x - mean * mean, 0.0) * m.x / (m.x - 1.0);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     let p = vec2i(gid.xy);
@@ -56,16 +74,25 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
     }
     var i = integrate(current, hist, mom, reprojected);
-    // A history that restarts here starts from the radiance cache's prior where there is one
-    // (passes/cache.rs), as `prior.a` samples of the cell's mean beside this one, and its moments
-    // from the cell's samples' (their luminance's mean and mean square): a history of 1 + a
-    // frames takes its variance from the moments, and one sample's would be 0.
+    // A history that restarts here counts this frame's sample as the k paths the trace averaged
+    // into it (more where it saw the surface uncovered: realtime/uncovered.wgsl), and starts
+    // from the radiance cache's prior where there is one (passes/cache.rs), as `prior.a`
+    // samples of the cell's mean beside them. Its moments are one path's, as the history's
+    // are: the k-path mean's luminance, and k times the variance of that mean across the
+    // neighbours that took k paths too; the prior's from the cell's samples (their luminance's
+    // mean and mean square). A history of k + a paths takes its variance from the moments (the
+    // variance pass's spatial estimate is for fewer than 4), and one sample's would be 0.
     if !reprojected && sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
+        let k = matte_paths(p);
+        if k > 1.0 {
+            let l = luminance(current);
+            i = Integrated(current, vec4f(l, l * l + k * paths_variance(p, k), k, 1.0 / k));
+        }
         let prior = cache_prior_at(p);
         if prior.a > 0.0 {
-            let w = 1.0 / (1.0 + prior.a);
+            let w = k / (k + prior.a);
             let m = mix(vec2f(luminance(prior.rgb), cache_prior_m2_at(p)), i.moments.xy, w);
-            i = Integrated(mix(prior.rgb, current, w), vec4f(m, 1.0 + prior.a, w));
+            i = Integrated(mix(prior.rgb, current, w), vec4f(m, k + prior.a, 1.0 / (k + prior.a)));
         }
     }
     textureStore(out_integrated, p, vec4f(half_safe(i.light), luminance(current)));

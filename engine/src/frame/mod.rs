@@ -186,8 +186,13 @@ impl Renderer {
         let moving = prepared.shutter_moves();
         let scene_in =
             SceneInputs { scene: &gpu_scene, params: &u.params, frame: &u.frame, moving };
-        let trace_in =
-            TraceInputs { scene: scene_in, g: &targets.gbuffer, t: &targets.trace, cache: None };
+        let trace_in = TraceInputs {
+            scene: scene_in,
+            g: &targets.gbuffer,
+            t: &targets.trace,
+            cache: None,
+            previous_depth: None,
+        };
         let trace = TracePass::new(gpu, &trace_in).context("creating the trace pass")?;
         let io = targets.io(&u.frame, &gpu_scene);
         let composite = CompositePass::new(gpu, &u.shown(&targets, &io, None))

@@ -34,7 +34,10 @@ pub struct FrameParams {
     /// On the first frame after a change of size whose histories were resampled to it
     /// (passes/rescale.rs): the most frames a history may count; 0 on every other frame.
     pub rescaled_frames: f32,
-    pub _pad: [u32; 3],
+    /// Paths per pixel where the pixel's surface was not on screen last frame
+    /// (`FrameSettings::uncovered_paths`); 0 where the frame has no history to test against.
+    pub uncovered_paths: u32,
+    pub _pad: [u32; 2],
 }
 
 impl FrameParams {
@@ -66,7 +69,7 @@ impl FrameParams {
             index,
             exposure: settings.exposure_scale(),
             accumulated,
-            paths: settings.paths_per_pixel.clamp(1, 64),
+            paths: settings.paths_per_pixel.clamp(1, crate::settings::MAX_PATHS_PER_PIXEL),
             representative_roughness,
             samples: if accumulated > 0 {
                 1
@@ -76,7 +79,8 @@ impl FrameParams {
             period: if accumulated > 0 { 1 } else { settings.sample_fraction.period() },
             primary_samples: 0,
             rescaled_frames: 0.0,
-            _pad: [0; 3],
+            uncovered_paths: 0,
+            _pad: [0; 2],
         }
     }
 }

@@ -7,7 +7,9 @@ use crate::gpu::{BindKey, Gpu, Parity};
 use crate::passes::converge::ConvergeParams;
 use crate::passes::matte::ChainView;
 use crate::passes::reference::{TraceView, make_params};
-use crate::settings::{FrameSettings, MAX_PRIMARY_SAMPLES, MAX_SAMPLES_PER_PIXEL};
+use crate::settings::{
+    FrameSettings, MAX_PATHS_PER_PIXEL, MAX_PRIMARY_SAMPLES, MAX_SAMPLES_PER_PIXEL,
+};
 use anyhow::{Context, Result, bail};
 use glam::{Mat4, Vec2};
 
@@ -116,7 +118,20 @@ impl Renderer {
         };
         let converge = self.converge_plan(gpu, input, settings, (denoiser, samples), &view);
         let denoised = denoiser.is_some();
-        self.upload(gpu, input, settings, (&cam, jittered, jitter), denoised, primary_samples);
+        // Extra paths where a move uncovered a surface only where a history is there to restart
+        // (on a cut, a first frame or a change of denoiser every pixel would take them) and
+        // something moved: in a still frame nothing is uncovered, and the depth test flags a
+        // grazing floor's pixels under TAA's jitter (1% of the level's at 320x180).
+        let uncovered_paths =
+            if view.history_valid && !view.static_view { settings.uncovered_paths } else { 0 };
+        self.upload(
+            gpu,
+            input,
+            settings,
+            (&cam, jittered, jitter),
+            denoised,
+            (primary_samples, uncovered_paths),
+        );
         self.history.denoised_last = denoiser;
         if let Some(target) = target {
             self.prepare_display(gpu, target, settings)?;
@@ -325,7 +340,7 @@ impl Renderer {
         settings: &FrameSettings,
         (cam, jittered, jitter): (&super::CameraSetup, Mat4, Vec2),
         denoised: bool,
-        primary_samples: u32,
+        (primary_samples, uncovered_paths): (u32, u32),
     ) {
         let (size, h) = (self.targets.size, &self.history);
         let g = &settings.glossy;
@@ -352,6 +367,7 @@ impl Renderer {
             representative,
         );
         fp.primary_samples = primary_samples;
+        fp.uncovered_paths = uncovered_paths.min(MAX_PATHS_PER_PIXEL);
         if self.rescale_from.is_some() {
             fp.rescaled_frames = settings.resample_history_frames;
         }

@@ -106,7 +106,11 @@ impl Renderer {
             p.record(&mut rec, gpu_scene);
         }
         let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
-        let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace, cache: None };
+        // The previous depth is this frame's last frame only where a denoiser ran (it is copied
+        // after a denoised frame).
+        let previous_depth =
+            t.previous.as_ref().filter(|_| plan.denoiser.is_some()).map(|p| &p.depth.1);
+        let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace, cache: None, previous_depth };
         let mut io = t.io(&u.frame, gpu_scene);
         io.feature_uncertainty =
             t.prefilter.as_ref().filter(|_| plan.prefilter).map(|pf| &pf.view.1);

@@ -240,6 +240,7 @@ fn scene_program(
         "realtime/frame.wgsl",
         "realtime/lens.wgsl",
         "realtime/area_light.wgsl",
+        "realtime/seen.wgsl",
         "cache/update.wgsl",
     ]);
     Reloadable::new(

@@ -96,7 +96,13 @@ pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
     } else {
         "realtime/trace_glossy_none.wgsl"
     });
-    m.extend(["realtime/trace.wgsl", "supersample/common.wgsl", "supersample/samples.wgsl"]);
+    // Its samples trace frame.paths: the uncovered pixels' extra paths are the guide's.
+    m.extend([
+        "realtime/uncovered_none.wgsl",
+        "realtime/trace.wgsl",
+        "supersample/common.wgsl",
+        "supersample/samples.wgsl",
+    ]);
     m
 }
 

@@ -52,11 +52,13 @@ impl TraceTargets {
     }
 }
 
-/// The trace's programs, made on first use: static or moving shutter (motion blur), and with
-/// or without matte paths that end in the radiance cache (shaders/cache/path_end.wgsl).
+/// The trace's programs, made on first use: static or moving shutter (motion blur), with or
+/// without matte paths that end in the radiance cache (shaders/cache/path_end.wgsl), and with
+/// or without the previous depth that tells which pixels a move uncovered
+/// (shaders/realtime/uncovered.wgsl).
 #[derive(Default)]
 pub struct TracePass {
-    programs: [Option<(crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>; 4],
+    programs: [Option<(crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>; 8],
 }
 
 fn program(
@@ -77,6 +79,11 @@ fn program(
     } else {
         "realtime/trace_glossy_none.wgsl"
     });
+    if inputs.previous_depth.is_some() {
+        modules.extend(["realtime/seen.wgsl", "realtime/uncovered.wgsl"]);
+    } else {
+        modules.push("realtime/uncovered_none.wgsl");
+    }
     modules.push("realtime/trace.wgsl");
     crate::shader::Reloadable::new(
         gpu,
@@ -106,20 +113,22 @@ impl<'a> SceneInputs<'a> {
     }
 }
 
-/// What the trace reads and writes: the scene, the G-buffer and its own outputs, and the
-/// radiance cache's table where matte paths may end in it.
+/// What the trace reads and writes: the scene, the G-buffer and its own outputs, the radiance
+/// cache's table where matte paths may end in it, and the previous frame's depth where a
+/// denoiser keeps histories (uncovered pixels trace `FrameSettings::uncovered_paths`).
 #[derive(Clone, Copy)]
 pub struct TraceInputs<'a> {
     pub scene: SceneInputs<'a>,
     pub g: &'a GBufferTargets,
     pub t: &'a TraceTargets,
     pub cache: Option<&'a super::cache::CacheCells>,
+    pub previous_depth: Option<&'a wgpu::TextureView>,
 }
 
 impl<'a> TraceInputs<'a> {
     /// What the trace (and the supersampling's samples pass, which shades as it does) binds.
     pub fn bindings(&self) -> Bindings<'a> {
-        let b = bindings(self.scene, self.g, self.t);
+        let b = bindings(self.scene, self.g, self.t).texture_opt("prev_depth", self.previous_depth);
         match self.cache {
             Some(c) => c.bindings(b),
             None => b,
@@ -168,7 +177,9 @@ impl TracePass {
     ) -> Result<()> {
         use crate::shader::Reload;
         let moving = inputs.scene.moving;
-        let slot = &mut self.programs[moving as usize + 2 * inputs.cache.is_some() as usize];
+        let slot = &mut self.programs[moving as usize
+            + 2 * inputs.cache.is_some() as usize
+            + 4 * inputs.previous_depth.is_some() as usize];
         if slot.is_none() {
             *slot = Some((program(rec.gpu, inputs, moving)?, BindCache::default()));
         }

@@ -66,8 +66,15 @@ const FRAME_FIELDS: &[Field] = &[
         "paths_per_pixel",
         "trace",
         "paths",
-        Int(1, 64),
+        Int(1, super::MAX_PATHS_PER_PIXEL as i64),
         "Indirect paths per pixel per frame (1 is the paper's real-time setting).",
+    ),
+    f(
+        "uncovered_paths",
+        "trace",
+        "paths",
+        Int(0, super::MAX_PATHS_PER_PIXEL as i64),
+        "Paths per pixel where a move uncovered the surface (a denoiser's history restarts there and counts them as that many frames); 0: off.",
     ),
     f(
         "samples_per_pixel",

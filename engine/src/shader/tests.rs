@@ -374,16 +374,22 @@ fn all_programs() -> Vec<Program> {
                 "realtime/area_light.wgsl",
                 glossy,
             ]);
+            // With the cache, the trace of a denoised frame: the previous depth's uncovered test.
             let mut cached_trace = crate::passes::cache::with_path_ends(m.clone());
-            cached_trace.push("realtime/trace.wgsl");
+            cached_trace.extend([
+                "realtime/seen.wgsl",
+                "realtime/uncovered.wgsl",
+                "realtime/trace.wgsl",
+            ]);
             let name = format!("realtime trace with the cache {bvh} {i}");
             v.push(compose(&name, &prelude, &cached_trace).unwrap());
-            m.push("realtime/trace.wgsl");
+            m.extend(["realtime/uncovered_none.wgsl", "realtime/trace.wgsl"]);
             v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
             cache.extend([
                 "realtime/frame.wgsl",
                 "realtime/lens.wgsl",
                 "realtime/area_light.wgsl",
+                "realtime/seen.wgsl",
                 "cache/update.wgsl",
             ]);
             v.push(compose(&format!("cache update {bvh} {i}"), &prelude, &cache).unwrap());
