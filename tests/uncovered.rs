@@ -5,10 +5,11 @@
 //! matte temporal counts the restarted history as that many frames; a first frame, a still
 //! frame and the setting at 0 trace one path everywhere.
 
-use glam::{DMat4, DVec3, Mat4, Vec4};
+use glam::{DMat4, DVec3, Mat4};
 use hush_engine::accel::BvhKind;
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::Gpu;
+use hush_engine::quality::DepthView;
 use hush_engine::scene::{Camera, Scene, load_gltf};
 use hush_engine::settings::{Denoiser, FrameSettings, TaaSettings};
 use hush_tests::half;
@@ -67,42 +68,12 @@ fn frame(gpu: &Gpu, r: &mut Renderer, input: &FrameInput, s: &FrameSettings) -> 
     }
 }
 
-/// The pixels of `now` whose surface `before` did not see: projected into the previous camera
-/// it falls outside the image, or the previous depth differs by more than 2% at each of the 3x3
-/// texels there (reversed Z: depth = clip z / w). `hush-cli quality` scores the same pixels.
+/// The pixels of `now` whose surface `before` did not see, by the CPU's test
+/// (hush_engine::quality::uncovered, which `hush-cli quality` scores).
 fn uncovered(before: &Frame, now: &Frame) -> Vec<bool> {
-    let (w, h) = SIZE;
-    let inverse = now.view_proj.inverse();
-    (0..(w * h) as usize)
-        .map(|i| {
-            let d = now.depth[i];
-            if d <= 0.0 {
-                return false;
-            }
-            let (x, y) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
-            let p = inverse * Vec4::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / h as f32 * 2.0, d, 1.0);
-            let c = before.view_proj * (p / p.w);
-            if c.w <= 0.0 {
-                return true;
-            }
-            let tx = ((c.x / c.w + 1.0) * 0.5 * w as f32).floor() as i64;
-            let ty = ((1.0 - c.y / c.w) * 0.5 * h as f32).floor() as i64;
-            if tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
-                return true;
-            }
-            let expected = c.z / c.w;
-            let seen =
-                (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (tx + dx, ty + dy))).any(|(x, y)| {
-                    x >= 0
-                        && y >= 0
-                        && x < w as i64
-                        && y < h as i64
-                        && (before.depth[(y * w as i64 + x) as usize] - expected).abs()
-                            <= 0.02 * expected
-                });
-            !seen
-        })
-        .collect()
+    let b = DepthView { depth: &before.depth, view_proj: before.view_proj };
+    let n = DepthView { depth: &now.depth, view_proj: now.view_proj };
+    hush_engine::quality::uncovered(&b, &n, SIZE)
 }
 
 /// Frames: the first camera (no history), the same again (still), then the second camera.

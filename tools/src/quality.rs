@@ -12,11 +12,12 @@ use crate::cli::preset_settings;
 use crate::cli::{bvh_kind, image_size, load_scene, parse_camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::quality::{
-    Image, compare, compare_with_flip_map, flip_over, luminance, region_mean, save_flip_heatmap,
+    DepthView, Image, compare, compare_with_flip_map, flip_over, luminance, region_mean,
+    save_flip_heatmap, uncovered,
 };
 use hush_engine::scene::{Camera, CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings};
@@ -128,46 +129,16 @@ impl Uncovered {
     }
 
     /// Age the pixels by a frame and restart those whose surface the previous frame did not
-    /// see: projected into the previous camera it falls outside the image, or the previous
-    /// depth buffer holds another depth at each of the 3x3 texels there (more than 2% off;
-    /// reversed Z, depth = clip z / w).
+    /// see (hush_engine::quality::uncovered: the trace's and the radiance cache's test).
     fn update(&mut self, r: &Renderer, gpu: &Gpu, camera: &Camera) -> Result<Vec<bool>> {
         let (bytes, _) = r.read_texture(gpu, "gbuffer/depth").context("reading the depth")?;
         let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
         let view_proj = r.camera_setup(camera).view_proj;
-        let (w, h) = r.size();
-        let inverse = view_proj.inverse();
-        let uncovered = |i: usize, prev: &[f32], prev_vp: &Mat4| {
-            let d = depth[i];
-            if d <= 0.0 || !d.is_finite() {
-                return false;
-            }
-            let (x, y) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
-            let ndc = Vec4::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / h as f32 * 2.0, d, 1.0);
-            let p = inverse * ndc;
-            let c = *prev_vp * (p / p.w);
-            if c.w <= 0.0 {
-                return true;
-            }
-            let tx = ((c.x / c.w + 1.0) * 0.5 * w as f32).floor() as i64;
-            let ty = ((1.0 - c.y / c.w) * 0.5 * h as f32).floor() as i64;
-            if tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
-                return true;
-            }
-            // The 3x3 texels around: both depth buffers were drawn with a sub-pixel jitter,
-            // which on a grazing floor moves a texel's depth by more than 2%.
-            let expected = c.z / c.w;
-            let seen =
-                (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (tx + dx, ty + dy))).any(|(x, y)| {
-                    let inside = x >= 0 && y >= 0 && x < w as i64 && y < h as i64;
-                    inside
-                        && (prev[(y * w as i64 + x) as usize] - expected).abs() <= 0.02 * expected
-                });
-            !seen
-        };
         if let Some((prev, prev_vp)) = &self.previous {
-            for (i, age) in self.age.iter_mut().enumerate() {
-                *age = if uncovered(i, prev, prev_vp) { 0 } else { age.saturating_add(1) };
+            let before = DepthView { depth: prev, view_proj: *prev_vp };
+            let now = DepthView { depth: &depth, view_proj };
+            for (age, new) in self.age.iter_mut().zip(uncovered(&before, &now, r.size())) {
+                *age = if new { 0 } else { age.saturating_add(1) };
             }
         }
         self.previous = Some((depth, view_proj));

@@ -4,6 +4,7 @@ mod image_io;
 mod metrics;
 mod ssim;
 mod timeline;
+mod uncovered;
 
 pub use image_io::{
     Image, decode_exr, linear_to_srgb, srgb_to_linear, tonemap_srgb8, write_exr, write_png,
@@ -14,3 +15,4 @@ pub use metrics::{
 };
 pub use ssim::ssim_luma;
 pub use timeline::Timeline;
+pub use uncovered::{DepthView, uncovered};
