@@ -67,9 +67,9 @@ pub struct FrameSettings {
     /// many frames. Costs (n - paths_per_pixel) paths at those pixels only: 3.9% of the
     /// level's at 320x180 on its jump's frame, and under TAA's jitter about 1% of a moving
     /// frame's (a grazing floor that the depth test flags). A cut or a first frame, with no
-    /// history, and a still frame trace paths_per_pixel everywhere. The level's jump, Mara,
-    /// uncovered pixels over the ten frames after it: FLIP 0.1357 at 1 path, 0.1263 at 8,
-    /// 0.1255 at 16. 0: off.
+    /// history, and a still frame trace paths_per_pixel everywhere. The level's jump,
+    /// uncovered pixels over the ten frames after it, FLIP at 1 / 8 paths (16: 0.1255 for
+    /// Mara): Mara 0.1357 / 0.1273, SVGF 0.1415 / 0.1377. 0: off.
     pub uncovered_paths: u32,
     /// Samples per pixel k of the real-time frame (Voorhuis §5, guide rays): the raster's sample
     /// (the guide) and k - 1 traced at random positions in the pixel, each mixed into its most
