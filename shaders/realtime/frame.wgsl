@@ -35,6 +35,9 @@ struct Frame {
     // Paths per pixel where the surface was not on screen last frame (realtime/uncovered.wgsl;
     // 0 where no frame before is there to test against).
     uncovered_paths: u32,
+    // The last frame's jitter: its depth texel t holds the surface at pixel position t + this.
+    prev_jitter_x: f32,
+    prev_jitter_y: f32,
 }
 
 var<uniform> frame: Frame;

@@ -37,7 +37,10 @@ pub struct FrameParams {
     /// Paths per pixel where the pixel's surface was not on screen last frame
     /// (`FrameSettings::uncovered_paths`); 0 where the frame has no history to test against.
     pub uncovered_paths: u32,
-    pub _pad: [u32; 2],
+    /// Where in its pixels the last frame's raster sampled (its `jitter`): its depth texel t
+    /// holds the surface at pixel position t + this (realtime/uncovered.wgsl).
+    pub prev_jitter_x: f32,
+    pub prev_jitter_y: f32,
 }
 
 impl FrameParams {
@@ -80,7 +83,8 @@ impl FrameParams {
             primary_samples: 0,
             rescaled_frames: 0.0,
             uncovered_paths: 0,
-            _pad: [0; 2],
+            prev_jitter_x: jitter.x,
+            prev_jitter_y: jitter.y,
         }
     }
 }

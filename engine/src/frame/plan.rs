@@ -130,7 +130,7 @@ impl Renderer {
             settings,
             (&cam, jittered, jitter),
             denoised,
-            (primary_samples, uncovered_paths),
+            (primary_samples, uncovered_paths, prev_jitter),
         );
         self.history.denoised_last = denoiser;
         if let Some(target) = target {
@@ -340,7 +340,7 @@ impl Renderer {
         settings: &FrameSettings,
         (cam, jittered, jitter): (&super::CameraSetup, Mat4, Vec2),
         denoised: bool,
-        (primary_samples, uncovered_paths): (u32, u32),
+        (primary_samples, uncovered_paths, prev_jitter): (u32, u32, Vec2),
     ) {
         let (size, h) = (self.targets.size, &self.history);
         let g = &settings.glossy;
@@ -368,6 +368,7 @@ impl Renderer {
         );
         fp.primary_samples = primary_samples;
         fp.uncovered_paths = uncovered_paths.min(MAX_PATHS_PER_PIXEL);
+        (fp.prev_jitter_x, fp.prev_jitter_y) = (prev_jitter.x, prev_jitter.y);
         if self.rescale_from.is_some() {
             fp.rescaled_frames = settings.resample_history_frames;
         }

@@ -15,4 +15,4 @@ pub use metrics::{
 };
 pub use ssim::ssim_luma;
 pub use timeline::Timeline;
-pub use uncovered::{DepthView, uncovered};
+pub use uncovered::{DepthView, Visibility, uncovered, visibility};

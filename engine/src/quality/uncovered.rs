@@ -12,31 +12,52 @@ pub struct DepthView<'a> {
     pub view_proj: Mat4,
 }
 
-/// Per pixel of `now` (`size`): its surface was not seen by `before`. A pixel with a surface is
-/// uncovered where its point, projected into the previous camera, falls behind it or outside
-/// the image, or where the previous depth differs by more than 2% at each of the 3x3 texels
-/// there (both depth buffers were drawn with a sub-pixel jitter, which on a grazing floor moves
-/// a texel's depth by more than 2%; depth = clip z / w).
+/// What the frame before knew of a pixel's surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Visibility {
+    /// The pixel shows no surface.
+    Background,
+    /// The previous depth holds the point's depth within 2% at one of the 3x3 texels it
+    /// projects to.
+    Seen,
+    /// The point projects behind the previous camera or outside its image.
+    OffScreen,
+    /// The point projects into the previous image, where another depth was drawn.
+    Hidden,
+}
+
+/// Per pixel of `now` (`size`): its surface was not seen by `before` (off screen or hidden).
 pub fn uncovered(before: &DepthView, now: &DepthView, size: (u32, u32)) -> Vec<bool> {
+    visibility(before, now, size)
+        .into_iter()
+        .map(|v| matches!(v, Visibility::OffScreen | Visibility::Hidden))
+        .collect()
+}
+
+/// Per pixel of `now` (`size`), its [`Visibility`] in `before`: the pixel's point projected into
+/// the previous camera, and the previous depth compared at each of the 3x3 texels there (both
+/// depth buffers were drawn with a sub-pixel jitter, which on a grazing floor moves a texel's
+/// depth by more than 2%; depth = clip z / w).
+pub fn visibility(before: &DepthView, now: &DepthView, size: (u32, u32)) -> Vec<Visibility> {
     let (w, h) = (size.0 as i64, size.1 as i64);
     let inverse = now.view_proj.inverse();
     (0..(w * h) as usize)
         .map(|i| {
             let d = now.depth[i];
             if d <= 0.0 || !d.is_finite() {
-                return false;
+                return Visibility::Background;
             }
             let (x, y) = ((i as i64 % w) as f32 + 0.5, (i as i64 / w) as f32 + 0.5);
             let ndc = Vec4::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / h as f32 * 2.0, d, 1.0);
             let p = inverse * ndc;
             let c = before.view_proj * (p / p.w);
             if c.w <= 0.0 {
-                return true;
+                return Visibility::OffScreen;
             }
             let tx = ((c.x / c.w + 1.0) * 0.5 * w as f32).floor() as i64;
             let ty = ((1.0 - c.y / c.w) * 0.5 * h as f32).floor() as i64;
             if tx < 0 || ty < 0 || tx >= w || ty >= h {
-                return true;
+                return Visibility::OffScreen;
             }
             let expected = c.z / c.w;
             let seen =
@@ -45,7 +66,7 @@ pub fn uncovered(before: &DepthView, now: &DepthView, size: (u32, u32)) -> Vec<b
                     inside
                         && (before.depth[(y * w + x) as usize] - expected).abs() <= 0.02 * expected
                 });
-            !seen
+            if seen { Visibility::Seen } else { Visibility::Hidden }
         })
         .collect()
 }

@@ -564,6 +564,8 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(offs[7] as usize, offset_of!(FrameParams, jitter));
     assert_eq!(offs[11] as usize, offset_of!(FrameParams, accumulated));
     assert_eq!(offs[12] as usize, offset_of!(FrameParams, paths));
+    assert_eq!(offs[18] as usize, offset_of!(FrameParams, uncovered_paths));
+    assert_eq!(offs[20] as usize, offset_of!(FrameParams, prev_jitter_y));
     let converge = programs.iter().find(|p| p.label == "taa/converge.wgsl").unwrap();
     let (size, offs) = wgsl_layout(converge, "ConvergeParams");
     use crate::passes::converge::ConvergeParams;
