@@ -120,8 +120,7 @@ impl Renderer {
         let denoised = denoiser.is_some();
         // Extra paths where a move uncovered a surface only where a history is there to restart
         // (on a cut, a first frame or a change of denoiser every pixel would take them) and
-        // something moved: in a still frame nothing is uncovered, and the depth test flags a
-        // grazing floor's pixels under TAA's jitter (1% of the level's at 320x180).
+        // something moved (in a still frame nothing is uncovered: the depth tests are skipped).
         let uncovered_paths =
             if view.history_valid && !view.static_view { settings.uncovered_paths } else { 0 };
         self.upload(

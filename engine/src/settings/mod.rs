@@ -64,12 +64,11 @@ pub struct FrameSettings {
     /// Paths per pixel where the pixel's surface was not on screen last frame (a move or an
     /// object uncovered it), in frames where something moved and a denoiser keeps a history:
     /// Mara's and SVGF's matte temporal stages count a restarted history's sample as that
-    /// many frames. Costs (n - paths_per_pixel) paths at those pixels only: 3.9% of the
-    /// level's at 320x180 on its jump's frame, and under TAA's jitter about 1% of a moving
-    /// frame's (a grazing floor that the depth test flags). A cut or a first frame, with no
-    /// history, and a still frame trace paths_per_pixel everywhere. The level's jump,
-    /// uncovered pixels over the ten frames after it, FLIP at 1 / 8 paths (16: 0.1255 for
-    /// Mara): Mara 0.1357 / 0.1273, SVGF 0.1415 / 0.1377. 0: off.
+    /// many frames. Costs (n - paths_per_pixel) paths at those pixels only (at most 3.9% of
+    /// the level's at 320x180 on its jump's frame). A cut or a first frame, with no history,
+    /// and a still frame trace paths_per_pixel everywhere. The level's jump, uncovered pixels
+    /// over the ten frames after it, FLIP at 1 / 8 paths: Mara 0.1357 / 0.1272, SVGF 0.1415 /
+    /// 0.1375. 0: off.
     pub uncovered_paths: u32,
     /// Samples per pixel k of the real-time frame (Voorhuis §5, guide rays): the raster's sample
     /// (the guide) and k - 1 traced at random positions in the pixel, each mixed into its most
