@@ -146,8 +146,8 @@ fn a_cell_holds_the_mean_of_its_samples() {
 
 /// After a jump, a pixel the last frame did not see reads its cell's mean as the frames before
 /// left it (its own sample not in it), weighted as min(samples, prior_frames); where the matte
-/// temporal finds no history, it starts from that prior: mix(prior, sample, 1 / (1 + a)), with a
-/// history length of 1 + a.
+/// temporal finds no history, it starts from that prior: mix(prior, sample, k / (k + a)) for a
+/// sample of k paths (FrameSettings::uncovered_paths), with a history length of k + a.
 #[test]
 fn an_uncovered_pixel_starts_from_its_cells_mean() {
     let size = (48, 27);
@@ -185,7 +185,11 @@ fn an_uncovered_pixel_starts_from_its_cells_mean() {
             continue;
         }
         checked += 1;
-        let w = 1.0 / (1.0 + p[3]);
+        // The pixel's own sample counts as the paths it averages (the trace's matte alpha: more
+        // where the trace found the surface uncovered too, realtime/uncovered.wgsl).
+        let paths = f.matte[i][3];
+        assert!(paths >= 1.0, "pixel {i}'s paths: {paths}");
+        let w = paths / (paths + p[3]);
         for k in 0..3 {
             let want = p[k] + (f.matte[i][k] - p[k]) * w;
             let got = temporal[i * 4 + k];
@@ -194,7 +198,7 @@ fn an_uncovered_pixel_starts_from_its_cells_mean() {
                 "pixel {i}: {got} against {want}"
             );
         }
-        assert_eq!(reason[i] >> 8, (1.0 + p[3]) as u32, "pixel {i}'s history length");
+        assert_eq!(reason[i] >> 8, (paths + p[3]) as u32, "pixel {i}'s history length");
     }
     println!("{checked} disoccluded pixels with a prior");
     assert!(checked > 50, "{checked} disoccluded pixels with a prior");
