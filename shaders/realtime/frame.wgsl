@@ -33,7 +33,7 @@ struct Frame {
     // (realtime/rescale.wgsl): the most frames a history may count (0 on every other frame).
     rescaled_frames: f32,
     // Paths per pixel where the surface was not on screen last frame (realtime/uncovered.wgsl;
-    // 0 where no frame before is there to test against).
+    // 0 where there is no history to restart or nothing moved).
     uncovered_paths: u32,
     // The last frame's jitter: its depth texel t holds the surface at pixel position t + this.
     prev_jitter_x: f32,

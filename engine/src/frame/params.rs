@@ -35,7 +35,8 @@ pub struct FrameParams {
     /// (passes/rescale.rs): the most frames a history may count; 0 on every other frame.
     pub rescaled_frames: f32,
     /// Paths per pixel where the pixel's surface was not on screen last frame
-    /// (`FrameSettings::uncovered_paths`); 0 where the frame has no history to test against.
+    /// (`FrameSettings::uncovered_paths`); 0 where there is no history to restart or nothing
+    /// moved.
     pub uncovered_paths: u32,
     /// Where in its pixels the last frame's raster sampled (its `jitter`): its depth texel t
     /// holds the surface at pixel position t + this (realtime/uncovered.wgsl).
