@@ -27,7 +27,13 @@ fn even() -> Scene {
 /// falling off to about 1/13 across the 1.3 m the camera sees (tests/area_light.rs checks this
 /// light against a quadrature of the emitter).
 fn from_one_side() -> Scene {
-    floor_under_light("bias_side", (Vec3::new(-1.5, 0.6, 0.0), 0.2, 10.0), [0.0, 1.2, 0.0])
+    // Written and loaded once: both tests use it, and two threads writing the same file raced.
+    static SCENE: std::sync::OnceLock<Scene> = std::sync::OnceLock::new();
+    SCENE
+        .get_or_init(|| {
+            floor_under_light("bias_side", (Vec3::new(-1.5, 0.6, 0.0), 0.2, 10.0), [0.0, 1.2, 0.0])
+        })
+        .clone()
 }
 
 /// The mean luminance of each of BANDS vertical bands (across x, the gradient's direction).

@@ -288,7 +288,8 @@ fn the_first_level_feeds_the_history_of_young_traced_pixels() {
 
 /// One a-trous level (step 1) against a CPU implementation of §4.4 from the same inputs (the
 /// variance stage's light and variance, the features, the G-buffer normals): the 3x3 kernel,
-/// w_N, w_D with its steep-gradient switch, w_L with its epsilon falling past
+/// w_N, w_D with its steep-gradient switch, w_L with the larger of the two pixels' variances
+/// and its epsilon falling past
 /// `epsilon_full_samples` (2 here, so that the 6 still frames reach it: epsilon_l x 2 / age),
 /// and the variance of the weighted mean. Within 2e-3 relative (half-float output) on 99% of
 /// the surface pixels.
@@ -353,7 +354,7 @@ fn an_atrous_level_matches_a_cpu_implementation() {
                         1.0
                     };
                     let w_l = (-(lc - luma([t[0], t[1], t[2]])).abs()
-                        / (p.sigma_l as f64 * c[3].max(0.0) + epsilon))
+                        / (p.sigma_l as f64 * c[3].max(t[3]).max(0.0) + epsilon))
                         .exp();
                     let wt = hk * w_n * w_d * w_l;
                     for k in 0..3 {
@@ -436,10 +437,48 @@ fn progressive_nonfinite_input_never_reaches_history_or_screen() {
 /// is within 1.2x of the plain accumulation of the same 256 frames, the mean within 0.5% of the
 /// reference per channel, and FLIP at frame 256 below FLIP at frame 64: the light is a mean of
 /// every sample and the luminance weight's epsilon falls with it (`epsilon_full_samples`).
-/// Measured: relMSE 0.000685 against the accumulation's 0.000802 (0.85x; with Dundr's fixed
-/// epsilon 0.002194, 2.7x); mean bias -0.17% / -0.16% / -0.09%; FLIP 0.0740 at 64, 0.0441 at 256.
+/// Measured: relMSE 0.000464 against the accumulation's 0.000803 (0.58x; with Dundr's fixed
+/// epsilon 0.002194, 2.7x); mean bias -0.28% / -0.25% / -0.17%; FLIP 0.0616 at 64, 0.0379 at 256.
 #[test]
 fn progressive_still_view_converges() {
     let filtered = FrameSettings { denoiser: Denoiser::named("progressive"), ..Default::default() };
     hush_tests::still_convergence(&filtered).check("progressive");
+}
+
+/// TAA's history length (n, in its history's alpha) in a still view: at one sample per pixel
+/// it keeps growing past 1 / taa.alpha towards taa.still_frames (the long still-view mean); where
+/// a frame traces one pixel in 16 it stops at 2 / alpha - 1 = 19, the exponential blend at
+/// `alpha`, since the light gains a sample per pixel only every 16 frames and a long mean kept
+/// its young frames (level 160x90, 64 frames at 1/16 spp: FLIP 0.1338 with the mean, 0.1182
+/// without; docs/decisions.md). 40 still frames: the longest history at 1 spp must exceed 19
+/// (it is 40 where the clamp never held it), and none at 1/16 may.
+#[test]
+fn taa_keeps_no_long_still_mean_below_one_sample_per_pixel() {
+    let input = FrameInput { camera: view(), time: 0.0, shutter: None };
+    let longest = |period: u32| {
+        let (gpu, mut r) =
+            Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE)
+                .unwrap();
+        let s = FrameSettings {
+            taa: TaaSettings::default(),
+            ..progressive(period, Default::default())
+        };
+        for _ in 0..40 {
+            r.render(&gpu, &input, &s, None).unwrap();
+        }
+        let mut n_max = 0f32;
+        for name in ["taa/history 0", "taa/history 1"] {
+            let (bytes, format) = r.read_texture(&gpu, name).unwrap();
+            assert_eq!(format, wgpu::TextureFormat::Rgba32Float, "{name}");
+            for texel in bytes.chunks_exact(16) {
+                n_max = n_max.max(f32::from_le_bytes(texel[12..16].try_into().unwrap()).abs());
+            }
+        }
+        n_max
+    };
+    let cap = 2.0 / TaaSettings::default().alpha - 1.0;
+    let (full, sub) = (longest(1), longest(16));
+    println!("longest TAA history after 40 still frames: 1 spp {full}, 1/16 spp {sub} (cap {cap})");
+    assert!(full > cap + 1.0, "at 1 spp TAA's still-view mean did not grow: n = {full}");
+    assert!(sub <= cap + 1e-3, "at 1/16 spp TAA's history grew to n = {sub}, past {cap}");
 }

@@ -355,7 +355,15 @@ impl Stages {
     ) -> Result<()> {
         let Some(d) = denoiser else { return Ok(()) };
         let s = plan.settings;
-        let dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, plan.frame_index, &plan.view);
+        let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, plan.frame_index, &plan.view);
+        // A frame that traces one pixel in N (N > 1) shows light that gains a sample per pixel
+        // only every N frames, so a still pixel's frames are not alike: TAA's long still-view
+        // mean (taa.still_frames) would keep the young, hole-filled frames in the image for
+        // tens of frames. There TAA blends at taa.alpha (docs/decisions.md, "Progressive
+        // filter", equal samples).
+        if s.sample_fraction.period() > 1 && !s.accumulate {
+            dp.taa_still_frames = 0.0;
+        }
         let follow = |p| (d.taa_follow(p), d.output(p).glossy);
         self.taa.record(rec, plan.output_key, io, follow, &dp, plan.parity)
     }
