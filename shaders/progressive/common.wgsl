@@ -18,9 +18,10 @@ struct ProgressiveParams {
     // The feedback level's output becomes the history of a pixel traced this frame whose
     // history holds fewer samples than this (0: never).
     feedback_samples: f32,
+    // 1: w_L reads the larger of the centre's and the tap's variances; 0: the centre's (Dundr).
+    symmetric_luminance: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 // Per dispatch: the a-trous step (large scale first), whether the signal only fills pixels

@@ -43,7 +43,8 @@ pub struct ProgressiveParams {
     pub temporal: u32,
     pub epsilon_full_samples: f32,
     pub feedback_samples: f32,
-    pub _pad: [u32; 3],
+    pub symmetric_luminance: u32,
+    pub _pad: [u32; 2],
 }
 
 impl ProgressiveParams {
@@ -58,7 +59,8 @@ impl ProgressiveParams {
             temporal: s.temporal as u32,
             epsilon_full_samples: s.epsilon_full_samples.clamp(0.0, STILL_FRAMES_MAX),
             feedback_samples: s.feedback_samples.clamp(0.0, STILL_FRAMES_MAX),
-            _pad: [0; 3],
+            symmetric_luminance: s.symmetric_luminance as u32,
+            _pad: [0; 2],
         }
     }
 }
