@@ -267,7 +267,7 @@ impl Renderer {
             false => settings.samples_per_pixel.clamp(1, MAX_SAMPLES_PER_PIXEL),
         };
         // Below one sample per pixel (Dundr §5): only denoisers that fill the untraced pixels.
-        let period = if settings.accumulate { 1 } else { settings.sample_fraction.period() };
+        let period = settings.sample_period();
         if period > 1 && samples > 1 {
             bail!(
                 "sample fraction {} traces some pixels each frame and {samples} samples per pixel \

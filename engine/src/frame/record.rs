@@ -361,7 +361,7 @@ impl Stages {
         // mean (taa.still_frames) would keep the young, hole-filled frames in the image for
         // tens of frames. There TAA blends at taa.alpha (docs/decisions.md, "Progressive
         // filter", equal samples).
-        if s.sample_fraction.period() > 1 && !s.accumulate {
+        if s.sample_period() > 1 {
             dp.taa_still_frames = 0.0;
         }
         let follow = |p| (d.taa_follow(p), d.output(p).glossy);

@@ -138,6 +138,12 @@ impl FrameSettings {
     pub fn exposure_scale(&self) -> f32 {
         2f32.powf(self.exposure_ev.clamp(-30.0, 30.0))
     }
+
+    /// Frames between two samples of one pixel: the sample fraction's 1 / f, and 1 in the
+    /// accumulate mode, which traces every pixel each frame.
+    pub fn sample_period(&self) -> u32 {
+        if self.accumulate { 1 } else { self.sample_fraction.period() }
+    }
 }
 
 impl Default for FrameSettings {
