@@ -102,7 +102,7 @@ fn matte_light_at(s: Surface, rd: vec3f, cone_width: f32, rng: ptr<function, u32
             }
         }
     }
-    return matte + matte_path(basis, origin, s.ng, cone_width, nee_select, rng);
+    return matte + matte_path(basis, origin, s.ng, cone_width, nee_select, rand2(rng), rng);
 }
 
 @compute @workgroup_size(8, 8)

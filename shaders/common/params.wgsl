@@ -34,7 +34,9 @@ struct Params {
     // x: 1 where each path sees the scene at a random time in the shutter, 0: all at the close.
     shutter: vec4f,
     // x: 1 where ray cones choose texture mip levels after the primary hit, 0: the finest.
-    texture_lod: vec4f,
+    // y: 1 where the real-time trace draws its leading dimensions from the screen's strata
+    // (common/rng.wgsl), 0: from the pixel's random sequence.
+    switches: vec4f,
 }
 
 var<uniform> params: Params;

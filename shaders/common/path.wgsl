@@ -258,7 +258,7 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     // The cone's width where it meets the surface; after the primary hit its footprint picks
     // the mip level of every texture read.
     let cone_width = (*st).cone.x + (*st).cone.y * hit.t;
-    if HAS_TEXTURES && segments > 1 && params.texture_lod.x > 0.0 && any(m.tex >= vec4i(0)) {
+    if HAS_TEXTURES && segments > 1 && params.switches.x > 0.0 && any(m.tex >= vec4i(0)) {
         s.tc.lod = cone_lod(hit, cone_width, dot(s.ng, rd));
         s.tc.xi = f32(pcg_hash(bitcast<u32>(hit.b.x) ^ pcg_hash(bitcast<u32>(hit.t)))) * (1.0 / 4294967296.0);
     }

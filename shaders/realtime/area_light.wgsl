@@ -9,13 +9,32 @@ fn area_groups() -> u32 {
 
 // One sample of the non-delta lights (emitters or environment, chosen uniformly).
 fn sample_area_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
-    let n = area_groups();
     let u = rand(rng);
-    var s: LightSample;
     if HAS_EMITTERS && (!HAS_ENV || u < 0.5) {
-        s = sample_emitter(p, vec3f(rand(rng), rand(rng), rand(rng)));
+        return sample_area_light_at(p, u, vec3f(rand(rng), rand(rng), rand(rng)));
+    }
+    return sample_area_light_at(p, u, vec3f(rand2(rng), 0.0));
+}
+
+// The same, its point on the emitter (or direction of the environment) from the screen's
+// strata (common/rng.wgsl), the choice between emitters and environment from rng.
+fn sample_area_light_strata(p: vec3f, st: Strata, rng: ptr<function, u32>) -> LightSample {
+    let u = rand(rng);
+    if HAS_EMITTERS && (!HAS_ENV || u < 0.5) {
+        return sample_area_light_at(p, u, strata3(st));
+    }
+    return sample_area_light_at(p, u, vec3f(strata2(st), 0.0));
+}
+
+// u_group chooses emitters (below 0.5) or environment; u places the sample (emitters use all
+// three numbers: triangle, then its two barycentrics; the environment u.xy).
+fn sample_area_light_at(p: vec3f, u_group: f32, u: vec3f) -> LightSample {
+    let n = area_groups();
+    var s: LightSample;
+    if HAS_EMITTERS && (!HAS_ENV || u_group < 0.5) {
+        s = sample_emitter(p, u);
     } else {
-        s = sample_env(rand2(rng));
+        s = sample_env(u.xy);
     }
     s.li *= f32(n);
     s.pdf /= f32(n);
@@ -25,8 +44,9 @@ fn sample_area_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
 // One cosine-sampled matte path (Mara et al. 2017, eq. (6)) from `origin` on a surface with
 // shading frame `basis` and geometric normal ng; 0 where the direction falls below the
 // geometric surface. Cosine sampling cancels eq. (7)'s cos / pi: the throughput starts at 1.
-fn matte_path(basis: mat3x3f, origin: vec3f, ng: vec3f, cone_width: f32, nee_select: f32, rng: ptr<function, u32>) -> vec3f {
-    let wl = cosine_hemisphere(rand2(rng));
+// u_dir places the first direction; the path's later vertices draw from rng.
+fn matte_path(basis: mat3x3f, origin: vec3f, ng: vec3f, cone_width: f32, nee_select: f32, u_dir: vec2f, rng: ptr<function, u32>) -> vec3f {
+    let wl = cosine_hemisphere(u_dir);
     let wi = basis * wl;
     if dot(wi, ng) <= 0.0 {
         return vec3f(0.0);

@@ -101,7 +101,7 @@ fn safe_ratio(a: vec3f, b: vec3f) -> vec3f {
 
 // One factored sample at the hit of camera ray direction rd, its area-light sample and paths
 // averaged over `path_count` independent ones.
-fn shade(rd: vec3f, hit: Hit, path_count: u32, rng: ptr<function, u32>) -> Shaded {
+fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng: ptr<function, u32>) -> Shaded {
     let eps = params.cam_pos.w;
     let s = surface_at(hit, rd);
     let m = material(s.material);
@@ -137,10 +137,21 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, rng: ptr<function, u32>) -> Shade
 
     let paths = max(path_count, 1u);
     for (var k = 0u; k < paths; k++) {
+        // With the screen's strata on (params.switches.y), the light's point and the matte
+        // path's first direction come from them (common/rng.wgsl), each use its own lattice:
+        // a 16-pixel block's matte light is then stratified over the light and the hemisphere.
+        let strata = params.switches.y > 0.0;
+        let st_light = strata_init(px, frame.index, strata_seed ^ ((2u * k + 1u) * 0x9e3779b9u));
+        let st_dir = strata_init(px, frame.index, strata_seed ^ ((2u * k + 2u) * 0x9e3779b9u));
         let groups = area_groups();
         let nee_select = 1.0 / f32(max(groups, 1u));
         if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
-            let ls = sample_area_light(s.p, rng);
+            var ls: LightSample;
+            if strata {
+                ls = sample_area_light_strata(s.p, st_light, rng);
+            } else {
+                ls = sample_area_light(s.p, rng);
+            }
             let wi = to_local(basis, ls.wi);
             if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
                 let leg = shadow_leg(origin, s.p, ls.wi, ls.dist, eps);
@@ -158,8 +169,14 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, rng: ptr<function, u32>) -> Shade
         }
 
         if has_matte {
-            matte += matte_path(basis, origin, s.ng, cone_width, nee_select, rng);
-        } else {
+            var u_dir: vec2f;
+            if strata {
+                u_dir = strata2(st_dir);
+            } else {
+                u_dir = rand2(rng);
+            }
+            matte += matte_path(basis, origin, s.ng, cone_width, nee_select, u_dir, rng);
+        } else if !strata {
             // Keep the random sequence of the glossy path independent of the material.
             rand2(rng);
         }
@@ -247,7 +264,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let hit = raster_hit(ro, rd, ids);
     let paths = pixel_paths(ro + rd * hit.t);
-    var sh = shade(rd, hit, paths, &rng);
+    var sh = shade(rd, hit, paths, px, params.seed ^ 0x73747261u, &rng);
     if frame.primary_samples > 1u && !sh.backface {
         let r = own_over_mean(px, hit, rd);
         sh.matte *= r.matte;

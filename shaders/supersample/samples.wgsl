@@ -37,7 +37,7 @@ fn samples(@builtin(global_invocation_id) gid: vec3u) {
             r.normal = 0u;
             r.material = NO_GUIDE;
         } else {
-            let sh = shade(rd, hit, frame.paths, &rng);
+            let sh = shade(rd, hit, frame.paths, px, params.seed ^ 0x73747261u ^ ((j + 1u) * 0x85ebca6bu), &rng);
             r.matte = pack_light(sh.matte);
             r.glossy = pack_light(sh.glossy);
             r.direct = pack_light(sh.direct);

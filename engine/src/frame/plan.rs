@@ -380,7 +380,8 @@ impl Renderer {
             shutter_camera: input.shutter.map(|s| s.camera),
             texture_lod: settings.texture_lod,
         };
-        let tp = make_params(&self.prepared, &trace_view);
+        let mut tp = make_params(&self.prepared, &trace_view);
+        tp.switches[1] = settings.screen_strata as u32 as f32;
         gpu.queue.write_buffer(&self.uniforms.params, 0, bytemuck::bytes_of(&tp));
         gpu.queue.write_buffer(&self.uniforms.frame, 0, bytemuck::bytes_of(&fp));
     }

@@ -44,7 +44,9 @@ pub struct TraceParams {
     /// instant exposure (every ray at the close).
     pub shutter: [f32; 4],
     /// x: 1 where ray cones choose texture mip levels after the primary hit, 0: the finest.
-    pub texture_lod: [f32; 4],
+    /// y: 1 where the real-time trace draws the light's point and the matte path's first
+    /// direction from the screen's strata ([`crate::settings::FrameSettings::screen_strata`]).
+    pub switches: [f32; 4],
 }
 
 /// What to render: the camera, image size and path settings.
@@ -281,7 +283,7 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
         cam_open_up: open.2.extend(0.0).to_array(),
         cam_open_fwd: open.3.extend(0.0).to_array(),
         shutter: [moving as u32 as f32, 0.0, 0.0, 0.0],
-        texture_lod: [view.texture_lod as u32 as f32, 0.0, 0.0, 0.0],
+        switches: [view.texture_lod as u32 as f32, 0.0, 0.0, 0.0],
     }
 }
 

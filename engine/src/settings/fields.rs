@@ -105,6 +105,13 @@ const FRAME_FIELDS: &[Field] = &[
         "Ray cones choose each texture's mip level after the primary hit: an indirect ray reads the mean of its footprint, not one texel (less noise, same converged image).",
     ),
     f(
+        "screen_strata",
+        "trace",
+        "",
+        Bool,
+        "Each 16x16 tile's pixels share a stratified set of light samples and first matte directions: the same noise per pixel, less left after the denoisers' windows.",
+    ),
+    f(
         "resample_history_frames",
         "frame/rescale",
         "frames",
