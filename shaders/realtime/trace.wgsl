@@ -100,7 +100,8 @@ fn safe_ratio(a: vec3f, b: vec3f) -> vec3f {
 }
 
 // One factored sample at the hit of camera ray direction rd, its area-light sample and paths
-// averaged over `path_count` independent ones.
+// averaged over `path_count` independent ones. With `screen_strata` on, pixel px's light sample
+// and first matte direction come from the screen's strata, seeded by strata_seed.
 fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng: ptr<function, u32>) -> Shaded {
     let eps = params.cam_pos.w;
     let s = surface_at(hit, rd);
