@@ -4,7 +4,7 @@
 
 use hush_engine::accel::BvhKind;
 use hush_engine::frame::{FrameInput, Renderer};
-use hush_engine::quality::Image;
+use hush_engine::quality::{Image, luminance};
 use hush_engine::settings::{FrameSettings, disable_stage};
 
 const SIDE: u32 = 64;
@@ -23,7 +23,7 @@ fn variances(screen_strata: bool) -> (f64, f64, f64) {
     let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, (SIDE, SIDE)).unwrap();
     let mut s = FrameSettings { screen_strata, ..Default::default() };
     assert!(disable_stage(&mut s, "taa"));
-    let lum = |v: glam::Vec3| f64::from(v.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722)));
+    let lum = |v: glam::Vec3| f64::from(luminance(v));
     let n = SIDE / BLOCK;
     let mut pixels = vec![Vec::new(); (SIDE * SIDE) as usize];
     let mut blocks = vec![Vec::new(); (n * n) as usize];
