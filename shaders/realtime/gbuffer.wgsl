@@ -97,5 +97,9 @@ fn fs_main(v: VsOut, @builtin(front_facing) facing: bool) -> GBufferOut {
         o.specular = vec4f(1.0, 1.0, 1.0, clamp(ms.roughness, 0.0, 1.0));
         o.emission.w = 1.0;
     }
+    // 8-bit targets: unbiased over the frames (realtime/gbuffer_dither.wgsl).
+    let stored = dither_material(o.base_color, o.specular, vec2u(v.clip.xy), frame.index);
+    o.base_color = stored[0];
+    o.specular = stored[1];
     return o;
 }

@@ -43,8 +43,10 @@ fn fs_main(@builtin(position) pos: vec4f) -> GBufferOut {
     let len = length(n.xyz);
     o.normal = oct_encode(select(-normalize(frame.cam_fwd.xyz), n.xyz / len, len > 1e-12));
     o.motion = bitcast<vec2f>(m.xy);
-    o.base_color = bitcast<vec4f>(features[f + 1u]);
-    o.specular = bitcast<vec4f>(features[f + 2u]);
+    // 8-bit targets: unbiased over the frames (realtime/gbuffer_dither.wgsl).
+    let stored = dither_material(bitcast<vec4f>(features[f + 1u]), bitcast<vec4f>(features[f + 2u]), px, frame.index);
+    o.base_color = stored[0];
+    o.specular = stored[1];
     // Reversed infinite Z of the mean view depth (any point at that depth along the view axis).
     let c = frame.unjittered_view_proj * vec4f(frame.cam_pos.xyz + normalize(frame.cam_fwd.xyz) * max(n.w, 1e-30), 1.0);
     o.depth = clamp(c.z / c.w, 0.0, 1.0);

@@ -10,7 +10,10 @@
 //! | specular | Rgba8Unorm | 4 | specular F0, roughness in alpha |
 //! | emission | Rgba16Float | 8 | emitted radiance, Fresnel f90 in alpha |
 //! | ids | Rg32Uint | 8 | object index, triangle slot (u32::MAX: no surface) |
-//! Eight bits per channel suffice for colours and F0 (sRGB-encoded base colour: < 0.5% error);
+//! Eight bits per channel suffice for colours and F0 because each frame stores one of the two
+//! codes around the material's value, chosen so that the frames average to the value
+//! (shaders/realtime/gbuffer_dither.wgsl): rounded to the nearest code, cornell_diffuse's white
+//! stayed 0.27% dark and a dielectric's F0 of 0.04 2% low in every frame and every mean of them;
 //! normals need more than 8 bits per octahedral coordinate for bilateral weights, motion more than
 //! 8 bits for sub-pixel reprojection. The six colour targets cost 40 bytes per sample under
 //! WebGPU's render-target accounting (8-bit RGBA counts 8), over its default of 32: the device
@@ -191,7 +194,8 @@ impl GBufferPass {
         let f = &scene.features;
         let mut modules = vec![
             "common/math.wgsl",
-            // pcg_hash, for the stochastic transparency of blended materials (alpha_mask.wgsl).
+            // pcg_hash, for the stochastic transparency of blended materials (alpha_mask.wgsl) and
+            // the material's dither (gbuffer_dither.wgsl).
             "common/rng.wgsl",
             "common/geometry.wgsl",
             "common/motion_none.wgsl",
@@ -200,7 +204,12 @@ impl GBufferPass {
             "common/bsdf.wgsl",
         ];
         modules.extend(scene.material_modules());
-        modules.extend(["realtime/frame.wgsl", f.motion().module(), "realtime/gbuffer.wgsl"]);
+        modules.extend([
+            "realtime/frame.wgsl",
+            f.motion().module(),
+            "realtime/gbuffer_dither.wgsl",
+            "realtime/gbuffer.wgsl",
+        ]);
         let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         // Reversed Z: larger is nearer.
         let pipeline = Reloadable::new(

@@ -126,8 +126,13 @@ impl Primaries {
             .buffer("features", &t.features)
             .buffer("edges", edges.unwrap_or(&t.features));
         let (p, caches) = super::chain::made(&mut self.resolve, || {
-            let modules =
-                ["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"];
+            let modules = [
+                "common/math.wgsl",
+                "common/rng.wgsl",
+                "realtime/frame.wgsl",
+                "realtime/gbuffer_dither.wgsl",
+                "realtime/primaries_resolve.wgsl",
+            ];
             // Every pixel is written: the depth is the resolved one, not a nearest surface.
             let p = Reloadable::new(
                 gpu,

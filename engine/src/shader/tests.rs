@@ -79,6 +79,7 @@ fn all_programs() -> Vec<Program> {
                 set[8],
                 "realtime/frame.wgsl",
                 motion,
+                "realtime/gbuffer_dither.wgsl",
                 "realtime/gbuffer.wgsl",
             ];
             v.push(compose("gbuffer", "", &m).unwrap());
@@ -296,7 +297,13 @@ fn all_programs() -> Vec<Program> {
         compose(
             "gbuffer/resolve",
             "",
-            &["common/math.wgsl", "realtime/frame.wgsl", "realtime/primaries_resolve.wgsl"],
+            &[
+                "common/math.wgsl",
+                "common/rng.wgsl",
+                "realtime/frame.wgsl",
+                "realtime/gbuffer_dither.wgsl",
+                "realtime/primaries_resolve.wgsl",
+            ],
         )
         .unwrap(),
     );
