@@ -5,7 +5,11 @@
 // around the value, the upper one with the probability that makes the stored value's expectation
 // the value itself (in linear terms, which the composite multiplies by), so the jittered frames
 // that TAA and the still-view means average converge to the material. The noise this adds to one
-// frame is under one code (1/255 in sRGB or linear).
+// frame is under one code (1/255 in sRGB or linear). Only the colours the light is multiplied by
+// (base colour, F0): metallic and roughness keep the nearest code, because the glossy chains
+// compare roughness with thresholds (`is_mirror`, the reflection reprojection's), and a material
+// between two codes would cross one from frame to frame; half a code of roughness moves a lobe's
+// width by under 0.2% of its range.
 //
 // Needs pcg_hash (common/rng.wgsl).
 
@@ -34,18 +38,17 @@ fn dither_srgb8(c: vec3f, u: f32) -> vec3f {
     return select(below, above, vec3f(u) < t);
 }
 
-// A value in [0, 1] for a linear 8-bit target: one of the two codes around it.
-fn dither_unorm8(c: vec4f, u: f32) -> vec4f {
-    let e = clamp(c, vec4f(0.0), vec4f(1.0)) * 255.0;
-    let lo = min(floor(e), vec4f(254.0));
-    return (lo + select(vec4f(0.0), vec4f(1.0), vec4f(u) < e - lo)) / 255.0;
+// A linear colour in [0, 1] for a linear 8-bit target: one of the two codes around it.
+fn dither_unorm8(c: vec3f, u: f32) -> vec3f {
+    let e = clamp(c, vec3f(0.0), vec3f(1.0)) * 255.0;
+    let lo = min(floor(e), vec3f(254.0));
+    return (lo + select(vec3f(0.0), vec3f(1.0), vec3f(u) < e - lo)) / 255.0;
 }
 
-// The base colour (sRGB target, metallic linear in alpha) and the specular target (F0 and
-// roughness, linear) as this frame stores them.
+// The base colour (sRGB target; metallic in alpha) and the specular target (F0; roughness in
+// alpha) as this frame stores them.
 fn dither_material(base: vec4f, specular: vec4f, pixel: vec2u, frame_index: u32) -> array<vec4f, 2> {
-    let u0 = gbuffer_dither_u(pixel, frame_index, 0u);
-    let u1 = gbuffer_dither_u(pixel, frame_index, 1u);
-    let b = vec4f(dither_srgb8(base.rgb, u0), dither_unorm8(vec4f(base.a), u0).x);
-    return array<vec4f, 2>(b, dither_unorm8(specular, u1));
+    let b = dither_srgb8(base.rgb, gbuffer_dither_u(pixel, frame_index, 0u));
+    let f0 = dither_unorm8(specular.rgb, gbuffer_dither_u(pixel, frame_index, 1u));
+    return array<vec4f, 2>(vec4f(b, base.a), vec4f(f0, specular.a));
 }

@@ -11,7 +11,7 @@
 //! | emission | Rgba16Float | 8 | emitted radiance, Fresnel f90 in alpha |
 //! | ids | Rg32Uint | 8 | object index, triangle slot (u32::MAX: no surface) |
 //! Eight bits per channel suffice for colours and F0 because each frame stores one of the two
-//! codes around the material's value, chosen so that the frames average to the value
+//! codes around the colour, chosen so that the frames average to it
 //! (shaders/realtime/gbuffer_dither.wgsl): rounded to the nearest code, cornell_diffuse's white
 //! stayed 0.27% dark and a dielectric's F0 of 0.04 2% low in every frame and every mean of them;
 //! normals need more than 8 bits per octahedral coordinate for bilateral weights, motion more than
