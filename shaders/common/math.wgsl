@@ -8,6 +8,15 @@ fn luminance(c: vec3f) -> f32 {
     return dot(c, vec3f(0.2126, 0.7152, 0.0722));
 }
 
+// The sRGB transfer function (IEC 61966-2-1), linear to encoded and back, for values in [0, 1].
+fn srgb_encode(c: vec3f) -> vec3f {
+    return select(1.055 * pow(c, vec3f(1.0 / 2.4)) - 0.055, c * 12.92, c <= vec3f(0.0031308));
+}
+
+fn srgb_decode(c: vec3f) -> vec3f {
+    return select(pow((c + 0.055) / 1.055, vec3f(2.4)), c / 12.92, c <= vec3f(0.04045));
+}
+
 fn max3(v: vec3f) -> f32 {
     return max(v.x, max(v.y, v.z));
 }

@@ -12,10 +12,6 @@ fn tex_word(i: u32) -> u32 {
     return select(select(t.x, t.y, c == 1u), select(t.z, t.w, c == 3u), c >= 2u);
 }
 
-fn srgb_decode(c: vec3f) -> vec3f {
-    return select(pow((c + 0.055) / 1.055, vec3f(2.4)), c / 12.92, c <= vec3f(0.04045));
-}
-
 // A coordinate wrapped into [0, 1] by the sampler mode (0 repeat, 1 clamp, 2 mirror), in float:
 // integer remainders are a division per lane on a CPU driver. Mirroring folds the coordinate
 // into [0, 1], where the neighbour across an edge is the edge texel itself, as with clamping.

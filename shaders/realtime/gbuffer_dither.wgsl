@@ -11,7 +11,7 @@
 // between two codes would cross one from frame to frame; half a code of roughness moves a lobe's
 // width by under 0.2% of its range.
 //
-// Needs pcg_hash (common/rng.wgsl).
+// Needs pcg_hash (common/rng.wgsl) and the sRGB transfer function (common/math.wgsl).
 
 // Uniform in [0, 1) per pixel, frame and use.
 fn gbuffer_dither_u(pixel: vec2u, frame_index: u32, salt: u32) -> f32 {
@@ -19,21 +19,13 @@ fn gbuffer_dither_u(pixel: vec2u, frame_index: u32, salt: u32) -> f32 {
     return f32(h >> 8u) * (1.0 / 16777216.0);
 }
 
-fn to_srgb(c: vec3f) -> vec3f {
-    return select(1.055 * pow(c, vec3f(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3f(0.0031308));
-}
-
-fn from_srgb(e: vec3f) -> vec3f {
-    return select(pow((e + 0.055) / 1.055, vec3f(2.4)), e / 12.92, e <= vec3f(0.04045));
-}
-
 // A linear colour in [0, 1] for an sRGB-encoded 8-bit target: exactly one of the two codes
 // around it, decoded (the target's encode gives that code back).
 fn dither_srgb8(c: vec3f, u: f32) -> vec3f {
-    let e = to_srgb(clamp(c, vec3f(0.0), vec3f(1.0))) * 255.0;
+    let e = srgb_encode(clamp(c, vec3f(0.0), vec3f(1.0))) * 255.0;
     let lo = min(floor(e), vec3f(254.0));
-    let below = from_srgb(lo / 255.0);
-    let above = from_srgb((lo + 1.0) / 255.0);
+    let below = srgb_decode(lo / 255.0);
+    let above = srgb_decode((lo + 1.0) / 255.0);
     let t = (c - below) / max(above - below, vec3f(1e-12));
     return select(below, above, vec3f(u) < t);
 }
