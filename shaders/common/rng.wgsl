@@ -32,7 +32,8 @@ fn rand2(state: ptr<function, u32>) -> vec2f {
 // consecutive points of the R_d sequence (Roberts 2018), in the order of the pixel's Morton
 // code, so every aligned 2^k x 2^k block of the tile holds 4^k consecutive points, which cover
 // the unit square or cube evenly. A random XOR of the code and a random toroidal shift
-// (Cranley-Patterson rotation), drawn per tile, per frame and per use, keep each pixel's point
+// (Cranley-Patterson rotation), drawn per tile, per frame (`sample_index`: the real-time trace
+// passes one index for the frames that share a lattice) and per use, keep each pixel's point
 // uniform and independent from frame to frame: a pixel's estimate is as unbiased and as noisy
 // as with `rand`, while a block's mean lies closer to the integral. The error left is at the
 // scale of a pixel, which the denoisers' spatial filters remove, instead of at the scale of

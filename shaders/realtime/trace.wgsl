@@ -141,9 +141,14 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
         // With the screen's strata on (params.switches.y), the light's point and the matte
         // path's first direction come from them (common/rng.wgsl), each use its own lattice:
         // a 16-pixel block's matte light is then stratified over the light and the hemisphere.
+        // Below one sample per pixel (1 / period) a lattice spans the `period` frames in which
+        // every pixel is traced once (frame.wgsl's schedule), so that a tile's samples of those
+        // frames take the whole lattice, as one frame's do at one sample per pixel; a lattice
+        // per frame would give its 256 / period traced pixels scattered points of 256.
         let strata = params.switches.y > 0.0;
-        let st_light = strata_init(px, frame.index, strata_seed ^ ((2u * k + 1u) * 0x9e3779b9u));
-        let st_dir = strata_init(px, frame.index, strata_seed ^ ((2u * k + 2u) * 0x9e3779b9u));
+        let epoch = frame.index / max(frame.period, 1u);
+        let st_light = strata_init(px, epoch, strata_seed ^ ((2u * k + 1u) * 0x9e3779b9u));
+        let st_dir = strata_init(px, epoch, strata_seed ^ ((2u * k + 2u) * 0x9e3779b9u));
         let groups = area_groups();
         let nee_select = 1.0 / f32(max(groups, 1u));
         if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
