@@ -291,15 +291,17 @@ fn the_first_level_feeds_the_history_of_young_traced_pixels() {
 /// w_N, w_D with its steep-gradient switch, w_L with the larger of the two pixels' variances
 /// (and with the centre's alone, Dundr's) and its epsilon falling past
 /// `epsilon_full_samples` (2 here, so that the 6 still frames reach it: epsilon_l x 2 / age),
-/// and the variance of the weighted mean. Within 2e-3 relative (half-float output) on 99% of
-/// the surface pixels.
+/// and the variance of the weighted mean; and with `reach_samples` at 5.5 / 256, so that the
+/// step-1 level's reach has ended at the 6 frames' samples, the light passed on unchanged.
+/// Within 2e-3 relative (half-float output) on 99% of the surface pixels.
 #[test]
 fn an_atrous_level_matches_a_cpu_implementation() {
-    for symmetric_luminance in [true, false] {
+    for (symmetric_luminance, reach_samples) in [(true, 1.0), (false, 1.0), (true, 5.5 / 256.0)] {
         let p = ProgressiveSettings {
             levels: 1,
             epsilon_full_samples: 2.0,
             symmetric_luminance,
+            reach_samples,
             ..Default::default()
         };
         atrous_level_matches_the_cpu(p);
@@ -326,7 +328,7 @@ fn atrous_level_matches_the_cpu(p: ProgressiveSettings) {
     let texel = |i: usize| [0, 1, 2, 3].map(|k| f32_at(&src, i * 4 + k) as f64);
     let feat = |i: usize| (f32_at(&features, i * 4) as f64, f32_at(&features, i * 4 + 1) as f64);
     let normal = |i: usize| oct_normal(&normals[i * 4..]).as_dvec3();
-    let (mut surface, mut agree) = (0u32, 0u32);
+    let (mut surface, mut agree, mut passed) = (0u32, 0u32, 0u32);
     for y in 0..h {
         for x in 0..w {
             let i = at(x, y);
@@ -376,12 +378,19 @@ fn atrous_level_matches_the_cpu(p: ProgressiveSettings) {
                     wsum += wt;
                 }
             }
-            let want = [
-                sum[0] / wsum,
-                sum[1] / wsum,
-                sum[2] / wsum,
-                (sum_var / (wsum * wsum)).clamp(0.0, 60000.0),
-            ];
+            // The step-1 level's reach ends past reach_samples x 16^2 samples.
+            let reach_ended = age > f64::from(p.reach_samples) * 256.0;
+            let want = if reach_ended {
+                c
+            } else {
+                [
+                    sum[0] / wsum,
+                    sum[1] / wsum,
+                    sum[2] / wsum,
+                    (sum_var / (wsum * wsum)).clamp(0.0, 60000.0),
+                ]
+            };
+            passed += reach_ended as u32;
             let got = [0, 1, 2, 3].map(|k| half(&out[i * 8 + k * 2..]) as f64);
             let ok = (0..4).all(|k| (got[k] - want[k]).abs() <= 2e-3 * want[k].abs().max(1e-2));
             if std::env::var("HUSH_TEST_VERBOSE").is_ok() && !ok {
@@ -391,10 +400,14 @@ fn atrous_level_matches_the_cpu(p: ProgressiveSettings) {
         }
     }
     println!(
-        "{agree} of {surface} surface pixels match the CPU's a-trous level (symmetric w_L: {})",
+        "{agree} of {surface} surface pixels match the CPU's a-trous level (symmetric w_L: {}; \
+         {passed} past the level's reach)",
         p.symmetric_luminance
     );
     assert!(surface > 1000);
+    if p.reach_samples * 256.0 < 6.0 {
+        assert!(passed * 2 > surface, "only {passed} of {surface} pixels past the reach");
+    }
     assert!(agree * 100 >= surface * 99, "only {agree} of {surface} pixels match");
 }
 

@@ -3,12 +3,14 @@
 // (variance < 0) are skipped; a pixel without one takes its neighbours' weighted mean (without
 // a luminance weight) and so has a sample for the next level. The variance follows the weights
 // (Dundr's var_{L+1} = w^2 var_L, normalised as the variance of the weighted mean:
-// sum w^2 var / (sum w)^2). The direct light's levels only fill missing pixels.
+// sum w^2 var / (sum w)^2). The direct light's levels only fill missing pixels. In a still view
+// a level of step s passes on light of more than reach_samples x (16 / s)^2 samples unfiltered
+// (Hush's; Dundr runs every level at every pixel).
 // The feedback level (step 1, run first; ProgressiveSettings::feedback_samples) also writes its
 // output as the history of each pixel traced this frame whose history is young (§4.4, §5).
 
 var src: texture_2d<f32>;
-// The light's moments (m1, m2, age): the age sets the luminance weight's epsilon.
+// The light's moments (m1, m2, age): the age sets the luminance weight's epsilon and the reach.
 var moments: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
 // The temporal stage's output, next frame's history (the feedback level only).
@@ -29,9 +31,19 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         textureStore(dst, p, c);
         return;
     }
+    let age = textureLoad(moments, p, 0).z;
+    // The filter's reach falls as the samples grow (ProgressiveSettings::reach_samples): a
+    // level of step s filters only light of at most reach_samples x (16 / s)^2 samples, so its
+    // area times the light's samples stays bounded. The feedback level passes such light on
+    // at its end, after writing the history.
+    let s16 = 16.0 / f32(level.step);
+    let reach_ended = !missing && dn.static_view != 0u && pp.reach_samples > 0.0 && age > pp.reach_samples * s16 * s16;
+    if reach_ended && level.feedback == 0u {
+        textureStore(dst, p, c);
+        return;
+    }
     let nc = oct_decode(f.zw);
     let lc = select(luma(c.rgb), -1.0, missing);
-    let age = textureLoad(moments, p, 0).z;
     // The luminance weight in displayed light (the light times the exposure, its variance times
     // the exposure squared), here in the light's own units: epsilon is an amount of light on
     // the screen, so a scene lit far below the display's white, shown brighter, is not blurred
@@ -79,7 +91,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let filtered = half_safe(sum / wsum);
-    textureStore(dst, p, vec4f(filtered, clamp(sum_var / (wsum * wsum), 0.0, 60000.0)));
+    let out = select(vec4f(filtered, clamp(sum_var / (wsum * wsum), 0.0, 60000.0)), c, reach_ended);
+    textureStore(dst, p, out);
     // A pixel whose history took a sample this frame (§5: once per sample, not every frame)
     // takes the filtered light; the others get back the light they had (the variance stage's
     // output is 32-bit for that). The store is under a uniform branch: lavapipe (Mesa 22.3)

@@ -20,7 +20,9 @@ struct ProgressiveParams {
     feedback_samples: f32,
     // 1: w_L reads the larger of the centre's and the tap's variances; 0: the centre's (Dundr).
     symmetric_luminance: u32,
-    _pad0: u32,
+    // In a still view a level of step s filters a pixel whose light holds at most this x
+    // (16 / s)^2 samples (0: every level everywhere).
+    reach_samples: f32,
     _pad1: u32,
 }
 

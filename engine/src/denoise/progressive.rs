@@ -8,7 +8,8 @@
 //! otherwise show its last direct light wherever the camera moved. `progressive/features`
 //! (depth and its gradient) -> per signal `temporal` (r = max(a, 1/age); an untraced pixel keeps
 //! light, age and moments) -> `variance` (3x3-blurred m2 - m1^2) -> `atrous` (3x3 kernel, large
-//! scale first, missing samples skipped and filled; the direct light only fills). The history is
+//! scale first, missing samples skipped and filled; the direct light only fills; in a still
+//! view a level's reach ends as the pixel's samples grow, `reach_samples`). The history is
 //! the accumulated light before the spatial filter, except for a pixel's first samples
 //! (`feedback_samples`): then the step-1 level runs first and its output becomes the history of
 //! the pixels traced this frame (Dundr §4.4-5; docs/decisions.md). The composite and TAA
@@ -44,7 +45,8 @@ pub struct ProgressiveParams {
     pub epsilon_full_samples: f32,
     pub feedback_samples: f32,
     pub symmetric_luminance: u32,
-    pub _pad: [u32; 2],
+    pub reach_samples: f32,
+    pub _pad: u32,
 }
 
 impl ProgressiveParams {
@@ -60,7 +62,8 @@ impl ProgressiveParams {
             epsilon_full_samples: s.epsilon_full_samples.clamp(0.0, STILL_FRAMES_MAX),
             feedback_samples: s.feedback_samples.clamp(0.0, STILL_FRAMES_MAX),
             symmetric_luminance: s.symmetric_luminance as u32,
-            _pad: [0; 2],
+            reach_samples: s.reach_samples.clamp(0.0, STILL_FRAMES_MAX),
+            _pad: 0,
         }
     }
 }
