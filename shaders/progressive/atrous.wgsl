@@ -35,22 +35,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // The filter's reach falls as the samples grow (ProgressiveSettings::reach_samples): a
     // level of step s filters only light of at most reach_samples x (16 / s)^2 samples, so its
     // area times the light's samples stays bounded. The feedback level passes such light on
-    // at its end, after writing the history. A pixel without samples of its own (its history
-    // lost on an edge under the jitter, or not yet traced) takes the largest age around it,
-    // short of the step-4 level's bound, so that the small levels always fill it: filled by
-    // the step-16 level, the level's silhouettes came out blurred.
-    var reach_age = age;
-    if age < 1.0 {
-        for (var j = 0; j < 9; j++) {
-            let q = p + vec2i(j % 3 - 1, j / 3 - 1);
-            if in_bounds(q) {
-                reach_age = max(reach_age, textureLoad(moments, q, 0).z);
-            }
-        }
-        reach_age = min(reach_age, 16.0 * pp.reach_samples);
-    }
+    // at its end, after writing the history. A pixel without samples (age 0) is filled by
+    // every level.
     let s16 = 16.0 / f32(level.step);
-    let reach_ended = dn.static_view != 0u && pp.reach_samples > 0.0 && reach_age > pp.reach_samples * s16 * s16;
+    let reach_ended = dn.static_view != 0u && pp.reach_samples > 0.0 && age > pp.reach_samples * s16 * s16;
     if reach_ended && level.feedback == 0u {
         textureStore(dst, p, c);
         return;

@@ -44,9 +44,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         // In a still view a pixel keeps its own history where the reprojection found none: on
         // a depth edge the jittered sample lands on either surface, and no previous texel of
-        // the 3x3 may pass for the one it hit this frame. Lost, an untraced pixel was missing
-        // until its next sample (the level's roof line, door and window frames: 469 of 14,400
-        // pixels at 160x90 and 1/16 spp), and its history's samples were gone.
+        // the 3x3 may pass for the one it hit this frame. Dropped, the history's samples would
+        // be lost, and an untraced pixel missing until its next sample.
         if !found && dn.static_view != 0u && has_surface(p) {
             let own = textureLoad(moments, p, 0);
             if own.z >= 1.0 {

@@ -78,12 +78,12 @@ described! {
         /// at most this x (16 / s)^2 samples: at 1, the step-16 level stops after the first
         /// sample, step 8 after 4, step 4 after 16, step 2 after 64 and step 1 after 256, so the
         /// filter's area shrinks as the light's variance falls and a still view ends at its
-        /// plain mean. A pixel without samples of its own reads the largest count of its 3x3
-        /// (the levels from step 4 down always fill it). FLIP of the last frame
-        /// (docs/decisions.md), 0 -> 1: cornell_diffuse 256², 64 frames at 1/16 spp 0.0642 ->
-        /// 0.0589 (Mara's 4 frames at 1 spp: 0.0586), 60 still frames at 1 spp 0.0508 ->
-        /// 0.0287, 64 frames at 1/64 unchanged (0.0893); the level 160x90 at 1/16 x 64 0.1157 ->
-        /// 0.1114 (Mara's: 0.0996). 0: every level everywhere (Dundr).
+        /// plain mean. Pixels without samples are filled by every level. FLIP of the last frame
+        /// (docs/decisions.md), 0 -> 1: cornell_diffuse 256², 64 frames at 1/16 spp 0.0641 ->
+        /// 0.0588 (Mara's 4 frames at 1 spp: 0.0586), 60 still frames at 1 spp 0.0508 ->
+        /// 0.0287, 64 frames at 1/64 unchanged (0.0893); the level 160x90 at 1/16 x 64 0.1113 /
+        /// 0.1097 -> 0.1100 / 0.1098 at seeds 0 / 1 (Mara's: 0.0996 / 0.0993). 0: every level
+        /// everywhere (Dundr).
         reach_samples: f32 = 1.0,
             ("progressive.reach_samples", "progressive/atrous", "samples", Float(0.0, 65536.0, 0.25));
         /// TAA follows the filter's matte light (`taa.current_light`'s share), as it follows
