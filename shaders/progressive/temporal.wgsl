@@ -1,7 +1,7 @@
 // Dundr §4.2 and §5: accumulation with r = max(a, 1 / age), where age counts the samples this
 // surface accumulated; a pixel not traced this frame keeps its light, age and moments as they
-// were (reprojected; in a still view its own where none reprojects), and a pixel with neither
-// a sample nor a history is missing (age 0).
+// were (reprojected; in a still view its own where none reprojects; the sky's from the nearest
+// texel that showed the sky), and a pixel with neither a sample nor a history is missing (age 0).
 // The matte signal's pass also writes the features (linear depth and its gradient).
 // Outputs: integrated (rgb), moments (m1, m2, age, frames): frames counts the frames since the
 // pixel's history last restarted, traced or not (TAA compares it with its own history's length
@@ -13,6 +13,19 @@ var history: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var out_integrated: texture_storage_2d<rgba32float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
+
+// The texel of p's 3x3 that showed the sky last frame with light in its history, p's own
+// first, then the edge neighbours before the corners; (-1, -1) where none did.
+fn sky_texel(p: vec2i) -> vec2i {
+    let order = array<vec2i, 9>(vec2i(0, 0), vec2i(1, 0), vec2i(-1, 0), vec2i(0, 1), vec2i(0, -1), vec2i(1, 1), vec2i(-1, 1), vec2i(1, -1), vec2i(-1, -1));
+    for (var k = 0; k < 9; k++) {
+        let q = p + order[k];
+        if in_bounds(q) && textureLoad(prev_object, q, 0).y == NO_SURFACE && textureLoad(moments, q, 0).z >= 1.0 {
+            return q;
+        }
+    }
+    return vec2i(-1);
+}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
@@ -36,11 +49,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 mom = textureLoad(moments, r.texel, 0);
                 found = mom.z >= 1.0;
             }
-        } else if textureLoad(prev_object, p, 0).y == NO_SURFACE {
-            // The sky stays where it was on screen.
-            hist = half_safe(textureLoad(history, p, 0).rgb);
-            mom = textureLoad(moments, p, 0);
-            found = mom.z >= 1.0;
+        } else {
+            // The sky stays where it was on screen. Where this texel showed a surface last
+            // frame (a silhouette under the jitter) the nearest texel that showed the sky
+            // holds the same light to within a pixel's change of direction.
+            let q = sky_texel(p);
+            if q.x >= 0 {
+                hist = half_safe(textureLoad(history, q, 0).rgb);
+                mom = textureLoad(moments, q, 0);
+                found = mom.z >= 1.0;
+            }
         }
         // In a still view a pixel keeps its own history where the reprojection found none: on
         // a depth edge the jittered sample lands on either surface, and no previous texel of
