@@ -255,6 +255,13 @@ struct Progressive {
     taa_follow: bool,
 }
 
+/// Whether TAA follows the filter's matte light this frame (`ProgressiveSettings::taa_follow`,
+/// and `taa_follow_fractions` where a frame traces one pixel in N > 1).
+fn follows_light(s: &FrameSettings) -> bool {
+    let p = &s.progressive;
+    p.taa_follow || (p.taa_follow_fractions && s.sample_period() > 1)
+}
+
 /// The modules of a program of `signal`'s `stage`.
 pub fn modules(
     stage: &'static str,
@@ -393,7 +400,7 @@ impl Denoiser for Progressive {
 
     fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
         let gpu = rec.gpu;
-        self.taa_follow = cx.settings.progressive.taa_follow;
+        self.taa_follow = follows_light(cx.settings);
         let Progressive { scene, res, stages, .. } = self;
         let missing = "the progressive filter records before its textures exist";
         let p = &cx.settings.progressive;
@@ -473,5 +480,31 @@ impl Denoiser for Progressive {
             );
         }
         v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::SampleFraction;
+
+    /// By default TAA follows the filter's light only where a frame traces one pixel in N > 1;
+    /// `taa_follow` extends it to every fraction and `taa_follow_fractions` off takes it away.
+    #[test]
+    fn taa_follows_the_light_below_one_sample_per_pixel() {
+        let at = |period: u32, follow: bool, fractions: bool| {
+            let mut s = FrameSettings {
+                sample_fraction: SampleFraction::one_in(period).unwrap(),
+                ..Default::default()
+            };
+            s.progressive.taa_follow = follow;
+            s.progressive.taa_follow_fractions = fractions;
+            follows_light(&s)
+        };
+        let d = ProgressiveSettings::default();
+        assert!(!at(1, d.taa_follow, d.taa_follow_fractions));
+        assert!(at(16, d.taa_follow, d.taa_follow_fractions));
+        assert!(!at(16, false, false));
+        assert!(at(1, true, false));
     }
 }

@@ -87,15 +87,26 @@ described! {
         reach_samples: f32 = 1.0,
             ("progressive.reach_samples", "progressive/atrous", "samples", Float(0.0, 65536.0, 0.25));
         /// TAA follows the filter's matte light (`taa.current_light`'s share), as it follows
-        /// Mara's and SVGF's, instead of averaging the frames shown. Off by default: 64 frames
-        /// at 1/16 spp gain 0.5% FLIP (level 160x90 0.1278 -> 0.1272, cornell_diffuse 256²
-        /// 0.0759 -> 0.0754) and cornell_mirror's still frame 60 5% (0.0917 -> 0.0869), but a
-        /// still view's relMSE at 1024 frames (cornell_diffuse 128²) rises from 1.56x the plain
+        /// Mara's and SVGF's, instead of averaging the frames shown, at every sample fraction
+        /// (below 1, `taa_follow_fractions` decides). Off by default: at one sample per pixel
+        /// cornell_mirror's still frame 60 gains 5% (0.0917 -> 0.0869), but a still view's
+        /// relMSE at 1024 frames (cornell_diffuse 128²) rises from 1.56x the plain
         /// accumulation's to 2.14x: at a pixel whose jittered samples fall on two surfaces TAA
         /// then shows the product of the averaged material and light, not the average of the
         /// products.
         taa_follow: bool = false,
             ("progressive.taa_follow", "taa", "", Bool);
+        /// Where a frame traces one pixel in N > 1, TAA follows the filter's matte light as
+        /// `taa_follow` does. There TAA blends at `taa.alpha` (no long still-view mean), and
+        /// its average lags the light, which gains a sample only every N frames. Last-frame
+        /// FLIP off -> on, 64 frames at 1/16 spp: the level 160x90 0.1035 / 0.1036 -> 0.1018 /
+        /// 0.1021 (seeds 0 / 1; relMSE unchanged), cornell_diffuse 256² 0.0589 (mean of four
+        /// seeds) -> 0.0569, cornell_mirror 0.1205 -> 0.1139; 16 frames at 1/4 spp: level
+        /// 0.1095 -> 0.1085, cornell_diffuse 0.0632 -> 0.0616. It costs where a pixel holds
+        /// one sample (64 frames at 1/64 spp: level 0.1661 -> 0.1669, cornell_diffuse 0.0898
+        /// -> 0.0915).
+        taa_follow_fractions: bool = true,
+            ("progressive.taa_follow_fractions", "taa", "", Bool);
     }
     hidden {
     }
