@@ -87,8 +87,9 @@ described! {
         reach_samples: f32 = 1.0,
             ("progressive.reach_samples", "progressive/atrous", "samples", Float(0.0, 65536.0, 0.25));
         /// TAA follows the filter's matte light (`taa.current_light`'s share), as it follows
-        /// Mara's and SVGF's, instead of averaging the frames shown, at every sample fraction
-        /// (below 1, `taa_follow_fractions` decides). Off by default: at one sample per pixel
+        /// Mara's and SVGF's, instead of averaging the frames shown, at every sample fraction.
+        /// Off by default (below one sample per pixel `taa_follow_fractions` alone turns the
+        /// following on): at one sample per pixel
         /// cornell_mirror's still frame 60 gains 5% (0.0917 -> 0.0869), but a still view's
         /// relMSE at 1024 frames (cornell_diffuse 128²) rises from 1.56x the plain
         /// accumulation's to 2.14x: at a pixel whose jittered samples fall on two surfaces TAA
