@@ -386,19 +386,24 @@ fn the_first_level_feeds_the_history_of_young_traced_pixels() {
 /// One a-trous level (step 1) against a CPU implementation of §4.4 from the same inputs (the
 /// variance stage's light and variance, the features, the G-buffer normals): the 3x3 kernel,
 /// w_N, w_D with its steep-gradient switch, w_L with the larger of the two pixels' variances
-/// (and with the centre's alone, Dundr's) and its epsilon falling past
+/// (the tap's capped at 64 and 2 x the centre's, and uncapped; and with the centre's alone,
+/// Dundr's) and its epsilon falling past
 /// `epsilon_full_samples` (2 here, so that the 6 still frames reach it: epsilon_l x 2 / age),
 /// and the variance of the weighted mean; and with `reach_samples` at 5.5 / 256, so that the
 /// step-1 level's reach has ended at the 6 frames' samples, the light passed on unchanged.
 /// Within 2e-3 relative (half-float output) on 99% of the surface pixels.
 #[test]
 fn an_atrous_level_matches_a_cpu_implementation() {
-    for (symmetric_luminance, reach_samples) in [(true, 1.0), (false, 1.0), (true, 5.5 / 256.0)] {
+    let cases = [(true, 1.0, 64.0), (true, 1.0, 0.0), (true, 1.0, 2.0), (false, 1.0, 64.0)];
+    for (symmetric_luminance, reach_samples, variance_cap) in
+        cases.into_iter().chain([(true, 5.5 / 256.0, 64.0)])
+    {
         let p = ProgressiveSettings {
             levels: 1,
             epsilon_full_samples: 2.0,
             symmetric_luminance,
             reach_samples,
+            variance_cap,
             ..Default::default()
         };
         atrous_level_matches_the_cpu(p);
@@ -463,7 +468,9 @@ fn atrous_level_matches_the_cpu(p: ProgressiveSettings) {
                     } else {
                         1.0
                     };
-                    let variance = if p.symmetric_luminance { c[3].max(t[3]) } else { c[3] };
+                    let cap = p.variance_cap as f64;
+                    let tap = if cap > 0.0 { t[3].min(cap * c[3].max(0.0)) } else { t[3] };
+                    let variance = if p.symmetric_luminance { c[3].max(tap) } else { c[3] };
                     let w_l = (-(lc - luma([t[0], t[1], t[2]])).abs()
                         / (p.sigma_l as f64 * variance.max(0.0) + epsilon))
                         .exp();
@@ -497,9 +504,9 @@ fn atrous_level_matches_the_cpu(p: ProgressiveSettings) {
         }
     }
     println!(
-        "{agree} of {surface} surface pixels match the CPU's a-trous level (symmetric w_L: {}; \
-         {passed} past the level's reach)",
-        p.symmetric_luminance
+        "{agree} of {surface} surface pixels match the CPU's a-trous level (symmetric w_L: {}, \
+         variance cap {}; {passed} past the level's reach)",
+        p.symmetric_luminance, p.variance_cap
     );
     assert!(surface > 1000);
     if p.reach_samples * 256.0 < 6.0 {

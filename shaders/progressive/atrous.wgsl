@@ -79,8 +79,12 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             // weight is then symmetric, so a pixel holding a rare bright sample (a large
             // variance) gives its light to the neighbours whose light it takes. With the
             // centre's, they refused it while it took theirs, and the filter lost 5% of the
-            // level's light at four samples (ProgressiveSettings::symmetric_luminance).
-            let v = select(variance, max(variance, t.a * k), pp.symmetric_luminance != 0u);
+            // level's light at four samples (ProgressiveSettings::symmetric_luminance). The
+            // tap's variance counts up to variance_cap x the centre's, so that one bright path
+            // is not spread over a patch (ProgressiveSettings::variance_cap).
+            let tv = t.a * k;
+            let capped = select(tv, min(tv, pp.variance_cap * variance), pp.variance_cap > 0.0);
+            let v = select(variance, max(variance, capped), pp.symmetric_luminance != 0u);
             let w = h * dundr_weight(fc, nc, lc, v, epsilon, fq, nq, luma(t.rgb), offset);
             sum += w * t.rgb;
             sum_var += w * w * t.a;

@@ -23,7 +23,8 @@ struct ProgressiveParams {
     // In a still view a level of step s filters a pixel whose light holds at most this x
     // (16 / s)^2 samples (0: every level everywhere).
     reach_samples: f32,
-    _pad1: u32,
+    // w_L's symmetric bandwidth takes a tap's variance up to this x the centre's (0: no cap).
+    variance_cap: f32,
 }
 
 // Per dispatch: the a-trous step (large scale first), whether the signal only fills pixels

@@ -46,7 +46,7 @@ pub struct ProgressiveParams {
     pub feedback_samples: f32,
     pub symmetric_luminance: u32,
     pub reach_samples: f32,
-    pub _pad: u32,
+    pub variance_cap: f32,
 }
 
 impl ProgressiveParams {
@@ -63,7 +63,7 @@ impl ProgressiveParams {
             feedback_samples: s.feedback_samples.clamp(0.0, STILL_FRAMES_MAX),
             symmetric_luminance: s.symmetric_luminance as u32,
             reach_samples: s.reach_samples.clamp(0.0, STILL_FRAMES_MAX),
-            _pad: 0,
+            variance_cap: s.variance_cap.clamp(0.0, STILL_FRAMES_MAX),
         }
     }
 }

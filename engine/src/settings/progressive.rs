@@ -74,6 +74,16 @@ described! {
         /// cornell_mirror 0.0863 -> 0.0748, cornell_diffuse 0.0517 -> 0.0516. Off: Dundr's.
         symmetric_luminance: bool = true,
             ("progressive.symmetric_luminance", "progressive/atrous", "", Bool);
+        /// With `symmetric_luminance`, a tap's variance widens w_L at most to this x the
+        /// pixel's own, so that one bright path (a large variance) is not spread over a patch
+        /// of its darker neighbours. Last-frame FLIP at 1/16 spp x 64 frames, uncapped -> 64:
+        /// level 160x90 0.1019 / 0.1021 / 0.0989 / 0.1083 -> 0.0991 / 0.1010 / 0.0989 / 0.1004
+        /// (seeds 0-3; relMSE 0.0451 -> 0.0432, mean -1.5% -> -2.2% in red), cornell_diffuse
+        /// 256² 0.0567 / 0.0570 / 0.0578 / 0.0561 -> 0.0568 / 0.0571 / 0.0578 / 0.0561; it
+        /// costs caustics, which are such paths (cornell_mirror 0.1138 -> 0.1187; at 1 spp x 60
+        /// 0.0789 -> 0.0793). At 16: level 0.0998 (mean), cornell_mirror 0.1223. 0: no cap.
+        variance_cap: f32 = 64.0,
+            ("progressive.variance_cap", "progressive/atrous", "x", Float(0.0, 65536.0, 1.0));
         /// In a still view a level of step s pixels filters a pixel only while its light holds
         /// at most this x (16 / s)^2 samples: at 1, the step-16 level stops after the first
         /// sample, step 8 after 4, step 4 after 16, step 2 after 64 and step 1 after 256, so the
