@@ -98,25 +98,24 @@ described! {
             ("progressive.reach_samples", "progressive/atrous", "samples", Float(0.0, 65536.0, 0.25));
         /// TAA follows the filter's matte light (`taa.current_light`'s share), as it follows
         /// Mara's and SVGF's, instead of averaging the frames shown, at every sample fraction.
-        /// Off by default (below one sample per pixel `taa_follow_fractions` alone turns the
-        /// following on): at one sample per pixel
-        /// cornell_mirror's still frame 60 gains 5% (0.0917 -> 0.0869), but a still view's
-        /// relMSE at 1024 frames (cornell_diffuse 128²) rises from 1.56x the plain
-        /// accumulation's to 2.14x: at a pixel whose jittered samples fall on two surfaces TAA
-        /// then shows the product of the averaged material and light, not the average of the
-        /// products.
+        /// Off by default (below one sample per pixel `taa_follow_fractions` turns it on
+        /// alone): at one sample per pixel cornell_mirror's still frame 60 gains 5% (0.0917 ->
+        /// 0.0869), but a still view's relMSE at 1024 frames (cornell_diffuse 128²) rises from
+        /// 1.56x the plain accumulation's to 2.14x: at a pixel whose jittered samples fall on
+        /// two surfaces TAA then shows the product of the averaged material and light, not the
+        /// average of the products.
         taa_follow: bool = false,
             ("progressive.taa_follow", "taa", "", Bool);
         /// Where a frame traces one pixel in N > 1, TAA follows the filter's matte light as
-        /// `taa_follow` does. There TAA blends at `taa.alpha` (no long still-view mean), and
-        /// its average lags the light, which gains a sample only every N frames. Last-frame
-        /// FLIP off -> on, 64 frames at 1/16 spp: the level 160x90 0.1035 / 0.1036 -> 0.1018 /
-        /// 0.1021 (seeds 0 / 1; relMSE unchanged), cornell_diffuse 256² 0.0589 (mean of four
-        /// seeds) -> 0.0569, cornell_mirror 0.1205 -> 0.1139; 16 frames at 1/4 spp: level
-        /// 0.1095 -> 0.1084, cornell_diffuse 0.0632 -> 0.0615. A pixel of fewer than two
-        /// samples is not followed: at 1/64 spp (one sample per pixel at frame 64) following
-        /// cost 0.5-2% (level 0.1661 -> 0.1669, cornell_diffuse 0.0898 -> 0.0915); now 0.1662
-        /// and 0.0898.
+        /// `taa_follow` does, at pixels whose light holds at least two samples (one is mostly
+        /// what the a-trous levels filled in around it). There TAA blends at `taa.alpha` (no
+        /// long still-view mean), and its average lags the light, which gains a sample only
+        /// every N frames. Last-frame FLIP off -> on, 64 frames at 1/16 spp: level 160x90 (mean
+        /// of seeds 0-3) 0.1019 -> 0.0998, cornell_diffuse 256² 0.0589 -> 0.0570,
+        /// cornell_mirror 0.1245 -> 0.1187; at 1/64 spp (one sample per pixel) the same 0.1672
+        /// on the level. The trade: the image moves more from frame to frame under motion (the
+        /// level's jump at 1/4 spp, measured before `variance_cap`: temporal error 0.0208 ->
+        /// 0.0235).
         taa_follow_fractions: bool = true,
             ("progressive.taa_follow_fractions", "taa", "", Bool);
     }
