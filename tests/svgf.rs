@@ -271,6 +271,7 @@ fn svgf_nonfinite_input_never_reaches_history_or_screen() {
         "moments 1",
         "integrated",
         "variance",
+        "excess",
         "ping",
         "pong",
         "regressed",

@@ -25,8 +25,9 @@ struct SvgfParams {
     regression_order: f32,
     // Past this many samples' worth the intervals narrow as sqrt(this / samples) (0: never).
     regression_full_samples: f32,
+    // The spike cut's ratio to the second brightest neighbour (0: off; SvgfSettings::spike_ratio).
+    spike_ratio: f32,
     _pad0: u32,
-    _pad1: u32,
 }
 
 // Per dispatch: which a-trous level (step 2^level pixels), whether it writes the history.

@@ -18,11 +18,19 @@
 // bright samples) biases nothing, where a luminance edge-stop drops bright taps more often than
 // dark ones. Light that has not settled (fewer than `regression_samples`' worth) passes the
 // a-trous output on.
+//
+// The fit reads each tap's light less what the variance stage's spike cut took off it
+// (SvgfSettings::spike_ratio: a lone pixel that one rare path made bright), and the pixel shows
+// the fit plus the cut light's weighted mean over the windows up to SPREAD_WINDOWS, whatever
+// window the intervals chose: a rare path's light is spread over its surface rather than held as
+// a dot or refused by the intervals, which left caustic-lit surfaces dark.
 
 var src: texture_2d<f32>;
 // The variance stage's output: rgb the accumulated light, a its variance (of the mean with
 // variance_of_mean).
 var light: texture_2d<f32>;
+// The light the spike cut took off each pixel (svgf/variance.wgsl).
+var excess: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var taps: texture_2d<u32>;
 var dst: texture_storage_2d<rgba16float, write>;
@@ -30,6 +38,11 @@ var dst: texture_storage_2d<rgba16float, write>;
 // Windows 1..WINDOWS: radius 2^(k-1) (at most regression_radius); a window's new taps lie on a
 // grid of its radius / 4 pixels (every pixel up to radius 4), outside the previous window.
 const WINDOWS: i32 = 6;
+
+// The windows the cut light is averaged over: up to radius 8 (taps every pixel to radius 4,
+// every other one beyond). Measured (cornell_mirror, frame 60): radius 4 0.0523, 8 0.0515; the
+// 3x3 window 0.0547.
+const SPREAD_WINDOWS: i32 = 5;
 
 // The half-width of the pixel's own interval and the 3x3 window's, in standard deviations. They
 // hold too few samples to judge the wider windows by at `regression_k`: at 1 sigma a third of
@@ -88,13 +101,25 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let gamma = sv.regression_k * narrowing;
     let narrow_gamma = NARROW_GAMMA * narrowing;
+    let spikes = sv.spike_ratio > 0.0;
+    var cut = vec3f(0.0);
+    if spikes {
+        cut = textureLoad(excess, p, 0).rgb;
+    }
+    // The cut light's weighted sum and weight.
+    var spread = cut;
+    var spread_w = 1.0;
+    let own = c.rgb - cut;
     var s: Sums;
-    add_tap(&s, 1.0, 0.0, 0.0, c.rgb, max(c.a, 0.0));
-    var shown = c.rgb;
+    add_tap(&s, 1.0, 0.0, 0.0, own, max(c.a, 0.0));
+    var shown = own;
+    // The intervals stopped widening; the cut light's windows may go on.
+    var stopped = false;
     var lo = -1e30;
     var hi = 1e30;
     let widest = min(WINDOWS, i32(floor(log2(max(sv.regression_radius, 1.0)))) + 1);
-    for (var k = 1; k <= widest; k++) {
+    let last = select(widest, max(widest, SPREAD_WINDOWS), spikes);
+    for (var k = 1; k <= last; k++) {
         let r = 1 << u32(k - 1);
         let inner = r / 2;
         let step = max(r / 4, 1);
@@ -116,16 +141,29 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 let w = exp(-0.5 * offset * offset / (reach * reach)) * feature_weight(fc, fq, offset, vc, vq);
                 if w > 1e-3 {
                     let t = textureLoad(light, q, 0);
-                    add_tap(&s, w, f32(dx) / 32.0, f32(dy) / 32.0, t.rgb, max(t.a, 0.0));
+                    var e = vec3f(0.0);
+                    if spikes {
+                        e = textureLoad(excess, q, 0).rgb;
+                        if k <= SPREAD_WINDOWS {
+                            spread += w * e;
+                            spread_w += w;
+                        }
+                    }
+                    if !stopped && k <= widest {
+                        add_tap(&s, w, f32(dx) / 32.0, f32(dy) / 32.0, t.rgb - e, max(t.a, 0.0));
+                    }
                 }
             }
+        }
+        if stopped || k > widest {
+            continue;
         }
         // One variance for every tap, the window's mean: a pixel that missed the rare bright
         // paths has a low mean and a low variance of its own, and would hold its interval shut.
         let var_pool = s.wvar / s.m0.x;
         if k == 1 {
             // The pixel alone, its standard deviation the 3x3 window's pooled one.
-            let l0 = luminance(c.rgb);
+            let l0 = luminance(own);
             lo = l0 - narrow_gamma * sqrt(var_pool);
             hi = l0 + narrow_gamma * sqrt(var_pool);
         }
@@ -140,12 +178,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         lo = max(lo, lm - g * sd);
         hi = min(hi, lm + g * sd);
         if lo > hi {
-            break;
+            stopped = true;
+            if k >= SPREAD_WINDOWS || !spikes {
+                break;
+            }
+            continue;
         }
         shown = fit.beta0;
     }
     if any(shown != shown) {
-        shown = c.rgb;
+        shown = own;
     }
+    shown += spread / spread_w;
     textureStore(dst, p, vec4f(half_safe(max(shown, vec3f(0.0))), passed.a));
 }

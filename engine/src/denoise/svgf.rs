@@ -56,7 +56,8 @@ pub struct SvgfParams {
     pub regression_samples: f32,
     pub regression_order: f32,
     pub regression_full_samples: f32,
-    pub _pad: [u32; 2],
+    pub spike_ratio: f32,
+    pub _pad: u32,
 }
 
 impl SvgfParams {
@@ -76,7 +77,8 @@ impl SvgfParams {
             regression_samples: s.regression_samples.max(1.0),
             regression_order: s.regression_order.min(2) as f32,
             regression_full_samples: s.regression_full_samples.clamp(0.0, STILL_FRAMES_MAX),
-            _pad: [0; 2],
+            spike_ratio: s.spike_ratio.max(0.0),
+            _pad: 0,
         }
     }
 }
@@ -120,7 +122,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     Ok(Box::new(Svgf { scene: *scene, res, matte: None, glossy: None, motion: None }))
 }
 
-/// One signal's textures: 140 bytes per pixel.
+/// One signal's textures: 148 bytes per pixel.
 pub struct SignalTargets {
     /// What the next frame reprojects, by parity: the integrated light, or the first a-trous
     /// level's output (`filtered_history`). 32-bit floats: a still view's mean of 1 / h steps
@@ -133,6 +135,8 @@ pub struct SignalTargets {
     pub integrated: Tex,
     /// The variance stage's output (rgb, variance): the first a-trous level's input.
     pub variance: Tex,
+    /// The light the regression's spike cut takes off each pixel (`SvgfSettings::spike_ratio`).
+    pub excess: Tex,
     /// The signal's edge-stopping features packed by the variance stage for the a-trous levels
     /// (z, dz, oct normal, reach: 16 bytes per pixel; one load per tap instead of four to
     /// seven). A texture rather than a storage buffer: on lavapipe a texel load is one load per
@@ -162,6 +166,7 @@ impl SignalTargets {
             moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
             integrated: t("integrated", RGBA32F),
             variance: t("variance", RGBA16F),
+            excess: t("excess", RGBA16F),
             ping: t("ping", RGBA16F),
             pong: t("pong", RGBA16F),
             regressed: t("regressed", RGBA16F),
@@ -453,7 +458,8 @@ impl Resources {
                 .texture("integrated", &s.integrated.1)
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.variance.1)
-                .texture("out_taps", &s.taps.1),
+                .texture("out_taps", &s.taps.1)
+                .texture("out_excess", &s.excess.1),
             Pass::Atrous(level) => {
                 let src = match level {
                     0 => &s.variance,
@@ -471,6 +477,7 @@ impl Resources {
             Pass::Regression(last) => b
                 .texture("src", &[&s.variance, &s.ping, &s.pong][last].1)
                 .texture("light", &s.variance.1)
+                .texture("excess", &s.excess.1)
                 .texture("taps", &s.taps.1)
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("dst", &s.regressed.1),

@@ -151,6 +151,18 @@ described! {
         /// Light with fewer samples' worth than this shows the a-trous output.
         regression_samples: f32 = 16.0,
             ("svgf.regression_samples", "svgf/regression", "samples", Float(1.0, 1024.0, 1.0));
+        /// The regression's spike cut (svgf/variance.wgsl, svgf/regression.wgsl): where a pixel's
+        /// accumulated light is over this many times its second brightest neighbour's on its
+        /// surface, and one rare path makes most of its samples' spread (their mean square over 8
+        /// times their mean's square), the fit reads it cut to that level and the cut light is
+        /// averaged over the windows up to radius 8 around each pixel: a caustic path's light is
+        /// spread over its surface, where the windows' tests dropped it and left the surface dark.
+        /// 0: off. Frame 60 of a still view (256², seeds 0-3): cornell_mirror FLIP 0.0517 / 0.0527
+        /// / 0.0522 / 0.0513 against 0.0562 / 0.0574 / 0.0567 off (its ceiling -2.3% against
+        /// Mitsuba, -3.8% off), cornell_diffuse 0.0241 either way. Costs a 3x3 read per pixel
+        /// and signal in the variance stage and one load per regression tap.
+        spike_ratio: f32 = 1.2,
+            ("svgf.spike_ratio", "svgf/regression", "", Float(0.0, 16.0, 0.1));
         /// Voorhuis §6's firefly suppression after the a-trous, outside the history loop, on diffuse
         /// light (the matte light, and the glossy light behind mirrors) that has not settled
         /// (`settled_samples`): a pixel brighter than all its neighbours is brought down to the
