@@ -155,7 +155,7 @@ described! {
         /// accumulated light is over this many times its second brightest neighbour's on its
         /// surface, and one rare path makes most of its samples' spread (their mean square over 8
         /// times their mean's square), the fit reads it cut to that level and the cut light is
-        /// averaged over the windows up to radius 8 around each pixel: a caustic path's light is
+        /// averaged over the windows up to radius 16 around each pixel: a caustic path's light is
         /// spread over its surface, where the windows' tests dropped it and left the surface dark.
         /// 0: off. Frame 60 of a still view (256², seeds 0-3): cornell_mirror FLIP 0.0517 / 0.0527
         /// / 0.0522 / 0.0513 against 0.0562 / 0.0574 / 0.0567 off (its ceiling -2.3% against
