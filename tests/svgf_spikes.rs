@@ -2,41 +2,26 @@
 //! the light the variance stage takes off a lone pixel that one rare path made bright, against a
 //! CPU computation of the same rule, and the regression keeping that light on the surface.
 
-use hush_engine::accel::BvhKind;
-use hush_engine::frame::{FrameInput, Renderer};
+use hush_engine::frame::Renderer;
 use hush_engine::gpu::Gpu;
-use hush_engine::quality::{Image, luminance};
-use hush_engine::scene::Camera;
+use hush_engine::quality::luminance;
 use hush_engine::settings::{Denoiser, FrameSettings, SvgfSettings, TaaSettings};
-use hush_tests::half;
+use hush_tests::{f32_at, half};
 
 const SIZE: u32 = 64;
 
-fn mirror() -> (Gpu, Renderer, Camera) {
+/// cornell_mirror at 64², `frames` still frames of SVGF with `spike_ratio`, TAA off so that
+/// every pixel's history is its own: the renderer, to read its textures.
+fn still_mirror(spike_ratio: f32, frames: u32) -> (Gpu, Renderer) {
     let dir = hush_tests::oracle("cornell_mirror");
     let scene = hush_engine::scene::load_gltf(&dir.join("cornell_mirror.gltf")).unwrap();
-    let cam = scene.camera_or_default();
-    let (gpu, r) = Renderer::headless(scene, BvhKind::DEFAULT, (SIZE, SIZE)).unwrap();
-    (gpu, r, cam)
-}
-
-fn svgf(spike_ratio: f32) -> FrameSettings {
-    FrameSettings {
+    let s = FrameSettings {
         denoiser: Denoiser::named("svgf"),
         svgf: SvgfSettings { spike_ratio, ..Default::default() },
+        taa: TaaSettings { enabled: false, ..Default::default() },
         ..Default::default()
-    }
-}
-
-fn frames(r: &mut Renderer, gpu: &Gpu, s: &FrameSettings, camera: Camera, n: u32) -> Image {
-    for _ in 0..n {
-        r.render(gpu, &FrameInput { camera, time: 0.0, shutter: None }, s, None).unwrap();
-    }
-    r.read_hdr(gpu).unwrap()
-}
-
-fn f32_at(b: &[u8], i: usize) -> f32 {
-    f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap())
+    };
+    hush_tests::realtime_renderer(&scene, (SIZE, SIZE), &s, frames).unwrap()
 }
 
 /// The taps record's features (svgf/variance.wgsl pack_taps): linear depth, its gradient (below
@@ -72,12 +57,7 @@ fn features(taps: &[u8], i: usize) -> Features {
 fn the_spike_cut_matches_a_cpu_computation() {
     let n = 20;
     let run = |ratio: f32| {
-        let (gpu, mut r, cam) = mirror();
-        let s = FrameSettings {
-            taa: TaaSettings { enabled: false, ..Default::default() },
-            ..svgf(ratio)
-        };
-        frames(&mut r, &gpu, &s, cam, n);
+        let (gpu, r) = still_mirror(ratio, n);
         let read = |name: &str| r.read_texture(&gpu, name).unwrap().0;
         let written = 1 - (n as usize - 1) % 2;
         (
@@ -85,10 +65,10 @@ fn the_spike_cut_matches_a_cpu_computation() {
             read(&format!("svgf/matte moments {written}")),
             read("svgf/matte taps"),
             read("svgf/matte excess"),
-            s.svgf,
         )
     };
-    let (integrated, moments, taps, excess, sv) = run(SvgfSettings::default().spike_ratio);
+    let sv = SvgfSettings::default();
+    let (integrated, moments, taps, excess) = run(sv.spike_ratio);
     let (w, h) = (SIZE as i64, SIZE as i64);
     let light = |i: usize| {
         glam::Vec3::new(
@@ -163,12 +143,7 @@ fn the_spike_cut_matches_a_cpu_computation() {
 fn the_spike_cut_keeps_the_light_of_caustics() {
     let n = 32;
     let ratio = |spike_ratio: f32| {
-        let (gpu, mut r, cam) = mirror();
-        let s = FrameSettings {
-            taa: TaaSettings { enabled: false, ..Default::default() },
-            ..svgf(spike_ratio)
-        };
-        frames(&mut r, &gpu, &s, cam, n);
+        let (gpu, r) = still_mirror(spike_ratio, n);
         let light = r.read_texture(&gpu, "svgf/matte variance").unwrap().0;
         let shown = r.read_texture(&gpu, "svgf/matte regressed").unwrap().0;
         let taps = r.read_texture(&gpu, "svgf/matte taps").unwrap().0;

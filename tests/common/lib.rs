@@ -195,6 +195,11 @@ pub fn half(b: &[u8]) -> f32 {
     half::f16::from_le_bytes([b[0], b[1]]).to_f32()
 }
 
+/// The `i`th little-endian f32 of a texture's bytes.
+pub fn f32_at(b: &[u8], i: usize) -> f32 {
+    f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap())
+}
+
 /// A G-buffer normal texel (Rg16Float, octahedral) as a unit vector, as oct_decode in
 /// shaders/realtime/frame.wgsl reads it.
 pub fn oct_normal(texel: &[u8]) -> glam::Vec3 {
