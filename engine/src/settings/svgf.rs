@@ -158,9 +158,9 @@ described! {
         /// averaged over the windows up to radius 16 around each pixel: a caustic path's light is
         /// spread over its surface, where the windows' tests dropped it and left the surface dark.
         /// 0: off. Frame 60 of a still view (256², seeds 0-3): cornell_mirror FLIP 0.0517 / 0.0527
-        /// / 0.0522 / 0.0513 against 0.0562 / 0.0574 / 0.0567 off (its ceiling -2.3% against
-        /// Mitsuba, -3.8% off), cornell_diffuse 0.0241 either way. Costs a 3x3 read per pixel
-        /// and signal in the variance stage and one load per regression tap.
+        /// / 0.0522 / 0.0513 against 0.0562 / 0.0574 / 0.0567 / 0.0557 off (its ceiling -2.3%
+        /// against Mitsuba, -3.8% off), cornell_diffuse 0.0241 either way. Costs a 3x3 read per
+        /// pixel and signal in the variance stage and one load per regression tap.
         spike_ratio: f32 = 1.2,
             ("svgf.spike_ratio", "svgf/regression", "", Float(0.0, 16.0, 0.1));
         /// Voorhuis §6's firefly suppression after the a-trous, outside the history loop, on diffuse
