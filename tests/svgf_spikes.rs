@@ -36,12 +36,8 @@ fn features(taps: &[u8], i: usize) -> Features {
     let word =
         |k: usize| u32::from_le_bytes(taps[i * 16 + k * 4..i * 16 + k * 4 + 4].try_into().unwrap());
     let snorm = |v: u32| ((v & 0xffff) as u16 as i16 as f32 / 32767.0).max(-1.0);
-    let (x, y) = (snorm(word(2)), snorm(word(2) >> 16));
-    let mut n = glam::Vec3::new(x, y, 1.0 - x.abs() - y.abs());
-    if n.z < 0.0 {
-        n = glam::Vec3::new((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum(), n.z);
-    }
-    Features { z: f32::from_bits(word(0)), dz: f32::from_bits(word(1)), n: n.normalize() }
+    let n = hush_tests::oct_decode(snorm(word(2)), snorm(word(2) >> 16));
+    Features { z: f32::from_bits(word(0)), dz: f32::from_bits(word(1)), n }
 }
 
 /// On the caustic-lit walls of cornell_mirror (64², 20 still frames, TAA off so that every pixel's

@@ -203,7 +203,11 @@ pub fn f32_at(b: &[u8], i: usize) -> f32 {
 /// A G-buffer normal texel (Rg16Float, octahedral) as a unit vector, as oct_decode in
 /// shaders/realtime/frame.wgsl reads it.
 pub fn oct_normal(texel: &[u8]) -> glam::Vec3 {
-    let (x, y) = (half(texel), half(&texel[2..]));
+    oct_decode(half(texel), half(&texel[2..]))
+}
+
+/// An octahedral encoding (x, y) as a unit vector, as oct_decode in shaders/realtime/frame.wgsl.
+pub fn oct_decode(x: f32, y: f32) -> glam::Vec3 {
     let mut n = glam::Vec3::new(x, y, 1.0 - x.abs() - y.abs());
     if n.z < 0.0 {
         n = glam::Vec3::new((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum(), n.z);
