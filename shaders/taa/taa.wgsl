@@ -277,6 +277,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 // edge between a lit and an unlit surface): the product of the averages is not
                 // the average of the products there.
                 if all(followed >= vec3f(0.0)) {
+                    // One share for every chain followed: TAA keeps no average of each chain's
+                    // term apart, so the larger of the two applies (TaaSettings::current_glossy).
                     let share = max(select(0.0, dn.taa_current_light, (left_out & FOLLOW_MATTE) != 0u), select(0.0, dn.taa_current_glossy, (left_out & FOLLOW_GLOSSY) != 0u));
                     result = mix(result, followed, share);
                 }
