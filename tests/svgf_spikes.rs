@@ -157,4 +157,9 @@ fn the_spike_cut_keeps_the_light_of_caustics() {
     println!(
         "the regression's mean over the light it reads: {with:.5} with the cut, {without:.5} without"
     );
+    assert!(with >= 0.982, "the regression shows {with:.5} of the light it reads with the cut");
+    assert!(
+        without < 0.982,
+        "without the cut it shows {without:.5}: the test no longer sees the loss"
+    );
 }
