@@ -32,6 +32,11 @@ struct Features {
     n: glam::Vec3,
 }
 
+/// The rgb of texel `i` of an Rgba16Float texture's bytes.
+fn rgb16(b: &[u8], i: usize) -> glam::Vec3 {
+    glam::Vec3::new(half(&b[i * 8..]), half(&b[i * 8 + 2..]), half(&b[i * 8 + 4..]))
+}
+
 fn features(taps: &[u8], i: usize) -> Features {
     let word =
         |k: usize| u32::from_le_bytes(taps[i * 16 + k * 4..i * 16 + k * 4 + 4].try_into().unwrap());
@@ -109,11 +114,7 @@ fn the_spike_cut_matches_a_cpu_computation() {
                 expected = c * (1.0 - sv.spike_ratio * second / l);
             }
         }
-        let got = glam::Vec3::new(
-            half(&excess[i * 8..]),
-            half(&excess[i * 8 + 2..]),
-            half(&excess[i * 8 + 4..]),
-        );
+        let got = rgb16(&excess, i);
         let ok = (got - expected).abs().max_element() <= 2e-3 * expected.max_element().max(1e-2);
         if !ok && std::env::var("HUSH_TEST_VERBOSE").is_ok() {
             println!("pixel ({x}, {y}): excess {got} against the CPU's {expected}");
@@ -143,11 +144,7 @@ fn the_spike_cut_keeps_the_light_of_caustics() {
         let light = r.read_texture(&gpu, "svgf/matte variance").unwrap().0;
         let shown = r.read_texture(&gpu, "svgf/matte regressed").unwrap().0;
         let taps = r.read_texture(&gpu, "svgf/matte taps").unwrap().0;
-        let lum = |b: &[u8], i: usize| {
-            let c =
-                glam::Vec3::new(half(&b[i * 8..]), half(&b[i * 8 + 2..]), half(&b[i * 8 + 4..]));
-            luminance(c) as f64
-        };
+        let lum = |b: &[u8], i: usize| luminance(rgb16(b, i)) as f64;
         let surface = (0..(SIZE * SIZE) as usize).filter(|i| features(&taps, *i).dz >= 0.0);
         let (read, out) =
             surface.fold((0.0, 0.0), |(a, b), i| (a + lum(&light, i), b + lum(&shown, i)));
