@@ -13,7 +13,7 @@ use hush_engine::passes::cache::NO_CELL;
 use hush_engine::scene::{Camera, Scene, cuboid, load_gltf, quad};
 use hush_engine::settings::{CacheSettings, Denoiser, FrameSettings, TaaSettings, View};
 use hush_tests::gltf_writer::GltfWriter;
-use hush_tests::half;
+use hush_tests::halves;
 use serde_json::json;
 use std::collections::HashMap;
 
@@ -34,14 +34,6 @@ fn u32s(bytes: &[u8]) -> Vec<u32> {
 
 fn f32s(bytes: &[u8]) -> Vec<f32> {
     bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect()
-}
-
-/// Rgba16Float texels as [r, g, b, a].
-fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
-    bytes
-        .chunks_exact(8)
-        .map(|t| [half(&t[0..2]), half(&t[2..4]), half(&t[4..6]), half(&t[6..8])])
-        .collect()
 }
 
 /// Per cell slot: the sum of the samples (each clamped as the cache clamps them: 64 at exposure

@@ -200,6 +200,14 @@ pub fn f32_at(b: &[u8], i: usize) -> f32 {
     f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap())
 }
 
+/// Rgba16Float texels read back, as [r, g, b, a].
+pub fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
+    bytes
+        .chunks_exact(8)
+        .map(|t| [half(&t[0..2]), half(&t[2..4]), half(&t[4..6]), half(&t[6..8])])
+        .collect()
+}
+
 /// A G-buffer normal texel (Rg16Float, octahedral) as a unit vector, as oct_decode in
 /// shaders/realtime/frame.wgsl reads it.
 pub fn oct_normal(texel: &[u8]) -> glam::Vec3 {
