@@ -121,6 +121,30 @@ fn integrate(current: vec3f, history: vec3f, moments_in: vec4f, reprojected: boo
     return Integrated(mix(history, current, alpha), vec4f(m, h, s));
 }
 
+// What TAA follows of a signal (taa/matte.wgsl, in matte/reason's format), from the moments the
+// temporal stage stored: REASON_DISOCCLUDED where the history restarted this frame,
+// REASON_NEIGHBOUR where it was not this pixel's own texel (`own`: read exactly, under a zero
+// motion vector), and above the 8 flag bits the samples' worth of the light (1 / the sum of the
+// squared integration weights), so that TAA follows a still view's mean but keeps averaging
+// SVGF's 0.2 moving average (about 9 samples' worth). A still pixel on a silhouette or a room's
+// corner reads a neighbour whenever the jitter moved its sample to the other surface: its light
+// then jumps between the two surfaces' from frame to frame, and TAA averages it, as it does
+// under Mara's chain (matte/temporal.wgsl), instead of showing the last surface's alone.
+fn follow_state(moments: vec4f, own: bool) -> u32 {
+    var state = select(REASON_NEIGHBOUR, 0u, own);
+    if moments.z < 2.0 {
+        state = REASON_DISOCCLUDED;
+    }
+    let worth = 1.0 / max(moments.w, 1e-6);
+    return state | (u32(clamp(worth + 0.5, 0.0, 16777215.0)) << 8u);
+}
+
+// Whether the motion vector at p is zero (the history texel under it is read exactly).
+fn still_pixel(p: vec2i) -> bool {
+    let mv = textureLoad(gb_motion, p, 0).xy;
+    return dot(mv, mv) <= 1e-8;
+}
+
 // The variance the filter steers by, from the samples' variance and the moments texel: of one
 // sample (Schied et al.) or of the integrated light (SV_VARIANCE_OF_MEAN).
 fn steering_variance(sample_variance: f32, moments: vec4f) -> f32 {

@@ -7,12 +7,6 @@
 var src: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
-// What TAA follows (taa/matte.wgsl, in matte/reason's format): REASON_DISOCCLUDED where the
-// history restarted this frame, REASON_NEIGHBOUR where it was not this pixel's own texel read
-// exactly (any motion), and the history's length above the 8 flag bits: the samples' worth
-// of the light (1 / the sum of the squared integration weights), so that TAA follows a still
-// view's mean but keeps averaging SVGF's 0.2 moving average (about 9 samples' worth).
-var out_state: texture_storage_2d<r32uint, write>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
@@ -22,14 +16,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     var c = textureLoad(src, p, 0).rgb;
     let m = textureLoad(moments, p, 0);
-    let h = m.z;
     let worth = 1.0 / max(m.w, 1e-6);
-    let mv = textureLoad(gb_motion, p, 0).xy;
-    var state = select(0u, REASON_NEIGHBOUR, dot(mv, mv) > 1e-8);
-    if h < 2.0 {
-        state = REASON_DISOCCLUDED;
-    }
-    textureStore(out_state, p, vec4u(state | (u32(clamp(worth + 0.5, 0.0, 16777215.0)) << 8u), 0u, 0u, 0u));
     // Settled light (SvgfSettings::settled_samples) has averaged its fireflies away.
     let settled = sv.settled_samples > 0.0 && worth >= sv.settled_samples;
     if sv_on(SV_FIREFLY) && signal_diffuse(p) && !settled {

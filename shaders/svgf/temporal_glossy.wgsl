@@ -14,6 +14,8 @@ var motion: texture_2d<f32>;
 var neighbourhood: texture_2d<f32>;
 var out_integrated: texture_storage_2d<rgba32float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
+// What TAA follows of the light (svgf/common.wgsl: follow_state).
+var out_state: texture_storage_2d<r32uint, write>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
@@ -25,11 +27,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !has_surface(p) {
         textureStore(out_integrated, p, vec4f(current, luminance(current)));
         textureStore(out_moments, p, vec4f(0.0));
+        textureStore(out_state, p, vec4u(follow_state(vec4f(0.0), false), 0u, 0u, 0u));
         return;
     }
     let x = position_at(p);
     let roughness = roughness_at(p);
     var reprojected = false;
+    // The history is this pixel's own texel, read exactly.
+    var own = false;
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);
     if sv_on(SV_TEMPORAL) && sv_on(SV_GLOSSY_TEMPORAL) && dn.history_valid != 0u {
@@ -83,6 +88,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 mom = vec4f(load_taps(moments, b, w).xy, mom.zw);
             }
             reprojected = mom.z >= 1.0;
+            own = r.bilinear && still_pixel(p);
             if reprojected && sv_on(SV_CLIPPING) && roughness < gp.clip_roughness {
                 hist = clip_to_neighbourhood(neighbourhood, p, hist);
             }
@@ -91,4 +97,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let i = integrate(current, hist, mom, reprojected);
     textureStore(out_integrated, p, vec4f(half_safe(i.light), luminance(current)));
     textureStore(out_moments, p, i.moments);
+    textureStore(out_state, p, vec4u(follow_state(i.moments, own), 0u, 0u, 0u));
 }

@@ -13,6 +13,8 @@ var history: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var out_integrated: texture_storage_2d<rgba32float, write>;
 var out_moments: texture_storage_2d<rgba32float, write>;
+// What TAA follows of the light (svgf/common.wgsl: follow_state).
+var out_state: texture_storage_2d<r32uint, write>;
 var out_features: texture_storage_2d<rg32float, write>;
 
 // The luminance variance of the matte light over the 3x3 pixels with a surface that averaged k
@@ -43,6 +45,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !has_surface(p) {
         textureStore(out_integrated, p, vec4f(current, luminance(current)));
         textureStore(out_moments, p, vec4f(0.0));
+        textureStore(out_state, p, vec4u(follow_state(vec4f(0.0), false), 0u, 0u, 0u));
         textureStore(out_features, p, vec4f(-1.0, 0.0, 0.0, 0.0));
         return;
     }
@@ -52,6 +55,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     textureStore(out_features, p, vec4f(z, dz, 0.0, 0.0));
 
     var reprojected = false;
+    // The history is this pixel's own texel, read exactly.
+    var own = false;
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);
     if sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
@@ -71,6 +76,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             }
             // A previous texel without a history (a miss then) does not count.
             reprojected = mom.z >= 1.0;
+            own = r.bilinear && still_pixel(p);
         }
     }
     var i = integrate(current, hist, mom, reprojected);
@@ -97,4 +103,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     textureStore(out_integrated, p, vec4f(half_safe(i.light), luminance(current)));
     textureStore(out_moments, p, i.moments);
+    textureStore(out_state, p, vec4u(follow_state(i.moments, own), 0u, 0u, 0u));
 }

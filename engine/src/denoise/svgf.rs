@@ -453,7 +453,8 @@ impl Resources {
                 .texture("moments", &s.moments.history(parity).1)
                 .texture("out_integrated", &s.integrated.1)
                 .texture("out_moments", &s.moments.output(parity).1)
-                .texture("out_features", &t.features.1),
+                .texture("out_features", &t.features.1)
+                .texture("out_state", &s.state.1),
             Pass::Variance => b
                 .texture("integrated", &s.integrated.1)
                 .texture("moments", &s.moments.output(parity).1)
@@ -484,8 +485,7 @@ impl Resources {
             Pass::Final => b
                 .texture("src", &s.regressed.1)
                 .texture("moments", &s.moments.output(parity).1)
-                .texture("dst", &s.out.1)
-                .texture("out_state", &s.state.1),
+                .texture("dst", &s.out.1),
         }
     }
 
