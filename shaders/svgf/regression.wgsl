@@ -21,9 +21,9 @@
 //
 // The fit reads each tap's light less what the variance stage's spike cut took off it
 // (SvgfSettings::spike_ratio: a lone pixel that one rare path made bright), and the pixel shows
-// the fit plus the cut light's weighted mean over the windows up to SPREAD_WINDOWS, whatever
-// window the intervals chose: a rare path's light is spread over its surface rather than held as
-// a dot or refused by the intervals, which left caustic-lit surfaces dark.
+// the fit plus the cut light's mean over its surface (svgf/spread.wgsl), whatever window the
+// intervals chose: a rare path's light is spread over its surface rather than held as a dot or
+// refused by the intervals, which left caustic-lit surfaces dark.
 
 var src: texture_2d<f32>;
 // The variance stage's output: rgb the accumulated light, a its variance (of the mean with
@@ -33,16 +33,14 @@ var light: texture_2d<f32>;
 var excess: texture_2d<f32>;
 var moments: texture_2d<f32>;
 var taps: texture_2d<u32>;
+// The cut light's mean over each pixel's surface (svgf/spread.wgsl).
+var spread: texture_2d<f32>;
 var dst: texture_storage_2d<rgba16float, write>;
 
 // Windows 1..WINDOWS: radius 2^(k-1) (at most regression_radius); a window's new taps lie on a
 // grid of its radius / 4 pixels (every pixel up to radius 4), outside the previous window.
 const WINDOWS: i32 = 6;
 
-// The windows the cut light is averaged over: up to radius 16 (the taps of every pixel to radius
-// 4, every other one to 8, every fourth to 16), wider than the regression's narrowest windows.
-// Measured (cornell_mirror, frame 60, ratio 1.2): up to radius 8 0.0523, 16 0.0515.
-const SPREAD_WINDOWS: i32 = 5;
 
 // The half-width of the pixel's own interval and the 3x3 window's, in standard deviations. They
 // hold too few samples to judge the wider windows by at `regression_k`: at 1 sigma a third of
@@ -55,19 +53,6 @@ const NARROW_GAMMA: f32 = 3.0;
 // The fit's sums and solve: svgf/fit.wgsl.
 fn unknowns() -> i32 {
     return array<i32, 3>(1, 3, 6)[min(u32(sv.regression_order), 2u)];
-}
-
-// SVGF's depth and normal edge-stops of tap t, with the features' variances where the frame
-// has them (vc, vt: the normal's and the depth's relative variance, realtime/uncertainty.wgsl);
-// without, edge_weight's terms exactly.
-fn feature_weight(c: Features, t: Features, offset: f32, vc: vec2f, vt: vec2f) -> f32 {
-    if !FEATURE_VARIANCE {
-        return edge_weight(c, t, offset, 0.0, 0.0, 1.0);
-    }
-    let s = sv.sigma_z * max(c.dz, 1e-6) * offset + 1e-6;
-    let z2 = c.z * c.z;
-    let wz = depth_distance(c.z - t.z, s, vc.y * z2, vt.y * t.z * t.z);
-    return exp(-wz) * normal_weight(dot(c.n, t.n), sv.sigma_n, vc.x, vt.x);
 }
 
 @compute @workgroup_size(8, 8)
@@ -106,20 +91,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if spikes {
         cut = textureLoad(excess, p, 0).rgb;
     }
-    // The cut light's weighted sum and weight.
-    var spread = cut;
-    var spread_w = 1.0;
     let own = c.rgb - cut;
     var s: Sums;
     add_tap(&s, 1.0, 0.0, 0.0, own, max(c.a, 0.0));
     var shown = own;
-    // The intervals stopped widening; the cut light's windows may go on.
-    var stopped = false;
     var lo = -1e30;
     var hi = 1e30;
     let widest = min(WINDOWS, i32(floor(log2(max(sv.regression_radius, 1.0)))) + 1);
-    let last = select(widest, max(widest, SPREAD_WINDOWS), spikes);
-    for (var k = 1; k <= last; k++) {
+    for (var k = 1; k <= widest; k++) {
         let r = 1 << u32(k - 1);
         let inner = r / 2;
         let step = max(r / 4, 1);
@@ -144,19 +123,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                     var e = vec3f(0.0);
                     if spikes {
                         e = textureLoad(excess, q, 0).rgb;
-                        if k <= SPREAD_WINDOWS {
-                            spread += w * e;
-                            spread_w += w;
-                        }
                     }
-                    if !stopped && k <= widest {
-                        add_tap(&s, w, f32(dx) / 32.0, f32(dy) / 32.0, t.rgb - e, max(t.a, 0.0));
-                    }
+                    add_tap(&s, w, f32(dx) / 32.0, f32(dy) / 32.0, t.rgb - e, max(t.a, 0.0));
                 }
             }
-        }
-        if stopped || k > widest {
-            continue;
         }
         // One variance for every tap, the window's mean: a pixel that missed the rare bright
         // paths has a low mean and a low variance of its own, and would hold its interval shut.
@@ -178,17 +148,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         lo = max(lo, lm - g * sd);
         hi = min(hi, lm + g * sd);
         if lo > hi {
-            stopped = true;
-            if k >= SPREAD_WINDOWS || !spikes {
-                break;
-            }
-            continue;
+            break;
         }
         shown = fit.beta0;
     }
     if any(shown != shown) {
         shown = own;
     }
-    shown += spread / spread_w;
+    if spikes {
+        shown += half_safe(textureLoad(spread, p, 0).rgb);
+    }
     textureStore(dst, p, vec4f(half_safe(max(shown, vec3f(0.0))), passed.a));
 }

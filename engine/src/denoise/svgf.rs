@@ -122,7 +122,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     Ok(Box::new(Svgf { scene: *scene, res, matte: None, glossy: None, motion: None }))
 }
 
-/// One signal's textures: 148 bytes per pixel.
+/// One signal's textures: 164 bytes per pixel.
 pub struct SignalTargets {
     /// What the next frame reprojects, by parity: the integrated light, or the first a-trous
     /// level's output (`filtered_history`). 32-bit floats: a still view's mean of 1 / h steps
@@ -147,6 +147,10 @@ pub struct SignalTargets {
     pub pong: Tex,
     /// The final regression's output (settled light fitted, the rest the a-trous output).
     pub regressed: Tex,
+    /// The spike cut's light spread over each pixel's surface (svgf/spread.wgsl): the rows'
+    /// weighted sums (rgb, weight), then the mean the regression adds to its fit.
+    pub spread_rows: Tex,
+    pub spread: Tex,
     /// The light for the composite.
     pub out: Tex,
     /// What TAA follows of the light (matte/reason's format: flags, history length).
@@ -170,6 +174,8 @@ impl SignalTargets {
             ping: t("ping", RGBA16F),
             pong: t("pong", RGBA16F),
             regressed: t("regressed", RGBA16F),
+            spread_rows: t("spread rows", RGBA16F),
+            spread: t("spread", RGBA16F),
             out: t("out", RGBA16F),
             state: t("state", wgpu::TextureFormat::R32Uint),
         }
@@ -243,7 +249,10 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
         m.push(if glossy { "svgf/features_glossy.wgsl" } else { "svgf/features_matte.wgsl" });
     }
     if stage == "svgf/regression.wgsl" {
-        m.extend(["svgf/fit.wgsl", "common/feature_weight.wgsl"]);
+        m.push("svgf/fit.wgsl");
+    }
+    if stage == "svgf/regression.wgsl" || stage == "svgf/spread.wgsl" {
+        m.extend(["common/feature_weight.wgsl", "svgf/tap_weight.wgsl"]);
     }
     m.push(stage);
     m
@@ -252,9 +261,12 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
 /// Whether a stage reads the pre-filter's feature uncertainty where the frame offers it (takes
 /// realtime/uncertainty.wgsl or uncertainty_none.wgsl before its own module): every glossy
 /// stage after the temporal one (the reach takes the circle of confusion) and both signals'
-/// regressions (their edge-stops weigh the features against their variances).
+/// regressions and the spike cut's spread (their edge-stops weigh the features against their
+/// variances).
 pub fn reads_uncertainty(stage: &str, glossy: bool) -> bool {
-    (glossy && !stage.starts_with("svgf/temporal")) || stage == "svgf/regression.wgsl"
+    (glossy && !stage.starts_with("svgf/temporal"))
+        || stage == "svgf/regression.wgsl"
+        || stage == "svgf/spread.wgsl"
 }
 
 /// The module that gives the a-trous stage its kernel: the radius is a constant of the
@@ -292,6 +304,8 @@ struct SignalStages {
     temporal: ChainStage,
     variance: ChainStage,
     atrous: ChainStage,
+    spread_h: ChainStage,
+    spread_v: ChainStage,
     regression: ChainStage,
     last: ChainStage,
 }
@@ -307,11 +321,13 @@ impl SignalStages {
         let temporal =
             if glossy { "svgf/temporal_glossy.wgsl" } else { "svgf/temporal_matte.wgsl" };
         // Labels are 'static: the profiler and the pass timings key on them.
-        let labels: [&'static str; 5] = if glossy {
+        let labels: [&'static str; 7] = if glossy {
             [
                 "svgf/temporal_glossy",
                 "svgf/variance_glossy",
                 "svgf/atrous_glossy",
+                "svgf/spread_h_glossy",
+                "svgf/spread_v_glossy",
                 "svgf/regression_glossy",
                 "svgf/final_glossy",
             ]
@@ -320,11 +336,13 @@ impl SignalStages {
                 "svgf/temporal_matte",
                 "svgf/variance_matte",
                 "svgf/atrous_matte",
+                "svgf/spread_h_matte",
+                "svgf/spread_v_matte",
                 "svgf/regression_matte",
                 "svgf/final_matte",
             ]
         };
-        let stage = |label, file, b: &Bindings| {
+        let entry_stage = |label, file, entry: &str, b: &Bindings| {
             let mut m = modules(file, glossy, motion);
             if file == "svgf/atrous.wgsl" {
                 m.insert(m.len() - 1, kernel_module(variant.kernel_5x5));
@@ -335,8 +353,9 @@ impl SignalStages {
             if reads_uncertainty(file, glossy) {
                 m.insert(m.len() - 1, crate::passes::io::uncertainty_module(variant.uncertain));
             }
-            ChainStage::new(gpu, label, &m, "main", b)
+            ChainStage::new(gpu, label, &m, entry, b)
         };
+        let stage = |label, file, b: &Bindings| entry_stage(label, file, "main", b);
         // The matte history restarts from the radiance cache's prior where there is one.
         let mut temporal_modules = modules(temporal, glossy, motion);
         if !glossy {
@@ -348,8 +367,10 @@ impl SignalStages {
             temporal: ChainStage::new(gpu, labels[0], &temporal_modules, "main", offered)?,
             variance: stage(labels[1], "svgf/variance.wgsl", offered)?,
             atrous: stage(labels[2], "svgf/atrous.wgsl", offered)?,
-            regression: stage(labels[3], "svgf/regression.wgsl", offered)?,
-            last: stage(labels[4], "svgf/final.wgsl", offered)?,
+            spread_h: entry_stage(labels[3], "svgf/spread.wgsl", "spread_h", offered)?,
+            spread_v: entry_stage(labels[4], "svgf/spread.wgsl", "spread_v", offered)?,
+            regression: stage(labels[5], "svgf/regression.wgsl", offered)?,
+            last: stage(labels[6], "svgf/final.wgsl", offered)?,
         })
     }
 
@@ -358,6 +379,8 @@ impl SignalStages {
             &mut self.temporal,
             &mut self.variance,
             &mut self.atrous,
+            &mut self.spread_h,
+            &mut self.spread_v,
             &mut self.regression,
             &mut self.last,
         ]
@@ -400,6 +423,9 @@ enum Pass {
     Variance,
     /// Level i: reads the variance stage's output (level 0), then pong and ping in turn.
     Atrous(usize),
+    /// The spike cut's spread: the rows' sums of the cut light, then their columns' mean.
+    SpreadRows,
+    SpreadColumns,
     /// Reads the last level's output: 0 the variance stage's (no level ran), 1 ping, 2 pong.
     Regression(usize),
     /// Reads the regression's output.
@@ -481,7 +507,18 @@ impl Resources {
                 .texture("excess", &s.excess.1)
                 .texture("taps", &s.taps.1)
                 .texture("moments", &s.moments.output(parity).1)
+                .texture("spread", &s.spread.1)
                 .texture("dst", &s.regressed.1),
+            Pass::SpreadRows => b
+                .texture("taps", &s.taps.1)
+                .texture("moments", &s.moments.output(parity).1)
+                .texture("src", &s.excess.1)
+                .texture("dst", &s.spread_rows.1),
+            Pass::SpreadColumns => b
+                .texture("taps", &s.taps.1)
+                .texture("moments", &s.moments.output(parity).1)
+                .texture("src", &s.spread_rows.1)
+                .texture("dst", &s.spread.1),
             Pass::Final => b
                 .texture("src", &s.regressed.1)
                 .texture("moments", &s.moments.output(parity).1)
@@ -531,11 +568,18 @@ impl Resources {
     /// layout is checked against them).
     fn offered<'a>(&'a self, io: &FrameIo<'a>, t: &'a SvgfTargets, s: Signal<'a>) -> Bindings<'a> {
         let p = Parity::default();
-        [Pass::Variance, Pass::Atrous(0), Pass::Regression(0), Pass::Final]
-            .into_iter()
-            .fold(self.bindings(io, t, s, Pass::Temporal, p), |b, pass| {
-                b.with(&self.bindings(io, t, s, pass, p))
-            })
+        [
+            Pass::Variance,
+            Pass::Atrous(0),
+            Pass::SpreadRows,
+            Pass::SpreadColumns,
+            Pass::Regression(0),
+            Pass::Final,
+        ]
+        .into_iter()
+        .fold(self.bindings(io, t, s, Pass::Temporal, p), |b, pass| {
+            b.with(&self.bindings(io, t, s, pass, p))
+        })
     }
 
     fn record_stages(
@@ -571,6 +615,11 @@ impl Resources {
                 s.history.output(parity).0.as_image_copy(),
                 extent,
             );
+        }
+        let sv = &cx.settings.svgf;
+        if sv.regression && sv.spike_ratio > 0.0 {
+            st.spread_h.record(rec, key, parity, size, |p| b(Pass::SpreadRows, p))?;
+            st.spread_v.record(rec, key, parity, size, |p| b(Pass::SpreadColumns, p))?;
         }
         // The last level wrote pong when its index was even; bind groups by (last, parity).
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };

@@ -155,12 +155,14 @@ described! {
         /// accumulated light is over this many times its second brightest neighbour's on its
         /// surface, and one rare path makes most of its samples' spread (their mean square over 8
         /// times their mean's square), the fit reads it cut to that level and the cut light is
-        /// averaged over the windows up to radius 16 around each pixel: a caustic path's light is
-        /// spread over its surface, where the windows' tests dropped it and left the surface dark.
-        /// 0: off. Frame 60 of a still view (256², seeds 0-3): cornell_mirror FLIP 0.0517 / 0.0527
-        /// / 0.0522 / 0.0513 against 0.0562 / 0.0574 / 0.0567 / 0.0557 off (its ceiling -2.3%
-        /// against Mitsuba, -3.8% off), cornell_diffuse 0.0241 either way. Costs a 3x3 read per
-        /// pixel and signal in the variance stage and one load per regression tap.
+        /// averaged over the pixel's surface within 16 pixels (svgf/spread.wgsl): a caustic path's
+        /// light is spread over its surface, where the windows' tests dropped it and left the
+        /// surface dark. 0: off. Frame 60 of a still view (256², seeds 0-3): cornell_mirror FLIP
+        /// 0.0495 / 0.0506 / 0.0505 / 0.0493 against 0.0554 / 0.0566 / 0.0561 / 0.0549 off,
+        /// cornell_diffuse 0.0238 either way (seed 0). Costs a 3x3 read per pixel and signal in
+        /// the variance stage, one load per regression tap, and two separable passes of 33 taps
+        /// where the light is fitted (cornell_mirror at 320², lavapipe: 57 of 661 ms a still
+        /// frame for both signals).
         spike_ratio: f32 = 1.2,
             ("svgf.spike_ratio", "svgf/regression", "", Float(0.0, 16.0, 0.1));
         /// Voorhuis §6's firefly suppression after the a-trous, outside the history loop, on diffuse
