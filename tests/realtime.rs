@@ -247,16 +247,23 @@ fn the_default_level_renders_without_nan() {
                 entry.info.name
             );
         }
-        // Emission may be off screen, and SVGF's spike cut waits for 4 frames' samples
-        // (tests/svgf_spikes.rs reads what it cuts); every other view shows something from the
-        // level's camera (the radiance cache's after a jump: tests/radiance_cache.rs).
+        // Emission may be off screen, and SVGF's spike cut waits for 4 frames' samples, its
+        // spread for the regression's 16 (tests/svgf_spikes.rs reads both); every other view
+        // shows something from the level's camera (the radiance cache's after a jump:
+        // tests/radiance_cache.rs).
         let own = hush_engine::settings::FRAME_VIEWS
             .iter()
             .filter(|v| !v.needs_traced_primaries() && !v.needs_cache())
             .chain(entry.info.views);
         let views: Vec<View> =
             std::iter::once(View::FINAL).chain(own.map(|v| View::named(v.name))).collect();
-        let blank = ["gbuffer/emission", "svgf/matte spikes", "svgf/glossy spikes"];
+        let blank = [
+            "gbuffer/emission",
+            "svgf/matte spikes",
+            "svgf/glossy spikes",
+            "svgf/matte spread",
+            "svgf/glossy spread",
+        ];
         for v in views.into_iter().filter(|v| !blank.contains(&v.name())) {
             let settings = FrameSettings { view: v.clone(), ..denoised.clone() };
             let shown = r.display_image(&gpu, &settings).unwrap();

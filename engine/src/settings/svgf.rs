@@ -282,8 +282,10 @@ pub const VIEWS: &[ViewSpec] = &[
         ViewMap::Grey { channel: 0, divisor: 1.0 },
     ),
     v("svgf/matte history", "svgf/matte history 0", ViewMap::Light),
-    // The light the regression's spike cut takes off each pixel (`spike_ratio`), then spreads.
+    // The light the regression's spike cut takes off each pixel (`spike_ratio`), and its mean
+    // over each pixel's surface, which the regression adds (svgf/spread.wgsl).
     v("svgf/matte spikes", "svgf/matte excess", ViewMap::Light),
+    v("svgf/matte spread", "svgf/matte spread", ViewMap::Light),
     // The final regression's output (settled light; the rest is the a-trous output).
     v("svgf/matte regression", "svgf/matte regressed", ViewMap::Light),
     v("svgf/matte", "svgf/matte out", ViewMap::Light),
@@ -296,6 +298,7 @@ pub const VIEWS: &[ViewSpec] = &[
     ),
     v("svgf/glossy history", "svgf/glossy history 0", ViewMap::Light),
     v("svgf/glossy spikes", "svgf/glossy excess", ViewMap::Light),
+    v("svgf/glossy spread", "svgf/glossy spread", ViewMap::Light),
     v("svgf/glossy motion", "svgf/glossy motion", ViewMap::Motion { channel: 0 }),
     v("svgf/glossy", "svgf/glossy out", ViewMap::Light),
 ];
