@@ -41,7 +41,6 @@ var dst: texture_storage_2d<rgba16float, write>;
 // grid of its radius / 4 pixels (every pixel up to radius 4), outside the previous window.
 const WINDOWS: i32 = 6;
 
-
 // The half-width of the pixel's own interval and the 3x3 window's, in standard deviations. They
 // hold too few samples to judge the wider windows by at `regression_k`: at 1 sigma a third of
 // all pixels, those whose mean lies over a sigma from their neighbours', would stop there and

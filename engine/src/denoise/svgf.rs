@@ -3,9 +3,11 @@
 //!
 //! Two signals, the matte and the glossy light (Hush's punctual direct light carries no noise
 //! and bypasses every denoiser), each through its own passes (shaders/svgf/*.wgsl):
-//! `svgf/temporal` (reprojection, moments, features) -> `svgf/variance` -> `svgf/atrous 0..4`
-//! (level 0 also writes the next frame's history) -> `svgf/final` (firefly median on the matte
-//! light, remodulation behind mirrors). In scenes with a specular lobe the glossy signal first
+//! `svgf/temporal` (reprojection, moments, features, what TAA follows) -> `svgf/variance` (and
+//! the spike cut) -> `svgf/atrous 0..4` (level 0 also writes the next frame's history) ->
+//! `svgf/spread_h`/`_v` (the cut light over its surface) -> `svgf/regression` (the settled
+//! light's fit) -> `svgf/final` (firefly median on the matte light, remodulation behind
+//! mirrors). In scenes with a specular lobe the glossy signal first
 //! runs the Mara glossy chain's `glossy/motion` (reflection motion vectors by diamond search)
 //! and, for the clip, `glossy/prefilter_h`/`_v`, on SVGF's own textures. The composite and TAA
 //! follow as for every denoiser. [`SvgfSettings`] switches each stage and each of Voorhuis's
