@@ -61,30 +61,25 @@ fn tap_value(q: vec2i, sums: bool) -> vec4f {
     return select(vec4f(t.rgb, 1.0), t, sums);
 }
 
-@compute @workgroup_size(8, 8)
-fn spread_h(@builtin(global_invocation_id) gid: vec3u) {
-    let p = vec2i(gid.xy);
+// One pass: the rows' weighted sums (rgb, weight) of the cut light, or the columns' mean of those.
+fn spread_pass(p: vec2i, rows: bool) {
     if !in_bounds(p) {
         return;
     }
-    if !fitted(p) {
-        textureStore(dst, p, vec4f(0.0));
-        return;
+    var out = vec4f(0.0);
+    if fitted(p) {
+        let s = sum_along(p, select(vec2i(0, 1), vec2i(1, 0), rows), !rows);
+        out = select(vec4f(half_safe(s.rgb / max(s.a, 1e-6)), 1.0), vec4f(half_safe(s.rgb), s.a), rows);
     }
-    let s = sum_along(p, vec2i(1, 0), false);
-    textureStore(dst, p, vec4f(half_safe(s.rgb), s.a));
+    textureStore(dst, p, out);
+}
+
+@compute @workgroup_size(8, 8)
+fn spread_h(@builtin(global_invocation_id) gid: vec3u) {
+    spread_pass(vec2i(gid.xy), true);
 }
 
 @compute @workgroup_size(8, 8)
 fn spread_v(@builtin(global_invocation_id) gid: vec3u) {
-    let p = vec2i(gid.xy);
-    if !in_bounds(p) {
-        return;
-    }
-    if !fitted(p) {
-        textureStore(dst, p, vec4f(0.0));
-        return;
-    }
-    let s = sum_along(p, vec2i(0, 1), true);
-    textureStore(dst, p, vec4f(half_safe(s.rgb / max(s.a, 1e-6)), 1.0));
+    spread_pass(vec2i(gid.xy), false);
 }

@@ -425,9 +425,9 @@ enum Pass {
     Variance,
     /// Level i: reads the variance stage's output (level 0), then pong and ping in turn.
     Atrous(usize),
-    /// The spike cut's spread: the rows' sums of the cut light, then their columns' mean.
-    SpreadRows,
-    SpreadColumns,
+    /// The spike cut's spread: the rows' sums of the cut light (false), then their columns' mean
+    /// (true).
+    Spread(bool),
     /// Reads the last level's output: 0 the variance stage's (no level ran), 1 ping, 2 pong.
     Regression(usize),
     /// Reads the regression's output.
@@ -511,16 +511,14 @@ impl Resources {
                 .texture("moments", &s.moments.output(parity).1)
                 .texture("spread", &s.spread.1)
                 .texture("dst", &s.regressed.1),
-            Pass::SpreadRows => b
-                .texture("taps", &s.taps.1)
-                .texture("moments", &s.moments.output(parity).1)
-                .texture("src", &s.excess.1)
-                .texture("dst", &s.spread_rows.1),
-            Pass::SpreadColumns => b
-                .texture("taps", &s.taps.1)
-                .texture("moments", &s.moments.output(parity).1)
-                .texture("src", &s.spread_rows.1)
-                .texture("dst", &s.spread.1),
+            Pass::Spread(columns) => {
+                let (src, dst) =
+                    if columns { (&s.spread_rows, &s.spread) } else { (&s.excess, &s.spread_rows) };
+                b.texture("src", &src.1)
+                    .texture("dst", &dst.1)
+                    .texture("taps", &s.taps.1)
+                    .texture("moments", &s.moments.output(parity).1)
+            }
             Pass::Final => b
                 .texture("src", &s.regressed.1)
                 .texture("moments", &s.moments.output(parity).1)
@@ -573,8 +571,8 @@ impl Resources {
         [
             Pass::Variance,
             Pass::Atrous(0),
-            Pass::SpreadRows,
-            Pass::SpreadColumns,
+            Pass::Spread(false),
+            Pass::Spread(true),
             Pass::Regression(0),
             Pass::Final,
         ]
@@ -620,8 +618,8 @@ impl Resources {
         }
         let sv = &cx.settings.svgf;
         if sv.regression && sv.spike_ratio > 0.0 {
-            st.spread_h.record(rec, key, parity, size, |p| b(Pass::SpreadRows, p))?;
-            st.spread_v.record(rec, key, parity, size, |p| b(Pass::SpreadColumns, p))?;
+            st.spread_h.record(rec, key, parity, size, |p| b(Pass::Spread(false), p))?;
+            st.spread_v.record(rec, key, parity, size, |p| b(Pass::Spread(true), p))?;
         }
         // The last level wrote pong when its index was even; bind groups by (last, parity).
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
