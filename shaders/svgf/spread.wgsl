@@ -10,8 +10,8 @@
 // against Mitsuba, seed 0 unless said): the windows' taps 0.0509 (seeds 0-3: 0.0509 / 0.0519 /
 // 0.0516 / 0.0505); a dense square of every pixel to radius 8 / 16 0.0498 / 0.0489 (289 and 1089
 // taps); of every other pixel to 16 / 24 / 32 0.0490 / 0.0494 / 0.0502, of every third or fourth
-// to 16 0.0501 / 0.0509; separable, every pixel to 16 (these passes) 0.0495 / 0.0506 / 0.0505 /
-// 0.0493 at seeds 0-3, every other one 0.0497 / 0.0508 at seeds 0-1 for half the taps.
+// to 16 0.0501 / 0.0509; separable, every pixel to 16 (these passes) 0.0494 / 0.0506 / 0.0504 /
+// 0.0492 at seeds 0-3, every other one 0.0497 / 0.0508 at seeds 0-1 for half the taps.
 
 var taps: texture_2d<u32>;
 var moments: texture_2d<f32>;

@@ -158,7 +158,7 @@ described! {
         /// averaged over the pixel's surface within 16 pixels (svgf/spread.wgsl): a caustic path's
         /// light is spread over its surface, where the windows' tests dropped it and left the
         /// surface dark. 0: off. Frame 60 of a still view (256², seeds 0-3): cornell_mirror FLIP
-        /// 0.0495 / 0.0506 / 0.0505 / 0.0493 against 0.0554 / 0.0566 / 0.0561 / 0.0549 off,
+        /// 0.0494 / 0.0506 / 0.0504 / 0.0492 against 0.0554 / 0.0566 / 0.0561 / 0.0549 off,
         /// cornell_diffuse 0.0238 either way (seed 0). Costs a 3x3 read per pixel and signal in
         /// the variance stage, one load per regression tap, and two separable passes of 33 taps
         /// where the light is fitted (cornell_mirror at 320², lavapipe: 57 of 661 ms a still
