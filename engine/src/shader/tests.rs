@@ -228,6 +228,7 @@ fn all_programs() -> Vec<Program> {
                 temporal,
                 "svgf/variance.wgsl",
                 "svgf/atrous.wgsl",
+                "svgf/spread.wgsl",
                 "svgf/regression.wgsl",
                 "svgf/final.wgsl",
             ] {
