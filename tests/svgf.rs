@@ -371,13 +371,12 @@ fn svgf_kernel_switch_mid_stream_takes_effect() {
 /// What SVGF tells TAA to follow (svgf/common.wgsl: follow_state) in a still view: a pixel whose
 /// sample the jitter moved to another surface (cornell_diffuse at 64x64: the room's corners, the
 /// blocks' silhouettes and the light's edge) reads its history from a neighbouring texel, and is
-/// flagged so (REASON_NEIGHBOUR) for TAA to average its light over the frames rather than show
-/// the last surface's alone; a pixel inside a face is followed. Measured over frames 4 to 11:
-/// 2,000 times a pixel changed surface, all flagged (134 when only a restarted history was),
-/// and 0 of 19,712 pixel-frames inside a face flagged. Unflagged,
-/// cornell_diffuse's frame 60 at 256x256 scored FLIP 0.0241 / 0.0244 / 0.0244 at seeds 0-2
-/// against Mitsuba, and the ceiling's corner row stood 21% over it; flagged, 0.0238 / 0.0240 /
-/// 0.0240 and 13%.
+/// flagged so (REASON_NEIGHBOUR) for TAA to average its light over the frames rather than show the
+/// last surface's alone; a pixel inside a face is followed. Measured over frames 4 to 11: 2,000
+/// times a pixel changed surface, all flagged (134 when only a restarted history was), and 0 of
+/// 19,712 pixel-frames inside a face flagged. Unflagged, cornell_diffuse's frame 60 at 256x256
+/// scored FLIP 0.0241 / 0.0244 / 0.0244 at seeds 0-2 against Mitsuba, and the ceiling's corner row
+/// stood 21% over it; flagged, 0.0238 / 0.0240 / 0.0240 and 13%.
 #[test]
 fn svgf_flags_a_still_pixel_that_changed_surface() {
     // shaders/matte/common.wgsl
