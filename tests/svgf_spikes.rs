@@ -32,6 +32,14 @@ struct Features {
     n: glam::Vec3,
 }
 
+/// SVGF's depth and normal edge-stops of tap t for pixel c at `offset` pixels (svgf/common.wgsl
+/// edge_weight without the luminance term; a pinhole view has no feature variances).
+fn edge_stop(c: &Features, t: &Features, offset: f32) -> f32 {
+    let sv = SvgfSettings::default();
+    let wz = (c.z - t.z).abs() / (sv.sigma_z * c.dz.max(1e-6) * offset + 1e-6);
+    (-wz).exp() * c.n.dot(t.n).max(0.0).powf(sv.sigma_n)
+}
+
 fn features(taps: &[u8], i: usize) -> Features {
     let word =
         |k: usize| u32::from_le_bytes(taps[i * 16 + k * 4..i * 16 + k * 4 + 4].try_into().unwrap());
@@ -95,9 +103,7 @@ fn the_spike_cut_matches_a_cpu_computation() {
                 if ft.dz < 0.0 {
                     continue;
                 }
-                let wz = (fc.z - ft.z).abs() / (sv.sigma_z * fc.dz.max(1e-6) + 1e-6);
-                let wn = fc.n.dot(ft.n).max(0.0).powf(sv.sigma_n);
-                if (-wz).exp() * wn < 0.05 {
+                if edge_stop(&fc, &ft, 1.0) < 0.05 {
                     continue;
                 }
                 let l = luminance(light(q));
@@ -175,7 +181,6 @@ fn the_cut_light_is_spread_evenly_over_its_surface() {
     let (excess, rows, spread) =
         (read("svgf/matte excess"), read("svgf/matte spread rows"), read("svgf/matte spread"));
     let taps = r.read_texture(&gpu, "svgf/matte taps").unwrap().0;
-    let sv = SvgfSettings::default();
     let n = SIZE as i32;
     let v4 = |t: &[f32; 4]| glam::DVec4::from_array(t.map(f64::from));
     // The weighted sum along `axis` about p of value(q), p's own weighing 1.
@@ -193,9 +198,7 @@ fn the_cut_light_is_spread_evenly_over_its_surface() {
             if ft.dz < 0.0 {
                 continue;
             }
-            let offset = d.abs() as f32;
-            let wz = (fc.z - ft.z).abs() / (sv.sigma_z * fc.dz.max(1e-6) * offset + 1e-6);
-            let w = ((-wz).exp() * fc.n.dot(ft.n).max(0.0).powf(sv.sigma_n)) as f64;
+            let w = edge_stop(&fc, &ft, d.abs() as f32) as f64;
             if w > 1e-3 {
                 acc += w * value(q);
             }

@@ -139,9 +139,8 @@ fn follow_state(moments: vec4f, own: bool) -> u32 {
     return state | (u32(clamp(worth + 0.5, 0.0, 16777215.0)) << 8u);
 }
 
-// Whether the motion vector at p is zero (the history texel under it is read exactly).
-fn still_pixel(p: vec2i) -> bool {
-    let mv = textureLoad(gb_motion, p, 0).xy;
+// Whether a motion vector is zero (the history texel under it is read exactly).
+fn still_motion(mv: vec2f) -> bool {
     return dot(mv, mv) <= 1e-8;
 }
 

@@ -63,7 +63,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let passed = textureLoad(src, p, 0);
     let m = textureLoad(moments, p, 0);
     let samples = 1.0 / max(m.w, 1e-6);
-    if !sv_on(SV_REGRESSION) || !has_surface(p) || samples < sv.regression_samples {
+    if !regression_fits(p, samples) {
         textureStore(dst, p, passed);
         return;
     }

@@ -4,14 +4,11 @@
 // regression adds to its fit (svgf/regression.wgsl). Separable: `spread_h` sums each row's
 // weighted cut light and weights about each pixel, `spread_v` each column of those sums, so a
 // pixel's weight for a tap is the product of its row's and column's (the separable
-// approximation of a cross-bilateral, as Mara et al.'s glossy blur is separated). On the
-// regression windows' own taps (every fourth pixel past radius 8), as before, a rare path's light
-// came back as a sparse lattice of dots around it. Measured (cornell_mirror, frame 60, 256², FLIP
-// against Mitsuba, seed 0 unless said): the windows' taps 0.0509 (seeds 0-3: 0.0509 / 0.0519 /
-// 0.0516 / 0.0505); a dense square of every pixel to radius 8 / 16 0.0498 / 0.0489 (289 and 1089
-// taps); of every other pixel to 16 / 24 / 32 0.0490 / 0.0494 / 0.0502, of every third or fourth
-// to 16 0.0501 / 0.0509; separable, every pixel to 16 (these passes) 0.0494 / 0.0506 / 0.0504 /
-// 0.0492 at seeds 0-3, every other one 0.0497 / 0.0508 at seeds 0-1 for half the taps.
+// approximation of a cross-bilateral, as Mara et al.'s glossy blur is separated): 2 x 33 taps
+// where the square would take 1089. Every pixel is a tap, so a rare path's light comes back even,
+// not as a lattice of dots. cornell_mirror's frame 60 (256², FLIP against Mitsuba, seeds 0-3):
+// 0.0494 / 0.0506 / 0.0504 / 0.0492; every other pixel a tap, half the cost, 0.0497 / 0.0508 at
+// seeds 0-1. The alternatives measured are in docs/decisions.md.
 
 var taps: texture_2d<u32>;
 var moments: texture_2d<f32>;
@@ -49,11 +46,10 @@ fn sum_along(p: vec2i, axis: vec2i, sums: bool) -> vec4f {
     return acc;
 }
 
-// Whether the regression fits p's light (it adds the spread only there): light of at least
-// regression_samples' worth. A moving view's short histories skip both passes' taps.
+// The regression adds the spread only where it fits the light: a moving view's short histories
+// skip both passes' taps.
 fn fitted(p: vec2i) -> bool {
-    let samples = 1.0 / max(textureLoad(moments, p, 0).w, 1e-6);
-    return sv_on(SV_REGRESSION) && has_surface(p) && samples >= sv.regression_samples;
+    return regression_fits(p, 1.0 / max(textureLoad(moments, p, 0).w, 1e-6));
 }
 
 fn tap_value(q: vec2i, sums: bool) -> vec4f {

@@ -1,4 +1,11 @@
-// The weight of a tap in SVGF's final stages (svgf/regression.wgsl, svgf/spread.wgsl).
+// What SVGF's final stages (svgf/regression.wgsl, svgf/spread.wgsl) share: which pixels' light
+// the regression fits, and the weight of a tap.
+
+// The regression fits light of at least regression_samples' worth on a surface; the rest shows
+// the a-trous output.
+fn regression_fits(p: vec2i, samples: f32) -> bool {
+    return sv_on(SV_REGRESSION) && has_surface(p) && samples >= sv.regression_samples;
+}
 
 // SVGF's depth and normal edge-stops of tap t, with the features' variances where the frame
 // has them (vc, vt: the normal's and the depth's relative variance, realtime/uncertainty.wgsl);

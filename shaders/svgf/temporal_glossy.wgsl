@@ -88,7 +88,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 mom = vec4f(load_taps(moments, b, w).xy, mom.zw);
             }
             reprojected = mom.z >= 1.0;
-            own = r.bilinear && still_pixel(p);
+            own = r.bilinear && still_motion(textureLoad(gb_motion, p, 0).xy);
             if reprojected && sv_on(SV_CLIPPING) && roughness < gp.clip_roughness {
                 hist = clip_to_neighbourhood(neighbourhood, p, hist);
             }

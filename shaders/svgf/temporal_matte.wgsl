@@ -60,7 +60,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);
     if sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
-        let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
+        let mv = textureLoad(gb_motion, p, 0).xy;
+        let prev = vec2f(p) + 0.5 + mv;
         let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
         let s = surface_frame(p, x);
         let r = reproject(prev_depth, prev_normal, prev, expected, s, dn.reprojection_min_cos);
@@ -76,7 +77,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             }
             // A previous texel without a history (a miss then) does not count.
             reprojected = mom.z >= 1.0;
-            own = r.bilinear && still_pixel(p);
+            own = r.bilinear && still_motion(mv);
         }
     }
     var i = integrate(current, hist, mom, reprojected);
