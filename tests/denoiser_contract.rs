@@ -8,8 +8,8 @@ use glam::DVec3;
 
 use hush_engine::denoise::{
     Bindings, ChainStage, Denoised, Denoiser, DenoiserInfo, DenoiserScene, Entry, Field,
-    FrameContext, FrameIo, FrameSettings, Gpu, GpuMemory, Kind, Parity, PingPong, Recorder,
-    Section, Stage, Tex, ViewMap, ViewSpec, made,
+    FrameContext, FrameIo, FrameSettings, Gpu, GpuMemory, Kind, Outputs, Parity, PingPong,
+    Recorder, Section, Stage, Tex, ViewMap, ViewSpec, made,
 };
 use hush_engine::frame::{BvhKind, DenoiserName, FrameInput, Renderer, View};
 use hush_engine::quality::{Image, compare};
@@ -108,21 +108,33 @@ impl Denoiser for Accumulate {
         false
     }
 
-    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
+    fn allocate(
+        &mut self,
+        gpu: &Gpu,
+        memory: &mut GpuMemory,
+        size: (u32, u32),
+        _kept: &[String],
+    ) -> anyhow::Result<()> {
         let usage = wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         let mut t =
             |l: &str| memory.texture(&gpu.device, l, size, wgpu::TextureFormat::Rgba32Float, usage);
         self.history = Some(PingPong::new(|i| t(&format!("accumulate/history {i}"))));
+        Ok(())
     }
 
-    fn record(
-        &mut self,
+    fn release(&mut self) {
+        self.history = None;
+        self.stage = None;
+    }
+
+    fn record<'s>(
+        &'s mut self,
         rec: &mut Recorder,
         io: &FrameIo,
         cx: &FrameContext,
-    ) -> anyhow::Result<()> {
+    ) -> anyhow::Result<Outputs<'s>> {
         let h = self.history.as_ref().context("recording before allocating")?;
         let params = AccumulateParams::new(cx.settings)?;
         rec.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -133,15 +145,14 @@ impl Denoiser for Accumulate {
         let stage = made(&mut self.stage, || {
             ChainStage::new(rec.gpu, "accumulate", &modules, "main", &offered)
         })?;
-        stage.record(rec, cx.key, cx.parity, io.size, |p| bindings(io, &self.params, h, p))
-    }
-
-    fn output(&self, parity: Parity) -> Denoised<'_> {
-        Denoised {
-            matte: self.history.as_ref().map(|h| &h.output(parity).1),
+        stage.record(rec, cx.key, cx.parity, io.size, |p| bindings(io, &self.params, h, p))?;
+        // The composite reads what this frame wrote; TAA averages the composite alone.
+        let light = Parity::BOTH.map(|p| Denoised {
+            matte: Some(&h.output(p).1),
             glossy: None,
             direct: None,
-        }
+        });
+        Ok(Outputs { light, follow: Default::default() })
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn hush_engine::shader::Reload> {
@@ -352,4 +363,60 @@ fn a_denoisers_own_wgsl_joins_the_library() {
         names.contains(&"history".to_string()) && names.contains(&"frame".to_string()),
         "{names:?}"
     );
+}
+
+fn level() -> (Gpu, Renderer) {
+    let scene = hush_engine::scene::default_level();
+    Renderer::headless(scene, BvhKind::DEFAULT, SIZE).unwrap()
+}
+
+fn with(denoiser: DenoiserName) -> FrameSettings {
+    FrameSettings { denoiser, ..Default::default() }
+}
+
+fn labels(r: &Renderer) -> Vec<String> {
+    r.allocations().into_iter().map(|(l, _)| l).collect()
+}
+
+/// Only the denoiser that runs holds textures: switching from SVGF to Mara forgets every one of
+/// SVGF's and leaves the frame with what a frame that only ever ran Mara holds; switching back
+/// holds SVGF's again, and the raw frame holds no denoiser's (TAA's, the frame's own, stay).
+#[test]
+fn only_the_active_denoiser_holds_memory() {
+    let (svgf, mara) = (with(DenoiserName::SVGF), with(DenoiserName::MARA));
+    let (gpu, mut only_mara) = level();
+    render(&mut only_mara, &gpu, &mara, 2);
+    let (gpu, mut r) = level();
+    render(&mut r, &gpu, &svgf, 2);
+    let svgf_bytes = r.bytes_per_pixel();
+    assert!(labels(&r).iter().any(|l| l.starts_with("svgf/")), "{:?}", labels(&r));
+    render(&mut r, &gpu, &mara, 2);
+    assert!(!labels(&r).iter().any(|l| l.starts_with("svgf/")), "{:?}", labels(&r));
+    assert_eq!(r.bytes_per_pixel(), only_mara.bytes_per_pixel(), "{:?}", labels(&r));
+    render(&mut r, &gpu, &svgf, 2);
+    assert_eq!(r.bytes_per_pixel(), svgf_bytes);
+    render(&mut r, &gpu, &with(DenoiserName::NONE), 1);
+    let held = labels(&r);
+    assert!(!held.iter().any(|l| l.starts_with("svgf/") || l.starts_with("matte/")), "{held:?}");
+}
+
+/// SVGF's transient textures share memory (the glossy signal's passes reuse the matte
+/// signal's), and the image is the same, bit for bit, as with every texture of its own
+/// (`keep(["svgf/"])`): no pass reads a texture another one overwrote. An intermediate a later
+/// texture shares memory with is not readable after the frame unless kept.
+#[test]
+fn svgf_shares_its_transients_memory_without_changing_the_image() {
+    let svgf = with(DenoiserName::SVGF);
+    let (gpu, mut pooled) = level();
+    let a = render(&mut pooled, &gpu, &svgf, 6);
+    let (gpu, mut own) = level();
+    own.keep(&["svgf/"]);
+    let b = render(&mut own, &gpu, &svgf, 6);
+    let same = a.data.iter().zip(&b.data).all(|(x, y)| x.to_array() == y.to_array());
+    assert!(same, "the pool changed the image");
+    assert!(pooled.transient_bytes_per_pixel() < own.transient_bytes_per_pixel());
+    assert!(pooled.read_texture(&gpu, "svgf/matte integrated").is_err());
+    let (kept, _) = own.read_texture(&gpu, "svgf/matte integrated").unwrap();
+    let floats: &[f32] = bytemuck::cast_slice(&kept);
+    assert!(floats.iter().all(|v| v.is_finite()) && floats.iter().any(|v| *v > 0.0));
 }

@@ -468,6 +468,8 @@ fn the_reference_search_comes_and_goes_with_its_setting() {
         let (gpu, mut r) =
             Renderer::headless(hush_engine::scene::reflection_scene(true), BvhKind::DEFAULT, size)
                 .unwrap();
+        // SVGF's search view is read after the frame.
+        r.keep(&[search]);
         let name = format!("{denoiser:?}");
         let mut s = FrameSettings { denoiser, ..Default::default() };
         s.glossy.reflection_mv = ReflectionMv::Diamond;

@@ -526,6 +526,8 @@ fn the_glossy_reach_takes_the_pre_filters_circle_of_confusion() {
             FrameSettings { denoiser, primary_samples: 4, prefilter, ..Default::default() };
         let (gpu, mut r) =
             Renderer::headless(scene.clone(), hush_engine::accel::BvhKind::DEFAULT, size).unwrap();
+        // SVGF's taps are read after the frame.
+        r.keep(&["svgf/glossy taps"]);
         for camera in [camera, last] {
             r.render(&gpu, &FrameInput { camera, time: 0.0, shutter: None }, &settings, None)
                 .unwrap();

@@ -16,8 +16,12 @@ use hush_tests::reproject::{
 
 const SIZE: (u32, u32) = (96, 54);
 
+/// The level, every SVGF texture readable after a frame (the tests read its intermediates).
 fn level() -> (Gpu, Renderer) {
-    Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap()
+    let (gpu, mut r) =
+        Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    r.keep(&["svgf/"]);
+    (gpu, r)
 }
 
 /// The courtyard and the hall's doorway (metal spheres: both signals run), the animated cube

@@ -2,7 +2,7 @@
 //! the light the variance stage takes off a lone pixel that one rare path made bright, against a
 //! CPU computation of the same rule, and the regression keeping that light on the surface.
 
-use hush_engine::frame::Renderer;
+use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::Gpu;
 use hush_engine::quality::luminance;
 use hush_engine::settings::{Denoiser, FrameSettings, SvgfSettings, TaaSettings};
@@ -21,7 +21,14 @@ fn still_mirror(spike_ratio: f32, frames: u32) -> (Gpu, Renderer) {
         taa: TaaSettings { enabled: false, ..Default::default() },
         ..Default::default()
     };
-    hush_tests::realtime_renderer(&scene, (SIZE, SIZE), &s, frames).unwrap()
+    // Every SVGF texture readable after the frames (the tests read its intermediates).
+    let (gpu, mut r) = hush_tests::realtime_renderer(&scene, (SIZE, SIZE), &s, 0).unwrap();
+    r.keep(&["svgf/"]);
+    let input = FrameInput { camera: scene.camera_or_default(), time: 0.0, shutter: None };
+    for _ in 0..frames {
+        r.render(&gpu, &input, &s, None).unwrap();
+    }
+    (gpu, r)
 }
 
 /// The taps record's features (svgf/variance.wgsl pack_taps): linear depth, its gradient (below

@@ -35,8 +35,13 @@ struct RealtimeResult {
     /// CPU spends besides waiting for the GPU; with --profile it includes puffin's scopes and
     /// the GPU timeline's report).
     cpu_record_median_ms: f64,
-    /// Per-pixel buffers and textures of the frame, bytes per pixel.
+    /// Per-pixel buffers and textures of the frame, bytes per pixel: in all, and of them the
+    /// histories and frame targets that outlive a frame (persistent) and the transient pools'
+    /// peak (textures that live within a frame, sharing memory where their lives do not
+    /// overlap).
     bytes_per_pixel: f64,
+    persistent_bytes_per_pixel: f64,
+    transient_bytes_per_pixel: f64,
     allocations: Vec<(String, u64)>,
 }
 
@@ -165,6 +170,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         cpu_frame_median_ms: median(&mut cpu),
         cpu_record_median_ms: median(&mut record),
         bytes_per_pixel: r.bytes_per_pixel(),
+        persistent_bytes_per_pixel: r.bytes_per_pixel() - r.transient_bytes_per_pixel(),
+        transient_bytes_per_pixel: r.transient_bytes_per_pixel(),
         allocations: r.allocations(),
     };
     if a.json {
@@ -183,6 +190,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             res.cpu_frame_median_ms,
             res.cpu_record_median_ms,
             res.bytes_per_pixel
+        );
+        println!(
+            "  memory     {:.0} bytes/pixel persistent + {:.0} transient peak = {:.0} in all",
+            res.persistent_bytes_per_pixel, res.transient_bytes_per_pixel, res.bytes_per_pixel
         );
     }
     Ok(())

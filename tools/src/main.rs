@@ -8,7 +8,9 @@ mod compare;
 mod conformance;
 mod convergence;
 mod quality;
+mod quality_args;
 mod realtime;
+mod reference;
 mod reflections;
 mod render;
 mod sweep;
@@ -47,6 +49,22 @@ enum Command {
     Level(LevelArgs),
     /// Measure BVH build, rays/s and reference samples/s, or (--mode realtime) GPU time per pass.
     Bench(bench::BenchArgs),
+    /// Print SVGF's frame graph as Markdown: its passes with what each reads and writes, the
+    /// transient pool's slots with the textures each holds in turn, and the histories.
+    Graph(GraphArgs),
+}
+
+#[derive(clap::Args)]
+struct GraphArgs {
+    /// The graph of a scene without a specular lobe (the matte signal alone).
+    #[arg(long)]
+    matte_only: bool,
+}
+
+fn graph(a: GraphArgs) -> Result<()> {
+    let g = hush_engine::denoise::svgf::frame_graph(!a.matte_only);
+    print!("{}", g.describe(&g.plan()?));
+    Ok(())
 }
 
 #[derive(clap::Args)]
@@ -96,6 +114,7 @@ fn main() {
         Command::Bench(a) if a.mode == "animate" => bench_animate::run(&a),
         Command::Bench(a) => bench::run(a),
         Command::Level(a) => level(a),
+        Command::Graph(a) => graph(a),
         Command::Quality(a) => quality::run(a),
         Command::TimeToQuality(a) => time_to_quality::run(a),
         Command::Sweep(a) => sweep::run(a),

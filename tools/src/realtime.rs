@@ -131,6 +131,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let name = scene.name.clone();
     let start = std::time::Instant::now();
     let (gpu, mut r) = Renderer::headless(scene, bvh_kind(&a.bvh)?, size)?;
+    // The frames keep what --view shows readable after them (a denoiser's intermediate shares
+    // its memory with later textures otherwise).
+    if let Some(spec) = view.as_ref().and_then(|v| v.spec()) {
+        r.keep(&[spec.texture]);
+    }
     if a.cpu_posing {
         r.set_gpu_posing(&gpu, false)?;
     }

@@ -126,7 +126,7 @@ fn realtime_bench_reports_every_pass() {
         assert!(*ns > 0 && *count == 3, "GPU {p}: {ns} ns over {count} frames");
         assert!(find(false, p).is_some_and(|s| s.3 == 3), "no CPU scope for {p} in {scopes:?}");
     }
-    for cpu in ["frame", "Renderer::record_frame", "animate", "upload", "encode", "submit"] {
+    for cpu in ["frame", "Renderer::render", "animate", "upload", "encode", "submit"] {
         assert!(find(false, cpu).is_some(), "no CPU scope {cpu} in {scopes:?}");
     }
     assert!(find(true, hush_engine::profile::GPU_FRAME).is_some_and(|s| s.2 > 0));

@@ -3,7 +3,7 @@
 //! Voorhuis's reflection reprojection, `passes/glossy.rs`). TAA follows both chains' temporal
 //! outputs ([`TaaFollow`]).
 
-use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
+use super::{Denoised, Denoiser, DenoiserScene, FrameContext, Outputs};
 use crate::gpu::{Gpu, GpuMemory, Parity, Recorder};
 use crate::passes::chain::made_for;
 use crate::passes::glossy::{
@@ -44,13 +44,33 @@ impl Denoiser for Mara {
         true
     }
 
-    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
+    /// Every texture outlives the frame (TAA follows the temporal outputs, the rest are a few
+    /// bytes a pixel), so `kept` holds already.
+    fn allocate(
+        &mut self,
+        gpu: &Gpu,
+        memory: &mut GpuMemory,
+        size: (u32, u32),
+        _kept: &[String],
+    ) -> Result<()> {
         let d = &gpu.device;
         let glossy = self.scene.glossy.then(|| GlossyChainTargets::new(d, memory, size));
         self.targets = Some((MatteTargets::new(d, memory, size), glossy));
+        Ok(())
     }
 
-    fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
+    fn release(&mut self) {
+        self.targets = None;
+        self.matte.iter_mut().for_each(MatteChain::release_groups);
+        self.glossy.iter_mut().for_each(GlossyChain::release_groups);
+    }
+
+    fn record<'s>(
+        &'s mut self,
+        rec: &mut Recorder,
+        io: &FrameIo,
+        cx: &FrameContext,
+    ) -> Result<Outputs<'s>> {
         let gpu = rec.gpu;
         let (m, g) =
             self.targets.as_ref().context("the Mara denoiser records before its textures exist")?;
@@ -91,35 +111,13 @@ impl Denoiser for Mara {
             )?;
             glossy.record(rec, cx.key, &inputs, cx.parity, &s.glossy)?;
         }
-        Ok(())
-    }
-
-    fn output(&self, _parity: Parity) -> Denoised<'_> {
-        let Some((m, g)) = &self.targets else { return Denoised::default() };
-        Denoised {
+        let light = Denoised {
             matte: Some(&m.denoised.1),
             glossy: g.as_ref().map(|g| &g.denoised.1),
             direct: None,
-        }
-    }
-
-    fn taa_follow(&self, parity: Parity) -> TaaFollow<'_> {
-        let Some((m, g)) = &self.targets else { return TaaFollow::default() };
-        TaaFollow {
-            matte: Some(MatteFollow {
-                light: &m.temporal.1,
-                state: &m.reason.1,
-                form: MatteState::Reason,
-            }),
-            // What the glossy temporal wrote this frame, and what it read.
-            glossy: g.as_ref().map(|g| GlossyFollow {
-                denoised: &g.denoised.1,
-                temporal: &g.history.output(parity).1,
-                previous: &g.history.history(parity).1,
-                info: &g.info.1,
-                params: &self.glossy_params,
-            }),
-        }
+        };
+        let follow = Parity::BOTH.map(|p| self.taa_follow(m, g.as_ref(), p));
+        Ok(Outputs { light: [light; 2], follow })
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
@@ -131,5 +129,32 @@ impl Denoiser for Mara {
             v.extend(c.pipelines());
         }
         v
+    }
+}
+
+impl Mara {
+    /// What TAA follows at parity `parity`: the matte chain's temporal output (before its
+    /// spatial stages) and what the glossy temporal wrote this frame and read.
+    fn taa_follow<'a>(
+        &'a self,
+        m: &'a MatteTargets,
+        g: Option<&'a GlossyChainTargets>,
+        parity: Parity,
+    ) -> TaaFollow<'a> {
+        TaaFollow {
+            matte: Some(MatteFollow {
+                light: &m.temporal.1,
+                state: &m.reason.1,
+                form: MatteState::Reason,
+            }),
+            // What the glossy temporal wrote this frame, and what it read.
+            glossy: g.map(|g| GlossyFollow {
+                denoised: &g.denoised.1,
+                temporal: &g.history.output(parity).1,
+                previous: &g.history.history(parity).1,
+                info: &g.info.1,
+                params: &self.glossy_params,
+            }),
+        }
     }
 }

@@ -3,9 +3,9 @@
 //! The frame (Mara et al. 2017, Figure 2) is gbuffer -> trace -> denoise -> composite -> TAA ->
 //! display. A [`Denoiser`] reads the frame's I/O ([`FrameIo`]: the frame uniform, this and the
 //! previous frame's G-buffer, the trace's signals), allocates its own per-pixel textures in the
-//! frame's labelled memory (so they are read back and reported by label), records its passes,
-//! and returns the denoised matte and glossy light the composite remodulates, plus what TAA may
-//! follow. TAA and the composite belong to the frame and run after any denoiser.
+//! frame's labelled memory (so they are read back and reported by label), and records its
+//! passes, returning from that call the denoised matte and glossy light the composite
+//! remodulates, plus what TAA may follow ([`Outputs`]). TAA and the composite belong to the frame and run after any denoiser.
 //!
 //! Adding a denoiser: one module implementing [`Denoiser`] (its WGSL in `shaders/`, or given to
 //! [`crate::shader::ShaderLibrary::add`]) and one [`Entry`]: what it declares
@@ -65,31 +65,65 @@ pub struct Denoised<'a> {
     pub direct: Option<&'a wgpu::TextureView>,
 }
 
+/// What a denoiser made this frame, for the stages after it, at each history parity (they make
+/// their bind groups for both at once): the light the composite remodulates, and what TAA may
+/// follow (nothing: TAA averages the composite alone).
+#[derive(Clone, Copy, Default)]
+pub struct Outputs<'a> {
+    pub light: [Denoised<'a>; 2],
+    pub follow: [TaaFollow<'a>; 2],
+}
+
+impl<'a> Outputs<'a> {
+    /// The same light and the same TAA follow at either parity.
+    pub fn same(light: Denoised<'a>, follow: TaaFollow<'a>) -> Outputs<'a> {
+        Outputs { light: [light; 2], follow: [follow; 2] }
+    }
+
+    /// The light and what TAA follows at parity `p`.
+    pub fn at(&self, p: Parity) -> (Denoised<'a>, TaaFollow<'a>) {
+        (self.light[p.index()], self.follow[p.index()])
+    }
+}
+
 pub trait Denoiser {
     /// Whether it reads the previous frame's depth, normal and object ids (`prev_depth`,
     /// `prev_normal`, `prev_object`); the frame then keeps them (16 bytes per pixel).
     fn needs_previous_gbuffer(&self) -> bool;
 
     /// Make its per-pixel textures in `memory` (labelled `name/...`), for frame targets of
-    /// `size`; called again after a resize.
-    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32));
+    /// `size`. `kept`: the frame reads the textures whose labels start with one of these after
+    /// the denoiser, besides its outputs (a debug view, a test's readback), so they must then
+    /// hold what this frame wrote; a denoiser whose
+    /// intermediates share memory ([`crate::gpu::graph`]) keeps them apart. Called again after a
+    /// resize, when `kept` changes, and when the denoiser is chosen again after another (the
+    /// frame forgets an inactive denoiser's textures: [`Denoiser::release`]).
+    fn allocate(
+        &mut self,
+        gpu: &Gpu,
+        memory: &mut GpuMemory,
+        size: (u32, u32),
+        kept: &[String],
+    ) -> Result<()>;
 
-    /// Record its passes for this frame.
-    fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()>;
+    /// Drop its per-pixel textures: another denoiser runs now, and only the active one holds
+    /// memory. Its pipelines stay, for a switch back.
+    fn release(&mut self);
 
-    /// The light it produced this frame (after [`Denoiser::record`]).
-    fn output(&self, parity: Parity) -> Denoised<'_>;
+    /// Record its passes for this frame, and return what it made: the light the composite
+    /// remodulates and what TAA may follow.
+    fn record<'s>(
+        &'s mut self,
+        rec: &mut Recorder,
+        io: &FrameIo,
+        cx: &FrameContext,
+    ) -> Result<Outputs<'s>>;
 
     /// Whether it takes frames where only some pixels were traced (a sample fraction below 1,
     /// [`crate::settings::SampleFraction`]; `scheduled_pixel` in shaders/realtime/frame.wgsl
     /// says which). The default, false: the frame refuses fractions below 1 with it.
     fn fills_untraced_pixels(&self) -> bool {
         false
-    }
-
-    /// What TAA may follow (the default, nothing: TAA averages the composite alone).
-    fn taa_follow(&self, _parity: Parity) -> TaaFollow<'_> {
-        TaaFollow::default()
     }
 
     /// Its pipelines, for hot reload.

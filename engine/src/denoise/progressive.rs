@@ -15,7 +15,7 @@
 //! the pixels traced this frame (Dundr §4.4-5; docs/decisions.md). The composite and TAA
 //! (Dundr's §4.5 blend with a clamped history) follow as for every denoiser.
 
-use super::{Denoised, Denoiser, DenoiserScene, FrameContext};
+use super::{Denoised, Denoiser, DenoiserScene, FrameContext, Outputs};
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::io::FrameIo;
@@ -149,7 +149,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
         signals.insert(1, Signal::Glossy);
     }
     let res = Resources { pp, dn, levels, feedback, targets: None };
-    Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals, taa_follow: false }))
+    Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
 }
 
 /// One signal's textures: 96 bytes per pixel.
@@ -190,6 +190,32 @@ impl SignalTargets {
             _ => &self.ping,
         }
     }
+}
+
+/// Each signal's last level, for the composite, and with `follow`
+/// (`ProgressiveSettings::taa_follow`) the matte light the filter shows for TAA to follow, so
+/// that a still view shows the latest accumulated and filtered light under TAA's averaged
+/// material rather than TAA's mean of every frame shown, whose first frames (below one sample
+/// per pixel, mostly filled in by the a-trous levels) are the blurriest.
+fn outputs(t: &Targets, follow: bool) -> Outputs<'_> {
+    let levels = t.levels.count;
+    let out =
+        |s: Signal| t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(levels).1);
+    let light = Denoised {
+        matte: out(Signal::Matte),
+        glossy: out(Signal::Glossy),
+        direct: out(Signal::Direct),
+    };
+    let matte = t.signals.iter().find(|(g, _)| *g == Signal::Matte).filter(|_| follow);
+    let follow = Parity::BOTH.map(|parity| TaaFollow {
+        matte: matte.map(|(_, s)| MatteFollow {
+            light: &s.output(levels).1,
+            state: &s.moments.output(parity).1,
+            form: MatteState::Moments,
+        }),
+        glossy: None,
+    });
+    Outputs { light: [light; 2], follow }
 }
 
 struct Targets {
@@ -251,8 +277,6 @@ struct Progressive {
     res: Resources,
     stages: Option<Stages>,
     signals: Vec<Signal>,
-    /// This frame's `ProgressiveSettings::taa_follow`.
-    taa_follow: bool,
 }
 
 /// Whether TAA follows the filter's matte light this frame (`ProgressiveSettings::taa_follow`,
@@ -385,7 +409,15 @@ impl Denoiser for Progressive {
         true
     }
 
-    fn allocate(&mut self, gpu: &Gpu, memory: &mut GpuMemory, size: (u32, u32)) {
+    /// Each signal's last level is what the composite reads, and which texture that is follows
+    /// the level count: every texture outlives the frame, so `kept` holds already.
+    fn allocate(
+        &mut self,
+        gpu: &Gpu,
+        memory: &mut GpuMemory,
+        size: (u32, u32),
+        _kept: &[String],
+    ) -> Result<()> {
         let rw = wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
@@ -396,11 +428,27 @@ impl Denoiser for Progressive {
             .map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name())))
             .collect();
         self.res.targets = Some(Targets { features, signals, levels: Levels::default() });
+        Ok(())
     }
 
-    fn record(&mut self, rec: &mut Recorder, io: &FrameIo, cx: &FrameContext) -> Result<()> {
+    fn release(&mut self) {
+        self.res.targets = None;
+        let Some(st) = self.stages.as_mut() else { return };
+        st.features.release_groups();
+        for s in st.signals.iter_mut() {
+            [&mut s.temporal, &mut s.variance, &mut s.atrous]
+                .into_iter()
+                .for_each(ChainStage::release_groups);
+        }
+    }
+
+    fn record<'s>(
+        &'s mut self,
+        rec: &mut Recorder,
+        io: &FrameIo,
+        cx: &FrameContext,
+    ) -> Result<Outputs<'s>> {
         let gpu = rec.gpu;
-        self.taa_follow = follows_light(cx.settings);
         let Progressive { scene, res, stages, .. } = self;
         let missing = "the progressive filter records before its textures exist";
         let p = &cx.settings.progressive;
@@ -435,37 +483,7 @@ impl Denoiser for Progressive {
                 )?;
             }
         }
-        Ok(())
-    }
-
-    /// With `ProgressiveSettings::taa_follow`, TAA follows the matte light the filter shows, so
-    /// that a still view shows the latest accumulated and filtered light under TAA's averaged
-    /// material rather than TAA's mean of every frame shown, whose first frames (below one
-    /// sample per pixel, mostly filled in by the a-trous levels) are the blurriest.
-    fn taa_follow(&self, parity: Parity) -> TaaFollow<'_> {
-        let Some(t) = self.res.targets.as_ref().filter(|_| self.taa_follow) else {
-            return TaaFollow::default();
-        };
-        let Some((_, s)) = t.signals.iter().find(|(g, _)| *g == Signal::Matte) else {
-            return TaaFollow::default();
-        };
-        let (light, state) = (&s.output(t.levels.count).1, &s.moments.output(parity).1);
-        TaaFollow {
-            matte: Some(MatteFollow { light, state, form: MatteState::Moments }),
-            glossy: None,
-        }
-    }
-
-    fn output(&self, _parity: Parity) -> Denoised<'_> {
-        let Some(t) = &self.res.targets else { return Denoised::default() };
-        let levels = t.levels.count;
-        let out =
-            |s: Signal| t.signals.iter().find(|(g, _)| *g == s).map(|(_, st)| &st.output(levels).1);
-        Denoised {
-            matte: out(Signal::Matte),
-            glossy: out(Signal::Glossy),
-            direct: out(Signal::Direct),
-        }
+        Ok(outputs(t, follows_light(cx.settings)))
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {

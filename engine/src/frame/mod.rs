@@ -83,10 +83,13 @@ pub struct DisplayTarget<'a> {
     pub size: (u32, u32),
 }
 
-/// A denoiser the frame made, with the targets epoch it allocated its textures for.
+/// A denoiser the frame made, with the targets epoch it allocated its textures for (None: it
+/// holds none), the labels it was asked to keep readable and what it allocated.
 struct MadeDenoiser {
     name: String,
     epoch: Option<u64>,
+    kept: Vec<String>,
+    labels: Vec<String>,
     denoiser: Box<dyn Denoiser>,
 }
 
@@ -97,8 +100,11 @@ pub struct Renderer {
     targets: Targets,
     uniforms: Uniforms,
     stages: Stages,
-    /// Every denoiser chosen so far (switching back keeps its pipelines and textures).
+    /// Every denoiser chosen so far (switching back keeps its pipelines; only the one that ran
+    /// last holds textures).
     denoisers: Vec<MadeDenoiser>,
+    /// Labels the frame keeps readable after every frame ([`Renderer::keep`]).
+    kept: Vec<String>,
     history: FrameHistory,
     timer: Option<GpuTimer>,
     /// Pass times are picked up by [`Renderer::poll_pass_spans`] frames later, not read back.
@@ -220,6 +226,7 @@ impl Renderer {
             uniforms,
             stages,
             denoisers: vec![],
+            kept: vec![],
             history: FrameHistory::default(),
             timer: GpuTimer::new(gpu, TIMED_PASSES),
             async_timings: false,
@@ -306,6 +313,22 @@ impl Renderer {
         self.targets.memory.total_bytes() as f64 / (w as f64 * h as f64)
     }
 
+    /// Bytes per pixel of the per-pixel targets that live within a frame (the transient pools'
+    /// slots, [`crate::gpu::graph`]); the rest outlives it.
+    pub fn transient_bytes_per_pixel(&self) -> f64 {
+        let (w, h) = self.targets.size;
+        self.targets.memory.transient_bytes() as f64 / (w as f64 * h as f64)
+    }
+
+    /// Keep the textures whose labels start with one of `prefixes` readable after every frame
+    /// ([`Renderer::read_texture`]; `&["svgf/"]` keeps all of SVGF's, and then no two of its
+    /// textures share memory): a denoiser's intermediate otherwise shares its memory with a
+    /// later texture of the frame, and holds that one's texels once the frame ends. The next
+    /// frame places them again.
+    pub fn keep(&mut self, prefixes: &[&str]) {
+        self.kept = prefixes.iter().map(|l| l.to_string()).collect();
+    }
+
     /// Render at `size` from the next frame on. Where `FrameSettings::resample_history_frames`
     /// is above 0 (the default) and a denoiser runs, that frame resamples every history to the
     /// new size (passes/rescale.rs); else the histories restart.
@@ -366,7 +389,13 @@ impl Renderer {
         settings: &FrameSettings,
         target: Option<&DisplayTarget>,
     ) -> Result<()> {
-        gpu.validated("rendering a frame", || self.record_frame(gpu, input, settings, target))
+        gpu.validated("rendering a frame", || {
+            // Named by hand: puffin's function scope would read this impl's path as
+            // "Renderer>::render".
+            puffin::profile_scope!("Renderer::render");
+            let plan = self.plan(gpu, input, settings, target)?;
+            self.record_frame(gpu, &plan, target)
+        })
     }
 
     /// Whether the denoiser `settings` asks for takes sample fractions below 1 (the raw frame

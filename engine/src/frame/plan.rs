@@ -207,13 +207,17 @@ impl Renderer {
         settings: &FrameSettings,
     ) -> Result<Option<usize>> {
         if settings.accumulate {
+            self.release_denoisers(None);
             return Ok(None);
         }
         let name = settings.denoiser.name();
         let i = match self.denoisers.iter().position(|d| d.name == name) {
             Some(i) => i,
             None => {
-                let Some(make) = crate::denoise::find(name)?.make else { return Ok(None) };
+                let Some(make) = crate::denoise::find(name)?.make else {
+                    self.release_denoisers(None);
+                    return Ok(None);
+                };
                 let scene = DenoiserScene {
                     glossy: self.prepared.features.glossy,
                     motion: self.prepared.features.motion(),
@@ -221,21 +225,52 @@ impl Renderer {
                 };
                 let denoiser =
                     make(gpu, &scene).with_context(|| format!("creating the {name} denoiser"))?;
-                self.denoisers.push(MadeDenoiser { name: name.to_string(), epoch: None, denoiser });
+                let (kept, labels) = (vec![], vec![]);
+                let name = name.to_string();
+                self.denoisers.push(MadeDenoiser { name, epoch: None, kept, labels, denoiser });
                 self.denoisers.len() - 1
             }
         };
+        self.release_denoisers(Some(i));
         let t = &mut self.targets;
+        let mut kept = self.kept.clone();
+        kept.extend(settings.view.spec().map(|v| v.texture.to_string()));
         let d = &mut self.denoisers[i];
-        if d.epoch != Some(t.epoch) {
-            d.denoiser.allocate(gpu, &mut t.memory, t.size);
-            d.epoch = Some(t.epoch);
+        if d.epoch != Some(t.epoch) || d.kept != kept {
+            // Made again for a new size, or placed again for other textures to keep: what it
+            // made before in these targets goes.
+            if d.epoch == Some(t.epoch) {
+                t.memory.forget_labels(&d.labels);
+            }
+            let before = t.memory.labels();
+            d.denoiser
+                .allocate(gpu, &mut t.memory, t.size, &kept)
+                .with_context(|| format!("allocating the {name} denoiser's textures"))?;
+            d.labels = t.memory.labels().into_iter().filter(|l| !before.contains(l)).collect();
+            (d.epoch, d.kept) = (Some(t.epoch), kept);
             t.generation += 1;
         }
         if d.denoiser.needs_previous_gbuffer() {
             t.ensure_previous(gpu);
         }
         Ok(Some(i))
+    }
+
+    /// Only the active denoiser (`active`, an index in `denoisers`) holds textures: every other
+    /// one drops its own, and the frame's memory forgets them.
+    fn release_denoisers(&mut self, active: Option<usize>) {
+        for (j, d) in self.denoisers.iter_mut().enumerate() {
+            if Some(j) == active || d.epoch.is_none() {
+                continue;
+            }
+            d.denoiser.release();
+            // Another size's targets went with their memory.
+            if d.epoch == Some(self.targets.epoch) {
+                self.targets.memory.forget_labels(&d.labels);
+            }
+            (d.epoch, d.labels) = (None, vec![]);
+            self.targets.generation += 1;
+        }
     }
 
     /// Accumulation restarts whenever anything that changes the image changes.

@@ -98,7 +98,7 @@ impl Renderer {
     pub fn read_texture(&self, gpu: &Gpu, name: &str) -> Result<(Vec<u8>, wgpu::TextureFormat)> {
         let tex = self.targets.memory.find_texture(name).with_context(|| {
             let labels: Vec<&str> = self.targets.memory.textures.iter().map(|(l, _)| l.as_str()).collect();
-            format!("no texture {name:?} in this frame (its textures: {}; a denoiser's appear once it has run)", labels.join(", "))
+            format!("no texture {name:?} in this frame (its textures: {}; a denoiser's appear once it has run, and one that shares its memory with a later texture of the frame once `Renderer::keep` names it)", labels.join(", "))
         })?;
         Ok((crate::gpu::readback_texture(gpu, tex)?, tex.format()))
     }

@@ -4,8 +4,8 @@
 use super::plan::FramePlan;
 use super::targets::{Targets, Uniforms};
 use super::{DisplayTarget, FrameInput, MadeDenoiser, Renderer};
-use crate::denoise::{Denoiser, FrameContext};
-use crate::gpu::{BindKey, Gpu, Recorder};
+use crate::denoise::{FrameContext, Outputs};
+use crate::gpu::{BindKey, Gpu, Parity, Recorder};
 use crate::passes::cache::{CacheInputs, RadianceCache};
 use crate::passes::composite::{self, CompositePass, DisplayPass, FrameBuffers};
 use crate::passes::converge::ConvergeStage;
@@ -59,17 +59,13 @@ pub(super) struct FrameHistory {
 pub(super) type ConvergeState = (crate::scene::Camera, Option<crate::scene::Camera>, FrameSettings);
 
 impl Renderer {
+    /// Record the planned frame, one line per stage, and submit it.
     pub(super) fn record_frame(
         &mut self,
         gpu: &Gpu,
-        input: &FrameInput,
-        settings: &FrameSettings,
+        plan: &FramePlan,
         target: Option<&DisplayTarget>,
     ) -> Result<()> {
-        // Named by hand: puffin's function scope would read this impl's path as
-        // "Renderer>::record_frame".
-        puffin::profile_scope!("Renderer::record_frame");
-        let plan = self.plan(gpu, input, settings, target)?;
         // Kept until the frame is submitted: its textures are read by the resampling.
         let rescale_from = self.rescale_from.take();
         let encode = crate::profile::scope("encode");
@@ -90,57 +86,34 @@ impl Renderer {
             t.begin_frame();
         }
         let mut rec = Recorder::new(gpu, &mut enc, timer.as_mut());
-        if let Some(old) = rescale_from.as_ref() {
-            let from = (&old.memory, old.previous.as_ref());
-            match s.rescale.record(&mut rec, from, (&t.memory, t.previous.as_ref())) {
-                Ok(done) => *last_rescale = done,
-                Err(e) => {
-                    // Nothing was resampled: the next frame must not read these targets as
-                    // histories.
-                    self.history.denoised_last = None;
-                    return Err(e);
-                }
-            }
+        if let Err(e) =
+            record_rescale(&mut rec, &mut s.rescale, rescale_from.as_ref(), t, last_rescale)
+        {
+            // Nothing was resampled: the next frame must not read these targets as histories.
+            self.history.denoised_last = None;
+            return Err(e);
         }
         if let Some(p) = posing.as_mut() {
             p.record(&mut rec, gpu_scene);
         }
-        let scene = SceneInputs { scene: gpu_scene, params: &u.params, frame: &u.frame, moving };
-        // The previous depth is this frame's last frame only where a denoiser ran (it is copied
-        // after a denoised frame).
-        let previous_depth =
-            t.previous.as_ref().filter(|_| plan.denoiser.is_some()).map(|p| &p.depth.1);
-        let trace = TraceInputs { scene, g: &t.gbuffer, t: &t.trace, cache: None, previous_depth };
-        let mut io = t.io(&u.frame, gpu_scene);
-        io.feature_uncertainty =
-            t.prefilter.as_ref().filter(|_| plan.prefilter).map(|pf| &pf.view.1);
+        let (scene, trace, io) = frame_inputs(plan, (t, u), gpu_scene, moving);
         // primaries [-> pre-filter] -> trace [-> mix] [-> radiance cache] -> denoise -> composite [-> resolve] -> TAA
         // [-> still-view mean] -> display; then this frame's G-buffer becomes the next one's previous.
-        s.record_primaries(&mut rec, &plan, scene, t)?;
-        {
-            let _pass = crate::profile::scope(trace::LABEL);
-            // Matte paths end in the radiance cache where it ran the frame before, and where their
-            // length is unlimited (shaders/cache/path_end.wgsl).
-            let ends = plan.cache
-                && plan.settings.cache.path_end_samples > 0.0
-                && plan.settings.max_depth < 0;
-            let cache = s.cache.live_cells(plan.frame_index).filter(|_| ends);
-            let inputs = TraceInputs { cache, ..trace };
-            s.trace.record(&mut rec, plan.key, &inputs, t.size, plan.period)?;
-        }
-        let io = s.record_mix(&mut rec, &plan, &trace, t, io)?;
-        let io = s.record_cache(&mut rec, &plan, scene, t, io)?;
-        let denoiser = record_denoiser(&mut rec, &plan, denoisers, &io)?;
-        s.record_composite(&mut rec, &plan, &io, denoiser, u.shown(t, &io, None))?;
-        s.record_resolve(&mut rec, &plan, &io, t)?;
-        s.record_taa(&mut rec, &plan, &io, denoiser)?;
-        s.record_converge(&mut rec, &plan, &io)?;
-        s.record_display(&mut rec, &plan, (&io, u, t), target)?;
+        s.record_primaries(&mut rec, plan, scene, t)?;
+        s.record_trace(&mut rec, plan, &trace, t)?;
+        let io = s.record_mix(&mut rec, plan, &trace, t, io)?;
+        let io = s.record_cache(&mut rec, plan, scene, t, io)?;
+        let denoiser = record_denoiser(&mut rec, plan, denoisers, &io)?;
+        s.record_composite(&mut rec, plan, &io, denoiser.as_ref(), u.shown(t, &io, None))?;
+        s.record_resolve(&mut rec, plan, &io, t)?;
+        s.record_taa(&mut rec, plan, &io, denoiser.as_ref())?;
+        s.record_converge(&mut rec, plan, &io)?;
+        s.record_display(&mut rec, plan, (&io, u, t), target)?;
         if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
             p.record_copy(rec.enc, &t.gbuffer, t.size);
         }
         drop(encode);
-        self.submit(gpu, enc, &plan);
+        self.submit(gpu, enc, plan);
         drop(rescale_from);
         Ok(())
     }
@@ -237,13 +210,48 @@ pub(super) fn after_taa<'a>(
     converge.output().or(taa.output())
 }
 
-/// The denoiser the plan chose, recorded on the frame's I/O.
+/// What the stages read: the scene, the trace's inputs, and the frame's I/O with the
+/// pre-filter's statistics where it ran.
+fn frame_inputs<'a>(
+    plan: &FramePlan,
+    (t, u): (&'a Targets, &'a Uniforms),
+    scene: &'a crate::gpu::GpuScene,
+    moving: bool,
+) -> (SceneInputs<'a>, TraceInputs<'a>, FrameIo<'a>) {
+    let s = SceneInputs { scene, params: &u.params, frame: &u.frame, moving };
+    // The previous depth is this frame's last frame only where a denoiser ran (it is copied
+    // after a denoised frame).
+    let previous_depth =
+        t.previous.as_ref().filter(|_| plan.denoiser.is_some()).map(|p| &p.depth.1);
+    let trace = TraceInputs { scene: s, g: &t.gbuffer, t: &t.trace, cache: None, previous_depth };
+    let mut io = t.io(&u.frame, scene);
+    io.feature_uncertainty = t.prefilter.as_ref().filter(|_| plan.prefilter).map(|pf| &pf.view.1);
+    (s, trace, io)
+}
+
+/// After a change of size, the last size's histories resampled into this one's
+/// (passes/rescale.rs), and what that carried into `last`.
+fn record_rescale(
+    rec: &mut Recorder,
+    rescale: &mut Rescale,
+    old: Option<&Targets>,
+    t: &Targets,
+    last: &mut crate::passes::rescale::Rescaled,
+) -> Result<()> {
+    if let Some(old) = old {
+        let from = (&old.memory, old.previous.as_ref());
+        *last = rescale.record(rec, from, (&t.memory, t.previous.as_ref()))?;
+    }
+    Ok(())
+}
+
+/// The denoiser the plan chose, recorded on the frame's I/O: what it made.
 fn record_denoiser<'d>(
     rec: &mut Recorder,
     plan: &FramePlan,
     denoisers: &'d mut [MadeDenoiser],
     io: &FrameIo,
-) -> Result<Option<&'d dyn Denoiser>> {
+) -> Result<Option<Outputs<'d>>> {
     let Some(d) = plan.denoiser.and_then(|i| denoisers.get_mut(i)) else { return Ok(None) };
     let cx = FrameContext {
         index: plan.frame_index,
@@ -252,8 +260,7 @@ fn record_denoiser<'d>(
         settings: plan.settings,
         key: plan.key,
     };
-    d.denoiser.record(rec, io, &cx)?;
-    Ok(Some(&*d.denoiser))
+    Ok(Some(d.denoiser.record(rec, io, &cx)?))
 }
 
 impl Stages {
@@ -278,6 +285,23 @@ impl Stages {
             edges = Some(&pf.features);
         }
         self.primaries.record_resolve(rec, plan.key, scene.frame, (p, edges), &t.gbuffer)
+    }
+
+    /// The trace; matte paths end in the radiance cache where it ran the frame before, and
+    /// where their length is unlimited (shaders/cache/path_end.wgsl).
+    fn record_trace(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        trace: &TraceInputs,
+        t: &Targets,
+    ) -> Result<()> {
+        let _pass = crate::profile::scope(trace::LABEL);
+        let s = plan.settings;
+        let ends = plan.cache && s.cache.path_end_samples > 0.0 && s.max_depth < 0;
+        let cache = self.cache.live_cells(plan.frame_index).filter(|_| ends);
+        let inputs = TraceInputs { cache, ..*trace };
+        self.trace.record(rec, plan.key, &inputs, t.size, plan.period)
     }
 
     /// With k > 1 samples per pixel, the extra samples mixed into their guides (Voorhuis §5,
@@ -318,11 +342,11 @@ impl Stages {
         rec: &mut Recorder,
         plan: &FramePlan,
         io: &FrameIo,
-        denoiser: Option<&dyn Denoiser>,
+        denoiser: Option<&Outputs>,
         shown: FrameBuffers,
     ) -> Result<()> {
-        let fb = |p| {
-            let out = denoiser.map(|d| d.output(p)).unwrap_or_default();
+        let fb = |p: Parity| {
+            let out = denoiser.map(|d| d.at(p).0).unwrap_or_default();
             let (matte, glossy, direct) = (out.matte, out.glossy, out.direct);
             let (shown, accumulation, display) = (shown.shown, shown.accumulation, shown.display);
             FrameBuffers { io: *io, shown, accumulation, display, matte, glossy, direct }
@@ -351,7 +375,7 @@ impl Stages {
         rec: &mut Recorder,
         plan: &FramePlan,
         io: &FrameIo,
-        denoiser: Option<&dyn Denoiser>,
+        denoiser: Option<&Outputs>,
     ) -> Result<()> {
         let Some(d) = denoiser else { return Ok(()) };
         let s = plan.settings;
@@ -364,7 +388,10 @@ impl Stages {
         if s.sample_period() > 1 {
             dp.taa_still_frames = 0.0;
         }
-        let follow = |p| (d.taa_follow(p), d.output(p).glossy);
+        let follow = |p: Parity| {
+            let (light, follow) = d.at(p);
+            (follow, light.glossy)
+        };
         self.taa.record(rec, plan.output_key, io, follow, &dp, plan.parity)
     }
 

@@ -12,19 +12,71 @@ pub struct GpuMemory {
     pub textures: Vec<(String, wgpu::Texture)>,
     /// Every buffer made through this tracker that can be copied from, by label.
     pub buffers: Vec<(String, wgpu::Buffer)>,
+    /// Labels of the allocations that are transient pool slots ([`super::graph`]): memory that
+    /// lives within a frame, shared by textures whose lives do not overlap.
+    pub transient: Vec<String>,
+    /// Transient textures that still hold what their pass wrote after the frame (nothing later
+    /// shares their slot), by name: debug views and readbacks find them here.
+    pub named: Vec<(String, wgpu::Texture)>,
 }
 
 impl GpuMemory {
     /// The texture labelled `label`, if this tracker made one.
     pub fn find_texture(&self, label: &str) -> Option<&wgpu::Texture> {
-        self.textures.iter().find(|(l, _)| l == label).map(|(_, t)| t)
+        let named = || self.named.iter().find(|(l, _)| l == label);
+        self.textures.iter().find(|(l, _)| l == label).or_else(named).map(|(_, t)| t)
     }
 
     /// Forget what was made under labels starting with `prefix` (it was replaced).
     pub fn forget(&mut self, prefix: &str) {
-        self.allocations.retain(|(l, _)| !l.starts_with(prefix));
-        self.textures.retain(|(l, _)| !l.starts_with(prefix));
-        self.buffers.retain(|(l, _)| !l.starts_with(prefix));
+        self.forget_where(|l| l.starts_with(prefix));
+    }
+
+    /// Forget what was made under `labels` (their owner was dropped or made them again).
+    pub fn forget_labels(&mut self, labels: &[String]) {
+        self.forget_where(|l| labels.iter().any(|x| x == l));
+    }
+
+    fn forget_where(&mut self, gone: impl Fn(&str) -> bool) {
+        self.allocations.retain(|(l, _)| !gone(l));
+        self.textures.retain(|(l, _)| !gone(l));
+        self.buffers.retain(|(l, _)| !gone(l));
+        self.transient.retain(|l| !gone(l));
+        self.named.retain(|(l, _)| !gone(l));
+    }
+
+    /// Every label made or named here.
+    pub fn labels(&self) -> Vec<String> {
+        let named = self.named.iter().map(|(l, _)| l.clone());
+        self.allocations.iter().map(|(l, _)| l.clone()).chain(named).collect()
+    }
+
+    /// Bytes of the transient pool slots (the rest outlives a frame).
+    pub fn transient_bytes(&self) -> u64 {
+        let t = |l: &String| self.transient.contains(l);
+        self.allocations.iter().filter(|(l, _)| t(l)).map(|(_, b)| b).sum()
+    }
+
+    /// A transient pool slot: a texture as [`GpuMemory::texture`] makes, counted as transient
+    /// and not found by label (its textures are named by [`GpuMemory::name_transient`]).
+    pub fn transient_texture(
+        &mut self,
+        device: &wgpu::Device,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> (wgpu::Texture, wgpu::TextureView) {
+        let made = self.texture(device, label, size, format, usage);
+        self.textures.pop();
+        self.transient.push(label.to_string());
+        made
+    }
+
+    /// Find the pool slot `texture` by the transient texture's `name` that it holds after the
+    /// frame.
+    pub fn name_transient(&mut self, name: &str, texture: &wgpu::Texture) {
+        self.named.push((name.to_string(), texture.clone()));
     }
 
     /// The buffer labelled `label`, if this tracker made one with COPY_SRC.

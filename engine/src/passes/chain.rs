@@ -84,6 +84,11 @@ impl ChainStage {
         Ok(ChainStage { label, pipeline, groups: BindCache::default() })
     }
 
+    /// Drop its bind groups: the textures they bind were released.
+    pub fn release_groups(&mut self) {
+        self.groups.clear();
+    }
+
     /// Dispatch one thread per pixel in 8x8 groups; `bindings(p)` gives what parity p binds.
     pub fn record<'a>(
         &mut self,

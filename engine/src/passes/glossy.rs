@@ -242,6 +242,11 @@ impl GlossyChain {
         self.stages.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 
+    /// Drop the stages' bind groups: the textures they bind were released.
+    pub fn release_groups(&mut self) {
+        self.stages.iter_mut().for_each(|(_, s)| s.release_groups());
+    }
+
     pub fn new(
         gpu: &Gpu,
         i: &GlossyInputs,

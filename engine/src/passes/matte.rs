@@ -300,6 +300,11 @@ impl MatteChain {
         self.stages.iter_mut().map(|(_, s)| &mut s.pipeline as &mut dyn crate::shader::Reload)
     }
 
+    /// Drop the stages' bind groups: the textures they bind were released.
+    pub fn release_groups(&mut self) {
+        self.stages.iter_mut().for_each(|(_, s)| s.release_groups());
+    }
+
     pub fn new(gpu: &Gpu, i: &ChainInputs, motion: crate::gpu::Motion) -> Result<MatteChain> {
         let mut stages = vec![];
         let prior = super::cache::prior_module(&i.io);

@@ -49,6 +49,14 @@ impl<'a> Bindings<'a> {
         }
     }
 
+    /// Offer under `name` what is offered under `from` (nothing where that is not offered).
+    pub fn alias(mut self, name: &'a str, from: &str) -> Self {
+        if let Some(r) = self.get(from) {
+            self.set(name, r);
+        }
+        self
+    }
+
     /// Everything `other` offers, over what this offers.
     pub fn with(mut self, other: &Bindings<'a>) -> Self {
         for (n, r) in &other.entries {
@@ -145,6 +153,11 @@ pub struct BindCache {
 }
 
 impl BindCache {
+    /// Drop the groups (and with them what they bind), as when their resources are released.
+    pub fn clear(&mut self) {
+        self.cached = None;
+    }
+
     /// The groups of variant `v`, making all variants with `make(v)` if `key` or `builds` changed.
     pub fn get(
         &mut self,
