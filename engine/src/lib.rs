@@ -15,6 +15,7 @@ pub mod frame;
 pub mod fuzz;
 pub mod governor;
 pub mod gpu;
+pub mod image_io;
 pub mod limits;
 pub mod passes;
 pub mod profile;

@@ -9,7 +9,7 @@
 //! last frame (`last_<stream>.exr`, and its FLIP heat map against the reference, `.png`).
 
 use crate::cli::preset_settings;
-use crate::quality::QualityArgs;
+use crate::quality_args::QualityArgs;
 use anyhow::{Context, Result, bail};
 use hush_engine::frame::FrameInput;
 use hush_engine::gpu::Gpu;
@@ -56,14 +56,14 @@ pub fn run(a: &QualityArgs, scene: Scene, size: (u32, u32), input: FrameInput) -
                     a.reference_frames, a.frames
                 );
             }
-            let mut r = crate::quality::new_renderer(&gpu, &scene, size)?;
+            let mut r = crate::reference::new_renderer(&gpu, &scene, size)?;
             let acc = FrameSettings {
                 accumulate: true,
                 seed: a.seed.wrapping_add(7919),
                 max_depth,
                 ..Default::default()
             };
-            crate::quality::reference(
+            crate::reference::reference(
                 &gpu,
                 &mut r,
                 &a.scene,
@@ -136,7 +136,7 @@ fn curve(
     reference: &Image,
     out_dir: &Path,
 ) -> Result<Curve> {
-    let mut r = crate::quality::new_renderer(gpu, scene, size)?;
+    let mut r = crate::reference::new_renderer(gpu, scene, size)?;
     let start = std::time::Instant::now();
     let mut points = vec![];
     let last = marks.last().copied().unwrap_or(0);

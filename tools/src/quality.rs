@@ -10,8 +10,9 @@
 
 use crate::cli::preset_settings;
 use crate::cli::{bvh_kind, image_size, load_scene, parse_camera};
+pub use crate::quality_args::QualityArgs;
+use crate::reference::{new_renderer, reference};
 use anyhow::{Context, Result, bail};
-use clap::Args;
 use glam::{Mat4, Vec3};
 use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::{Gpu, PreparedScene};
@@ -22,76 +23,7 @@ use hush_engine::quality::{
 use hush_engine::scene::{Camera, CameraPath, Scene};
 use hush_engine::settings::{Denoiser, FrameSettings};
 use std::io::Write;
-use std::path::{Path, PathBuf};
-
-#[derive(Args)]
-pub struct QualityArgs {
-    /// A .gltf/.glb file, `default` or `level`.
-    pub scene: String,
-    #[arg(long)]
-    pub camera_path: Option<PathBuf>,
-    /// A still camera, "eye=x,y,z;target=x,y,z;fov=deg" (default: the scene's).
-    #[arg(long)]
-    pub camera: Option<String>,
-    #[arg(long, default_value_t = 60)]
-    pub frames: u32,
-    /// `none`, `mara`, `svgf` or `progressive`; default mara, or the preset's.
-    #[arg(long)]
-    pub denoiser: Option<String>,
-    /// Start from the settings of this preset file (TOML); --denoiser, --disable and
-    /// --reflection-mv then override it.
-    #[arg(long)]
-    pub preset: Option<PathBuf>,
-    /// Stages to switch off (see `render --disable`).
-    #[arg(long, value_delimiter = ',')]
-    pub disable: Vec<String>,
-    /// Reflection motion vectors of the glossy chain (see `render --reflection-mv`).
-    /// Default diamond, or the preset's.
-    #[arg(long)]
-    pub reflection_mv: Option<String>,
-    /// Frames accumulated for each frame's reference.
-    #[arg(long, default_value_t = 256)]
-    pub reference_frames: u32,
-    #[arg(long, default_value_t = 320)]
-    pub width: u32,
-    #[arg(long)]
-    pub height: Option<u32>,
-    /// Animation clock rate for a still camera (frame k is at k / fps seconds); 0 freezes it.
-    #[arg(long, default_value_t = 0.0)]
-    pub fps: f64,
-    #[arg(long, default_value_t = 0)]
-    pub seed: u32,
-    /// Also run the stream with each denoiser stage off.
-    #[arg(long)]
-    pub ablations: bool,
-    /// Instead of the stream: run each of --denoisers and the plain accumulation of the same
-    /// frames over --frames frames of the still view, and write convergence.csv and
-    /// convergence.png (FLIP and relMSE against frames on log axes, 1 to --frames).
-    #[arg(long)]
-    pub convergence: bool,
-    /// The denoisers --convergence compares with the accumulation.
-    #[arg(long, value_delimiter = ',', default_value = "svgf,mara,progressive")]
-    pub denoisers: Vec<String>,
-    /// With --convergence: score against this image (an EXR, e.g. a Mitsuba render of the
-    /// scene) instead of the accumulated real-time frame.
-    #[arg(long)]
-    pub reference: Option<PathBuf>,
-    #[arg(long)]
-    pub out_dir: PathBuf,
-    /// Keep each reference as an EXR in this folder, named by what it depends on (scene file,
-    /// size, camera, time, reference frames, seed, path length), and reuse it when a later run
-    /// asks for the same one: a converged reference of an interior takes thousands of frames,
-    /// and comparing settings needs it only once.
-    #[arg(long)]
-    pub reference_cache: Option<PathBuf>,
-    /// Independent 64-frame accumulations (different seeds) averaged into the yardstick's FLIP.
-    /// One accumulation is a poor yardstick where rare bright paths dominate the error:
-    /// FlightHelmet at 160x90 measured 0.0055 to 0.0089 over five seeds.
-    #[arg(long, default_value_t = 4)]
-    pub yardstick_seeds: u32,
-    #[command(flatten)]
-    pub load: crate::cli::LoadArgs,
-}
+use std::path::Path;
 
 /// One stream's per-frame scores against the reference.
 #[derive(Default, Clone)]
@@ -199,12 +131,6 @@ struct Setup {
 
 fn renderer(s: &Setup) -> Result<Renderer> {
     new_renderer(&s.gpu, &s.scene, s.size)
-}
-
-/// A real-time frame of `scene` on an open device (the default BVH layout).
-pub fn new_renderer(gpu: &Gpu, scene: &Scene, size: (u32, u32)) -> Result<Renderer> {
-    let prepared = PreparedScene::new(scene, bvh_kind(&None)?)?;
-    Renderer::new(gpu, scene.clone(), prepared, size)
 }
 
 /// Render the stream with `settings`, scoring every frame against `references`. Returns the
@@ -434,77 +360,6 @@ pub fn run(a: QualityArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// What a reference depends on, hashed with FNV-1a: the standard library's hasher may change
-/// between Rust releases, and a cache key has to outlive the build that wrote it.
-pub fn reference_cache_key(
-    scene: &str,
-    size: (u32, u32),
-    input: &FrameInput,
-    frames: u32,
-    acc: &FrameSettings,
-) -> u64 {
-    // A scene file's size and modification time stand for its content. `default` and `level`
-    // are built in: their key changes with Hush's version only, so clear the cache after
-    // editing them.
-    let stamp = match std::fs::metadata(scene) {
-        Ok(m) => format!("{} {:?}", m.len(), m.modified().ok()),
-        Err(_) => format!("built-in {}", env!("CARGO_PKG_VERSION")),
-    };
-    let key =
-        format!("{scene} {stamp} {size:?} {input:?} {frames} {} {:?}", acc.seed, acc.max_depth);
-    key.bytes()
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
-}
-
-/// The real-time frame of `input` accumulated over `frames` frames with `acc` (the converged
-/// image every stream is scored against), from `cache` when it holds it, else rendered and
-/// kept there.
-pub fn reference(
-    gpu: &Gpu,
-    r: &mut Renderer,
-    scene: &str,
-    input: &FrameInput,
-    frames: u32,
-    acc: &FrameSettings,
-    cache: Option<&Path>,
-) -> Result<Image> {
-    let size = r.size();
-    let cached = cache.map(|dir| {
-        dir.join(format!(
-            "reference_{:016x}.exr",
-            reference_cache_key(scene, size, input, frames, acc)
-        ))
-    });
-    if let Some(path) = cached.as_ref().filter(|p| p.exists()) {
-        let img = Image::load(path)
-            .with_context(|| format!("reading the cached reference {}", path.display()))?;
-        if (img.width, img.height) != size {
-            bail!(
-                "cached reference {} is {}x{}, not {}x{}",
-                path.display(),
-                img.width,
-                img.height,
-                size.0,
-                size.1
-            );
-        }
-        return Ok(img);
-    }
-    if let Some(path) = &cached {
-        eprintln!("rendering the reference into {}", path.display());
-    }
-    for _ in 0..frames {
-        r.render(gpu, input, acc, None)?;
-    }
-    let img = r.read_hdr(gpu)?;
-    if let Some(path) = &cached {
-        std::fs::create_dir_all(path.parent().unwrap_or(Path::new(".")))
-            .with_context(|| format!("creating the folder of {}", path.display()))?;
-        img.save(path)?;
-    }
-    Ok(img)
 }
 
 fn write_csv(path: &Path, inputs: &[FrameInput], den: &Scores, raw: &Scores) -> Result<()> {

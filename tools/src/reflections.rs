@@ -14,7 +14,7 @@
 //!    instead of the traced representative ray: mean error and share within one pixel.
 
 use crate::cli::{bvh_kind, image_size, load_scene};
-use crate::quality::new_renderer;
+use crate::reference::new_renderer;
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::{DMat4, DVec3, Vec3};
@@ -321,6 +321,8 @@ pub fn run(a: ReflectionsArgs) -> Result<()> {
         s.glossy.trace_representative_ray = traced;
         s.glossy.reference_search_radius = a.search_radius;
         let mut r = new_renderer(&gpu, &mv_scene, size)?;
+        // The search's textures are read after each frame.
+        r.keep(&[svgf::GLOSSY_PREFIX]);
         // (sum of errors, within one pixel, count) for mirror and glossy pixels.
         let mut stats = [(0.0f64, 0usize, 0usize); 2];
         for k in 0..a.path_frames {

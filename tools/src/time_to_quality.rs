@@ -18,8 +18,8 @@
 
 use crate::cli::preset_settings;
 use crate::cli::{Spp, bvh_kind, image_size, load_scene, parse_camera, parse_spp};
-use crate::quality::{new_renderer, reference};
 use crate::realtime::{GovernedFrame, governed_frame};
+use crate::reference::{new_renderer, reference};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::{DMat4, DVec3};

@@ -19,7 +19,7 @@ pub enum BvhKind {
 }
 
 impl BvhKind {
-    /// Measured on llvmpipe (see README, "BVH layouts").
+    /// Measured on llvmpipe (see docs/architecture.md, "BVH layouts").
     pub const DEFAULT: BvhKind = BvhKind::Cwbvh;
 
     pub fn name(self) -> &'static str {

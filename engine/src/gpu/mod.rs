@@ -2,6 +2,7 @@
 //! scene's GPU form.
 
 mod context;
+pub mod graph;
 pub mod history;
 mod memory;
 mod pack;
@@ -9,12 +10,14 @@ pub mod posing;
 pub mod prepare;
 mod record;
 pub mod scene;
+mod texels;
 mod timestamps;
 
 pub use crate::shader::binding::{
     BindCache, BindKey, Bindings, Resource, set_compute_groups, set_render_groups,
 };
 pub use context::{Gpu, GpuRequirements, NO_ADAPTER_HELP, REALTIME_STORAGE_FORMATS};
+pub use graph::{FrameGraph, GraphError, GraphPlan, TransientPool};
 pub use history::{Parity, PingPong, Tex};
 pub use memory::{GpuMemory, readback_buffer, readback_texture};
 pub use pack::TEXTURE_BUDGET_BYTES;

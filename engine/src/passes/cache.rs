@@ -22,7 +22,7 @@
 //! R32Uint, which the tests read).
 
 use super::io::FrameIo;
-use super::trace::SceneInputs;
+use super::scene::SceneInputs;
 use crate::gpu::{BindCache, BindKey, Bindings, Gpu, GpuMemory, Recorder, Tex, set_compute_groups};
 use crate::settings::{CacheSettings, MAX_CELLS_LOG2};
 use crate::shader::{Reload, Reloadable, compute_pipeline};

@@ -17,6 +17,7 @@ pub mod matte;
 pub mod prefilter;
 pub mod primaries;
 pub mod rescale;
+pub mod scene;
 pub mod schedule;
 pub mod supersample;
 pub mod taa;

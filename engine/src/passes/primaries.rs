@@ -9,7 +9,7 @@
 
 use crate::gpu::{BindCache, Bindings, GpuMemory, Recorder, set_compute_groups, set_render_groups};
 use crate::passes::gbuffer::{GBufferTargets, render_pipeline};
-use crate::passes::trace::SceneInputs;
+use crate::passes::scene::SceneInputs;
 use crate::shader::compute_pipeline;
 use crate::shader::{Reload, Reloadable};
 use anyhow::Result;

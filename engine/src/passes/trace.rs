@@ -8,7 +8,8 @@
 //! mirrors (Voorhuis §4.1).
 
 use super::gbuffer::{Channel, GBufferTargets};
-use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, GpuScene, Recorder, set_compute_groups};
+pub use super::scene::SceneInputs;
+use crate::gpu::{BindCache, Bindings, Gpu, GpuMemory, Recorder, set_compute_groups};
 use crate::shader::compute_pipeline;
 use anyhow::Result;
 
@@ -94,23 +95,6 @@ fn program(
         &inputs.bindings(),
         |d, m, l| compute_pipeline(d, LABEL, m, l, "main"),
     )
-}
-
-/// The scene as the frame's shading stages bind it: its buffers, the trace uniform
-/// (`TraceParams`) and the frame uniform (`FrameParams`).
-#[derive(Clone, Copy)]
-pub struct SceneInputs<'a> {
-    pub scene: &'a GpuScene,
-    pub params: &'a wgpu::Buffer,
-    pub frame: &'a wgpu::Buffer,
-    /// Objects move during the shutter: the motion-blur programs.
-    pub moving: bool,
-}
-
-impl<'a> SceneInputs<'a> {
-    pub fn bindings(&self) -> Bindings<'a> {
-        self.scene.bindings().buffer("params", self.params).buffer("frame", self.frame)
-    }
 }
 
 /// What the trace reads and writes: the scene, the G-buffer and its own outputs, the radiance

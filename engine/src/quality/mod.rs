@@ -1,12 +1,11 @@
 //! Images, files and the metrics every comparison in Hush uses (the oracle's definitions).
 
-mod image_io;
 mod metrics;
 mod ssim;
 mod timeline;
 mod uncovered;
 
-pub use image_io::{
+pub use crate::image_io::{
     Image, decode_exr, linear_to_srgb, srgb_to_linear, tonemap_srgb8, write_exr, write_png,
 };
 pub use metrics::{

@@ -26,7 +26,7 @@ pub struct EnvMap {
 
 impl EnvMap {
     /// An equirectangular map from EXR bytes, decoded within `budget` (see
-    /// [`crate::quality::decode_exr`]).
+    /// [`crate::image_io::decode_exr`]).
     pub fn from_exr(
         name: &str,
         bytes: &[u8],
@@ -34,7 +34,7 @@ impl EnvMap {
         rotation_y_degrees: f32,
         budget: &mut crate::limits::Budget,
     ) -> Result<EnvMap> {
-        let (width, height, rgb) = crate::quality::decode_exr(name, bytes, budget)
+        let (width, height, rgb) = crate::image_io::decode_exr(name, bytes, budget)
             .with_context(|| format!("reading environment map {name}"))?;
         if width == 0 || height == 0 {
             bail!("environment map {name} is empty");

@@ -7,7 +7,7 @@
 //! written as a static mesh in its rest pose (its skin, targets and weights channels are not).
 
 use super::{AlphaMode, Environment, Light, Scene, Track, Wrap};
-use crate::quality::Image;
+use crate::image_io::Image;
 use anyhow::{Context, Result};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use serde_json::{Value, json};

@@ -1,5 +1,5 @@
 //! Scenes on the CPU: what a glTF file (or the built-in default scene) describes, in the units and
-//! conventions of `README.md` ("Scene conventions").
+//! conventions of `docs/scenes.md`.
 
 mod accessor;
 mod animation;
@@ -40,7 +40,7 @@ pub use gltf_import::{
 pub use level::{DEFAULT_SUN, default_level, default_level_with_sun};
 pub use reflections::{BUILTIN_SCENES, builtin_scene, reflection_scene};
 pub use terrain::{MAX_TERRAIN_TRIANGLES, terrain};
-pub use texture::{Texture, TextureRef, Wrap, decode_image, mip_chain_texels};
+pub use texture::{Texture, TextureRef, Wrap, mip_chain_texels};
 
 use anyhow::Result;
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};

@@ -1,6 +1,6 @@
+use crate::image_io::{decode_image, linear_to_srgb, srgb_to_linear};
 use crate::limits::Budget;
-use crate::quality::{linear_to_srgb, srgb_to_linear};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use glam::{Affine2, Mat2, Vec2};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -194,26 +194,6 @@ impl Texture {
             nearest: false,
         })
     }
-}
-
-/// A PNG or JPEG decoded within `budget`: its header's size is charged (4 bytes a pixel, what
-/// is kept) before decoding, and the decoder may allocate no more than that image at 16 bytes
-/// a pixel (16-bit RGBA and its conversion), so a header that lies cannot make it allocate more.
-pub fn decode_image(name: &str, bytes: &[u8], budget: &mut Budget) -> Result<image::DynamicImage> {
-    let reader = || {
-        image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .with_context(|| format!("reading image {name}"))
-    };
-    let (w, h) = reader()?.into_dimensions().with_context(|| format!("decoding image {name}"))?;
-    budget.image(w as u64, h as u64, 4, format_args!("image {name}"))?;
-    let mut r = reader()?;
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(w);
-    limits.max_image_height = Some(h);
-    limits.max_alloc = Some((w as u64 * h as u64 * 16).max(1 << 20));
-    r.limits(limits);
-    r.decode().with_context(|| format!("decoding image {name}"))
 }
 
 #[cfg(test)]

@@ -1,3 +1,7 @@
+//! Images as Hush reads and writes them: the linear RGB [`Image`] the metrics compare, EXR and
+//! PNG files, the sRGB curves, and the bounded decoding of PNG and JPEG that textures and
+//! references share. Below both `scene` and `quality`, which each use it.
+
 use anyhow::{Context, Result, anyhow, bail};
 use glam::Vec3;
 use std::path::Path;
@@ -32,7 +36,7 @@ impl Image {
             let (width, height, data) = decode_exr(&name, &bytes, &mut budget)?;
             return Ok(Image { width, height, data });
         }
-        let img = crate::scene::decode_image(&name, &bytes, &mut budget)?.to_rgb32f();
+        let img = decode_image(&name, &bytes, &mut budget)?.to_rgb32f();
         // 8-bit files hold display values: undo the sRGB curve so metrics compare radiance.
         let data = img
             .pixels()
@@ -195,6 +199,30 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 /// The sRGB transfer function's inverse (IEC 61966-2-1): an encoded value in [0, 1] to linear.
 pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// A PNG or JPEG decoded within `budget`: its header's size is charged (4 bytes a pixel, what
+/// is kept) before decoding, and the decoder may allocate no more than that image at 16 bytes
+/// a pixel (16-bit RGBA and its conversion), so a header that lies cannot make it allocate more.
+pub fn decode_image(
+    name: &str,
+    bytes: &[u8],
+    budget: &mut crate::limits::Budget,
+) -> Result<image::DynamicImage> {
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .with_context(|| format!("reading image {name}"))
+    };
+    let (w, h) = reader()?.into_dimensions().with_context(|| format!("decoding image {name}"))?;
+    budget.image(w as u64, h as u64, 4, format_args!("image {name}"))?;
+    let mut r = reader()?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(w);
+    limits.max_image_height = Some(h);
+    limits.max_alloc = Some((w as u64 * h as u64 * 16).max(1 << 20));
+    r.limits(limits);
+    r.decode().with_context(|| format!("decoding image {name}"))
 }
 
 #[cfg(test)]
