@@ -226,27 +226,25 @@ struct Targets {
     levels: Levels,
 }
 
-/// This frame's a-trous levels: how many, and whether the first feeds the history.
-#[derive(Clone, Copy, Default)]
+/// This frame's a-trous levels: how many, and whether the first feeds the history (both pick
+/// each level's step and uniform, so the bind groups are made for them).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 struct Levels {
     count: usize,
     feedback: bool,
 }
 
-impl Levels {
-    /// Both in the bind groups' key, since they pick each level's step and uniform.
-    fn key(self) -> usize {
-        self.count | (self.feedback as usize) << 8
-    }
-}
+/// A stage of the filter: its bind groups by the history parity, the pass they bind and the
+/// levels.
+type Stage = ChainStage<(Parity, Pass, Levels)>;
 
 struct SignalStages {
-    temporal: ChainStage,
-    variance: ChainStage,
-    atrous: ChainStage,
+    temporal: Stage,
+    variance: Stage,
+    atrous: Stage,
 }
 
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Pass {
     Features,
     Temporal,
@@ -268,7 +266,7 @@ struct Resources {
 
 /// The features stage and each signal's stages, made on the first frame.
 struct Stages {
-    features: ChainStage,
+    features: Stage,
     signals: Vec<SignalStages>,
 }
 
@@ -438,7 +436,7 @@ impl Denoiser for Progressive {
         for s in st.signals.iter_mut() {
             [&mut s.temporal, &mut s.variance, &mut s.atrous]
                 .into_iter()
-                .for_each(ChainStage::release_groups);
+                .for_each(Stage::release_groups);
         }
     }
 
@@ -463,24 +461,20 @@ impl Denoiser for Progressive {
             res.make_stages(gpu, io, t, scene).context("creating the progressive filter's stages")
         })?;
         let matte = t.signals.first().map(|(g, s)| (*g, s)).context("no signal to filter")?;
-        stages.features.record(rec, key, parity, size, |p| {
-            res.bindings(io, t, matte, Pass::Features, p, levels)
-        })?;
+        stages.features.record(
+            rec,
+            key,
+            (parity, Pass::Features, levels),
+            size,
+            |(p, pass, l)| res.bindings(io, t, matte, pass, p, l),
+        )?;
         for (st, (signal, s)) in stages.signals.iter_mut().zip(&t.signals) {
             let sig = (*signal, s);
-            let b = |pass, p| res.bindings(io, t, sig, pass, p, levels);
-            st.temporal.record(rec, key, parity, size, |p| b(Pass::Temporal, p))?;
-            st.variance.record(rec, key, parity, size, |p| b(Pass::Variance, p))?;
+            let b = |(p, pass, l)| res.bindings(io, t, sig, pass, p, l);
+            st.temporal.record(rec, key, (parity, Pass::Temporal, levels), size, b)?;
+            st.variance.record(rec, key, (parity, Pass::Variance, levels), size, b)?;
             for i in 0..levels.count {
-                // Bind groups are keyed by (parity, level) and by the levels.
-                let k = crate::gpu::BindKey { levels: levels.key(), ..key };
-                st.atrous.record_variant(
-                    rec,
-                    k,
-                    (2 * LEVELS, parity.index() * LEVELS + i),
-                    size,
-                    |v| b(Pass::Atrous(v % LEVELS), Parity::BOTH[v / LEVELS]),
-                )?;
+                st.atrous.record(rec, key, (parity, Pass::Atrous(i), levels), size, b)?;
             }
         }
         Ok(outputs(t, follows_light(cx.settings)))

@@ -44,13 +44,7 @@ fn run_filtered(
 }
 
 /// A device whose whole frame scales: `area * (rest + trace f)` ms.
-fn run(
-    g: &mut Governor,
-    rest: f64,
-    trace: f64,
-    frames: usize,
-    moving: bool,
-) -> Vec<(Choice, f64)> {
+fn run(g: &mut Governor, rest: f64, trace: f64, frames: usize, moving: bool) -> Vec<(Choice, f64)> {
     run_fixed(g, (0.0, rest, trace), frames, moving)
 }
 
@@ -314,8 +308,7 @@ fn the_fixed_cost_is_not_scaled() {
     run_fixed(&mut g, (40.0, 400.0, 2000.0), 10, true);
     // Its prediction holds for a choice it has not run: 40 + 0.25 (400 + 500) = 265 ms,
     // where a model that scales everything would say 0.25 x 4 x the frame it ran.
-    let c =
-        Choice { scale: 0.5, fraction: SampleFraction::one_in(4).unwrap(), levels: ALL_LEVELS };
+    let c = Choice { scale: 0.5, fraction: SampleFraction::one_in(4).unwrap(), levels: ALL_LEVELS };
     let t = g.predict(c).unwrap();
     assert!((t - 265.0).abs() < 1e-6, "{t}");
     // The fixed part alone over the target: the frame still gets SCALABLE_FLOOR of it for

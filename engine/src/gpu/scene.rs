@@ -1,8 +1,8 @@
 //! A scene on the GPU: the buffers of a [`PreparedScene`] and what they cost.
 
 use super::prepare::{Draw, EnvKind, PreparedScene, SceneFeatures};
-use super::{Bindings, Gpu, GpuMemory, GpuRequirements};
 pub use super::texels::{TEXEL_ROW, Texels, texel_row_count};
+use super::{Bindings, Gpu, GpuMemory, GpuRequirements};
 use crate::accel::BvhKind;
 
 /// The shading modules' `path_end` that never ends a path (common/path.wgsl); a program with a

@@ -180,7 +180,7 @@ impl Pass {
         let _scope = crate::profile::scope(self.label);
         let p = &self.pipeline;
         let device = &rec.gpu.device;
-        let g = self.groups.get(key, p.builds(), 1, 0, |_| p.bind_groups(device, offered))?;
+        let g = self.groups.get(key, p.builds(), (), |_| p.bind_groups(device, offered))?;
         let mut pass = rec.compute_pass(self.label);
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, g);

@@ -1,5 +1,6 @@
 //! One compute pass of a denoise chain (matte.rs, glossy.rs): its pipeline, and its bind groups
-//! for history parity 0 and 1, remade when the key of what they bind or the pipeline changes.
+//! by variant (history parity, level, ...), remade when the key of what they bind or the
+//! pipeline changes.
 
 use crate::gpu::{BindCache, BindKey, Bindings, Gpu, Parity, Recorder, set_compute_groups};
 use crate::shader::compute_pipeline;
@@ -44,21 +45,23 @@ pub fn made_for_epoch<T>(
     true
 }
 
-pub struct ChainStage {
+/// One compute pass of a chain: its pipeline and its bind groups by variant `V` (by default
+/// the history parity; a stage with levels or several inputs names its own variant type).
+pub struct ChainStage<V = Parity> {
     pub label: &'static str,
     pub pipeline: Reloadable<wgpu::ComputePipeline>,
-    groups: BindCache,
+    groups: BindCache<V>,
 }
 
-impl ChainStage {
-    /// `offered`: what the stage binds for either parity (only the names matter here).
+impl<V: std::hash::Hash + Eq + Copy> ChainStage<V> {
+    /// `offered`: what the stage binds in any variant (only the names matter here).
     pub fn new(
         gpu: &Gpu,
         label: &'static str,
         modules: &[&'static str],
         entry: &str,
         offered: &Bindings,
-    ) -> Result<ChainStage> {
+    ) -> Result<ChainStage<V>> {
         ChainStage::with_prelude(gpu, label, "", modules, entry, offered)
     }
 
@@ -70,7 +73,7 @@ impl ChainStage {
         modules: &[&'static str],
         entry: &str,
         offered: &Bindings,
-    ) -> Result<ChainStage> {
+    ) -> Result<ChainStage<V>> {
         let entry = entry.to_string();
         let pipeline = Reloadable::new(
             gpu,
@@ -89,32 +92,20 @@ impl ChainStage {
         self.groups.clear();
     }
 
-    /// Dispatch one thread per pixel in 8x8 groups; `bindings(p)` gives what parity p binds.
+    /// Dispatch one thread per pixel in 8x8 groups, bound as `variant`; `bindings(v)` gives
+    /// what variant v binds (asked once per variant while `key` and the pipeline stay).
     pub fn record<'a>(
         &mut self,
         rec: &mut Recorder,
         key: BindKey,
-        parity: Parity,
+        variant: V,
         size: (u32, u32),
-        bindings: impl Fn(Parity) -> Bindings<'a>,
-    ) -> Result<()> {
-        self.record_variant(rec, key, (2, parity.index()), size, |v| bindings(Parity::BOTH[v]))
-    }
-
-    /// As [`ChainStage::record`] for a stage with `variant.0` sets of bindings (parity, level,
-    /// ...), recording set `variant.1`; `bindings(v)` gives set v.
-    pub fn record_variant<'a>(
-        &mut self,
-        rec: &mut Recorder,
-        key: BindKey,
-        variant: (usize, usize),
-        size: (u32, u32),
-        bindings: impl Fn(usize) -> Bindings<'a>,
+        bindings: impl Fn(V) -> Bindings<'a>,
     ) -> Result<()> {
         let p = &self.pipeline;
-        let groups = self.groups.get(key, p.builds(), variant.0, variant.1, |v| {
-            p.bind_groups(&rec.gpu.device, &bindings(v))
-        })?;
+        let groups = self
+            .groups
+            .get(key, p.builds(), variant, |v| p.bind_groups(&rec.gpu.device, &bindings(v)))?;
         let _scope = crate::profile::scope(self.label);
         let mut pass = rec.compute_pass(self.label);
         pass.set_pipeline(p.get());

@@ -60,7 +60,7 @@ pub fn modules(glossy: bool, last: &[&'static str]) -> Vec<&'static str> {
 
 pub struct CompositePass {
     pub pipeline: Reloadable<wgpu::ComputePipeline>,
-    groups: BindCache,
+    groups: BindCache<Parity>,
 }
 
 impl CompositePass {
@@ -89,8 +89,8 @@ impl CompositePass {
     ) -> Result<()> {
         let p = &self.pipeline;
         let size = b(parity).io.size;
-        let groups = self.groups.get(key, p.builds(), 2, parity.index(), |v| {
-            let b = b(Parity::BOTH[v]);
+        let groups = self.groups.get(key, p.builds(), parity, |v| {
+            let b = b(v);
             p.bind_groups(&rec.gpu.device, &inputs(&b, b.io.hdr))
         })?;
         let mut pass = rec.compute_pass(COMPOSITE);
@@ -188,7 +188,7 @@ impl DisplayPass {
     ) -> Result<()> {
         let p = &self.pipeline;
         let (zf, zu) = (&self.zero_float.1, &self.zero_uint.1);
-        let groups = self.groups.get(key, p.builds(), 1, 0, |_| {
+        let groups = self.groups.get(key, p.builds(), (), |_| {
             let shown = view.map(|t| (view_slot(t.format()), t.create_view(&Default::default())));
             let mut r = inputs(b, b.shown).texture("view_float", zf).texture("view_uint", zu);
             if let Some((Some(slot), v)) = &shown {

@@ -235,8 +235,7 @@ impl GBufferPass {
         let groups = self.groups.get(
             BindKey { scene: scene.generation, ..BindKey::default() },
             p.builds(),
-            1,
-            0,
+            (),
             |_| p.bind_groups(&rec.gpu.device, &bindings(scene, frame)),
         )?;
         let mut pass = t.begin_pass(rec, LABEL);

@@ -102,7 +102,7 @@ pub fn modules(step: &'static str) -> Vec<&'static str> {
 
 #[derive(Default)]
 pub struct Prefilter {
-    stages: Option<[ChainStage; 3]>,
+    stages: Option<[ChainStage<()>; 3]>,
 }
 
 impl Prefilter {
@@ -132,7 +132,7 @@ impl Prefilter {
             ])
         })?;
         for s in stages {
-            s.record_variant(rec, key, (1, 0), size, |_| offered.clone())?;
+            s.record(rec, key, (), size, |_| offered.clone())?;
         }
         Ok(())
     }

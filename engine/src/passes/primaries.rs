@@ -54,7 +54,7 @@ impl PrimaryTargets {
 pub struct Primaries {
     /// Without and with objects moving during the shutter.
     trace: [Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>; 2],
-    resolve: Option<(Reloadable<wgpu::RenderPipeline>, [BindCache; 2])>,
+    resolve: Option<(Reloadable<wgpu::RenderPipeline>, BindCache<bool>)>,
 }
 
 fn trace_bindings<'a>(scene: SceneInputs<'a>, t: &'a PrimaryTargets) -> Bindings<'a> {
@@ -100,7 +100,7 @@ impl Primaries {
             )?;
             Ok((p, BindCache::default()))
         })?;
-        let groups = cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
+        let groups = cache.get(key, p.builds(), (), |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(LABEL);
         let mut pass = rec.compute_pass(LABEL);
         pass.set_pipeline(p.get());
@@ -147,8 +147,9 @@ impl Primaries {
             )?;
             Ok((p, Default::default()))
         })?;
-        let groups = caches[filtered as usize]
-            .get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &offered))?;
+        // Bound with the pre-filter's edges (filtered) or without.
+        let groups =
+            caches.get(key, p.builds(), filtered, |_| p.bind_groups(&gpu.device, &offered))?;
         let _scope = crate::profile::scope(RESOLVE);
         let mut pass = g.begin_pass(rec, RESOLVE);
         pass.set_pipeline(p.get());

@@ -108,7 +108,7 @@ pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
 
 pub struct Supersample {
     samples: Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>,
-    stages: Option<[ChainStage; 3]>,
+    stages: Option<[ChainStage<()>; 3]>,
 }
 
 impl Supersample {
@@ -166,7 +166,7 @@ impl Supersample {
             Ok((p, BindCache::default()))
         })?;
         let groups =
-            cache.get(key, p.builds(), 1, 0, |_| p.bind_groups(&gpu.device, &sample_bindings))?;
+            cache.get(key, p.builds(), (), |_| p.bind_groups(&gpu.device, &sample_bindings))?;
         {
             let _scope = crate::profile::scope(SAMPLES);
             let mut pass = rec.compute_pass(SAMPLES);
@@ -185,8 +185,8 @@ impl Supersample {
                 stage("supersample/resolve", "supersample/resolve.wgsl")?,
             ])
         })?;
-        assign.record_variant(rec, key, (1, 0), size, |_| offered.clone())?;
-        mix.record_variant(rec, key, (1, 0), size, |_| offered.clone())
+        assign.record(rec, key, (), size, |_| offered.clone())?;
+        mix.record(rec, key, (), size, |_| offered.clone())
     }
 
     /// After the composite: each pixel the mean of its samples' guides, copied back into the
@@ -202,7 +202,7 @@ impl Supersample {
         let Some([_, _, resolve]) = self.stages.as_mut() else {
             anyhow::bail!("the supersampling resolves before it mixed")
         };
-        resolve.record_variant(rec, key, (1, 0), io.size, |_| offered.clone())?;
+        resolve.record(rec, key, (), io.size, |_| offered.clone())?;
         rec.enc.copy_buffer_to_buffer(
             &t.resolved,
             0,

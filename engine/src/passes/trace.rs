@@ -59,7 +59,28 @@ impl TraceTargets {
 /// (shaders/realtime/uncovered.wgsl).
 #[derive(Default)]
 pub struct TracePass {
-    programs: [Option<(crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>; 8],
+    programs: Vec<(TraceProgram, crate::shader::Reloadable<wgpu::ComputePipeline>, BindCache)>,
+}
+
+/// What a trace program is made for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct TraceProgram {
+    /// Objects move during the shutter.
+    moving: bool,
+    /// Matte paths end in the radiance cache.
+    cache: bool,
+    /// The previous depth tells which pixels a move uncovered.
+    previous_depth: bool,
+}
+
+impl TraceProgram {
+    fn of(inputs: &TraceInputs) -> TraceProgram {
+        TraceProgram {
+            moving: inputs.scene.moving,
+            cache: inputs.cache.is_some(),
+            previous_depth: inputs.previous_depth.is_some(),
+        }
+    }
 }
 
 fn program(
@@ -144,9 +165,10 @@ impl TracePass {
     /// The pass with its common program (static shutter, no cache) made now, so that a scene
     /// the trace cannot compile fails here.
     pub fn new(gpu: &Gpu, inputs: &TraceInputs) -> Result<TracePass> {
-        let mut pass = TracePass::default();
-        pass.programs[0] = Some((program(gpu, inputs, false)?, BindCache::default()));
-        Ok(pass)
+        let scene = SceneInputs { moving: false, ..inputs.scene };
+        let common = TraceInputs { scene, cache: None, previous_depth: None, ..*inputs };
+        let (what, p) = (TraceProgram::of(&common), program(gpu, &common, false)?);
+        Ok(TracePass { programs: vec![(what, p, BindCache::default())] })
     }
 
     /// `key`: bind groups are rebuilt when it changes. `period`: 1 / f, the frames between two
@@ -160,16 +182,18 @@ impl TracePass {
         period: u32,
     ) -> Result<()> {
         use crate::shader::Reload;
-        let moving = inputs.scene.moving;
-        let slot = &mut self.programs[moving as usize
-            + 2 * inputs.cache.is_some() as usize
-            + 4 * inputs.previous_depth.is_some() as usize];
-        if slot.is_none() {
-            *slot = Some((program(rec.gpu, inputs, moving)?, BindCache::default()));
-        }
-        let Some((p, cache)) = slot.as_mut() else { unreachable!("made above") };
+        let what = TraceProgram::of(inputs);
+        let i = match self.programs.iter().position(|(w, _, _)| *w == what) {
+            Some(i) => i,
+            None => {
+                let p = program(rec.gpu, inputs, what.moving)?;
+                self.programs.push((what, p, BindCache::default()));
+                self.programs.len() - 1
+            }
+        };
+        let (_, p, cache) = &mut self.programs[i];
         let groups = cache
-            .get(key, p.builds(), 1, 0, |_| p.bind_groups(&rec.gpu.device, &inputs.bindings()))?;
+            .get(key, p.builds(), (), |_| p.bind_groups(&rec.gpu.device, &inputs.bindings()))?;
         let mut pass = rec.compute_pass(LABEL);
         pass.set_pipeline(p.get());
         set_compute_groups(&mut pass, groups);
@@ -186,7 +210,7 @@ impl TracePass {
     /// Its pipelines, for hot reload.
     pub fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
         let mut v: Vec<&mut dyn crate::shader::Reload> = vec![];
-        for (p, _) in self.programs.iter_mut().flatten() {
+        for (_, p, _) in self.programs.iter_mut() {
             v.push(p);
         }
         v

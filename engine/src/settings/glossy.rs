@@ -156,10 +156,18 @@ described! {
 impl GlossySettings {
     /// Stage bits as shaders/glossy/common.wgsl reads them.
     pub fn stage_bits(&self) -> u32 {
-        self.temporal as u32
-            | (self.clipping as u32) << 1
-            | (self.bilateral as u32) << 2
-            | (self.hit_test as u32) << 3
+        super::switch_bits(&self.switches())
+    }
+
+    /// Each stage by its WGSL constant (`GSTAGE_*`), in the order of its bit (checked against
+    /// the WGSL by a test).
+    pub fn switches(&self) -> [(&'static str, bool); 4] {
+        [
+            ("GSTAGE_TEMPORAL", self.temporal),
+            ("GSTAGE_CLIPPING", self.clipping),
+            ("GSTAGE_BILATERAL", self.bilateral),
+            ("GSTAGE_HIT_TEST", self.hit_test),
+        ]
     }
 
     /// The glossy bilateral's Gaussian sigma in pixels: Mara et al. §3.4's 7 r^0.1 + epsilon,

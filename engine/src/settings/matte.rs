@@ -138,10 +138,18 @@ impl MatteSettings {
     /// Stage bits as the shaders read them (shaders/matte/common.wgsl: STAGE_*; TAA's bit is
     /// [`super::TaaSettings::stage_bit`]).
     pub fn stage_bits(&self) -> u32 {
-        [self.temporal, self.history_bilateral, self.disocclusion, self.firefly, self.bilateral]
-            .iter()
-            .enumerate()
-            .map(|(i, on)| (*on as u32) << i)
-            .sum()
+        super::switch_bits(&self.switches())
+    }
+
+    /// Each stage by its WGSL constant, in the order of its bit (checked against the WGSL by a
+    /// test).
+    pub fn switches(&self) -> [(&'static str, bool); 5] {
+        [
+            ("STAGE_TEMPORAL", self.temporal),
+            ("STAGE_HISTORY_BILATERAL", self.history_bilateral),
+            ("STAGE_DISOCCLUSION", self.disocclusion),
+            ("STAGE_FIREFLY", self.firefly),
+            ("STAGE_BILATERAL", self.bilateral),
+        ]
     }
 }

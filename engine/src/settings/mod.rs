@@ -323,3 +323,9 @@ fn levels_path(s: &FrameSettings) -> Option<&'static str> {
 fn levels_at(v: &Value, path: &str) -> Option<u32> {
     u32::try_from(get_field(v, path)?.as_u64()?).ok()
 }
+
+/// A switch word as the shaders read it: bit i is the i-th switch's state (each switch named by
+/// the WGSL constant that tests it).
+pub fn switch_bits(switches: &[(&str, bool)]) -> u32 {
+    switches.iter().enumerate().map(|(i, (_, on))| (*on as u32) << i).sum()
+}

@@ -203,26 +203,28 @@ impl SvgfSettings {
 
     /// Switch bits as shaders/svgf/common.wgsl reads them (SV_*).
     pub fn bits(&self) -> u32 {
+        super::switch_bits(&self.switches())
+    }
+
+    /// Each switch by the WGSL constant that tests it (shaders/svgf/common.wgsl `SV_*`), in the
+    /// order of its bit in [`SvgfSettings::bits`] (a test checks the constants against it).
+    pub fn switches(&self) -> [(&'static str, bool); 14] {
         [
-            self.temporal,
-            self.spatial_variance,
-            self.accumulated_moments,
-            self.bandwidth_boost,
-            self.variance_filtering,
-            self.firefly,
-            self.reflection_reprojection,
-            self.clipping,
-            self.mirror_features,
-            self.variance_of_mean,
-            self.filtered_history,
-            self.glossy_temporal,
-            self.regression,
-            self.hit_test,
+            ("SV_TEMPORAL", self.temporal),
+            ("SV_SPATIAL_VARIANCE", self.spatial_variance),
+            ("SV_ACCUMULATED_MOMENTS", self.accumulated_moments),
+            ("SV_BANDWIDTH_BOOST", self.bandwidth_boost),
+            ("SV_VARIANCE_FILTERING", self.variance_filtering),
+            ("SV_FIREFLY", self.firefly),
+            ("SV_REFLECTION_REPROJECTION", self.reflection_reprojection),
+            ("SV_CLIPPING", self.clipping),
+            ("SV_MIRROR_FEATURES", self.mirror_features),
+            ("SV_VARIANCE_OF_MEAN", self.variance_of_mean),
+            ("SV_FILTERED_HISTORY", self.filtered_history),
+            ("SV_GLOSSY_TEMPORAL", self.glossy_temporal),
+            ("SV_REGRESSION", self.regression),
+            ("SV_HIT_TEST", self.hit_test),
         ]
-        .iter()
-        .enumerate()
-        .map(|(i, on)| (*on as u32) << i)
-        .sum()
     }
 
     /// The a-trous levels the filter runs (at most 5: steps 1 to 16 pixels).

@@ -75,8 +75,15 @@ impl TaaSettings {
     /// Its `--disable` name.
     pub const STAGE: &str = "taa";
 
-    /// Its bit among the chains' stage bits (shaders/matte/common.wgsl: STAGE_TAA).
+    /// Its bit among the chains' stage bits, after the matte chain's
+    /// ([`super::MatteSettings::switches`]; shaders/matte/common.wgsl: STAGE_TAA).
     pub fn stage_bit(&self) -> u32 {
-        (self.enabled as u32) << 5
+        let after = super::MatteSettings::default().switches().len();
+        (self.enabled as u32) << after
+    }
+
+    /// Its switch by its WGSL constant.
+    pub fn switch(&self) -> (&'static str, bool) {
+        ("STAGE_TAA", self.enabled)
     }
 }

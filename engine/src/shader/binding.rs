@@ -4,7 +4,7 @@
 //! program that asks for a name nobody offers is an error that names it.
 
 use super::ProgramBindings;
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 #[derive(Clone, Copy)]
 pub enum Resource<'a> {
@@ -140,41 +140,46 @@ pub struct BindKey {
     pub denoiser: Option<usize>,
     /// The debug view the display shows (its index in the view list; 0: the final image).
     pub view: usize,
-    /// A stage's own choice that changes what it binds (the progressive filter's level count
-    /// and feedback).
-    pub levels: usize,
 }
 
-/// A pass's bind groups for each of its variants (history parity 0 and 1, or one), remade
-/// when the key of what they bind or the pipeline's build changes.
-#[derive(Default)]
-pub struct BindCache {
-    cached: Option<(BindKey, u32, Vec<Vec<wgpu::BindGroup>>)>,
+/// A pass's bind groups by variant `V` (the history parity, a level, what a program was made
+/// for: any type with derived `Hash` and `Eq`; `()` where there is one), each made the first
+/// time it is asked for, all remade when the key of what they bind or the pipeline's build
+/// changes.
+pub struct BindCache<V = ()> {
+    made_for: Option<(BindKey, u32)>,
+    groups: std::collections::HashMap<V, Vec<wgpu::BindGroup>>,
 }
 
-impl BindCache {
+impl<V> Default for BindCache<V> {
+    fn default() -> Self {
+        BindCache { made_for: None, groups: Default::default() }
+    }
+}
+
+impl<V: std::hash::Hash + Eq + Copy> BindCache<V> {
     /// Drop the groups (and with them what they bind), as when their resources are released.
     pub fn clear(&mut self) {
-        self.cached = None;
+        self.groups.clear();
+        self.made_for = None;
     }
 
-    /// The groups of variant `v`, making all variants with `make(v)` if `key` or `builds` changed.
+    /// The groups of variant `v`, made with `make(v)` where this key and build have none yet.
     pub fn get(
         &mut self,
         key: BindKey,
         builds: u32,
-        variants: usize,
-        v: usize,
-        make: impl Fn(usize) -> Result<Vec<wgpu::BindGroup>>,
+        v: V,
+        make: impl FnOnce(V) -> Result<Vec<wgpu::BindGroup>>,
     ) -> Result<&[wgpu::BindGroup]> {
-        let cached = match self.cached.take() {
-            Some(c) if c.0 == key && c.1 == builds => c,
-            _ => (key, builds, (0..variants).map(&make).collect::<Result<_>>()?),
+        if self.made_for != Some((key, builds)) {
+            self.groups.clear();
+            self.made_for = Some((key, builds));
+        }
+        let groups = match self.groups.entry(v) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => e.insert(make(v)?),
         };
-        let (_, _, groups) = self.cached.insert(cached);
-        groups
-            .get(v)
-            .map(Vec::as_slice)
-            .with_context(|| format!("bind-group variant {v} of {variants}"))
+        Ok(groups.as_slice())
     }
 }

@@ -1,5 +1,7 @@
 use super::*;
 
+mod layouts;
+
 const FEATURE_SETS: &[[&str; 9]] = &[
     [
         "common/alpha_none.wgsl",
@@ -51,7 +53,7 @@ const MOTIONS: [crate::gpu::Motion; 3] =
     [crate::gpu::Motion::Static, crate::gpu::Motion::Objects, crate::gpu::Motion::Vertices];
 
 /// Every program Hush can compose, over both BVH layouts and the feature alternatives.
-fn all_programs() -> Vec<Program> {
+pub(super) fn all_programs() -> Vec<Program> {
     let mut v = vec![];
     for set in FEATURE_SETS {
         for motion in [

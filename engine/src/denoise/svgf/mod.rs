@@ -28,6 +28,10 @@ pub fn frame_graph(glossy: bool) -> crate::gpu::FrameGraph {
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext, Outputs};
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, Recorder};
 use crate::passes::chain::{ChainStage, made_for};
+
+/// An SVGF stage: its bind groups by the history parity and the pass they bind (a-trous level,
+/// the regression's input).
+type Stage = ChainStage<(Parity, Pass)>;
 use crate::passes::glossy::{GlossyParams, MotionProgram};
 use crate::passes::io::FrameIo;
 use crate::passes::matte::DenoiseParams;
@@ -224,13 +228,13 @@ impl Variant {
 /// One signal's passes.
 struct SignalStages {
     variant: Variant,
-    temporal: ChainStage,
-    variance: ChainStage,
-    atrous: ChainStage,
-    spread_h: ChainStage,
-    spread_v: ChainStage,
-    regression: ChainStage,
-    last: ChainStage,
+    temporal: Stage,
+    variance: Stage,
+    atrous: Stage,
+    spread_h: Stage,
+    spread_v: Stage,
+    regression: Stage,
+    last: Stage,
 }
 
 impl SignalStages {
@@ -281,7 +285,7 @@ impl SignalStages {
         })
     }
 
-    fn stages(&mut self) -> impl Iterator<Item = &mut ChainStage> {
+    fn stages(&mut self) -> impl Iterator<Item = &mut Stage> {
         [
             &mut self.temporal,
             &mut self.variance,
@@ -298,9 +302,9 @@ impl SignalStages {
 struct MotionStages {
     /// What the motion stage's program was made for.
     program: MotionProgram,
-    motion: ChainStage,
-    prefilter_h: ChainStage,
-    prefilter_v: ChainStage,
+    motion: Stage,
+    prefilter_h: Stage,
+    prefilter_v: Stage,
 }
 
 /// SVGF's parameter buffers and per-pixel textures: what its stages bind.
@@ -395,19 +399,12 @@ impl Resources {
     ) -> Result<()> {
         let t = self.targets.as_ref().context("SVGF records before its textures exist")?;
         let (key, parity, size) = (cx.key, cx.parity, io.size);
-        let b = |pass, p| self.bindings(io, t, c, pass, p);
-        st.temporal.record(rec, key, parity, size, |p| b(Pass::Temporal, p))?;
-        st.variance.record(rec, key, parity, size, |p| b(Pass::Variance, p))?;
+        let b = |(p, pass)| self.bindings(io, t, c, pass, p);
+        st.temporal.record(rec, key, (parity, Pass::Temporal), size, b)?;
+        st.variance.record(rec, key, (parity, Pass::Variance), size, b)?;
         let levels = cx.settings.svgf.atrous_levels() as usize;
         for level in 0..levels {
-            // Bind groups by (parity, level).
-            st.atrous.record_variant(
-                rec,
-                key,
-                (2 * LEVELS, parity.index() * LEVELS + level),
-                size,
-                |v| b(Pass::Atrous(v % LEVELS), Parity::BOTH[v / LEVELS]),
-            )?;
+            st.atrous.record(rec, key, (parity, Pass::Atrous(level)), size, b)?;
         }
         if levels == 0 || !cx.settings.svgf.filtered_history {
             // No level wrote the history: it is the integrated light.
@@ -423,16 +420,13 @@ impl Resources {
         }
         let sv = &cx.settings.svgf;
         if sv.regression && sv.spike_ratio > 0.0 {
-            st.spread_h.record(rec, key, parity, size, |p| b(Pass::Spread(false), p))?;
-            st.spread_v.record(rec, key, parity, size, |p| b(Pass::Spread(true), p))?;
+            st.spread_h.record(rec, key, (parity, Pass::Spread(false)), size, b)?;
+            st.spread_v.record(rec, key, (parity, Pass::Spread(true)), size, b)?;
         }
-        // The last level wrote pong when its index was even; bind groups by (last, parity).
+        // The last level wrote pong when its index was even.
         let last = if levels == 0 { 0 } else { 1 + (levels % 2) };
-        let variant = (6, 2 * last + parity.index());
-        st.regression.record_variant(rec, key, variant, size, |v| {
-            b(Pass::Regression(v / 2), Parity::BOTH[v % 2])
-        })?;
-        st.last.record(rec, key, parity, size, |p| b(Pass::Final, p))
+        st.regression.record(rec, key, (parity, Pass::Regression(last)), size, b)?;
+        st.last.record(rec, key, (parity, Pass::Final), size, b)
     }
 
     fn record_motion(
@@ -445,11 +439,11 @@ impl Resources {
         let t = self.targets.as_ref().context("SVGF records before its textures exist")?;
         let (key, parity, size) = (cx.key, cx.parity, io.size);
         let sv = &cx.settings.svgf;
-        let b = |pass, p| self.bindings(io, t, Chain::Glossy, pass, p);
-        st.motion.record(rec, key, parity, size, |p| b(Pass::Motion, p))?;
+        let b = |(p, pass)| self.bindings(io, t, Chain::Glossy, pass, p);
+        st.motion.record(rec, key, (parity, Pass::Motion), size, b)?;
         if sv.clipping && sv.temporal {
-            st.prefilter_h.record(rec, key, parity, size, |p| b(Pass::Prefilter(false), p))?;
-            st.prefilter_v.record(rec, key, parity, size, |p| b(Pass::Prefilter(true), p))?;
+            st.prefilter_h.record(rec, key, (parity, Pass::Prefilter(false)), size, b)?;
+            st.prefilter_v.record(rec, key, (parity, Pass::Prefilter(true)), size, b)?;
         }
         Ok(())
     }
@@ -535,7 +529,7 @@ impl Denoiser for Svgf {
 
     fn release(&mut self) {
         self.res.targets = None;
-        self.stages().for_each(ChainStage::release_groups);
+        self.stages().for_each(Stage::release_groups);
     }
 
     fn pipelines(&mut self) -> Vec<&mut dyn crate::shader::Reload> {
@@ -563,7 +557,7 @@ fn outputs(t: &SvgfTargets) -> Outputs<'_> {
 
 impl Svgf {
     /// Every stage it made.
-    fn stages(&mut self) -> impl Iterator<Item = &mut ChainStage> {
+    fn stages(&mut self) -> impl Iterator<Item = &mut Stage> {
         let signals = self.matte.iter_mut().chain(self.glossy.iter_mut()).flat_map(|s| s.stages());
         let motion = self
             .motion
