@@ -149,13 +149,22 @@ const BUILT_IN_MAKERS: &[(&str, MakeDenoiser)] = &[
     (crate::settings::progressive::INFO.name, progressive::make),
 ];
 
+/// The makers of the denoisers an application registered.
+static REGISTERED_MAKERS: std::sync::RwLock<Vec<(&'static str, MakeDenoiser)>> =
+    std::sync::RwLock::new(Vec::new());
+
 /// Add a denoiser beside the built-in ones (an application's or a test's own): its name then
 /// works in `--denoiser`, presets and the viewer, its settings in presets, panels and
 /// `--disable`. An error if its name, a view, a stage or its settings section is taken.
 pub fn register(entry: Entry) -> Result<()> {
-    let make = entry.make.map(|m| std::sync::Arc::new(m) as crate::settings::registry::Maker);
     let taken = FrameSettings::typed_sections();
-    crate::settings::registry::register(entry.info, make, &taken)
+    // The maker first, so that no frame finds the name without it.
+    let mut makers = crate::sync::write(&REGISTERED_MAKERS);
+    crate::settings::registry::register(entry.info, &taken)?;
+    if let Some(make) = entry.make {
+        makers.push((entry.info.name, make));
+    }
+    Ok(())
 }
 
 /// Every denoiser, built-in first.
@@ -169,12 +178,9 @@ pub fn find(name: &str) -> Result<Entry> {
 }
 
 fn entry(info: DenoiserInfo) -> Entry {
-    let built_in = BUILT_IN_MAKERS.iter().find(|(n, _)| *n == info.name).map(|(_, m)| *m);
-    let registered = || {
-        crate::settings::registry::registered_maker(info.name)
-            .and_then(|m| m.downcast_ref::<MakeDenoiser>().copied())
-    };
-    Entry { info, make: built_in.or_else(registered) }
+    let registered = crate::sync::read(&REGISTERED_MAKERS);
+    let mut makers = BUILT_IN_MAKERS.iter().chain(registered.iter());
+    Entry { info, make: makers.find(|(n, _)| *n == info.name).map(|(_, m)| *m) }
 }
 
 #[cfg(test)]

@@ -4,15 +4,14 @@
 //! ones (declared in `settings/<name>.rs`) and any an application registers through
 //! `crate::denoise::register`.
 //!
-//! The registry holds a denoiser's maker without naming its type (`crate::denoise` stores and
-//! reads it), so that settings, which every stage reads, depend on no stage.
+//! The registry holds what a denoiser declares; `crate::denoise` keeps how each is made, so
+//! that settings, which every stage reads, depend on no stage.
 
 pub use super::denoiser_info::{DenoiserInfo, Off, Section, Stage};
 use super::taa::TaaSettings;
 use super::view_spec::{FRAME_VIEWS, ViewSpec};
 use anyhow::{Result, bail};
-use std::any::Any;
-use std::sync::{Arc, RwLock};
+use std::sync::RwLock;
 
 /// The raw frame: no denoiser.
 pub const NONE: DenoiserInfo = DenoiserInfo {
@@ -30,20 +29,12 @@ pub const NONE: DenoiserInfo = DenoiserInfo {
 pub const BUILT_IN: &[DenoiserInfo] =
     &[NONE, super::mara::INFO, super::svgf::INFO, super::progressive::INFO];
 
-/// A maker as `crate::denoise` stores it (a `MakeDenoiser` fn pointer).
-pub type Maker = Arc<dyn Any + Send + Sync>;
-
-struct Registered {
-    info: DenoiserInfo,
-    make: Option<Maker>,
-}
-
-static REGISTERED: RwLock<Vec<Registered>> = RwLock::new(Vec::new());
+static REGISTERED: RwLock<Vec<DenoiserInfo>> = RwLock::new(Vec::new());
 
 /// Every denoiser, built-in first.
 pub fn denoisers() -> Vec<DenoiserInfo> {
     let registered = crate::sync::read(&REGISTERED);
-    BUILT_IN.iter().copied().chain(registered.iter().map(|r| r.info)).collect()
+    BUILT_IN.iter().chain(registered.iter()).copied().collect()
 }
 
 /// Every view: the frame's, then each denoiser's.
@@ -64,20 +55,12 @@ pub fn denoiser(name: &str) -> Result<DenoiserInfo> {
     }
 }
 
-/// The maker an application registered for `name` (None for the built-in ones, whose makers
-/// `crate::denoise` knows).
-pub(crate) fn registered_maker(name: &str) -> Option<Maker> {
-    let registered = crate::sync::read(&REGISTERED);
-    registered.iter().find(|r| r.info.name == name).and_then(|r| r.make.clone())
-}
-
 /// Add a denoiser beside the built-in ones; an error if its name, a view's name, a stage's
 /// name or its section is taken (`taken`: the names the built-in settings use), or a field lies
 /// outside its section.
-pub(crate) fn register(info: DenoiserInfo, make: Option<Maker>, taken: &[String]) -> Result<()> {
+pub(crate) fn register(info: DenoiserInfo, taken: &[String]) -> Result<()> {
     let mut registered = crate::sync::write(&REGISTERED);
-    let all: Vec<DenoiserInfo> =
-        BUILT_IN.iter().copied().chain(registered.iter().map(|r| r.info)).collect();
+    let all: Vec<DenoiserInfo> = BUILT_IN.iter().chain(registered.iter()).copied().collect();
     let name = info.name;
     if all.iter().any(|e| e.name == name) {
         bail!("a denoiser named {name:?} is already registered");
@@ -110,6 +93,6 @@ pub(crate) fn register(info: DenoiserInfo, make: Option<Maker>, taken: &[String]
         }
         None => {}
     }
-    registered.push(Registered { info, make });
+    registered.push(info);
     Ok(())
 }
