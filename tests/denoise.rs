@@ -6,7 +6,9 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::passes::matte::history_rejected;
 use hush_engine::quality::{Image, compare, flip_over};
 use hush_engine::scene::Camera;
-use hush_engine::settings::{Denoiser, FrameSettings, GlossySettings, MatteSettings, TaaSettings};
+use hush_engine::settings::{
+    Denoiser, FrameSettings, GlossySettings, MatteSettings, ReprojectionSettings, TaaSettings,
+};
 use hush_tests::half;
 use hush_tests::reproject::{
     CameraStep, DepthFrame, Stepped, neighbours_3x3, step_camera, stepped,
@@ -158,11 +160,8 @@ fn denoised_frames_beat_raw_ones() {
 #[test]
 fn nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) = level();
-    let base = FrameSettings {
-        denoiser: Denoiser::MARA,
-        matte: MatteSettings { inject_nonfinite: true, ..Default::default() },
-        ..Default::default()
-    };
+    let base =
+        FrameSettings { denoiser: Denoiser::MARA, inject_nonfinite: true, ..Default::default() };
     let mut cases = vec![base.clone()];
     for stage in
         hush_engine::settings::mara::INFO.stages.iter().map(|s| s.name).chain([TaaSettings::STAGE])
@@ -311,7 +310,7 @@ fn history_resets_on_disocclusion() {
     let f32_at = |b: &[u8], i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size: SIZE };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
-    let d1 = MatteSettings::default().d1_px;
+    let d1 = ReprojectionSettings::default().d1_px;
     let (mut rejected, mut flagged, mut exact) = (0, 0, 0);
     for Stepped { i, surface, prev: q, .. } in stepped(&now, &normal, &motion, &setup1) {
         let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
@@ -359,7 +358,7 @@ fn taa_restarts_where_a_move_uncovers_a_surface() {
     let taa = histories.iter().max_by_key(|h| moving(h)).unwrap();
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size: SIZE };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
-    let d1 = MatteSettings::default().d1_px;
+    let d1 = ReprojectionSettings::default().d1_px;
     let distance = |p: glam::Vec3| (p - setup1.pos).length();
     let (mut uncovered, mut restarted) = (0, 0);
     for Stepped { x, y, i, surface, prev: q } in stepped(&now, &normal, &motion, &setup1) {
@@ -443,7 +442,7 @@ fn bilinear_history_reads_only_taps_that_pass() {
     );
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size: SIZE };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
-    let (d0, d1) = (MatteSettings::default().d0_px, MatteSettings::default().d1_px);
+    let (d0, d1) = (ReprojectionSettings::default().d0_px, ReprojectionSettings::default().d1_px);
     let (mut edges, mut outside) = (0, 0);
     for Stepped { i, surface, prev: q, .. } in stepped(&now, &normal, &motion, &setup1) {
         let distance = |tx: i64, ty: i64| before.world(tx, ty).map(|w| surface.distance(w));

@@ -307,7 +307,7 @@ fn glossy_bilateral_sigma() {
 #[test]
 fn glossy_history_stays_on_its_face() {
     use hush_engine::frame::halton_jitter;
-    use hush_engine::settings::MatteSettings;
+    use hush_engine::settings::ReprojectionSettings;
     let size = (96u32, 54u32);
     let (gpu, mut r) =
         Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, size).unwrap();
@@ -330,7 +330,7 @@ fn glossy_history_stays_on_its_face() {
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size };
     let (m, cos_max) = (
-        MatteSettings::default(),
+        ReprojectionSettings::default(),
         GlossySettings::default().reprojection_normal_degrees.to_radians().cos(),
     );
     let (mut creases, mut kept) = (0, Vec::new());

@@ -10,7 +10,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::passes::schedule::{scheduled_pixel, tile};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{
-    Denoiser, FrameSettings, MatteSettings, ProgressiveSettings, SampleFraction, TaaSettings,
+    Denoiser, FrameSettings, ProgressiveSettings, SampleFraction, TaaSettings,
 };
 use hush_tests::{half, oct_normal};
 
@@ -533,10 +533,8 @@ fn progressive_nonfinite_input_never_reaches_history_or_screen() {
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let mut cases = vec![];
     for period in [1, 4] {
-        let base = FrameSettings {
-            matte: MatteSettings { inject_nonfinite: true, ..Default::default() },
-            ..progressive(period, Default::default())
-        };
+        let base =
+            FrameSettings { inject_nonfinite: true, ..progressive(period, Default::default()) };
         cases.push(base.clone());
         for stage in hush_engine::settings::progressive::INFO.stages.iter().map(|s| s.name) {
             let mut s = base.clone();

@@ -8,7 +8,9 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::Gpu;
 use hush_engine::quality::{Image, compare, luminance};
 use hush_engine::scene::Camera;
-use hush_engine::settings::{Denoiser, FrameSettings, MatteSettings, SvgfSettings, TaaSettings};
+use hush_engine::settings::{
+    Denoiser, FrameSettings, ReprojectionSettings, SvgfSettings, TaaSettings,
+};
 use hush_tests::half;
 use hush_tests::reproject::{
     CameraStep, DepthFrame, Stepped, neighbours_3x3, step_camera, stepped,
@@ -137,7 +139,7 @@ fn svgf_history_resets_on_disocclusion() {
         (read(&format!("svgf/matte moments {written}")), read("svgf/matte integrated"));
     let before = DepthFrame { depth: &depth0, inv_view_proj: inv0, size: SIZE };
     let now = DepthFrame { depth: &depth1, inv_view_proj: inv1, size: SIZE };
-    let d1 = MatteSettings::default().d1_px;
+    let d1 = ReprojectionSettings::default().d1_px;
     let (mut rejected, mut restarted, mut kept) = (0, 0, 0);
     for Stepped { i, surface, prev: q, .. } in stepped(&now, &normal, &motion, &setup1) {
         let closest = neighbours_3x3(q.0.floor() as i64, q.1.floor() as i64)
@@ -249,10 +251,7 @@ fn svgf_variance_matches_cpu_moments() {
 #[test]
 fn svgf_nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) = level();
-    let base = FrameSettings {
-        matte: MatteSettings { inject_nonfinite: true, ..Default::default() },
-        ..svgf()
-    };
+    let base = FrameSettings { inject_nonfinite: true, ..svgf() };
     // The final regression on every pixel from its first frame.
     let regression =
         SvgfSettings { regression: true, regression_samples: 1.0, ..Default::default() };

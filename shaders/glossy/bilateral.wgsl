@@ -91,7 +91,7 @@ fn bilateral_h(@builtin(global_invocation_id) gid: vec3u) {
         // with it (cornell_dof, 60 frames: relMSE 0.02240 -> 0.01572). While the camera or
         // anything in view moves it is not taken: the defocused box's highlight then spread past
         // its extent (a slide of 30 frames at 128x128: relMSE 0.04722 -> 0.05416).
-        if dn.static_view != 0u {
+        if frame.static_view != 0u {
             sigma = max(sigma, min(defocus_sigma(p), gp.max_sigma_px));
         }
     }

@@ -1,7 +1,8 @@
 // Shared by the glossy chain's stages (Mara et al. 2017 §3.4 stages 8-10, with the reflection
 // reprojection and neighbourhood clipping of Voorhuis §4). engine/src/passes/glossy.rs mirrors
-// GlossyParams; the chain also reads the matte chain's DenoiseParams (matte/common.wgsl) for the
-// camera matrices, the history parity and whether history exists.
+// GlossyParams; the cameras, the reprojection's thresholds and whether history exists are the
+// frame's (realtime/reproject.wgsl), the bilateral weight's normal power and plane sigma the
+// matte chain's (MatteParams, matte/common.wgsl).
 
 struct GlossyParams {
     // Stage switches (GSTAGE_*).
@@ -34,11 +35,11 @@ struct GlossyParams {
     // 1 when neither the camera nor an object moved since the previous frame: every reflection
     // then stands still, and the reflection motion is the surface's (zero) in every mode.
     static_view: u32,
-    // The surface reprojection's normal test (DenoiseParams::reprojection_min_cos).
+    // The surface reprojection's normal test (MatteParams::reprojection_min_cos for the matte chain).
     reprojection_min_cos: f32,
     // A bilinearly resampled history counts as at most this many frames (0: no cap).
     resampled_history_frames: f32,
-    // GlossySettings::still_frames, as DenoiseParams::still_frames for the matte chain.
+    // GlossySettings::still_frames, as MatteParams::still_frames for the matte chain.
     still_frames: f32,
 }
 

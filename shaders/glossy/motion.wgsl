@@ -38,7 +38,7 @@ fn search_distance(q: vec2i, probe: Probe) -> f32 {
     if probe.kind == HIT_MIRROR || TRACED_HITS {
         return length(probe.h - ph.xyz);
     }
-    let oq = world_from_depth(dn.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));
+    let oq = world_from_depth(frame.prev_inv_view_proj, q, textureLoad(prev_depth, q, 0));
     return ray_distance(probe.o, probe.h, oq, ph.xyz);
 }
 
@@ -68,13 +68,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if reflective && gp.mode == MV_VIRTUAL {
         mv = virtual_mv;
     }
-    if reflective && gp.mode == MV_DIAMOND && dn.history_valid != 0u {
+    if reflective && gp.mode == MV_DIAMOND && frame.history_valid != 0u {
         let probe = Probe(x, h, hit_class(roughness));
         let start = vec2i(floor(vec2f(p) + 0.5 + surface_mv));
         let r = diamond_search(p, start, gp.initial_step, gp.max_search_steps, probe);
         // The search matches samples; the two frames sampled their pixels at different jitters.
         if r.dist < INF {
-            mv = r.coord - (vec2f(p) + 0.5) + dn.jitter_shift;
+            mv = r.coord - (vec2f(p) + 0.5) + frame.jitter_shift;
         }
         let reach = reflected_footprint(p, x);
         // A still surface (no surface motion) whose pixel still shows the same reflected point
@@ -93,7 +93,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         search = vec4f(f32(r.steps), length(mv - virtual_mv), r.dist / reach, 0.0);
         if REFERENCE_RADIUS > 0 {
             let b = brute_force_search(p, REFERENCE_RADIUS, probe);
-            let ref_mv = select(mv, b.coord - (vec2f(p) + 0.5) + dn.jitter_shift, b.dist < INF);
+            let ref_mv = select(mv, b.coord - (vec2f(p) + 0.5) + frame.jitter_shift, b.dist < INF);
             search.y = length(mv - ref_mv);
             // The reference's answer replaces the virtual one in zw.
             textureStore(out_motion, p, vec4f(mv, ref_mv));

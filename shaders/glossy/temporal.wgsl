@@ -58,7 +58,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var s = SurfaceFrame(vec3f(0.0), 1.0, 1.0);
     var hit = x;
     var reach = 1.0;
-    if dn.history_valid != 0u {
+    if frame.history_valid != 0u {
         if !reflected {
             expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
             s = surface_frame(p, x);

@@ -25,7 +25,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     var v = textureLoad(filter_in, p, 0).rgb;
     if stage_on(STAGE_BILATERAL) {
-        v = sparse_bilateral(p, max(textureLoad(radius_in, p, 0).r, dn.min_radius_px), dn.edge_stop_sigmas);
+        v = sparse_bilateral(p, max(textureLoad(radius_in, p, 0).r, mp.min_radius_px), mp.edge_stop_sigmas);
     }
     textureStore(out_matte, p, vec4f(half_safe(v), 1.0));
 }

@@ -8,7 +8,7 @@ var min_in: texture_2d<f32>;
 var out_min: texture_storage_2d<r32float, write>;
 
 fn box_radius() -> i32 {
-    return max(i32(dn.disocclusion_radius_px), 1);
+    return max(i32(mp.disocclusion_radius_px), 1);
 }
 
 @compute @workgroup_size(8, 8)
@@ -37,12 +37,12 @@ fn min_v(@builtin(global_invocation_id) gid: vec3u) {
     for (var d = -r; d < r; d++) {
         m = min(m, textureLoad(min_in, vec2i(p.x, clamp(p.y + d, 0, i32(frame.size.y) - 1)), 0).r);
     }
-    var radius = (1.0 - m) * dn.disocclusion_radius_px;
+    var radius = (1.0 - m) * mp.disocclusion_radius_px;
     if textureLoad(filter_in, p, 0).a < 0.5 {
-        radius *= dn.low_confidence_multiplier;
+        radius *= mp.low_confidence_multiplier;
     }
     if !stage_on(STAGE_DISOCCLUSION) {
         radius = 0.0;
     }
-    textureStore(out_min, p, vec4f(min(radius, dn.max_radius_px), 0.0, 0.0, 0.0));
+    textureStore(out_min, p, vec4f(min(radius, mp.max_radius_px), 0.0, 0.0, 0.0));
 }

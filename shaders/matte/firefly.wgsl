@@ -54,7 +54,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     // Only stage 7's edge-stop reads the guide.
     var guide = luminance(centre.rgb);
-    if stage_on(STAGE_BILATERAL) && dn.edge_stop_sigmas > 0.0 {
+    if stage_on(STAGE_BILATERAL) && mp.edge_stop_sigmas > 0.0 {
         guide = edge_guide(p);
     }
     if !stage_on(STAGE_FIREFLY) {

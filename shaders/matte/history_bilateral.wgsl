@@ -15,7 +15,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let n = f32(textureLoad(reason_in, p, 0).x >> 8u);
     if stage_on(STAGE_HISTORY_BILATERAL) {
         // The disk shrinks past history_full_frames (settings: MatteSettings).
-        v = sparse_bilateral(p, dn.history_radius_px * history_falloff(dn.history_full_frames, n), 0.0);
+        v = sparse_bilateral(p, mp.history_radius_px * history_falloff(mp.history_full_frames, n), 0.0);
     }
     textureStore(out_history, p, vec4f(half_safe(v), n));
 }

@@ -1,4 +1,4 @@
-// The sparse cross-bilateral filter of stages (4) and (7): `dn.taps` taps in a disk, weighted by
+// The sparse cross-bilateral filter of stages (4) and (7): `mp.taps` taps in a disk, weighted by
 // plane distance and normals, and with edge_k > 0 also by luminance (stage 7's edge-stop, see
 // matte/bilateral.wgsl). Where the program's uncertainty module gives the features' variances
 // (stage 7 with the pre-filter) the plane and normal weights count them (common/
@@ -44,8 +44,8 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
         // through falls faster than the history's own error and a still view ends at its mean.
         let n = max(f32(textureLoad(reason_in, p, 0).x >> 8u), 1.0);
         var k = edge_k;
-        if dn.edge_stop_full_frames > 0.0 {
-            k *= sqrt(min(1.0, dn.edge_stop_full_frames / n));
+        if mp.edge_stop_full_frames > 0.0 {
+            k *= sqrt(min(1.0, mp.edge_stop_full_frames / n));
         }
         sigma_l = k * history_noise(p, xc, nc, fc, n) / 3.0 + 1e-6;
     }
@@ -54,10 +54,10 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
     var sum = c;
     var wsum = 1.0;
     // Mara et al. §3.2's Gaussian over the disk, where it is on.
-    let sigma = dn.tap_sigma * radius;
+    let sigma = mp.tap_sigma * radius;
     let inv_two_sigma2 = select(0.0, 1.0 / (2.0 * sigma * sigma), sigma > 0.0);
-    for (var i = 0u; i < dn.taps; i++) {
-        let off = spiral_tap(i, dn.taps, radius, p);
+    for (var i = 0u; i < mp.taps; i++) {
+        let off = spiral_tap(i, mp.taps, radius, p);
         let q = p + vec2i(round(off));
         if !in_bounds(q) || !has_surface(q) {
             continue;
@@ -88,6 +88,6 @@ fn sparse_bilateral(p: vec2i, radius: f32, edge_k: f32) -> vec3f {
 fn uncertain_bilateral_weight(xc: vec3f, nc: vec3f, fc: f32, vc: vec2f, xt: vec3f, nt: vec3f, vt: vec2f) -> f32 {
     let zc = dot(xc - frame.cam_pos.xyz, frame.cam_fwd.xyz);
     let zt = dot(xt - frame.cam_pos.xyz, frame.cam_fwd.xyz);
-    let plane = depth_distance(dot(nc, xt - xc), dn.plane_sigma_px * fc, vc.y * zc * zc, vt.y * zt * zt);
-    return normal_weight(dot(nc, nt), dn.normal_power, vc.x, vt.x) * exp(-plane * plane);
+    let plane = depth_distance(dot(nc, xt - xc), mp.plane_sigma_px * fc, vc.y * zc * zc, vt.y * zt * zt);
+    return normal_weight(dot(nc, nt), mp.normal_power, vc.x, vt.x) * exp(-plane * plane);
 }

@@ -47,19 +47,19 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var c = 0.0;
     var r = Reprojection(vec2i(floor(prev)), true, -1.0);
     // A long still-view history tests normals too (MatteSettings::still_normal_degrees).
-    var min_cos = dn.reprojection_min_cos;
-    if dn.history_valid != 0u {
+    var min_cos = mp.reprojection_min_cos;
+    if frame.history_valid != 0u {
         let own = clamp(vec2i(floor(prev)), vec2i(0), vec2i(frame.size) - 1);
-        if dn.static_view != 0u && dn.edge_stop_full_frames > 0.0 && textureLoad(history, own, 0).a > dn.edge_stop_full_frames {
-            min_cos = max(min_cos, dn.still_normal_min_cos);
+        if frame.static_view != 0u && mp.edge_stop_full_frames > 0.0 && textureLoad(history, own, 0).a > mp.edge_stop_full_frames {
+            min_cos = max(min_cos, mp.still_normal_min_cos);
         }
         r = reproject(prev_depth, prev_normal, prev, expected, s, min_cos);
     }
     if r.distance < 0.0 {
         reason = REASON_DISOCCLUDED;
     } else {
-        c = confidence(dn.hysteresis, r.distance);
-        if c < 0.5 * dn.hysteresis {
+        c = confidence(mp.hysteresis, r.distance);
+        if c < 0.5 * mp.hysteresis {
             reason = REASON_LOW_CONFIDENCE;
         }
     }
@@ -67,20 +67,20 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var n = 1.0;
     if c > 0.0 {
         let texel = textureLoad(history, r.texel, 0);
-        let still = dn.static_view != 0u && dn.still_frames > 0.0 && c >= dn.hysteresis;
+        let still = frame.static_view != 0u && mp.still_frames > 0.0 && c >= mp.hysteresis;
         n = next_length(texel.a, still);
         var hist = half_safe(texel.rgb);
         if r.bilinear {
             let b = bilinear_taps(prev);
             let w = passing_weights(b, surface_taps(prev_depth, prev_normal, b, expected, s, min_cos));
             hist = half_safe(load_taps(history, b, w).rgb);
-            n = resampled_length(n, prev, dn.resampled_history_frames);
+            n = resampled_length(n, prev, mp.resampled_history_frames);
         } else {
             reason |= REASON_NEIGHBOUR;
         }
         n = rescaled_length(n - 1.0) + 1.0;
         var clamped = hist;
-        if dn.clamp_sigma > 0.0 {
+        if mp.clamp_sigma > 0.0 {
             // The current neighbourhood's mean and standard deviation: the paper's 3x3, plus 24
             // sparse taps on the same surface within 4 pixels. At one sample per pixel an indirectly
             // lit region is mostly zeros with rare bright samples; nine samples are then often all
@@ -95,20 +95,20 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             m = surface_moments(m, p, x, s.n, s.footprint, 24u, 4.0);
             let m1 = m.m1.xyz / m.count;
             let sigma = sqrt(max(m.m2.xyz / m.count - m1 * m1, vec3f(0.0)));
-            let lo = m1 - dn.clamp_sigma * sigma;
-            let hi = m1 + dn.clamp_sigma * sigma;
+            let lo = m1 - mp.clamp_sigma * sigma;
+            let hi = m1 + mp.clamp_sigma * sigma;
             clamped = clamp(hist, lo, hi);
             if any(clamped != hist) {
                 reason |= REASON_CLAMPED;
             }
         }
-        result = mix(clamped, current, new_frame_weight(c, n, dn.still_frames, still));
+        result = mix(clamped, current, new_frame_weight(c, n, mp.still_frames, still));
     }
     // A history that restarts here (a surface a move uncovered) counts this frame's sample as
     // the paths the trace averaged into it (more where it saw the surface uncovered), and
     // starts from the radiance cache's prior where there is one (passes/cache.rs): its cell's
     // mean, weighed as the frames' worth of samples it holds, instead of this one sample.
-    if c <= 0.0 && dn.history_valid != 0u {
+    if c <= 0.0 && frame.history_valid != 0u {
         n = matte_paths(p);
         let prior = cache_prior_at(p);
         if prior.a > 0.0 {

@@ -38,7 +38,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // at its end, after writing the history. A pixel without samples (age 0) is filled by
     // every level.
     let s16 = 16.0 / f32(level.step);
-    let reach_ended = dn.static_view != 0u && pp.reach_samples > 0.0 && age > pp.reach_samples * s16 * s16;
+    let reach_ended = frame.static_view != 0u && pp.reach_samples > 0.0 && age > pp.reach_samples * s16 * s16;
     if reach_ended && level.feedback == 0u {
         textureStore(dst, p, c);
         return;

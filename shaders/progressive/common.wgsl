@@ -25,6 +25,12 @@ struct ProgressiveParams {
     reach_samples: f32,
     // w_L's symmetric bandwidth takes a tap's variance up to this x the centre's (0: no cap).
     variance_cap: f32,
+    // The temporal stage's reprojection passes a previous texel only where its normal is within
+    // this cosine of the surface's.
+    normal_min_cos: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 }
 
 // Per dispatch: the a-trous step (large scale first), whether the signal only fills pixels
@@ -54,7 +60,7 @@ fn luma(c: vec3f) -> f32 {
 // (Dundr's 0.01 to 0.1, in displayed luminance) outlasts it and keeps the 61-pixel filter
 // blurring a converged view's shading.
 fn luminance_epsilon(age: f32) -> f32 {
-    if dn.static_view == 0u || pp.epsilon_full_samples <= 0.0 {
+    if frame.static_view == 0u || pp.epsilon_full_samples <= 0.0 {
         return pp.epsilon_l;
     }
     return pp.epsilon_l * min(1.0, pp.epsilon_full_samples / max(age, 1.0));

@@ -38,13 +38,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);
     var found = false;
-    if pp.temporal != 0u && dn.history_valid != 0u {
+    if pp.temporal != 0u && frame.history_valid != 0u {
         if has_surface(p) {
             let x = position_at(p);
             let prev = vec2f(p) + 0.5 + textureLoad(gb_motion, p, 0).xy;
             let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
-            let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), dn.reprojection_min_cos);
-            if r.distance >= 0.0 && r.distance <= dn.d1_px && same_object(p, r.texel) {
+            let r = reproject(prev_depth, prev_normal, prev, expected, surface_frame(p, x), pp.normal_min_cos);
+            if r.distance >= 0.0 && r.distance <= frame.d1_px && same_object(p, r.texel) {
                 hist = half_safe(textureLoad(history, r.texel, 0).rgb);
                 mom = textureLoad(moments, r.texel, 0);
                 found = mom.z >= 1.0;
@@ -64,7 +64,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // a depth edge the jittered sample lands on either surface, and no previous texel of
         // the 3x3 may pass for the one it hit this frame. Dropped, the history's samples would
         // be lost, and an untraced pixel missing until its next sample.
-        if !found && dn.static_view != 0u && has_surface(p) {
+        if !found && frame.static_view != 0u && has_surface(p) {
             let own = textureLoad(moments, p, 0);
             if own.z >= 1.0 {
                 hist = half_safe(textureLoad(history, p, 0).rgb);
@@ -84,7 +84,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // 2^24: sample counts stay whole numbers in f32.
         let age = select(1.0, min(mom.z + 1.0, 16777216.0), found);
         var a = pp.alpha;
-        if dn.static_view != 0u && pp.still_samples > 0.0 {
+        if frame.static_view != 0u && pp.still_samples > 0.0 {
             a = min(a, 1.0 / pp.still_samples);
         }
         let r = max(a, 1.0 / age);

@@ -38,6 +38,25 @@ struct Frame {
     // The last frame's jitter: its depth texel t holds the surface at pixel position t + this.
     prev_jitter_x: f32,
     prev_jitter_y: f32,
+    // What every denoiser's temporal stages and TAA read of the two frames (the frame owns it;
+    // engine/src/frame/params.rs: ChainView). Rebased world from clip, this frame and the
+    // previous one, both with their jitter, as their depth buffers were rasterised.
+    inv_view_proj: mat4x4f,
+    prev_inv_view_proj: mat4x4f,
+    // The previous frame's sub-pixel jitter minus this frame's, pixels: what separates the two
+    // frames' samples of one pixel in a still view.
+    jitter_shift: vec2f,
+    // 0 when there is no usable history (first denoised frame, a change of denoiser, a cut):
+    // temporal stages then start over.
+    history_valid: u32,
+    // 1 when neither the camera nor any object moved since the last frame.
+    static_view: u32,
+    // Eq. (11)'s reprojection test (Mara et al. 2017), in pixel footprints at the surface: full
+    // confidence within d0, none beyond d1 (ReprojectionSettings).
+    d0_px: f32,
+    d1_px: f32,
+    // Tests: the matte light entering a denoiser is NaN / +Inf / -Inf on 1 pixel in 7.
+    inject_nonfinite: u32,
 }
 
 var<uniform> frame: Frame;

@@ -1,6 +1,6 @@
 // Shared by SVGF's stages (Schied et al. 2017, with Voorhuis §4 and §6): parameters, the
 // per-signal and per-level uniforms, the edge-stopping weights and the moment integration.
-// engine/src/denoise/svgf.rs mirrors SvgfParams and Level.
+// engine/src/denoise/svgf/mod.rs mirrors SvgfParams and Level.
 
 struct SvgfParams {
     // Switches (SV_*), SvgfSettings::bits.
@@ -27,7 +27,9 @@ struct SvgfParams {
     regression_full_samples: f32,
     // The spike cut's ratio to the second brightest neighbour (0: off; SvgfSettings::spike_ratio).
     spike_ratio: f32,
-    _pad0: u32,
+    // The temporal stages' reprojection passes a previous texel only where its normal is
+    // within this cosine of the surface's (Schied et al. §4.1's normal test).
+    normal_min_cos: f32,
 }
 
 // Per dispatch: which a-trous level (step 2^level pixels), whether it writes the history.
@@ -107,7 +109,7 @@ fn integrate(current: vec3f, history: vec3f, moments_in: vec4f, reprojected: boo
     let h = min(moments.z + 1.0, 16777216.0);
     var floor_alpha = sv.alpha;
     var floor_moments = sv.alpha_moments;
-    if dn.static_view != 0u && sv.still_frames > 0.0 {
+    if frame.static_view != 0u && sv.still_frames > 0.0 {
         floor_alpha = min(floor_alpha, 1.0 / sv.still_frames);
         floor_moments = min(floor_moments, 1.0 / sv.still_frames);
     }

@@ -37,7 +37,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var own = false;
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);
-    if sv_on(SV_TEMPORAL) && sv_on(SV_GLOSSY_TEMPORAL) && dn.history_valid != 0u {
+    if sv_on(SV_TEMPORAL) && sv_on(SV_GLOSSY_TEMPORAL) && frame.history_valid != 0u {
         // In a static view the reflection stood still too: the surface test is exact there.
         let reflected = sv_on(SV_REFLECTION_REPROJECTION) && roughness < gp.roughness_threshold && gp.static_view == 0u;
         let prev = vec2f(p) + 0.5 + textureLoad(motion, p, 0).xy;
@@ -64,8 +64,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         } else {
             expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
             s = surface_frame(p, x);
-            r = reproject(prev_depth, prev_normal, prev, expected, s, dn.reprojection_min_cos);
-            if r.distance > dn.d1_px || (r.distance >= 0.0 && !same_object(p, r.texel)) {
+            r = reproject(prev_depth, prev_normal, prev, expected, s, sv.normal_min_cos);
+            if r.distance > frame.d1_px || (r.distance >= 0.0 && !same_object(p, r.texel)) {
                 r.distance = -1.0;
             }
         }
@@ -79,7 +79,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 let b = bilinear_taps(prev);
                 var ok = lobe_taps(b);
                 if !reflected {
-                    ok = same_object_taps(p, b, ok & surface_taps(prev_depth, prev_normal, b, expected, s, dn.reprojection_min_cos));
+                    ok = same_object_taps(p, b, ok & surface_taps(prev_depth, prev_normal, b, expected, s, sv.normal_min_cos));
                 } else if lobe_class != HIT_NONE {
                     ok = hit_taps(b, hit, reach, lobe_class);
                 }

@@ -59,18 +59,18 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var own = false;
     var hist = vec3f(0.0);
     var mom = vec4f(0.0);
-    if sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
+    if sv_on(SV_TEMPORAL) && frame.history_valid != 0u {
         let mv = textureLoad(gb_motion, p, 0).xy;
         let prev = vec2f(p) + 0.5 + mv;
         let expected = previous_surface(textureLoad(gb_object, p, 0).xy, x);
         let s = surface_frame(p, x);
-        let r = reproject(prev_depth, prev_normal, prev, expected, s, dn.reprojection_min_cos);
-        if r.distance >= 0.0 && r.distance <= dn.d1_px && same_object(p, r.texel) {
+        let r = reproject(prev_depth, prev_normal, prev, expected, s, sv.normal_min_cos);
+        if r.distance >= 0.0 && r.distance <= frame.d1_px && same_object(p, r.texel) {
             mom = textureLoad(moments, r.texel, 0);
             hist = half_safe(textureLoad(history, r.texel, 0).rgb);
             if r.bilinear {
                 let b = bilinear_taps(prev);
-                let ok = surface_taps(prev_depth, prev_normal, b, expected, s, dn.reprojection_min_cos);
+                let ok = surface_taps(prev_depth, prev_normal, b, expected, s, sv.normal_min_cos);
                 let w = passing_weights(b, same_object_taps(p, b, ok));
                 hist = half_safe(load_taps(history, b, w).rgb);
                 mom = vec4f(load_taps(moments, b, w).xy, mom.zw);
@@ -89,7 +89,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // neighbours that took k paths too; the prior's from the cell's samples (their luminance's
     // mean and mean square). A history of k + a paths takes its variance from the moments (the
     // variance pass's spatial estimate is for fewer than 4), and one sample's would be 0.
-    if !reprojected && sv_on(SV_TEMPORAL) && dn.history_valid != 0u {
+    if !reprojected && sv_on(SV_TEMPORAL) && frame.history_valid != 0u {
         let k = matte_paths(p);
         if k > 1.0 {
             let l = luminance(current);

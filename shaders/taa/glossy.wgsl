@@ -1,4 +1,4 @@
-// What TAA reads of the glossy chain (MatteSettings::taa_current_glossy): the glossy temporal's
+// What TAA reads of the glossy chain (TaaSettings::current_glossy): the glossy temporal's
 // output this frame and last frame (glossy light divided by the mirror demodulation), and
 // whether this frame's continues last frame's at this pixel (glossy/temporal.wgsl, info.w).
 

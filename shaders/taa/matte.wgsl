@@ -1,4 +1,4 @@
-// What TAA reads of the denoiser's matte light (MatteSettings::taa_current_light): its temporal
+// What TAA reads of the denoiser's matte light (TaaSettings::current_light): its temporal
 // output this frame (light before any spatial filter) and its state, as the matte temporal
 // writes `matte/reason`: the REASON_* flags in the low 8 bits, the history length above them.
 

@@ -1,7 +1,7 @@
 // Temporal anti-aliasing of the composited image (the raster is jittered over a Halton(2, 3)
 // sequence). History is fetched bilinearly at pixel + motion and clamped to the min/max box of
 // the current 3x3 neighbourhood in YCoCg (Karis 2014), which bounds ghosting to colours present
-// now (not in a static view, where nothing can ghost); then blended with weight taa_alpha for
+// now (not in a static view, where nothing can ghost); then blended with weight taa_params.alpha for
 // the current frame. Without a history (first frame, off screen, no surface) the current
 // colour is used as is. Nor is there where a pixel that moved finds its surface at none of the
 // bilinear taps' previous depths (eq. (11) of Mara et al., as the denoisers' temporal stages
@@ -13,17 +13,17 @@
 // the exponential blend whose samples are as old on average as an n-frame mean's, so that the
 // first frames (denoised from little history) fade faster than in a plain mean. A still pixel
 // (zero motion: its history texel is read exactly, not resampled) whose history the clamp left
-// alone lets the weight fall to 1 / taa_still_frames: a long blend over whole Halton cycles
-// converges to the box-filtered pixel, where taa_alpha weighs the latest offsets most and keeps
+// alone lets the weight fall to 1 / taa_params.still_frames: a long blend over whole Halton cycles
+// converges to the box-filtered pixel, where taa_params.alpha weighs the latest offsets most and keeps
 // an edge pixel off by a fraction of the edge's contrast. Moving or clamped, the weight is held
-// at taa_alpha: bilinear resampling blurs a long history, and a clamp means the history no
+// at taa_params.alpha: bilinear resampling blurs a long history, and a clamp means the history no
 // longer matches what the pixel shows. Such a history is stored with a negative length, and
-// when the pixel stands still again its length restarts at taa_resampled_frames: held at
-// taa_alpha, the blur that resampling left in it would otherwise outlast the stop by tens of
+// when the pixel stands still again its length restarts at taa_params.resampled_frames: held at
+// taa_params.alpha, the blur that resampling left in it would otherwise outlast the stop by tens of
 // frames.
 //
 // The image shown is the history, except at a settled pixel, where it is the last image shown
-// blended towards the history by taa_display_ratio x 2 / (n + 1) (at most 1): a second
+// blended towards the history by taa_params.display_ratio x 2 / (n + 1) (at most 1): a second
 // low-pass that damps the flicker of a sub-pixel edge sampled at a new Halton offset every
 // frame (the history moves by 2 / (n + 1) of the edge's contrast each frame) and passes the
 // slower convergence of the denoised light. The history itself is not smoothed; the last image
@@ -35,7 +35,7 @@
 // the residual: the composite less those factors times the two chains' temporal outputs. Where a
 // chain's history continues last frame's (this pixel's own texel, at least as long as TAA's), TAA
 // follows that chain: its term becomes avg(factor) x current light, mixed in by
-// taa_current_light (matte) or taa_current_glossy: the same image while the light stands still,
+// taa_params.current_light (matte) or taa_params.current_glossy: the same image while the light stands still,
 // and no lag while it converges. The residual's alpha holds which chains it leaves out (bit 0
 // matte, bit 1 glossy), as they were followed last frame; a chain followed from last frame on
 // needs its term left out of the residual then. Where the glossy chain stops continuing, its
@@ -50,18 +50,41 @@
 // were written while moving the difference is exactly the history of the rest of the composite
 // (after a still frame it is off by TAA's average of the glossy term less the last frame's).
 
+// TAA's own parameters (engine/src/passes/taa.rs: TaaParams; TaaSettings).
+struct TaaParams {
+    // 0: TAA is off and the composite passes through.
+    enabled: u32,
+    // The current frame's weight.
+    alpha: f32,
+    // In a still view the current frame's weight falls to 1 / this.
+    still_frames: f32,
+    // A pixel that stands still again restarts its history length here (0: carries on).
+    resampled_frames: f32,
+    // The shown image follows a settled pixel's history with this many times the history's own
+    // weight (0: the history is shown as is).
+    display_ratio: f32,
+    // Share of a settled pixel's matte-light lag taken out (TaaSettings::current_light).
+    current_light: f32,
+    // The same for the glossy light (TaaSettings::current_glossy).
+    current_glossy: f32,
+    // Where a pixel moves, the history's glossy term is replaced by this frame's
+    // (TaaSettings::moving_glossy).
+    moving_glossy: u32,
+}
+
+var<uniform> taa_params: TaaParams;
 var<storage, read> hdr: array<vec4f>;
 var prev_depth: texture_depth_2d;
 var history: texture_2d<f32>;
 var out_history: texture_storage_2d<rgba32float, write>;
 var<storage, read_write> final_image: array<vec4f>;
 // Averages, over TAA's history, of the matte factor m (1 - F)^2 and of the composite less that
-// factor times the matte temporal's output (MatteSettings::taa_current_light).
+// factor times the matte temporal's output (TaaSettings::current_light).
 var material_history: texture_2d<f32>;
 var out_material: texture_storage_2d<rgba32float, write>;
 var residual_history: texture_2d<f32>;
 var out_residual: texture_storage_2d<rgba32float, write>;
-// Average of the glossy factor F(w_s) x the mirror demodulation (MatteSettings::taa_current_glossy).
+// Average of the glossy factor F(w_s) x the mirror demodulation (TaaSettings::current_glossy).
 var glossy_factor_history: texture_2d<f32>;
 var out_glossy_factor: texture_storage_2d<rgba32float, write>;
 // The glossy term of the composite each history texel was last blended with
@@ -156,7 +179,7 @@ fn history_taps(p: vec2i, prev: vec2f, still: bool) -> BilinearTaps {
     var shown = false;
     for (var k = 0; k < 4; k++) {
         let d = previous_plane_distance(prev_depth, bilinear_tap(b, k), expected, s);
-        shown = shown || (b.w[k] > 0.0 && d >= 0.0 && d <= dn.d1_px);
+        shown = shown || (b.w[k] > 0.0 && d >= 0.0 && d <= frame.d1_px);
     }
     if !shown && !on_silhouette(p, linear_depth(x)) {
         b.w = vec4f(0.0);
@@ -189,7 +212,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var material = m_k;
     var glossy = gl.factor;
     // The chains TAA follows from this frame on.
-    var chains = select(0u, FOLLOW_MATTE, own_light && dn.taa_current_light > 0.0) | select(0u, FOLLOW_GLOSSY, gl.own && dn.taa_current_glossy > 0.0);
+    var chains = select(0u, FOLLOW_MATTE, own_light && taa_params.current_light > 0.0) | select(0u, FOLLOW_GLOSSY, gl.own && taa_params.current_glossy > 0.0);
     var result = current;
     var n = 1.0;
     var shown_weight = 1.0;
@@ -197,7 +220,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let on_screen = all(prev >= vec2f(0.0)) && all(prev < vec2f(frame.size));
     let still = dot(prev - vec2f(p) - 0.5, prev - vec2f(p) - 0.5) < 1e-4;
     var taps = BilinearTaps(vec2i(0), vec4f(0.0));
-    if stage_on(STAGE_TAA) && on_screen && dn.history_valid != 0u {
+    if taa_params.enabled != 0u && on_screen && frame.history_valid != 0u {
         taps = history_taps(p, prev, still);
     }
     if any(taps.w != vec4f(0.0)) {
@@ -213,7 +236,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let texel = load_taps(history, taps, taps.w);
         var hist = half_safe(texel.rgb);
         // After a change of size the history was resampled but the terms were not.
-        if dn.taa_moving_glossy != 0u && !still && frame.rescaled_frames <= 0.0 {
+        if taa_params.moving_glossy != 0u && !still && frame.rescaled_frames <= 0.0 {
             // The history's glossy term moved with the surface; the reflection moves its own way,
             // and the denoiser's glossy light followed it there.
             hist = half_safe(hist - glossy_term_taps(taps) + glossy_term);
@@ -224,15 +247,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // stair nosing, a lantern's lit glass) lies between the jittered samples of most frames,
         // the current 3x3 box then misses it, and the clamp darkened it every such frame.
         var yc = y;
-        if dn.static_view == 0u || !still {
+        if frame.static_view == 0u || !still {
             yc = clamp(y, lo, hi);
         }
         let clamped = from_ycocg(yc);
         // A clamp by more than half-precision rounding.
         let held = any(abs(yc - y) > vec3f(1e-3 * max(abs(y.x), 1e-2)));
-        // Read exactly and left alone: the history may grow past 1 / taa_alpha.
+        // Read exactly and left alone: the history may grow past 1 / taa_params.alpha.
         let settled = still && !held;
-        let weight_floor = select(dn.taa_alpha, min(dn.taa_alpha, 1.0 / max(dn.taa_still_frames, 1.0)), settled);
+        let weight_floor = select(taa_params.alpha, min(taa_params.alpha, 1.0 / max(taa_params.still_frames, 1.0)), settled);
         // A negative length marks a history last resampled or clamped.
         var n_prev = select(texel.a, 1.0, texel.a != texel.a);
         // After a change of size every history was resampled (realtime/rescale.wgsl): TAA's
@@ -242,8 +265,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         if n_prev < 0.0 {
             n_prev = -n_prev;
-            if settled && dn.taa_resampled_frames > 0.0 {
-                n_prev = min(n_prev, dn.taa_resampled_frames);
+            if settled && taa_params.resampled_frames > 0.0 {
+                n_prev = min(n_prev, taa_params.resampled_frames);
             }
         }
         n = clamp(n_prev + 1.0, 1.0, 2.0 / weight_floor - 1.0);
@@ -279,14 +302,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 if all(followed >= vec3f(0.0)) {
                     // One share for every chain followed: TAA keeps no average of each chain's
                     // term apart, so the larger of the two applies (TaaSettings::current_glossy).
-                    let share = max(select(0.0, dn.taa_current_light, (left_out & FOLLOW_MATTE) != 0u), select(0.0, dn.taa_current_glossy, (left_out & FOLLOW_GLOSSY) != 0u));
+                    let share = max(select(0.0, taa_params.current_light, (left_out & FOLLOW_MATTE) != 0u), select(0.0, taa_params.current_glossy, (left_out & FOLLOW_GLOSSY) != 0u));
                     result = mix(result, followed, share);
                 }
             }
-            if dn.taa_display_ratio > 0.0 {
-                // taa_display_ratio times the history's own weight: a fresh history is shown as
+            if taa_params.display_ratio > 0.0 {
+                // taa_params.display_ratio times the history's own weight: a fresh history is shown as
                 // is.
-                shown_weight = min(dn.taa_display_ratio * 2.0 / (n + 1.0), 1.0);
+                shown_weight = min(taa_params.display_ratio * 2.0 / (n + 1.0), 1.0);
             }
         }
     }

@@ -10,7 +10,7 @@ use crate::passes::glossy::{
     GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams, MotionProgram,
 };
 use crate::passes::io::FrameIo;
-use crate::passes::matte::{ChainInputs, DenoiseParams, MatteChain, MatteTargets};
+use crate::passes::matte::{ChainInputs, MatteChain, MatteParams, MatteTargets};
 use crate::passes::taa::{GlossyFollow, MatteFollow, MatteState, TaaFollow};
 use anyhow::{Context, Result};
 
@@ -18,7 +18,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let mut memory = GpuMemory::default();
     let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
     let d = &gpu.device;
-    let params = memory.buffer(d, "matte/params", size_of::<DenoiseParams>() as u64, u);
+    let params = memory.buffer(d, "matte/params", size_of::<MatteParams>() as u64, u);
     let glossy_params = memory.buffer(d, "glossy/params", size_of::<GlossyParams>() as u64, u);
     Ok(Box::new(Mara {
         scene: *scene,
@@ -75,8 +75,8 @@ impl Denoiser for Mara {
         let (m, g) =
             self.targets.as_ref().context("the Mara denoiser records before its textures exist")?;
         let s = cx.settings;
-        let dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&dp));
+        let mp = MatteParams::new(&s.matte, io.size.0, cx.index);
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&mp));
         let gp = GlossyParams::new(&s.glossy, self.scene.extent, cx.view.static_view);
         gpu.queue.write_buffer(&self.glossy_params, 0, bytemuck::bytes_of(&gp));
         let inputs = ChainInputs { io: *io, params: &self.params, matte: m };
@@ -93,7 +93,7 @@ impl Denoiser for Mara {
         if let Some(g) = g {
             let inputs = GlossyInputs {
                 io: *io,
-                denoise: &self.params,
+                matte: &self.params,
                 params: &self.glossy_params,
                 glossy: g,
             };

@@ -21,8 +21,8 @@ pub mod svgf;
 
 pub use crate::gpu::{BindKey, Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 pub use crate::passes::chain::{ChainStage, made};
+pub use crate::passes::io::ChainView;
 pub use crate::passes::io::{FrameIo, PreviousGBuffer};
-pub use crate::passes::matte::ChainView;
 pub use crate::passes::taa::{GlossyFollow, MatteFollow, MatteState, TaaFollow};
 pub use crate::settings::FrameSettings;
 pub use crate::settings::{

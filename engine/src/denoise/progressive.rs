@@ -19,7 +19,6 @@ use super::{Denoised, Denoiser, DenoiserScene, FrameContext, Outputs};
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
 use crate::passes::chain::ChainStage;
 use crate::passes::io::FrameIo;
-use crate::passes::matte::DenoiseParams;
 use crate::passes::taa::{MatteFollow, MatteState, TaaFollow};
 use crate::settings::{
     FrameSettings, PROGRESSIVE_MAX_LEVELS, ProgressiveSettings, STILL_FRAMES_MAX,
@@ -47,6 +46,9 @@ pub struct ProgressiveParams {
     pub symmetric_luminance: u32,
     pub reach_samples: f32,
     pub variance_cap: f32,
+    /// Cosine of the temporal stage's normal test (25 degrees, as SVGF's).
+    pub normal_min_cos: f32,
+    pub _pad: [f32; 3],
 }
 
 impl ProgressiveParams {
@@ -64,6 +66,8 @@ impl ProgressiveParams {
             symmetric_luminance: s.symmetric_luminance as u32,
             reach_samples: s.reach_samples.clamp(0.0, STILL_FRAMES_MAX),
             variance_cap: s.variance_cap.clamp(0.0, STILL_FRAMES_MAX),
+            normal_min_cos: crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES),
+            _pad: [0.0; 3],
         }
     }
 }
@@ -133,7 +137,6 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
     let d = &gpu.device;
     let pp = memory.buffer(d, "progressive/params", size_of::<ProgressiveParams>() as u64, u);
-    let dn = memory.buffer(d, "progressive/denoise params", size_of::<DenoiseParams>() as u64, u);
     let mut level = |label: &str, step: i32, fill_only: bool, feedback: bool| {
         let b = memory.buffer(d, label, size_of::<Level>() as u64, u);
         let l = Level { step, fill_only: fill_only as u32, feedback: feedback as u32, _pad: 0 };
@@ -148,7 +151,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     if scene.glossy {
         signals.insert(1, Signal::Glossy);
     }
-    let res = Resources { pp, dn, levels, feedback, targets: None };
+    let res = Resources { pp, levels, feedback, targets: None };
     Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
 }
 
@@ -256,7 +259,6 @@ enum Pass {
 /// The filter's parameter buffers and per-pixel textures: what its stages bind.
 struct Resources {
     pp: wgpu::Buffer,
-    dn: wgpu::Buffer,
     /// Per level, for filtering signals and for the direct light (fill only).
     levels: [[wgpu::Buffer; LEVELS]; 2],
     /// The feedback level's: step 1, its output also the history.
@@ -295,7 +297,7 @@ pub fn modules(
     if glossy {
         m.push("realtime/glossy_in.wgsl");
     }
-    m.extend(["common/bilinear.wgsl", "matte/common.wgsl"]);
+    m.extend(["common/bilinear.wgsl", "realtime/reproject.wgsl"]);
     m.push(motion.module());
     m.extend(["progressive/common.wgsl", signal.module(), stage]);
     m
@@ -311,11 +313,7 @@ impl Resources {
         parity: Parity,
         levels: Levels,
     ) -> Bindings<'a> {
-        let b = io
-            .bindings()
-            .buffer("pp", &self.pp)
-            .buffer("dn", &self.dn)
-            .texture("features", &t.features.1);
+        let b = io.bindings().buffer("pp", &self.pp).texture("features", &t.features.1);
         match pass {
             Pass::Features => b.texture("out_features", &t.features.1),
             Pass::Temporal => b
@@ -350,16 +348,13 @@ impl Resources {
         }
     }
 
-    fn write_params(&self, gpu: &Gpu, io: &FrameIo, cx: &FrameContext) {
+    fn write_params(&self, gpu: &Gpu, cx: &FrameContext) {
         let s: &FrameSettings = cx.settings;
         gpu.queue.write_buffer(
             &self.pp,
             0,
             bytemuck::bytes_of(&ProgressiveParams::new(&s.progressive)),
         );
-        let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
-        dp.reprojection_min_cos = crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES);
-        gpu.queue.write_buffer(&self.dn, 0, bytemuck::bytes_of(&dp));
     }
 
     /// Every stage's programs, checked against what the frame and the filter offer.
@@ -455,7 +450,7 @@ impl Denoiser for Progressive {
             feedback: p.feedback_samples > 0.0 && p.levels > 0,
         };
         let t = res.targets.as_ref().context(missing)?;
-        res.write_params(gpu, io, cx);
+        res.write_params(gpu, cx);
         let (key, parity, size, levels) = (cx.key, cx.parity, io.size, t.levels);
         let stages = crate::passes::chain::made(stages, || {
             res.make_stages(gpu, io, t, scene).context("creating the progressive filter's stages")

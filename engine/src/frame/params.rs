@@ -1,6 +1,7 @@
 //! The per-frame uniform (mirror of `Frame` in shaders/realtime/frame.wgsl) and the camera
 //! matrices behind it.
 
+use crate::passes::io::ChainView;
 use crate::scene::Camera;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
@@ -42,9 +43,34 @@ pub struct FrameParams {
     /// holds the surface at pixel position t + this (realtime/uncovered.wgsl).
     pub prev_jitter_x: f32,
     pub prev_jitter_y: f32,
+    /// [`ChainView::inv_view_proj`], [`ChainView::prev_inv_view_proj`]: what every temporal
+    /// stage reprojects with.
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub prev_inv_view_proj: [[f32; 4]; 4],
+    /// [`ChainView::jitter_shift`].
+    pub jitter_shift: [f32; 2],
+    /// [`ChainView::history_valid`].
+    pub history_valid: u32,
+    /// [`ChainView::static_view`].
+    pub static_view: u32,
+    /// [`crate::settings::ReprojectionSettings::d0_px`] and `d1_px` (d1 above d0).
+    pub d0_px: f32,
+    pub d1_px: f32,
+    /// [`crate::settings::FrameSettings::inject_nonfinite`].
+    pub inject_nonfinite: u32,
+    pub _pad: u32,
 }
 
 impl FrameParams {
+    /// The two frames' cameras and history state as the temporal stages read them.
+    pub fn set_view(&mut self, view: &ChainView) {
+        self.inv_view_proj = view.inv_view_proj.to_cols_array_2d();
+        self.prev_inv_view_proj = view.prev_inv_view_proj.to_cols_array_2d();
+        self.jitter_shift = view.jitter_shift.to_array();
+        self.history_valid = view.history_valid as u32;
+        self.static_view = view.static_view as u32;
+    }
+
     /// `jittered`: this frame's view-projection with `jitter` (the raster's); `prev`: the last
     /// frame's without jitter (motion vectors compare it with `cam.view_proj`).
     #[allow(clippy::too_many_arguments)]
@@ -60,6 +86,7 @@ impl FrameParams {
         ray_epsilon: f32,
         representative_roughness: f32,
     ) -> FrameParams {
+        let r = &settings.reprojection;
         FrameParams {
             view_proj: jittered.to_cols_array_2d(),
             unjittered_view_proj: cam.view_proj.to_cols_array_2d(),
@@ -86,6 +113,15 @@ impl FrameParams {
             uncovered_paths: 0,
             prev_jitter_x: jitter.x,
             prev_jitter_y: jitter.y,
+            inv_view_proj: jittered.inverse().to_cols_array_2d(),
+            prev_inv_view_proj: jittered.inverse().to_cols_array_2d(),
+            jitter_shift: [0.0; 2],
+            history_valid: 0,
+            static_view: 0,
+            d0_px: r.d0_px.max(0.0),
+            d1_px: r.d1_px.max(r.d0_px + 1e-3),
+            inject_nonfinite: settings.inject_nonfinite as u32,
+            _pad: 0,
         }
     }
 }

@@ -5,7 +5,7 @@ use super::{DisplayTarget, FrameInput, FrameParams, MadeDenoiser, Renderer, halt
 use crate::denoise::DenoiserScene;
 use crate::gpu::{BindKey, Gpu, Parity};
 use crate::passes::converge::ConvergeParams;
-use crate::passes::matte::ChainView;
+use crate::passes::io::ChainView;
 use crate::passes::reference::{TraceView, make_params};
 use crate::settings::{
     FrameSettings, MAX_PATHS_PER_PIXEL, MAX_PRIMARY_SAMPLES, MAX_SAMPLES_PER_PIXEL,
@@ -127,7 +127,7 @@ impl Renderer {
             gpu,
             input,
             settings,
-            (&cam, jittered, jitter),
+            (&cam, jittered, jitter, &view),
             denoised,
             (primary_samples, uncovered_paths, prev_jitter),
         );
@@ -372,7 +372,7 @@ impl Renderer {
         gpu: &Gpu,
         input: &FrameInput,
         settings: &FrameSettings,
-        (cam, jittered, jitter): (&super::CameraSetup, Mat4, Vec2),
+        (cam, jittered, jitter, view): (&super::CameraSetup, Mat4, Vec2, &ChainView),
         denoised: bool,
         (primary_samples, uncovered_paths, prev_jitter): (u32, u32, Vec2),
     ) {
@@ -400,6 +400,7 @@ impl Renderer {
             self.prepared.ray_epsilon(),
             representative,
         );
+        fp.set_view(view);
         fp.primary_samples = primary_samples;
         fp.uncovered_paths = uncovered_paths.min(MAX_PATHS_PER_PIXEL);
         (fp.prev_jitter_x, fp.prev_jitter_y) = (prev_jitter.x, prev_jitter.y);

@@ -11,11 +11,11 @@ use crate::passes::composite::{self, CompositePass, DisplayPass, FrameBuffers};
 use crate::passes::converge::ConvergeStage;
 use crate::passes::gbuffer::{self, GBufferPass};
 use crate::passes::io::FrameIo;
-use crate::passes::matte::DenoiseParams;
 use crate::passes::prefilter::Prefilter;
 use crate::passes::primaries::Primaries;
 use crate::passes::rescale::Rescale;
 use crate::passes::supersample::Supersample;
+use crate::passes::taa::TaaParams;
 use crate::passes::taa::TaaStage;
 use crate::passes::trace::{self, SceneInputs, TraceInputs, TracePass};
 use crate::settings::FrameSettings;
@@ -379,20 +379,20 @@ impl Stages {
     ) -> Result<()> {
         let Some(d) = denoiser else { return Ok(()) };
         let s = plan.settings;
-        let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, plan.frame_index, &plan.view);
+        let mut tp = TaaParams::new(&s.taa);
         // A frame that traces one pixel in N (N > 1) shows light that gains a sample per pixel
         // only every N frames, so a still pixel's frames are not alike: TAA's long still-view
         // mean (taa.still_frames) would keep the young, hole-filled frames in the image for
         // tens of frames. There TAA blends at taa.alpha (docs/decisions.md, "Progressive
         // filter", equal samples).
         if s.sample_period() > 1 {
-            dp.taa_still_frames = 0.0;
+            tp.still_frames = 0.0;
         }
         let follow = |p: Parity| {
             let (light, follow) = d.at(p);
             (follow, light.glossy)
         };
-        self.taa.record(rec, plan.output_key, io, follow, &dp, plan.parity)
+        self.taa.record(rec, plan.output_key, io, follow, &tp, plan.parity)
     }
 
     /// In a still view, TAA's image moved towards the mean of the pixel's samples

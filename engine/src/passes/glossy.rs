@@ -155,8 +155,8 @@ impl GlossyChainTargets {
 pub struct GlossyInputs<'a> {
     /// The frame's I/O, with the previous G-buffer (the chain asks for it).
     pub io: FrameIo<'a>,
-    /// The matte chain's DenoiseParams (camera matrices, parity, history validity).
-    pub denoise: &'a wgpu::Buffer,
+    /// Mara's matte uniform ([`super::matte::MatteParams`]): the bilateral weights.
+    pub matte: &'a wgpu::Buffer,
     pub params: &'a wgpu::Buffer,
     pub glossy: &'a GlossyChainTargets,
 }
@@ -182,7 +182,7 @@ const STAGES: [(Kind, &str, &str, &str); 6] = [
 
 fn bindings<'a>(kind: Kind, i: &GlossyInputs<'a>, parity: Parity) -> Bindings<'a> {
     let g = i.glossy;
-    let b = i.io.bindings().buffer("dn", i.denoise).buffer("gp", i.params);
+    let b = i.io.bindings().buffer("mp", i.matte).buffer("gp", i.params);
     match kind {
         Kind::Motion => b
             .texture("prev_hit", &g.hit.history(parity).1)
@@ -213,6 +213,7 @@ pub fn modules(stage: &'static str, motion: crate::gpu::Motion) -> Vec<&'static 
         "realtime/gbuffer_in.wgsl",
         "realtime/glossy_in.wgsl",
         "common/bilinear.wgsl",
+        "realtime/reproject.wgsl",
         "matte/common.wgsl",
         "glossy/common.wgsl",
     ];

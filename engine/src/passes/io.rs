@@ -13,6 +13,24 @@ pub fn uncertainty_module(uncertain: bool) -> &'static str {
     if uncertain { "realtime/uncertainty.wgsl" } else { "realtime/uncertainty_none.wgsl" }
 }
 
+/// What every temporal stage needs to know of this frame's camera and the previous one's (the
+/// frame uploads it in its uniform, `FrameParams`).
+#[derive(Clone, Copy, Debug)]
+pub struct ChainView {
+    /// Rebased world from clip, this frame and the previous one (both with their jitter, as
+    /// their depth buffers were rasterised).
+    pub inv_view_proj: glam::Mat4,
+    pub prev_inv_view_proj: glam::Mat4,
+    /// The previous frame's sub-pixel jitter minus this frame's, pixels: what separates the two
+    /// frames' samples of one pixel in a still view.
+    pub jitter_shift: glam::Vec2,
+    /// False when there is no usable history (first denoised frame, resize, denoiser paused).
+    pub history_valid: bool,
+    /// Neither the camera nor any object moved since the last frame: every surface, and
+    /// everything seen in a reflection, stands where it stood.
+    pub static_view: bool,
+}
+
 /// What the frame offers a stage (all borrowed from the frame for one recording).
 #[derive(Clone, Copy)]
 pub struct FrameIo<'a> {

@@ -6,7 +6,7 @@
 use super::chain::ChainStage;
 use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
-use crate::settings::{MatteSettings, STILL_FRAMES_MAX, TaaSettings};
+use crate::settings::{MatteSettings, STILL_FRAMES_MAX};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 
@@ -17,54 +17,33 @@ const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 const R32F: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 const R32U: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
-/// Mirror of `DenoiseParams` in shaders/matte/common.wgsl.
+/// Mirror of `MatteParams` in shaders/matte/common.wgsl: Mara's matte chain's uniform (the
+/// glossy chain reads its bilateral weights). What every temporal stage shares (the cameras,
+/// the reprojection's thresholds, history validity) is the frame's ([`crate::frame::FrameParams`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct DenoiseParams {
-    pub inv_view_proj: [[f32; 4]; 4],
-    pub prev_inv_view_proj: [[f32; 4]; 4],
+pub struct MatteParams {
     pub stages: u32,
     pub taps: u32,
-    pub parity: u32,
     pub max_radius_px: f32,
     pub hysteresis: f32,
-    pub d0_px: f32,
-    pub d1_px: f32,
     pub clamp_sigma: f32,
     pub history_radius_px: f32,
     pub disocclusion_radius_px: f32,
     pub low_confidence_multiplier: f32,
     pub normal_power: f32,
     pub plane_sigma_px: f32,
-    pub taa_alpha: f32,
     pub rotation: f32,
-    pub history_valid: u32,
-    /// [`MatteSettings::inject_nonfinite`].
-    pub inject_nonfinite: u32,
     /// [`MatteSettings::history_full_frames`].
     pub history_full_frames: f32,
-    /// [`ChainView::jitter_shift`].
-    pub jitter_shift: [f32; 2],
-    /// [`TaaSettings::still_frames`].
-    pub taa_still_frames: f32,
     /// [`MatteSettings::min_radius_fraction`] in pixels.
     pub min_radius_px: f32,
     /// [`MatteSettings::edge_stop_sigmas`].
     pub edge_stop_sigmas: f32,
-    /// [`ChainView::static_view`].
-    pub static_view: u32,
     /// Cosine of [`MatteSettings::reprojection_normal_degrees`].
     pub reprojection_min_cos: f32,
     /// [`MatteSettings::resampled_history_frames`].
     pub resampled_history_frames: f32,
-    /// [`TaaSettings::resampled_frames`].
-    pub taa_resampled_frames: f32,
-    /// [`TaaSettings::display_ratio`].
-    pub taa_display_ratio: f32,
-    /// [`TaaSettings::current_light`].
-    pub taa_current_light: f32,
-    /// [`TaaSettings::current_glossy`].
-    pub taa_current_glossy: f32,
     /// [`MatteSettings::still_frames`].
     pub still_frames: f32,
     /// [`MatteSettings::edge_stop_full_frames`].
@@ -73,78 +52,35 @@ pub struct DenoiseParams {
     pub still_normal_min_cos: f32,
     /// [`MatteSettings::tap_sigma_fraction`].
     pub tap_sigma: f32,
-    /// [`TaaSettings::moving_glossy`].
-    pub taa_moving_glossy: u32,
-    pub _pad: [f32; 1],
 }
 
-/// What the chains need to know of this frame's camera and the previous one's.
-#[derive(Clone, Copy, Debug)]
-pub struct ChainView {
-    /// Rebased world from clip, this frame and the previous one (both with their jitter, as
-    /// their depth buffers were rasterised).
-    pub inv_view_proj: glam::Mat4,
-    pub prev_inv_view_proj: glam::Mat4,
-    /// The previous frame's sub-pixel jitter minus this frame's, pixels: what separates the two
-    /// frames' samples of one pixel in a still view.
-    pub jitter_shift: glam::Vec2,
-    /// False when there is no usable history (first denoised frame, resize, denoiser paused).
-    pub history_valid: bool,
-    /// Neither the camera nor any object moved since the last frame: every surface, and
-    /// everything seen in a reflection, stands where it stood.
-    pub static_view: bool,
-}
-
-impl DenoiseParams {
-    /// The matte chain's parameters and TAA's (`taa`), which TAA reads from the same struct.
-    pub fn new(
-        s: &MatteSettings,
-        taa: &TaaSettings,
-        width: u32,
-        frame: u32,
-        view: &ChainView,
-    ) -> DenoiseParams {
+impl MatteParams {
+    /// The matte chain's parameters at a frame `width` pixels wide, frame `frame`.
+    pub fn new(s: &MatteSettings, width: u32, frame: u32) -> MatteParams {
         let w = width as f32;
-        DenoiseParams {
-            inv_view_proj: view.inv_view_proj.to_cols_array_2d(),
-            prev_inv_view_proj: view.prev_inv_view_proj.to_cols_array_2d(),
-            stages: s.stage_bits() | taa.stage_bit(),
+        MatteParams {
+            stages: s.stage_bits(),
             taps: s.taps.clamp(1, 256),
-            parity: frame % 2,
             max_radius_px: (s.max_radius_fraction * w).max(0.0),
             hysteresis: s.hysteresis.clamp(0.0, 1.0),
-            d0_px: s.d0_px.max(0.0),
-            d1_px: s.d1_px.max(s.d0_px + 1e-3),
             clamp_sigma: s.clamp_sigma.max(0.0),
             history_radius_px: (s.history_diameter_fraction * w * 0.5).max(0.0),
             disocclusion_radius_px: (s.disocclusion_fraction * w).clamp(1.0, 512.0),
             low_confidence_multiplier: s.low_confidence_multiplier.max(0.0),
             normal_power: s.normal_power.max(0.0),
             plane_sigma_px: s.plane_sigma_px.max(1e-3),
-            taa_alpha: taa.alpha.clamp(0.01, 1.0),
             // Golden-ratio steps: consecutive frames' tap patterns interleave.
             rotation: (frame as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU),
-            history_valid: view.history_valid as u32,
-            inject_nonfinite: s.inject_nonfinite as u32,
             history_full_frames: s.history_full_frames.max(0.0),
-            jitter_shift: view.jitter_shift.to_array(),
-            taa_still_frames: taa.still_frames.clamp(0.0, 1024.0),
             min_radius_px: (s.min_radius_fraction * w)
                 .clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
             edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
-            static_view: view.static_view as u32,
             reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
-            taa_resampled_frames: taa.resampled_frames.clamp(0.0, 1024.0),
-            taa_display_ratio: taa.display_ratio.clamp(0.0, 1024.0),
-            taa_current_light: taa.current_light.clamp(0.0, 1.0),
-            taa_current_glossy: taa.current_glossy.clamp(0.0, 1.0),
             still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
             edge_stop_full_frames: s.edge_stop_full_frames.clamp(0.0, STILL_FRAMES_MAX),
             still_normal_min_cos: normal_test_cos(s.still_normal_degrees),
             tap_sigma: s.tap_sigma_fraction.clamp(0.0, 4.0),
-            taa_moving_glossy: taa.moving_glossy as u32,
-            _pad: [0.0; 1],
         }
     }
 }
@@ -190,7 +126,7 @@ impl MatteTargets {
     }
 }
 
-/// Everything a stage may bind: the frame's I/O, the chain's `DenoiseParams` and textures.
+/// Everything a stage may bind: the frame's I/O, the chain's `MatteParams` and textures.
 pub struct ChainInputs<'a> {
     pub io: FrameIo<'a>,
     pub params: &'a wgpu::Buffer,
@@ -218,7 +154,7 @@ const STAGES: [(Kind, &str); 6] = [
 
 fn bindings<'a>(kind: Kind, i: &ChainInputs<'a>, parity: Parity) -> Bindings<'a> {
     let m = i.matte;
-    let b = i.io.bindings().buffer("dn", i.params);
+    let b = i.io.bindings().buffer("mp", i.params);
     match kind {
         Kind::Temporal => b
             .texture("history", &m.history.history(parity).1)
@@ -262,6 +198,7 @@ fn modules(
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
         "common/bilinear.wgsl",
+        "realtime/reproject.wgsl",
         "matte/common.wgsl",
     ];
     m.push(motion.module());

@@ -6,9 +6,10 @@
 
 use super::chain::ChainStage;
 use super::io::FrameIo;
-use super::matte::DenoiseParams;
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
+use crate::settings::TaaSettings;
 use anyhow::{Context, Result};
+use bytemuck::{Pod, Zeroable};
 
 pub const LABEL: &str = "taa";
 const RGBA32F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -104,6 +105,38 @@ enum GlossyInput {
     Follow,
 }
 
+/// Mirror of `TaaParams` in shaders/taa/taa.wgsl: TAA's own uniform (the cameras and the
+/// reprojection test are the frame's).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TaaParams {
+    /// [`TaaSettings::enabled`]: 0 passes the composite on.
+    pub enabled: u32,
+    pub alpha: f32,
+    /// [`TaaSettings::still_frames`] (0: the still view blends at `alpha` too).
+    pub still_frames: f32,
+    pub resampled_frames: f32,
+    pub display_ratio: f32,
+    pub current_light: f32,
+    pub current_glossy: f32,
+    pub moving_glossy: u32,
+}
+
+impl TaaParams {
+    pub fn new(s: &TaaSettings) -> TaaParams {
+        TaaParams {
+            enabled: s.enabled as u32,
+            alpha: s.alpha.clamp(0.01, 1.0),
+            still_frames: s.still_frames.clamp(0.0, 1024.0),
+            resampled_frames: s.resampled_frames.clamp(0.0, 1024.0),
+            display_ratio: s.display_ratio.clamp(0.0, 1024.0),
+            current_light: s.current_light.clamp(0.0, 1.0),
+            current_glossy: s.current_glossy.clamp(0.0, 1.0),
+            moving_glossy: s.moving_glossy as u32,
+        }
+    }
+}
+
 pub struct TaaStage {
     params: wgpu::Buffer,
     targets: Option<(u64, TaaTargets)>,
@@ -116,7 +149,7 @@ pub struct TaaStage {
 impl TaaStage {
     pub fn new(gpu: &Gpu, memory: &mut GpuMemory, motion: crate::gpu::Motion) -> TaaStage {
         let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
-        let params = memory.buffer(&gpu.device, "taa/params", size_of::<DenoiseParams>() as u64, u);
+        let params = memory.buffer(&gpu.device, "taa/params", size_of::<TaaParams>() as u64, u);
         TaaStage { params, targets: None, programs: vec![], motion }
     }
 
@@ -141,7 +174,7 @@ impl TaaStage {
         self.targets.as_ref().map(|(_, t)| &t.final_image)
     }
 
-    /// Record TAA of `io.hdr`; `params` as the denoisers write them (its `taa*` and `stages`).
+    /// Record TAA of `io.hdr` with `params`.
     /// `key` changes whenever a bound resource may have (scene, targets, denoiser).
     /// `follow(p)`: what TAA follows at history parity p, and the glossy light the composite
     /// showed.
@@ -151,7 +184,7 @@ impl TaaStage {
         key: crate::gpu::BindKey,
         io: &FrameIo<'a>,
         follow: impl Fn(Parity) -> (TaaFollow<'a>, Option<&'a wgpu::TextureView>),
-        params: &DenoiseParams,
+        params: &TaaParams,
         parity: Parity,
     ) -> Result<()> {
         let gpu = rec.gpu;
@@ -193,7 +226,7 @@ fn taa_bindings<'a>(
 ) -> Bindings<'a> {
     let mut b = io
         .bindings()
-        .buffer("dn", params)
+        .buffer("taa_params", params)
         .buffer("hdr", io.hdr)
         .buffer("final_image", &t.final_image)
         .texture("history", &t.history.history(parity).1)
@@ -235,7 +268,7 @@ fn modules(
         "realtime/frame.wgsl",
         "realtime/gbuffer_in.wgsl",
         "common/bilinear.wgsl",
-        "matte/common.wgsl",
+        "realtime/reproject.wgsl",
     ];
     m.push(motion.module());
     m.extend(match glossy {

@@ -127,14 +127,19 @@ const FRAME_FIELDS: &[Field] = &[
     ),
 ];
 
-/// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, then
-/// the radiance cache's, each denoiser's as the registry lists them ([`super::registry`]), then
+/// Every field of [`FrameSettings`] that is saved in presets, in panel order: the frame's, its
+/// reprojection test's, the radiance cache's, each denoiser's as the registry lists them ([`super::registry`]), then
 /// TAA's.
 pub fn fields() -> impl Iterator<Item = &'static Field> {
     let denoisers = super::registry::denoisers();
     let own: Vec<&'static Field> =
         denoisers.iter().flat_map(|d| d.fields.iter().flat_map(|f| f.iter())).collect();
-    FRAME_FIELDS.iter().chain(super::cache::FIELDS).chain(own).chain(super::taa::FIELDS)
+    FRAME_FIELDS
+        .iter()
+        .chain(super::reprojection::FIELDS)
+        .chain(super::cache::FIELDS)
+        .chain(own)
+        .chain(super::taa::FIELDS)
 }
 
 /// The value at a dotted path of a serde form.
@@ -176,6 +181,8 @@ impl FrameSettings {
     /// Settings from a JSON value; every field must be one [`fields`] describes, in range. What
     /// `v` leaves out keeps its default.
     pub fn from_value(v: &Value) -> Result<FrameSettings> {
+        let moved = moved(v);
+        let v = &moved;
         let mut full = FrameSettings::default().to_value();
         let known = leaves(&full);
         for leaf in leaves(v) {
@@ -194,6 +201,32 @@ impl FrameSettings {
         merge(&mut full, v);
         serde_json::from_value(full).map_err(|e| anyhow!("bad settings: {e}"))
     }
+}
+
+/// Settings that moved to another group (old path, new path): a preset saved before the move
+/// loads as it did. Eq. (11)'s distances steer every denoiser's reprojection, so they left
+/// Mara's matte group for the frame's own.
+const MOVED: &[(&str, &str)] =
+    &[("matte.d0_px", "reprojection.d0_px"), ("matte.d1_px", "reprojection.d1_px")];
+
+/// `v` with every [`MOVED`] setting at its new path (a value there already wins).
+fn moved(v: &Value) -> Value {
+    let mut v = v.clone();
+    for (old, new) in MOVED {
+        let Some((group, key)) = old.split_once('.') else { continue };
+        let Some(x) = v.get_mut(group).and_then(Value::as_object_mut).and_then(|g| g.remove(key))
+        else {
+            continue;
+        };
+        let Some((to, to_key)) = new.split_once('.') else { continue };
+        if let Some(obj) = v.as_object_mut() {
+            let g = obj.entry(to).or_insert_with(|| Value::Object(Default::default()));
+            if let Some(g) = g.as_object_mut() {
+                g.entry(to_key).or_insert(x);
+            }
+        }
+    }
+    v
 }
 
 /// `over`'s leaves written into `base`.
@@ -239,6 +272,18 @@ fn check(field: &Field, x: &Value) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_preset_from_before_a_setting_moved_loads_it_at_its_new_place() {
+        let v = serde_json::json!({"matte": {"d1_px": 12.0, "hysteresis": 0.9}});
+        let s = FrameSettings::from_value(&v).unwrap();
+        assert_eq!(s.reprojection.d1_px, 12.0);
+        assert_eq!(s.matte.hysteresis, 0.9);
+        // Out of range at its old place is refused as at its new one.
+        let bad = serde_json::json!({"matte": {"d0_px": -1.0}});
+        let e = FrameSettings::from_value(&bad).unwrap_err().to_string();
+        assert!(e.contains("reprojection.d0_px"), "{e}");
+    }
 
     #[test]
     fn every_setting_is_described_once_and_defaults_are_in_range() {

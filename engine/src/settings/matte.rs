@@ -15,14 +15,6 @@ described! {
         /// h of eq. 11: the history's weight at full confidence (paper 0.98).
         hysteresis: f32 = 0.98,
             ("matte.hysteresis", "matte/temporal", "", Float(0.0, 1.0, 0.001));
-        /// Eq. (11)'s d0 and d1 in pixel footprints at the surface (the paper's 5 cm and 7 cm are
-        /// about 6 and 8.5 footprints at 5 m in a 720p, 60-degree view; a footprint keeps the test
-        /// the same at any scene scale and resolution).
-        d0_px: f32 = 6.0,
-            ("matte.d0_px", "matte/temporal", "footprints", Float(0.0, 64.0, 0.05));
-        /// Eq. 11's d1: zero confidence beyond this reprojection distance.
-        d1_px: f32 = 8.5,
-            ("matte.d1_px", "matte/temporal", "footprints", Float(0.0, 64.0, 0.05));
         /// History clamp to the neighbourhood's mean +- k standard deviations (Mara §3.4), k in [0, 16],
         /// default 0 (off): at one sample per pixel it erases correct indirect history (living room
         /// interior 0.049 of a 0.176 mean at 4 sigma); off, lighting changes lag about 1 / (1 - h) frames.
@@ -36,7 +28,7 @@ described! {
         /// hysteresis alone 0.000960, 4.0x, and 0.0289). 0: the paper's exponential blend always.
         still_frames: f32 = STILL_FRAMES_MAX,
             ("matte.still_frames", "matte/temporal", "frames", Float(0.0, STILL_FRAMES_MAX as f64, 1.0));
-        /// Reprojection also rejects a texel whose normal is more than this many degrees off, [0, 180],
+        /// Mara's reprojection also rejects a texel whose normal is more than this many degrees off, [0, 180],
         /// default 180 (off): matte light varies slowly across a crease and the test only shortens
         /// histories (staircase FLIP 0.0655 off, 0.0675 at 25 degrees).
         reprojection_normal_degrees: f32 = 180.0,
@@ -127,16 +119,11 @@ described! {
             ("matte.tap_sigma_fraction", "matte/bilateral", "of radius", Float(0.0, 4.0, 0.01));
     }
     hidden {
-        /// Fault injection for tests: the temporal stage reads NaN, +Inf and -Inf in place of the
-        /// matte light on a sparse pixel pattern (1 in 7).
-        #[serde(skip)]
-        inject_nonfinite: bool = false;
     }
 }
 
 impl MatteSettings {
-    /// Stage bits as the shaders read them (shaders/matte/common.wgsl: STAGE_*; TAA's bit is
-    /// [`super::TaaSettings::stage_bit`]).
+    /// Stage bits as the shaders read them (shaders/matte/common.wgsl: STAGE_*).
     pub fn stage_bits(&self) -> u32 {
         super::switch_bits(&self.switches())
     }

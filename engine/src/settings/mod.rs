@@ -12,6 +12,7 @@ mod matte;
 mod preset;
 pub mod progressive;
 pub mod registry;
+mod reprojection;
 pub mod svgf;
 mod taa;
 mod view;
@@ -25,6 +26,7 @@ pub use matte::MatteSettings;
 pub use progressive::{MAX_LEVELS as PROGRESSIVE_MAX_LEVELS, ProgressiveSettings};
 pub use registry::all_views;
 pub use registry::{DenoiserInfo, Off, Section, Stage};
+pub use reprojection::ReprojectionSettings;
 pub use svgf::{MAX_LEVELS as SVGF_MAX_LEVELS, STILL_FRAMES_MAX, SvgfSettings};
 pub use taa::TaaSettings;
 pub use view::View;
@@ -51,6 +53,8 @@ pub struct FrameSettings {
     /// What the display shows.
     pub view: View,
     pub denoiser: Denoiser,
+    /// The reprojection test every temporal stage shares (the frame's, not a denoiser's).
+    pub reprojection: ReprojectionSettings,
     pub matte: MatteSettings,
     pub taa: TaaSettings,
     pub glossy: GlossySettings,
@@ -127,6 +131,10 @@ pub struct FrameSettings {
     /// in a preset, `name.field` in a field path ([`registry::Section`]).
     #[serde(flatten)]
     pub sections: BTreeMap<String, Value>,
+    /// Fault injection for tests: the matte light entering every denoiser reads NaN, +Inf and
+    /// -Inf on a sparse pixel pattern (1 in 7).
+    #[serde(skip)]
+    pub inject_nonfinite: bool,
 }
 
 /// Traced primary samples per pixel by default (Moon et al. use 4 in their interactive tests'
@@ -177,6 +185,7 @@ impl FrameSettings {
             accumulate: false,
             view: View::FINAL,
             denoiser: Denoiser::NONE,
+            reprojection: ReprojectionSettings::default(),
             matte: MatteSettings::default(),
             taa: TaaSettings::default(),
             glossy: GlossySettings::default(),
@@ -193,6 +202,7 @@ impl FrameSettings {
             primary_samples: DEFAULT_PRIMARY_SAMPLES,
             prefilter: true,
             sections: BTreeMap::new(),
+            inject_nonfinite: false,
         }
     }
 

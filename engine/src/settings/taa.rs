@@ -74,16 +74,4 @@ described! {
 impl TaaSettings {
     /// Its `--disable` name.
     pub const STAGE: &str = "taa";
-
-    /// Its bit among the chains' stage bits, after the matte chain's
-    /// ([`super::MatteSettings::switches`]; shaders/matte/common.wgsl: STAGE_TAA).
-    pub fn stage_bit(&self) -> u32 {
-        let after = super::MatteSettings::default().switches().len();
-        (self.enabled as u32) << after
-    }
-
-    /// Its switch by its WGSL constant.
-    pub fn switch(&self) -> (&'static str, bool) {
-        ("STAGE_TAA", self.enabled)
-    }
 }

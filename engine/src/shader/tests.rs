@@ -184,6 +184,7 @@ pub(super) fn all_programs() -> Vec<Program> {
                 "realtime/frame.wgsl",
                 "realtime/gbuffer_in.wgsl",
                 "common/bilinear.wgsl",
+                "realtime/reproject.wgsl",
                 "matte/common.wgsl",
                 motion,
             ];
@@ -581,13 +582,6 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     use crate::passes::converge::ConvergeParams;
     assert_eq!(size as usize, size_of::<ConvergeParams>());
     assert_eq!(offs[2] as usize, offset_of!(ConvergeParams, min_samples));
-    let taa = programs.iter().find(|p| p.label == "taa/taa.wgsl").unwrap();
-    let (size, offs) = wgsl_layout(taa, "DenoiseParams");
-    use crate::passes::matte::DenoiseParams;
-    assert_eq!(size as usize, size_of::<DenoiseParams>());
-    assert_eq!(offs[2] as usize, offset_of!(DenoiseParams, stages));
-    assert_eq!(offs[17] as usize, offset_of!(DenoiseParams, history_valid));
-    assert_eq!(offs[35] as usize, offset_of!(DenoiseParams, taa_moving_glossy));
     let temporal = programs.iter().find(|p| p.label == "glossy/temporal.wgsl").unwrap();
     let (size, offs) = wgsl_layout(temporal, "GlossyParams");
     use crate::passes::glossy::GlossyParams;

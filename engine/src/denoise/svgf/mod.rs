@@ -34,7 +34,6 @@ use crate::passes::chain::{ChainStage, made_for};
 type Stage = ChainStage<(Parity, Pass)>;
 use crate::passes::glossy::{GlossyParams, MotionProgram};
 use crate::passes::io::FrameIo;
-use crate::passes::matte::DenoiseParams;
 use crate::passes::taa::{MatteFollow, MatteState, TaaFollow};
 use crate::settings::{FrameSettings, SvgfSettings, svgf::STILL_FRAMES_MAX};
 use anyhow::{Context, Result};
@@ -66,7 +65,8 @@ pub struct SvgfParams {
     pub regression_order: f32,
     pub regression_full_samples: f32,
     pub spike_ratio: f32,
-    pub _pad: u32,
+    /// Cosine of the temporal stages' normal test (25 degrees).
+    pub normal_min_cos: f32,
 }
 
 impl SvgfParams {
@@ -87,7 +87,7 @@ impl SvgfParams {
             regression_order: s.regression_order.min(2) as f32,
             regression_full_samples: s.regression_full_samples.clamp(0.0, STILL_FRAMES_MAX),
             spike_ratio: s.spike_ratio.max(0.0),
-            _pad: 0,
+            normal_min_cos: crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES),
         }
     }
 }
@@ -111,7 +111,6 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
     let d = &gpu.device;
     let sv = memory.buffer(d, "svgf/params", size_of::<SvgfParams>() as u64, u);
-    let dn = memory.buffer(d, "svgf/denoise params", size_of::<DenoiseParams>() as u64, u);
     let gp = memory.buffer(d, "svgf/glossy params", size_of::<GlossyParams>() as u64, u);
     let levels = std::array::from_fn(|i| {
         let b = memory.buffer(d, &format!("svgf/level {i}"), size_of::<Level>() as u64, u);
@@ -127,7 +126,7 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
         );
         b
     });
-    let res = Resources { sv, dn, gp, levels, targets: None };
+    let res = Resources { sv, gp, levels, targets: None };
     Ok(Box::new(Svgf { scene: *scene, res, matte: None, glossy: None, motion: None }))
 }
 
@@ -139,7 +138,7 @@ pub fn modules(stage: &'static str, glossy: bool, motion: crate::gpu::Motion) ->
     if glossy {
         m.push("realtime/glossy_in.wgsl");
     }
-    m.extend(["common/bilinear.wgsl", "matte/common.wgsl"]);
+    m.extend(["common/bilinear.wgsl", "realtime/reproject.wgsl"]);
     if glossy {
         m.push("glossy/common.wgsl");
     }
@@ -310,7 +309,6 @@ struct MotionStages {
 /// SVGF's parameter buffers and per-pixel textures: what its stages bind.
 struct Resources {
     sv: wgpu::Buffer,
-    dn: wgpu::Buffer,
     gp: wgpu::Buffer,
     levels: [wgpu::Buffer; LEVELS],
     targets: Option<SvgfTargets>,
@@ -337,7 +335,7 @@ impl Resources {
         pass: Pass,
         parity: Parity,
     ) -> Bindings<'a> {
-        let mut b = io.bindings().buffer("sv", &self.sv).buffer("dn", &self.dn);
+        let mut b = io.bindings().buffer("sv", &self.sv);
         if c == Chain::Glossy {
             b = b.buffer("gp", &self.gp);
         }
@@ -353,13 +351,10 @@ impl Resources {
         b
     }
 
-    fn write_params(&self, gpu: &Gpu, io: &FrameIo, cx: &FrameContext, extent: f32) {
+    fn write_params(&self, gpu: &Gpu, cx: &FrameContext, extent: f32) {
         let s: &FrameSettings = cx.settings;
         let sv = &s.svgf;
         gpu.queue.write_buffer(&self.sv, 0, bytemuck::bytes_of(&SvgfParams::new(sv)));
-        let mut dp = DenoiseParams::new(&s.matte, &s.taa, io.size.0, cx.index, &cx.view);
-        dp.reprojection_min_cos = crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES);
-        gpu.queue.write_buffer(&self.dn, 0, bytemuck::bytes_of(&dp));
         let mut gp = GlossyParams::new(&s.glossy, extent, cx.view.static_view);
         gp.roughness_threshold = sv.roughness_threshold;
         gp.clip_roughness = sv.clip_roughness;
@@ -501,7 +496,7 @@ impl Denoiser for Svgf {
         let gpu = rec.gpu;
         let Svgf { scene, res, matte, glossy, motion } = self;
         let t = res.targets.as_ref().context("SVGF records before its textures exist")?;
-        res.write_params(gpu, io, cx, scene.extent);
+        res.write_params(gpu, cx, scene.extent);
         let wanted = |c| Variant::wanted(c == Chain::Glossy, io, &cx.settings.svgf);
         let stages = |c: Chain| {
             let offered = res.offered(io, t, c);

@@ -56,7 +56,8 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
     use crate::passes::cache::CacheParams;
     use crate::passes::converge::ConvergeParams;
     use crate::passes::glossy::GlossyParams;
-    use crate::passes::matte::DenoiseParams;
+    use crate::passes::matte::MatteParams;
+    use crate::passes::taa::TaaParams;
     let v = all_programs();
     same(
         &v,
@@ -75,6 +76,8 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
             symmetric_luminance,
             reach_samples,
             variance_cap,
+            normal_min_cos,
+            _pad,
         }),
     );
     same(
@@ -97,51 +100,49 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
             regression_order,
             regression_full_samples,
             spike_ratio,
-            _pad,
+            normal_min_cos,
         }),
     );
     same(
         &v,
-        "taa/taa.wgsl",
-        "DenoiseParams",
-        layout!(DenoiseParams {
-            inv_view_proj,
-            prev_inv_view_proj,
+        "matte/temporal.wgsl",
+        "MatteParams",
+        layout!(MatteParams {
             stages,
             taps,
-            parity,
             max_radius_px,
             hysteresis,
-            d0_px,
-            d1_px,
             clamp_sigma,
             history_radius_px,
             disocclusion_radius_px,
             low_confidence_multiplier,
             normal_power,
             plane_sigma_px,
-            taa_alpha,
             rotation,
-            history_valid,
-            inject_nonfinite,
             history_full_frames,
-            jitter_shift,
-            taa_still_frames,
             min_radius_px,
             edge_stop_sigmas,
-            static_view,
             reprojection_min_cos,
             resampled_history_frames,
-            taa_resampled_frames,
-            taa_display_ratio,
-            taa_current_light,
-            taa_current_glossy,
             still_frames,
             edge_stop_full_frames,
             still_normal_min_cos,
             tap_sigma,
-            taa_moving_glossy,
-            _pad,
+        }),
+    );
+    same(
+        &v,
+        "taa/taa.wgsl",
+        "TaaParams",
+        layout!(TaaParams {
+            enabled,
+            alpha,
+            still_frames,
+            resampled_frames,
+            display_ratio,
+            current_light,
+            current_glossy,
+            moving_glossy,
         }),
     );
     same(
@@ -224,6 +225,15 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
             uncovered_paths,
             prev_jitter_x,
             prev_jitter_y,
+            inv_view_proj,
+            prev_inv_view_proj,
+            jitter_shift,
+            history_valid,
+            static_view,
+            d0_px,
+            d1_px,
+            inject_nonfinite,
+            _pad,
         }),
     );
 }
@@ -254,13 +264,10 @@ fn same_bits(path: &str, prefix: &str, rust: &[(&str, bool)]) {
 
 #[test]
 fn every_switch_word_matches_its_wgsl_constants() {
-    use crate::settings::{GlossySettings, MatteSettings, SvgfSettings, TaaSettings};
+    use crate::settings::{GlossySettings, MatteSettings, SvgfSettings};
     let sv = SvgfSettings::default();
     same_bits("svgf/common.wgsl", "SV_", &sv.switches());
     assert_eq!(sv.bits(), crate::settings::switch_bits(&sv.switches()));
-    // TAA's bit follows the matte chain's stages in the same word.
-    let mut matte = MatteSettings::default().switches().to_vec();
-    matte.push(TaaSettings::default().switch());
-    same_bits("matte/common.wgsl", "STAGE_", &matte);
+    same_bits("matte/common.wgsl", "STAGE_", &MatteSettings::default().switches());
     same_bits("glossy/common.wgsl", "GSTAGE_", &GlossySettings::default().switches());
 }
