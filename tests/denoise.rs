@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 use hush_engine::accel::BvhKind;
+use hush_engine::denoise::mara::matte::history_rejected;
 use hush_engine::frame::{FrameInput, Renderer};
-use hush_engine::passes::matte::history_rejected;
 use hush_engine::quality::{Image, compare, flip_over};
 use hush_engine::scene::Camera;
 use hush_engine::settings::{

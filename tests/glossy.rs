@@ -454,7 +454,7 @@ fn glossy_history_follows_its_reflected_point() {
 }
 
 /// The reflection motion's program has the brute-force search compiled in only while
-/// `glossy.reference_search_radius` asks for it (passes/glossy.rs: MotionProgram), so a change of
+/// `glossy.reference_search_radius` asks for it (denoise/mara/glossy.rs: MotionProgram), so a change of
 /// the setting between frames must make the stage again, in Mara's glossy chain and in SVGF's
 /// glossy signal alike. The search view's fourth channel is the brute-force search's best
 /// distance: zero everywhere without it, and set on reflective pixels with it. With the stage

@@ -1,5 +1,5 @@
 // Shared by the glossy chain's stages (Mara et al. 2017 §3.4 stages 8-10, with the reflection
-// reprojection and neighbourhood clipping of Voorhuis §4). engine/src/passes/glossy.rs mirrors
+// reprojection and neighbourhood clipping of Voorhuis §4). engine/src/denoise/mara/glossy.rs mirrors
 // GlossyParams; the cameras, the reprojection's thresholds and whether history exists are the
 // frame's (realtime/reproject.wgsl), the bilateral weight's normal power and plane sigma the
 // matte chain's (MatteParams, matte/common.wgsl).

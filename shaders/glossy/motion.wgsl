@@ -9,7 +9,7 @@
 //           (encode_hit_w).
 // The program's prelude defines TRACED_HITS (GlossySettings::trace_representative_ray) and
 // REFERENCE_RADIUS (GlossySettings::reference_search_radius, 0: no brute-force search) as
-// constants (passes/glossy.rs: MotionProgram says why they are not uniforms).
+// constants (denoise/mara/glossy.rs: MotionProgram says why they are not uniforms).
 
 var prev_depth: texture_depth_2d;
 var prev_hit: texture_2d<f32>;

@@ -1,6 +1,6 @@
 // Mara et al. 2017's chains (the matte chain, §3.4, Figure 2 stages 3-7, and the glossy chain
 // beside it): their uniform, the cross-bilateral weight, eq. (11)'s confidence and the sparse tap
-// pattern. engine/src/passes/matte.rs mirrors MatteParams; what the frame's stages share (the
+// pattern. engine/src/denoise/mara/matte.rs mirrors MatteParams; what the frame's stages share (the
 // cameras, the reprojection) is in realtime/reproject.wgsl, read from the frame's uniform.
 
 struct MatteParams {

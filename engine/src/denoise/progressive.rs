@@ -66,7 +66,7 @@ impl ProgressiveParams {
             symmetric_luminance: s.symmetric_luminance as u32,
             reach_samples: s.reach_samples.clamp(0.0, STILL_FRAMES_MAX),
             variance_cap: s.variance_cap.clamp(0.0, STILL_FRAMES_MAX),
-            normal_min_cos: crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES),
+            normal_min_cos: crate::passes::io::normal_test_cos(NORMAL_TEST_DEGREES),
             _pad: [0.0; 3],
         }
     }

@@ -31,6 +31,11 @@ pub struct ChainView {
     pub static_view: bool,
 }
 
+/// A reprojection's normal test as a cosine: 180 degrees or more passes every normal.
+pub fn normal_test_cos(degrees: f32) -> f32 {
+    if degrees >= 180.0 { -2.0 } else { degrees.max(0.0).to_radians().cos() }
+}
+
 /// What the frame offers a stage (all borrowed from the frame for one recording).
 #[derive(Clone, Copy)]
 pub struct FrameIo<'a> {

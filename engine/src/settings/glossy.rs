@@ -70,7 +70,7 @@ described! {
         /// sampled depths, whose jumps between near and far geometry make eq. (5)'s minimum
         /// ambiguous, and 0.31 px (92.6%) with traced ones, for one closest-hit ray per such pixel.
         /// A constant of the motion stage's program (a change makes it again): on lavapipe eq. (5)
-        /// cost every search tap even while unused (passes/glossy.rs: MotionProgram).
+        /// cost every search tap even while unused (denoise/mara/glossy.rs: MotionProgram).
         trace_representative_ray: bool = true,
             ("glossy.trace_representative_ray", "glossy/motion", "", Bool);
         /// Stage switches. Without `temporal` nothing is reprojected (Voorhuis's "NoSpecReproj").

@@ -199,13 +199,15 @@ pub(super) fn all_programs() -> Vec<Program> {
             "glossy/temporal.wgsl",
             "glossy/bilateral.wgsl",
         ] {
-            let m = crate::passes::glossy::modules(stage, animated);
+            let m = crate::denoise::mara::glossy::modules(stage, animated);
             if stage == "glossy/motion.wgsl" {
                 // Each of the search's program variants.
                 for traced_hits in [false, true] {
                     for reference_radius in [0, 4] {
-                        let p =
-                            crate::passes::glossy::MotionProgram { traced_hits, reference_radius };
+                        let p = crate::denoise::mara::glossy::MotionProgram {
+                            traced_hits,
+                            reference_radius,
+                        };
                         v.push(compose(stage, &p.prelude(), &m).unwrap());
                     }
                 }
@@ -584,7 +586,7 @@ fn gpu_structs_match_their_wgsl_mirrors() {
     assert_eq!(offs[2] as usize, offset_of!(ConvergeParams, min_samples));
     let temporal = programs.iter().find(|p| p.label == "glossy/temporal.wgsl").unwrap();
     let (size, offs) = wgsl_layout(temporal, "GlossyParams");
-    use crate::passes::glossy::GlossyParams;
+    use crate::denoise::mara::glossy::GlossyParams;
     assert_eq!(size as usize, size_of::<GlossyParams>());
     assert_eq!(offs[4] as usize, offset_of!(GlossyParams, roughness_threshold));
     assert_eq!(offs[16] as usize, offset_of!(GlossyParams, max_sigma_px));

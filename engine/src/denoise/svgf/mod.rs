@@ -32,7 +32,7 @@ use crate::passes::chain::{ChainStage, made_for};
 /// An SVGF stage: its bind groups by the history parity and the pass they bind (a-trous level,
 /// the regression's input).
 type Stage = ChainStage<(Parity, Pass)>;
-use crate::passes::glossy::{GlossyParams, MotionProgram};
+use crate::denoise::mara::glossy::{GlossyParams, MotionProgram};
 use crate::passes::io::FrameIo;
 use crate::passes::taa::{MatteFollow, MatteState, TaaFollow};
 use crate::settings::{FrameSettings, SvgfSettings, svgf::STILL_FRAMES_MAX};
@@ -87,7 +87,7 @@ impl SvgfParams {
             regression_order: s.regression_order.min(2) as f32,
             regression_full_samples: s.regression_full_samples.clamp(0.0, STILL_FRAMES_MAX),
             spike_ratio: s.spike_ratio.max(0.0),
-            normal_min_cos: crate::passes::matte::normal_test_cos(NORMAL_TEST_DEGREES),
+            normal_min_cos: crate::passes::io::normal_test_cos(NORMAL_TEST_DEGREES),
         }
     }
 }
@@ -452,7 +452,7 @@ fn motion_stages(
     motion: crate::gpu::Motion,
     program: MotionProgram,
 ) -> Result<MotionStages> {
-    use crate::passes::glossy::modules;
+    use crate::denoise::mara::glossy::modules;
     let p = Parity::default();
     let stage = |label, file, entry, pass, prelude: &str| {
         let offered = res.bindings(io, t, Chain::Glossy, pass, p);

@@ -25,13 +25,17 @@ fn pass_program(c: Chain, pass: Pass, v: Variant) -> Option<(String, Vec<&'stati
         Pass::Regression(_) => "svgf/regression.wgsl",
         Pass::Final => "svgf/final.wgsl",
         Pass::Motion => {
-            let prelude = crate::passes::glossy::MotionProgram::of(&Default::default()).prelude();
-            return Some((prelude, crate::passes::glossy::modules("glossy/motion.wgsl", motion)));
+            let prelude =
+                crate::denoise::mara::glossy::MotionProgram::of(&Default::default()).prelude();
+            return Some((
+                prelude,
+                crate::denoise::mara::glossy::modules("glossy/motion.wgsl", motion),
+            ));
         }
         Pass::Prefilter(_) => {
             return Some((
                 String::new(),
-                crate::passes::glossy::modules("glossy/prefilter.wgsl", motion),
+                crate::denoise::mara::glossy::modules("glossy/prefilter.wgsl", motion),
             ));
         }
         Pass::HistoryCopy => return None,

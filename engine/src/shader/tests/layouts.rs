@@ -50,13 +50,13 @@ fn same(programs: &[Program], label: &str, name: &str, (size, rust): (usize, Vec
 
 #[test]
 fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
+    use crate::denoise::mara::glossy::GlossyParams;
+    use crate::denoise::mara::matte::MatteParams;
     use crate::denoise::progressive::ProgressiveParams;
     use crate::denoise::svgf::SvgfParams;
     use crate::frame::FrameParams;
     use crate::passes::cache::CacheParams;
     use crate::passes::converge::ConvergeParams;
-    use crate::passes::glossy::GlossyParams;
-    use crate::passes::matte::MatteParams;
     use crate::passes::taa::TaaParams;
     let v = all_programs();
     same(

@@ -3,9 +3,9 @@
 //! only) -> `matte/disocclusion_h`, `matte/disocclusion_v` -> `matte/firefly` -> `matte/bilateral`.
 //! Each stage can be switched off at run time ([`MatteSettings`]); it then passes its input on.
 
-use super::chain::ChainStage;
-use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
+use crate::passes::chain::ChainStage;
+use crate::passes::io::FrameIo;
 use crate::settings::{MatteSettings, STILL_FRAMES_MAX};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
@@ -75,19 +75,14 @@ impl MatteParams {
             min_radius_px: (s.min_radius_fraction * w)
                 .clamp(0.0, (s.max_radius_fraction * w).max(0.0)),
             edge_stop_sigmas: s.edge_stop_sigmas.max(0.0),
-            reprojection_min_cos: normal_test_cos(s.reprojection_normal_degrees),
+            reprojection_min_cos: crate::passes::io::normal_test_cos(s.reprojection_normal_degrees),
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
             still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
             edge_stop_full_frames: s.edge_stop_full_frames.clamp(0.0, STILL_FRAMES_MAX),
-            still_normal_min_cos: normal_test_cos(s.still_normal_degrees),
+            still_normal_min_cos: crate::passes::io::normal_test_cos(s.still_normal_degrees),
             tap_sigma: s.tap_sigma_fraction.clamp(0.0, 4.0),
         }
     }
-}
-
-/// The reprojections' normal test as a cosine: 180 degrees or more passes every normal.
-pub fn normal_test_cos(degrees: f32) -> f32 {
-    if degrees >= 180.0 { -2.0 } else { degrees.max(0.0).to_radians().cos() }
 }
 
 /// Pixels whose matte history the temporal stage rejected this frame (disoccluded, or a
@@ -244,7 +239,7 @@ impl MatteChain {
 
     pub fn new(gpu: &Gpu, i: &ChainInputs, motion: crate::gpu::Motion) -> Result<MatteChain> {
         let mut stages = vec![];
-        let prior = super::cache::prior_module(&i.io);
+        let prior = crate::passes::cache::prior_module(&i.io);
         for (kind, label) in STAGES {
             let entry = match kind {
                 Kind::MinH => "min_h",

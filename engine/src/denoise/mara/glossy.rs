@@ -5,9 +5,9 @@
 //! `glossy/bilateral_v`. The composite then remodulates the output with F(w_s).
 //! Runs in scenes with a specular lobe when the denoiser is on; [`GlossySettings`] switches it.
 
-use super::chain::ChainStage;
-use super::io::FrameIo;
 use crate::gpu::{Bindings, Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
+use crate::passes::chain::ChainStage;
+use crate::passes::io::FrameIo;
 use crate::settings::{GlossySettings, MAX_GLOSSY_SIGMA_PX, ReflectionMv, STILL_FRAMES_MAX};
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
@@ -76,7 +76,7 @@ impl GlossyParams {
             representative_traced: s.trace_representative_ray as u32,
             sigma_full_frames: s.sigma_full_frames,
             static_view: static_view as u32,
-            reprojection_min_cos: super::matte::normal_test_cos(s.reprojection_normal_degrees),
+            reprojection_min_cos: crate::passes::io::normal_test_cos(s.reprojection_normal_degrees),
             resampled_history_frames: s.resampled_history_frames.clamp(0.0, 1024.0),
             still_frames: s.still_frames.clamp(0.0, STILL_FRAMES_MAX),
         }

@@ -1,18 +1,21 @@
-//! The denoiser of Mara et al. 2017 (§3.4, Figure 2): the matte chain (stages 3-7,
-//! `passes/matte.rs`) and, in scenes with a specular lobe, the glossy chain (stages 8-10 with
-//! Voorhuis's reflection reprojection, `passes/glossy.rs`). TAA follows both chains' temporal
-//! outputs ([`TaaFollow`]).
+//! The denoiser of Mara et al. 2017 (§3.4, Figure 2): the matte chain (stages 3-7, [`matte`])
+//! and, in scenes with a specular lobe, the glossy chain (stages 8-10 with Voorhuis's
+//! reflection reprojection, [`glossy`]; SVGF's glossy signal reuses its reflection motion).
+//! TAA follows both chains' temporal outputs ([`TaaFollow`]). Its settings are
+//! `settings/mara.rs` (what the registry knows), `settings/matte.rs` and `settings/glossy.rs`;
+//! its WGSL is `shaders/matte/` and `shaders/glossy/`.
+
+pub mod glossy;
+pub mod matte;
 
 use super::{Denoised, Denoiser, DenoiserScene, FrameContext, Outputs};
 use crate::gpu::{Gpu, GpuMemory, Parity, Recorder};
 use crate::passes::chain::made_for;
-use crate::passes::glossy::{
-    GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams, MotionProgram,
-};
 use crate::passes::io::FrameIo;
-use crate::passes::matte::{ChainInputs, MatteChain, MatteParams, MatteTargets};
 use crate::passes::taa::{GlossyFollow, MatteFollow, MatteState, TaaFollow};
 use anyhow::{Context, Result};
+use glossy::{GlossyChain, GlossyChainTargets, GlossyInputs, GlossyParams, MotionProgram};
+use matte::{ChainInputs, MatteChain, MatteParams, MatteTargets};
 
 pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     let mut memory = GpuMemory::default();
