@@ -420,3 +420,36 @@ fn svgf_shares_its_transients_memory_without_changing_the_image() {
     let floats: &[f32] = bytemuck::cast_slice(&kept);
     assert!(floats.iter().all(|v| v.is_finite()) && floats.iter().any(|v| *v > 0.0));
 }
+
+/// The trace writes the glossy path's reflection data (the virtual position, the mirror
+/// direction, what the glossy path hit: 28 bytes a pixel) only while a stage reads it: the raw
+/// frame and the progressive filter hold none, Mara makes it, a switch back drops it, and a
+/// kept `trace/reflection` brings it back to the raw frame. The image does not depend on it:
+/// the raw frame's is the same, bit for bit, with the data written and without.
+#[test]
+fn the_reflection_data_is_written_only_while_something_reads_it() {
+    // The trace's outputs: their count and bytes a pixel.
+    let trace = |r: &Renderer| {
+        let a: Vec<(String, u64)> =
+            r.allocations().into_iter().filter(|(l, _)| l.starts_with("trace/")).collect();
+        let bytes: u64 = a.iter().map(|(_, b)| b).sum();
+        (a.len(), bytes as f64 / (SIZE.0 * SIZE.1) as f64)
+    };
+    let none = with(DenoiserName::NONE);
+    let (gpu, mut r) = level();
+    let plain = render(&mut r, &gpu, &none, 2);
+    // Matte, direct and glossy light, 8 bytes each.
+    assert_eq!(trace(&r), (3, 24.0), "{:?}", labels(&r));
+    render(&mut r, &gpu, &with(DenoiserName::PROGRESSIVE), 1);
+    assert_eq!(trace(&r), (3, 24.0), "{:?}", labels(&r));
+    render(&mut r, &gpu, &with(DenoiserName::MARA), 1);
+    assert_eq!(trace(&r), (6, 52.0), "{:?}", labels(&r));
+    render(&mut r, &gpu, &none, 1);
+    assert_eq!(trace(&r), (3, 24.0), "{:?}", labels(&r));
+    let (gpu, mut kept) = level();
+    kept.keep(&["trace/reflection"]);
+    let written = render(&mut kept, &gpu, &none, 2);
+    assert_eq!(trace(&kept), (6, 52.0));
+    let same = plain.data.iter().zip(&written.data).all(|(x, y)| x.to_array() == y.to_array());
+    assert!(same, "writing the reflection data changed the raw frame");
+}

@@ -91,6 +91,15 @@ pub trait Denoiser {
     /// `prev_normal`, `prev_object`); the frame then keeps them (16 bytes per pixel).
     fn needs_previous_gbuffer(&self) -> bool;
 
+    /// Whether its stages read the glossy path's reflection data (`tr_reflection`, `tr_mirror`,
+    /// `tr_mirror_hit`: the virtual position, the mirror direction and what the glossy path hit,
+    /// Voorhuis §4), or offer TAA a glossy light to follow (TAA demodulates it with them). The
+    /// frame writes and keeps them (28 bytes a pixel) only while such a denoiser runs; the
+    /// default, false, leaves them out, and a program that binds them then fails to make.
+    fn reads_reflections(&self) -> bool {
+        false
+    }
+
     /// Make its per-pixel textures in `memory` (labelled `name/...`), for frame targets of
     /// `size`. `kept`: the frame reads the textures whose labels start with one of these after
     /// the denoiser, besides its outputs (a debug view, a test's readback), so they must then

@@ -324,7 +324,8 @@ impl Renderer {
     /// ([`Renderer::read_texture`]; `&["svgf/"]` keeps all of SVGF's, and then no two of its
     /// textures share memory): a denoiser's intermediate otherwise shares its memory with a
     /// later texture of the frame, and holds that one's texels once the frame ends. The next
-    /// frame places them again.
+    /// frame places them again. The trace's reflection data (`trace/reflection`, `trace/mirror`)
+    /// is written only while something reads it; naming it here makes every frame write it.
     pub fn keep(&mut self, prefixes: &[&str]) {
         self.kept = prefixes.iter().map(|l| l.to_string()).collect();
     }

@@ -83,6 +83,7 @@ impl Renderer {
             // TAA's test of what a move uncovered reads the previous depth.
             t.ensure_previous(gpu);
         }
+        self.reflections(gpu, settings, denoiser);
         let (samples, period) = self.sampling(gpu, settings, denoiser)?;
         let (traced, primary_samples, prefilter) = self.primaries(gpu, input, settings, samples)?;
         let cache = settings.cache.enabled && denoiser.is_some();
@@ -256,6 +257,21 @@ impl Renderer {
         Ok(Some(i))
     }
 
+    /// The trace writes the glossy path's reflection data where the active denoiser reads it,
+    /// the view shows it or [`Renderer::keep`] names it, and drops it otherwise (28 bytes a
+    /// pixel in a glossy scene).
+    fn reflections(&mut self, gpu: &Gpu, settings: &FrameSettings, denoiser: Option<usize>) {
+        use crate::passes::trace::REFLECTION_LABELS;
+        let read = denoiser.is_some_and(|i| self.denoisers[i].denoiser.reads_reflections());
+        let shown = settings.view.spec().is_some_and(|v| REFLECTION_LABELS.contains(&v.texture));
+        let kept = self.kept.iter().any(|k| REFLECTION_LABELS.iter().any(|l| l.starts_with(k)));
+        let shown = shown || kept;
+        let t = &mut self.targets;
+        if t.trace.set_reflections(gpu, &mut t.memory, t.size, read || shown) {
+            t.generation += 1;
+        }
+    }
+
     /// Only the active denoiser (`active`, an index in `denoisers`) holds textures: every other
     /// one drops its own, and the frame's memory forgets them.
     fn release_denoisers(&mut self, active: Option<usize>) {
@@ -379,7 +395,9 @@ impl Renderer {
         let (size, h) = (self.targets.size, &self.history);
         let g = &settings.glossy;
         // The glossy chain's reflection motion wants the representative ray of glossy surfaces.
+        // Only the reflection data (the virtual position) reads the representative ray's hit.
         let representative = if denoised
+            && self.targets.trace.has_reflections()
             && g.trace_representative_ray
             && g.reflection_mv != crate::settings::ReflectionMv::Primary
         {

@@ -97,11 +97,13 @@ impl<'a> FrameIo<'a> {
             .texture_opt("cache_prior_m2", self.cache_prior.map(|p| p.1))
             .texture_opt("gb_uncertainty", self.feature_uncertainty);
         if let Some(gl) = &t.glossy {
-            b = b
-                .texture("tr_glossy", &gl.light.1)
-                .texture("tr_reflection", &gl.reflection.1)
-                .texture("tr_mirror", &gl.mirror.1)
-                .texture("tr_mirror_hit", &gl.mirror_hit.1);
+            b = b.texture("tr_glossy", &gl.light.1);
+            if let Some(r) = &gl.reflections {
+                b = b
+                    .texture("tr_reflection", &r.reflection.1)
+                    .texture("tr_mirror", &r.mirror.1)
+                    .texture("tr_mirror_hit", &r.mirror_hit.1);
+            }
         }
         if let Some(m) = self.mixed {
             b = b.texture("tr_matte", &m.matte.1).texture("tr_direct", &m.direct.1);

@@ -86,16 +86,13 @@ pub fn modules(stage: &'static str, glossy: bool) -> Vec<&'static str> {
 }
 
 /// The samples program: the trace's (it shades as the trace does) and the supersampling's.
-pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
+/// `reflections`: the trace writes the glossy path's reflection data this frame.
+pub fn sample_modules(scene: &GpuScene, reflections: bool) -> Vec<&'static str> {
     let mut m = scene.shading_modules();
     m.push("realtime/frame.wgsl");
     m.push("realtime/lens.wgsl");
     m.push("realtime/area_light.wgsl");
-    m.push(if scene.features.glossy {
-        "realtime/trace_glossy.wgsl"
-    } else {
-        "realtime/trace_glossy_none.wgsl"
-    });
+    m.push(super::trace::glossy_module(scene.features.glossy, reflections));
     // Its samples trace frame.paths: the uncovered pixels' extra paths are the guide's.
     m.extend([
         "realtime/uncovered_none.wgsl",
@@ -107,7 +104,8 @@ pub fn sample_modules(scene: &GpuScene) -> Vec<&'static str> {
 }
 
 pub struct Supersample {
-    samples: Option<(Reloadable<wgpu::ComputePipeline>, BindCache)>,
+    /// The samples program, and whether it writes the reflection data.
+    samples: Option<(Reloadable<wgpu::ComputePipeline>, BindCache, bool)>,
     stages: Option<[ChainStage<()>; 3]>,
 }
 
@@ -119,7 +117,7 @@ impl Supersample {
     /// Its pipelines, for hot reload.
     pub fn pipelines(&mut self) -> Vec<&mut dyn Reload> {
         let mut v: Vec<&mut dyn Reload> = vec![];
-        if let Some((p, _)) = self.samples.as_mut() {
+        if let Some((p, _, _)) = self.samples.as_mut() {
             v.push(p);
         }
         if let Some(s) = self.stages.as_mut() {
@@ -153,17 +151,21 @@ impl Supersample {
     ) -> Result<()> {
         let (gpu, scene, size) = (rec.gpu, trace.scene.scene, io.size);
         let sample_bindings = Self::own(t, trace.bindings());
-        let (p, cache) = super::chain::made(&mut self.samples, || {
+        let reflections = trace.t.has_reflections();
+        if self.samples.as_ref().is_some_and(|s| s.2 != reflections) {
+            self.samples = None;
+        }
+        let (p, cache, _) = super::chain::made(&mut self.samples, || {
             let p = Reloadable::new(
                 gpu,
                 SAMPLES,
                 &scene.prelude(),
-                &sample_modules(scene),
+                &sample_modules(scene, reflections),
                 wgpu::ShaderStages::COMPUTE,
                 &sample_bindings,
                 |d, m, l| compute_pipeline(d, SAMPLES, m, l, "samples"),
             )?;
-            Ok((p, BindCache::default()))
+            Ok((p, BindCache::default(), reflections))
         })?;
         let groups =
             cache.get(key, p.builds(), (), |_| p.bind_groups(&gpu.device, &sample_bindings))?;

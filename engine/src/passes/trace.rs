@@ -5,7 +5,8 @@
 //! (Rgba16Float, 8), the virtual position with that distance (Rgba32Float, 16: positions need
 //! f32), the representative mirror direction (two snorm16 in R32Uint, 4) and what the glossy
 //! path hit first: its reflectance and normal (Rg32Uint, 8), which the glossy chain uses behind
-//! mirrors (Voorhuis §4.1).
+//! mirrors (Voorhuis §4.1). The last three (28 bytes) are written only while a stage reads them
+//! ([`TraceTargets::set_reflections`]).
 
 use super::gbuffer::{Channel, GBufferTargets};
 pub use super::scene::SceneInputs;
@@ -29,27 +30,75 @@ pub struct TraceTargets {
 
 pub struct GlossyTargets {
     pub light: (wgpu::Texture, wgpu::TextureView),
+    /// What the glossy chains reproject and demodulate with (Voorhuis §4): made only while a
+    /// stage reads them ([`TraceTargets::set_reflections`]).
+    pub reflections: Option<Reflections>,
+}
+
+/// The glossy path's reflection data: the virtual position with the secondary hit distance,
+/// the representative mirror direction and what the glossy path hit first (28 bytes a pixel).
+pub struct Reflections {
     pub reflection: (wgpu::Texture, wgpu::TextureView),
     pub mirror: (wgpu::Texture, wgpu::TextureView),
     pub mirror_hit: (wgpu::Texture, wgpu::TextureView),
 }
 
+/// The labels of [`Reflections`]' textures.
+pub const REFLECTION_LABELS: [&str; 3] = ["trace/reflection", "trace/mirror", "trace/mirror hit"];
+
+fn usage() -> wgpu::TextureUsages {
+    wgpu::TextureUsages::STORAGE_BINDING
+        | wgpu::TextureUsages::TEXTURE_BINDING
+        | wgpu::TextureUsages::COPY_SRC
+}
+
 impl TraceTargets {
+    /// The trace's outputs for frames of `size`; with `glossy` the glossy light (the reflection
+    /// data waits for a stage that reads it).
     pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32), glossy: bool) -> TraceTargets {
-        let usage = wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC;
         let d = &gpu.device;
         TraceTargets {
-            matte: mem.texture(d, "trace/matte", size, MATTE_FORMAT, usage),
-            direct: mem.texture(d, "trace/direct", size, MATTE_FORMAT, usage),
+            matte: mem.texture(d, "trace/matte", size, MATTE_FORMAT, usage()),
+            direct: mem.texture(d, "trace/direct", size, MATTE_FORMAT, usage()),
             glossy: glossy.then(|| GlossyTargets {
-                light: mem.texture(d, "trace/glossy", size, MATTE_FORMAT, usage),
-                reflection: mem.texture(d, "trace/reflection", size, REFLECTION_FORMAT, usage),
-                mirror: mem.texture(d, "trace/mirror", size, MIRROR_FORMAT, usage),
-                mirror_hit: mem.texture(d, "trace/mirror hit", size, MIRROR_HIT_FORMAT, usage),
+                light: mem.texture(d, "trace/glossy", size, MATTE_FORMAT, usage()),
+                reflections: None,
             }),
         }
+    }
+
+    /// Make (`on`) or drop the reflection data; true if it changed. Only Mara's and SVGF's
+    /// glossy chains (and TAA following their glossy light) read it, so the raw frame and the
+    /// progressive filter neither write nor keep it.
+    pub fn set_reflections(
+        &mut self,
+        gpu: &Gpu,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        on: bool,
+    ) -> bool {
+        let Some(g) = self.glossy.as_mut() else { return false };
+        if g.reflections.is_some() == on {
+            return false;
+        }
+        if on {
+            let [r, m, h] = REFLECTION_LABELS;
+            let d = &gpu.device;
+            g.reflections = Some(Reflections {
+                reflection: mem.texture(d, r, size, REFLECTION_FORMAT, usage()),
+                mirror: mem.texture(d, m, size, MIRROR_FORMAT, usage()),
+                mirror_hit: mem.texture(d, h, size, MIRROR_HIT_FORMAT, usage()),
+            });
+        } else {
+            g.reflections = None;
+            mem.forget_labels(&REFLECTION_LABELS.map(str::to_string));
+        }
+        true
+    }
+
+    /// Whether the trace writes the reflection data this frame.
+    pub fn has_reflections(&self) -> bool {
+        self.glossy.as_ref().is_some_and(|g| g.reflections.is_some())
     }
 }
 
@@ -71,6 +120,8 @@ struct TraceProgram {
     cache: bool,
     /// The previous depth tells which pixels a move uncovered.
     previous_depth: bool,
+    /// It writes the glossy path's reflection data ([`Reflections`]).
+    reflections: bool,
 }
 
 impl TraceProgram {
@@ -79,7 +130,18 @@ impl TraceProgram {
             moving: inputs.scene.moving,
             cache: inputs.cache.is_some(),
             previous_depth: inputs.previous_depth.is_some(),
+            reflections: inputs.t.has_reflections(),
         }
+    }
+}
+
+/// The module that writes the glossy outputs: all of them where a stage reads the reflection
+/// data, the light alone where none does, nothing in a scene without a specular lobe.
+pub fn glossy_module(glossy: bool, reflections: bool) -> &'static str {
+    match (glossy, reflections) {
+        (true, true) => "realtime/trace_glossy.wgsl",
+        (true, false) => "realtime/trace_glossy_light.wgsl",
+        (false, _) => "realtime/trace_glossy_none.wgsl",
     }
 }
 
@@ -96,11 +158,7 @@ fn program(
     modules.push("realtime/frame.wgsl");
     modules.push("realtime/lens.wgsl");
     modules.push("realtime/area_light.wgsl");
-    modules.push(if scene.features.glossy {
-        "realtime/trace_glossy.wgsl"
-    } else {
-        "realtime/trace_glossy_none.wgsl"
-    });
+    modules.push(glossy_module(scene.features.glossy, inputs.t.has_reflections()));
     if inputs.previous_depth.is_some() {
         modules.extend(["realtime/seen.wgsl", "realtime/uncovered.wgsl"]);
     } else {
@@ -152,11 +210,13 @@ fn bindings<'a>(s: SceneInputs<'a>, g: &'a GBufferTargets, t: &'a TraceTargets) 
         .texture("out_matte", &t.matte.1)
         .texture("out_direct", &t.direct.1);
     if let Some(gl) = &t.glossy {
-        b = b
-            .texture("out_glossy", &gl.light.1)
-            .texture("out_reflection", &gl.reflection.1)
-            .texture("out_mirror", &gl.mirror.1)
-            .texture("out_mirror_hit", &gl.mirror_hit.1);
+        b = b.texture("out_glossy", &gl.light.1);
+        if let Some(r) = &gl.reflections {
+            b = b
+                .texture("out_reflection", &r.reflection.1)
+                .texture("out_mirror", &r.mirror.1)
+                .texture("out_mirror_hit", &r.mirror_hit.1);
+        }
     }
     b
 }
@@ -167,6 +227,8 @@ impl TracePass {
     pub fn new(gpu: &Gpu, inputs: &TraceInputs) -> Result<TracePass> {
         let scene = SceneInputs { moving: false, ..inputs.scene };
         let common = TraceInputs { scene, cache: None, previous_depth: None, ..*inputs };
+        // The frame's first targets have no reflection data yet: this program is the raw
+        // frame's.
         let (what, p) = (TraceProgram::of(&common), program(gpu, &common, false)?);
         Ok(TracePass { programs: vec![(what, p, BindCache::default())] })
     }

@@ -362,11 +362,13 @@ pub(super) fn all_programs() -> Vec<Program> {
             let mut reference = m.clone();
             reference.push("reference/trace.wgsl");
             v.push(compose(&format!("trace {bvh} {i}"), &prelude, &reference).unwrap());
-            let glossy = if i % 2 == 0 {
-                "realtime/trace_glossy.wgsl"
-            } else {
-                "realtime/trace_glossy_none.wgsl"
-            };
+            // Every glossy output: all, the light alone (no stage reads the reflection data),
+            // none.
+            let glossy = [
+                "realtime/trace_glossy.wgsl",
+                "realtime/trace_glossy_light.wgsl",
+                "realtime/trace_glossy_none.wgsl",
+            ][i % 3];
             let mut primaries = m.clone();
             primaries.extend([
                 "realtime/frame.wgsl",

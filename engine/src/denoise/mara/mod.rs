@@ -47,6 +47,11 @@ impl Denoiser for Mara {
         true
     }
 
+    /// The glossy chain reprojects along the virtual position and demodulates behind mirrors.
+    fn reads_reflections(&self) -> bool {
+        true
+    }
+
     /// Every texture outlives the frame (TAA follows the temporal outputs, the rest are a few
     /// bytes a pixel), so `kept` holds already.
     fn allocate(

@@ -473,6 +473,11 @@ impl Denoiser for Svgf {
         true
     }
 
+    /// The glossy signal's reflection motion and features read them.
+    fn reads_reflections(&self) -> bool {
+        true
+    }
+
     fn allocate(
         &mut self,
         gpu: &Gpu,
