@@ -225,9 +225,11 @@ fn the_default_level_renders_without_nan() {
     assert!(
         r.prepared.features.glossy && r.prepared.features.animated && r.prepared.features.textures
     );
-    // The views below are drawn after the frames: SVGF's intermediates must outlive them (a
-    // frame keeps the texture of the view it renders with, and no other).
-    r.keep(&["svgf/"]);
+    // The views below are drawn after the frames: SVGF's and the progressive filter's
+    // intermediates must outlive them (a frame keeps the texture of the view it renders with,
+    // and no other), and the trace must write its reflection data, which it writes only while
+    // something reads it.
+    r.keep(&["svgf/", "progressive/", "trace/"]);
     // Each built-in denoiser in turn: the frame's views and its own.
     for entry in hush_engine::denoise::entries().iter().filter(|e| e.make.is_some()) {
         let mut denoised = FrameSettings {
