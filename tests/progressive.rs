@@ -334,6 +334,8 @@ fn taa_follows_the_light_only_where_a_pixel_holds_two_samples() {
 fn the_first_level_feeds_the_history_of_young_traced_pixels() {
     let (gpu, mut r) =
         Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    // The matte signal's variance output and scratch level are read after the frame.
+    r.keep(&["progressive/matte"]);
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let feedback = 2.0;
     let p = ProgressiveSettings { levels: 2, feedback_samples: feedback, ..Default::default() };
@@ -421,6 +423,8 @@ fn an_atrous_level_matches_a_cpu_implementation() {
 fn atrous_level_matches_the_cpu(p: ProgressiveSettings) {
     let (gpu, mut r) =
         Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    // The matte signal's variance output is read after the frame (the signals share it).
+    r.keep(&["progressive/matte"]);
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let s = progressive(1, p.clone());
     for _ in 0..6 {
@@ -530,6 +534,8 @@ fn atrous_level_matches_the_cpu(p: ProgressiveSettings) {
 fn progressive_nonfinite_input_never_reaches_history_or_screen() {
     let (gpu, mut r) =
         Renderer::headless(hush_engine::scene::default_level(), BvhKind::DEFAULT, SIZE).unwrap();
+    // Every signal's intermediates are read after the frames: each keeps its own, unshared.
+    r.keep(&["progressive/"]);
     let input = FrameInput { camera: view(), time: 0.0, shutter: None };
     let mut cases = vec![];
     for period in [1, 4] {

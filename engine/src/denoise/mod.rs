@@ -101,19 +101,27 @@ pub trait Denoiser {
     }
 
     /// Make its per-pixel textures in `memory` (labelled `name/...`), for frame targets of
-    /// `size`. `kept`: the frame reads the textures whose labels start with one of these after
-    /// the denoiser, besides its outputs (a debug view, a test's readback), so they must then
-    /// hold what this frame wrote; a denoiser whose
-    /// intermediates share memory ([`crate::gpu::graph`]) keeps them apart. Called again after a
-    /// resize, when `kept` changes, and when the denoiser is chosen again after another (the
-    /// frame forgets an inactive denoiser's textures: [`Denoiser::release`]).
+    /// `size` and frames with `settings`. `kept`: the frame reads the textures whose labels
+    /// start with one of these after the denoiser, besides its outputs (a debug view, a test's
+    /// readback), so they must then hold what this frame wrote; a denoiser whose intermediates
+    /// share memory ([`crate::gpu::graph`]) keeps them apart. Called again after a resize, when
+    /// `kept` or [`Denoiser::layout`] changes, and when the denoiser is chosen again after
+    /// another (the frame forgets an inactive denoiser's textures: [`Denoiser::release`]).
     fn allocate(
         &mut self,
         gpu: &Gpu,
         memory: &mut GpuMemory,
         size: (u32, u32),
         kept: &[String],
+        settings: &FrameSettings,
     ) -> Result<()>;
+
+    /// What of `settings` its textures' placement depends on (the progressive filter's level
+    /// count decides which of its textures the composite reads): the frame allocates again when
+    /// it changes. The default, 0: nothing.
+    fn layout(&self, _settings: &FrameSettings) -> u64 {
+        0
+    }
 
     /// Drop its per-pixel textures: another denoiser runs now, and only the active one holds
     /// memory. Its pipelines stay, for a switch back.

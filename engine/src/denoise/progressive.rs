@@ -23,7 +23,7 @@ use crate::passes::taa::{MatteFollow, MatteState, TaaFollow};
 use crate::settings::{
     FrameSettings, PROGRESSIVE_MAX_LEVELS, ProgressiveSettings, STILL_FRAMES_MAX,
 };
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use bytemuck::{Pod, Zeroable};
 
 const RGBA16F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -155,7 +155,8 @@ pub fn make(gpu: &Gpu, scene: &DenoiserScene) -> Result<Box<dyn Denoiser>> {
     Ok(Box::new(Progressive { scene: *scene, res, stages: None, signals }))
 }
 
-/// One signal's textures: 96 bytes per pixel.
+/// One signal's textures: 96 bytes per pixel with one texture each; 56 where the variance
+/// stage's output and the levels' scratch are shared ([`Placement`]).
 pub struct SignalTargets {
     /// The accumulated light (rgb) by parity: this frame's is next frame's history.
     pub history: PingPong<Tex>,
@@ -167,22 +168,87 @@ pub struct SignalTargets {
     pub pong: Tex,
 }
 
+/// Where the filter's per-frame textures live for a level count. Each signal's last level is
+/// what the composite (and TAA) reads, so it is the signal's own; with one level or more the
+/// variance stage's output and the other texture of the ping-pong are dead once the signal's
+/// levels ran, and the signals, recorded one after another, share one of each (48 bytes a pixel
+/// less with three signals). With no level the variance stage's output is what the composite
+/// reads, and nothing is shared. A texture the frame keeps (a view, a readback) is its own.
+/// A change of placement (no level to some, or the last level's parity) makes the textures
+/// again, and the histories restart from nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Placement {
+    levels: usize,
+}
+
+impl Placement {
+    fn of(s: &FrameSettings) -> Placement {
+        Placement { levels: levels_of(s).count }
+    }
+
+    /// What the placement depends on: no level, or the parity of the last one.
+    fn key(self) -> u64 {
+        match self.levels {
+            0 => 0,
+            l => 1 + (l % 2) as u64,
+        }
+    }
+}
+
+/// This frame's levels from the settings.
+fn levels_of(s: &FrameSettings) -> Levels {
+    let p = &s.progressive;
+    Levels {
+        count: p.levels.min(PROGRESSIVE_MAX_LEVELS) as usize,
+        feedback: p.feedback_samples > 0.0 && p.levels > 0,
+    }
+}
+
+/// The shared textures of a [`Placement`], made by the first signal that needs them.
+#[derive(Default)]
+struct Shared {
+    variance: Option<Tex>,
+    scratch: Option<Tex>,
+}
+
 impl SignalTargets {
-    fn new(d: &wgpu::Device, mem: &mut GpuMemory, size: (u32, u32), name: &str) -> SignalTargets {
+    fn new(
+        d: &wgpu::Device,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        name: &str,
+        (placement, shared, kept): (Placement, &mut Shared, &[String]),
+    ) -> SignalTargets {
         let rw = wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
-        let mut t =
-            |label: &str, f| mem.texture(d, &format!("progressive/{name} {label}"), size, f, rw);
-        SignalTargets {
-            // 32-bit: a half float stalls a 1 / age mean after about a thousand samples.
-            history: PingPong::new(|i| t(&format!("history {i}"), RGBA32F)),
-            moments: PingPong::new(|i| t(&format!("moments {i}"), RGBA32F)),
-            // 32-bit: with feedback, the first level writes it back into the history.
-            variance: t("variance", RGBA32F),
-            ping: t("ping", RGBA16F),
-            pong: t("pong", RGBA16F),
-        }
+        let label = |what: &str| format!("progressive/{name} {what}");
+        let share = |what: &str| {
+            let l = label(what);
+            placement.levels > 0 && !kept.iter().any(|k| l.starts_with(k.as_str()))
+        };
+        let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
+        // 32-bit: a half float stalls a 1 / age mean after about a thousand samples.
+        let history = PingPong::new(|i| t(&label(&format!("history {i}")), RGBA32F));
+        let moments = PingPong::new(|i| t(&label(&format!("moments {i}")), RGBA32F));
+        // 32-bit: with feedback, the first level writes it back into the history.
+        let variance = match share("variance") {
+            true => {
+                shared.variance.get_or_insert_with(|| t("progressive/variance", RGBA32F)).clone()
+            }
+            false => t(&label("variance"), RGBA32F),
+        };
+        // Level i of n writes pong for even i, ping for odd: the last is pong for odd n.
+        let (last, other) =
+            if placement.levels % 2 == 1 { ("pong", "ping") } else { ("ping", "pong") };
+        let last_tex = t(&label(last), RGBA16F);
+        let other_tex = match share(other) {
+            true => shared.scratch.get_or_insert_with(|| t("progressive/scratch", RGBA16F)).clone(),
+            false => t(&label(other), RGBA16F),
+        };
+        let (ping, pong) =
+            if last == "ping" { (last_tex, other_tex) } else { (other_tex, last_tex) };
+        SignalTargets { history, moments, variance, ping, pong }
     }
 
     /// What the last of `levels` levels wrote (the variance stage's output when none ran).
@@ -227,6 +293,8 @@ struct Targets {
     features: Tex,
     signals: Vec<(Signal, SignalTargets)>,
     levels: Levels,
+    /// The level count the textures were placed for.
+    placement: Placement,
 }
 
 /// This frame's a-trous levels: how many, and whether the first feeds the history (both pick
@@ -403,25 +471,36 @@ impl Denoiser for Progressive {
     }
 
     /// Each signal's last level is what the composite reads, and which texture that is follows
-    /// the level count: every texture outlives the frame, so `kept` holds already.
+    /// the level count ([`Placement`]); what the frame keeps is each signal's own.
     fn allocate(
         &mut self,
         gpu: &Gpu,
         memory: &mut GpuMemory,
         size: (u32, u32),
-        _kept: &[String],
+        kept: &[String],
+        settings: &FrameSettings,
     ) -> Result<()> {
         let rw = wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         let features = memory.texture(&gpu.device, "progressive/features", size, RGBA32F, rw);
+        let placement = Placement::of(settings);
+        let mut shared = Shared::default();
         let signals = self
             .signals
             .iter()
-            .map(|&s| (s, SignalTargets::new(&gpu.device, memory, size, s.name())))
+            .map(|&s| {
+                let how = (placement, &mut shared, kept);
+                (s, SignalTargets::new(&gpu.device, memory, size, s.name(), how))
+            })
             .collect();
-        self.res.targets = Some(Targets { features, signals, levels: Levels::default() });
+        let levels = Levels::default();
+        self.res.targets = Some(Targets { features, signals, levels, placement });
         Ok(())
+    }
+
+    fn layout(&self, settings: &FrameSettings) -> u64 {
+        Placement::of(settings).key()
     }
 
     fn release(&mut self) {
@@ -444,11 +523,11 @@ impl Denoiser for Progressive {
         let gpu = rec.gpu;
         let Progressive { scene, res, stages, .. } = self;
         let missing = "the progressive filter records before its textures exist";
-        let p = &cx.settings.progressive;
-        res.targets.as_mut().context(missing)?.levels = Levels {
-            count: p.levels.min(PROGRESSIVE_MAX_LEVELS) as usize,
-            feedback: p.feedback_samples > 0.0 && p.levels > 0,
-        };
+        let t = res.targets.as_mut().context(missing)?;
+        t.levels = levels_of(cx.settings);
+        if t.placement.key() != Placement::of(cx.settings).key() {
+            bail!("the progressive filter's textures were placed for another level count");
+        }
         let t = res.targets.as_ref().context(missing)?;
         res.write_params(gpu, cx);
         let (key, parity, size, levels) = (cx.key, cx.parity, io.size, t.levels);

@@ -89,6 +89,8 @@ struct MadeDenoiser {
     name: String,
     epoch: Option<u64>,
     kept: Vec<String>,
+    /// [`Denoiser::layout`] of the settings it was allocated for.
+    layout: u64,
     labels: Vec<String>,
     denoiser: Box<dyn Denoiser>,
 }

@@ -228,7 +228,8 @@ impl Renderer {
                     make(gpu, &scene).with_context(|| format!("creating the {name} denoiser"))?;
                 let (kept, labels) = (vec![], vec![]);
                 let name = name.to_string();
-                self.denoisers.push(MadeDenoiser { name, epoch: None, kept, labels, denoiser });
+                let d = MadeDenoiser { name, epoch: None, kept, layout: 0, labels, denoiser };
+                self.denoisers.push(d);
                 self.denoisers.len() - 1
             }
         };
@@ -237,18 +238,19 @@ impl Renderer {
         let mut kept = self.kept.clone();
         kept.extend(settings.view.spec().map(|v| v.texture.to_string()));
         let d = &mut self.denoisers[i];
-        if d.epoch != Some(t.epoch) || d.kept != kept {
-            // Made again for a new size, or placed again for other textures to keep: what it
-            // made before in these targets goes.
+        let layout = d.denoiser.layout(settings);
+        if d.epoch != Some(t.epoch) || d.kept != kept || d.layout != layout {
+            // Made again for a new size, or placed again for other textures to keep or other
+            // settings: what it made before in these targets goes.
             if d.epoch == Some(t.epoch) {
                 t.memory.forget_labels(&d.labels);
             }
             let before = t.memory.labels();
             d.denoiser
-                .allocate(gpu, &mut t.memory, t.size, &kept)
+                .allocate(gpu, &mut t.memory, t.size, &kept, settings)
                 .with_context(|| format!("allocating the {name} denoiser's textures"))?;
             d.labels = t.memory.labels().into_iter().filter(|l| !before.contains(l)).collect();
-            (d.epoch, d.kept) = (Some(t.epoch), kept);
+            (d.epoch, d.kept, d.layout) = (Some(t.epoch), kept, layout);
             t.generation += 1;
         }
         if d.denoiser.needs_previous_gbuffer() {

@@ -8,7 +8,7 @@
 pub mod glossy;
 pub mod matte;
 
-use super::{Denoised, Denoiser, DenoiserScene, FrameContext, Outputs};
+use super::{Denoised, Denoiser, DenoiserScene, FrameContext, FrameSettings, Outputs};
 use crate::gpu::{Gpu, GpuMemory, Parity, Recorder};
 use crate::passes::chain::made_for;
 use crate::passes::io::FrameIo;
@@ -60,6 +60,7 @@ impl Denoiser for Mara {
         memory: &mut GpuMemory,
         size: (u32, u32),
         _kept: &[String],
+        _settings: &FrameSettings,
     ) -> Result<()> {
         let d = &gpu.device;
         let glossy = self.scene.glossy.then(|| GlossyChainTargets::new(d, memory, size));

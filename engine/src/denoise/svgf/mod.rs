@@ -484,6 +484,7 @@ impl Denoiser for Svgf {
         memory: &mut GpuMemory,
         size: (u32, u32),
         kept: &[String],
+        _settings: &FrameSettings,
     ) -> Result<()> {
         let glossy = self.scene.glossy;
         let t = SvgfTargets::new(&gpu.device, memory, size, glossy, kept)
