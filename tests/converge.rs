@@ -139,3 +139,37 @@ fn the_still_view_mean_is_a_stage_disable_switches_off() {
     assert!(s.taa.enabled);
     assert_eq!(s.taa.converge_min_samples, 4.0);
 }
+
+/// The image shown goes into the composite's buffer, which TAA has read by then and nothing
+/// reads after it: 16 bytes a pixel less than a buffer of the stage's own, and the same image
+/// bit for bit. Where the frame keeps `composite/hdr` (a readback of the composite's image) the
+/// stage writes `converge/shown` instead, and the composite's image stays as the composite
+/// wrote it.
+#[test]
+fn the_image_shown_takes_the_composites_buffer_unless_the_frame_keeps_it() {
+    let frames = 8;
+    let (gpu, mut shared, input) = cornell();
+    let (gpu_k, mut kept, _) = cornell();
+    kept.keep(&["composite/hdr"]);
+    let s = settings(1.0);
+    for _ in 0..frames {
+        shared.render(&gpu, &input, &s, None).unwrap();
+        kept.render(&gpu_k, &input, &s, None).unwrap();
+    }
+    let bits = |img: &Image| -> Vec<u32> {
+        img.data.iter().flat_map(|p| p.to_array()).map(f32::to_bits).collect()
+    };
+    let shown = shared.read_hdr(&gpu).unwrap();
+    assert_eq!(bits(&shown), bits(&kept.read_hdr(&gpu_k).unwrap()), "the images differ");
+    assert_eq!(kept.bytes_per_pixel() - shared.bytes_per_pixel(), 16.0);
+    let own = |r: &Renderer| r.allocations().iter().any(|(l, _)| l == "converge/shown");
+    assert!(!own(&shared) && own(&kept));
+    let rgb = |b: Vec<u8>| -> Vec<u32> {
+        floats(&b).chunks_exact(4).flat_map(|p| p[..3].to_vec()).map(f32::to_bits).collect()
+    };
+    let hdr = |r: &Renderer, g: &Gpu| rgb(r.read_buffer(g, "composite/hdr").unwrap());
+    assert_eq!(hdr(&shared, &gpu), bits(&shown), "the shared buffer holds the image shown");
+    let composite = hdr(&kept, &gpu_k);
+    let differ = composite.iter().zip(bits(&shown)).filter(|(a, b)| **a != *b).count();
+    assert!(differ * 2 > composite.len(), "the kept composite's image is TAA's: {differ} differ");
+}

@@ -71,6 +71,8 @@ fn mara() -> FrameSettings {
 /// for tests that find on the CPU which pixels the step uncovered.
 fn step() -> (hush_engine::gpu::Gpu, Renderer, CameraStep) {
     let (gpu, mut r) = level();
+    // The composite's image is read after the step: the still-view mean must not write over it.
+    r.keep(&["composite/hdr"]);
     let moved = Camera::look_at(DVec3::new(-2.2, 1.7, 3.6), DVec3::new(-2.0, 1.2, -6.0), 60.0);
     let step = step_camera(&mut r, &gpu, &mara(), (view(), moved), 8);
     (gpu, r, step)

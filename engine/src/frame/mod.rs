@@ -328,6 +328,8 @@ impl Renderer {
     /// later texture of the frame, and holds that one's texels once the frame ends. The next
     /// frame places them again. The trace's reflection data (`trace/reflection`, `trace/mirror`)
     /// is written only while something reads it; naming it here makes every frame write it.
+    /// The composite's image (`composite/hdr`) holds the still-view mean's image once that stage
+    /// ran; naming it here gives that stage a buffer of its own (16 bytes a pixel).
     pub fn keep(&mut self, prefixes: &[&str]) {
         self.kept = prefixes.iter().map(|l| l.to_string()).collect();
     }

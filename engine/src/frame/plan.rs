@@ -189,7 +189,8 @@ impl Renderer {
             view.history_valid && view.static_view && h.converge_state.as_ref() == Some(&state);
         h.converge_state = Some(state);
         let t = &mut self.targets;
-        if self.stages.converge.allocate(gpu, &mut t.memory, t.size, t.epoch) {
+        let keep_composite = self.kept.iter().any(|k| "composite/hdr".starts_with(k.as_str()));
+        if self.stages.converge.allocate(gpu, &mut t.memory, (t.size, t.epoch), keep_composite) {
             t.generation += 1;
         }
         Some(ConvergeParams {

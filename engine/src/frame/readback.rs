@@ -76,9 +76,10 @@ impl Renderer {
     pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
         let (w, h) = self.targets.size;
         let n = w as u64 * h as u64 * 16;
-        let shown = super::record::after_taa(&self.stages.taa, &self.stages.converge)
-            .filter(|_| self.history.denoised_last.is_some())
-            .unwrap_or(&self.targets.hdr);
+        let shown =
+            super::record::after_taa(&self.stages.taa, &self.stages.converge, &self.targets.hdr)
+                .filter(|_| self.history.denoised_last.is_some())
+                .unwrap_or(&self.targets.hdr);
         let (buf, scale) = match (&self.targets.accumulation, self.history.accumulated) {
             (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
             _ => (shown, 1.0),

@@ -159,7 +159,7 @@ impl Renderer {
             let (t, u) = (&self.targets, &self.uniforms);
             let io = t.io(&u.frame, &self.gpu_scene);
             let denoised = self.history.denoised_last;
-            let after_taa = after_taa(&self.stages.taa, &self.stages.converge);
+            let after_taa = after_taa(&self.stages.taa, &self.stages.converge, &t.hdr);
             let fb = u.shown(t, &io, after_taa.filter(|_| denoised.is_some()));
             let (view, view_key) = t.view_texture(settings);
             let key = BindKey { view: view_key, ..self.bind_key(denoised) };
@@ -206,8 +206,9 @@ impl Renderer {
 pub(super) fn after_taa<'a>(
     taa: &'a TaaStage,
     converge: &'a ConvergeStage,
+    hdr: &'a wgpu::Buffer,
 ) -> Option<&'a wgpu::Buffer> {
-    converge.output().or(taa.output())
+    converge.output(hdr).or(taa.output())
 }
 
 /// What the stages read: the scene, the trace's inputs, and the frame's I/O with the
@@ -421,7 +422,7 @@ impl Stages {
     ) -> Result<()> {
         let (Some(target), Some(d)) = (target, self.display.as_mut()) else { return Ok(()) };
         let _pass = crate::profile::scope(composite::DISPLAY);
-        let after_taa = after_taa(&self.taa, &self.converge);
+        let after_taa = after_taa(&self.taa, &self.converge, &t.hdr);
         let shown = u.shown(t, io, after_taa.filter(|_| plan.denoiser.is_some()));
         let (view, view_key) = t.view_texture(plan.settings);
         d.record(rec, BindKey { view: view_key, ..plan.output_key }, &shown, view, target.view)

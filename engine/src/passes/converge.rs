@@ -7,8 +7,11 @@
 //! sample. Its settings are [`crate::settings::TaaSettings::converge_sigmas`] and
 //! `converge_min_samples`; its output, `converge/shown`, is then the image shown.
 //!
-//! Per pixel: 40 bytes of history (the mean and count, the mean square) and 16 for the image
-//! shown, allocated on the stage's first frame at a size (never where it stays off).
+//! Per pixel: 40 bytes of history (the mean and count, the mean square), allocated on the
+//! stage's first frame at a size (never where it stays off). The image shown goes into the
+//! composite's `composite/hdr`, which TAA has read and nothing reads after it in the frame;
+//! only where the frame keeps the composite's image (`Renderer::keep`) does the stage write a
+//! buffer of its own, `converge/shown` (16 bytes a pixel).
 
 use super::chain::{ChainStage, made};
 use super::io::FrameIo;
@@ -17,6 +20,8 @@ use anyhow::{Context, Result};
 
 pub const MEAN: &str = "converge/mean";
 pub const LABEL: &str = "converge";
+/// The stage's own image, made only where the frame keeps the composite's.
+pub const SHOWN: &str = "converge/shown";
 
 /// Mirrors `ConvergeParams` (shaders/taa/converge_common.wgsl).
 #[repr(C)]
@@ -34,7 +39,8 @@ struct ConvergeTargets {
     mean: PingPong<Tex>,
     /// Mean of the samples' squared length.
     m2: PingPong<Tex>,
-    shown: wgpu::Buffer,
+    /// The image shown where the frame keeps `composite/hdr`; else the stage writes that.
+    shown: Option<wgpu::Buffer>,
 }
 
 impl ConvergeTargets {
@@ -47,11 +53,27 @@ impl ConvergeTargets {
         };
         let mean = pair("mean", wgpu::TextureFormat::Rgba32Float);
         let m2 = pair("m2", wgpu::TextureFormat::R32Float);
+        ConvergeTargets { mean, m2, shown: None }
+    }
+
+    /// Make or drop the stage's own image buffer; true if it changed.
+    fn own_image(
+        &mut self,
+        device: &wgpu::Device,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        own: bool,
+    ) -> bool {
+        if self.shown.is_some() == own {
+            return false;
+        }
+        mem.forget(SHOWN);
         let usage = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
             | wgpu::BufferUsages::COPY_DST;
-        let shown = mem.buffer(device, "converge/shown", size.0 as u64 * size.1 as u64 * 16, usage);
-        ConvergeTargets { mean, m2, shown }
+        let bytes = size.0 as u64 * size.1 as u64 * 16;
+        self.shown = own.then(|| mem.buffer(device, SHOWN, bytes, usage));
+        true
     }
 }
 
@@ -84,21 +106,27 @@ impl ConvergeStage {
         })
     }
 
-    /// Make the textures for the frame targets of `epoch` (once per size); true if it did.
+    /// Make the textures for the frame targets of `epoch` (once per size), and an image buffer
+    /// of its own where `keep_composite` (the frame reads `composite/hdr` after it); true if it
+    /// made or dropped anything.
     pub fn allocate(
         &mut self,
         gpu: &Gpu,
         memory: &mut GpuMemory,
-        size: (u32, u32),
-        epoch: u64,
+        (size, epoch): ((u32, u32), u64),
+        keep_composite: bool,
     ) -> bool {
         let make = || ConvergeTargets::new(&gpu.device, memory, size);
-        super::chain::made_for_epoch(&mut self.targets, epoch, make)
+        let made = super::chain::made_for_epoch(&mut self.targets, epoch, make);
+        let Some((_, t)) = self.targets.as_mut() else { return made };
+        t.own_image(&gpu.device, memory, size, keep_composite) || made
     }
 
-    /// The image shown after this stage, if the last frame ran it.
-    pub fn output(&self) -> Option<&wgpu::Buffer> {
-        self.targets.as_ref().filter(|_| self.ran).map(|(_, t)| &t.shown)
+    /// The image shown after this stage, if the last frame ran it: `hdr` (the composite's
+    /// buffer) or the stage's own.
+    pub fn output<'a>(&'a self, hdr: &'a wgpu::Buffer) -> Option<&'a wgpu::Buffer> {
+        let (_, t) = self.targets.as_ref().filter(|_| self.ran)?;
+        Some(t.shown.as_ref().unwrap_or(hdr))
     }
 
     /// Note that this frame does not run the stage (TAA's image is shown).
@@ -138,7 +166,7 @@ impl ConvergeStage {
                 .texture("mean", &t.mean.output(p).1)
                 .texture("m2", &t.m2.output(p).1)
                 .buffer("taa_image", taa_image)
-                .buffer("shown", &t.shown)
+                .buffer("shown", t.shown.as_ref().unwrap_or(io.hdr))
         };
         let programs = made(&mut self.programs, || {
             let glossy = io.trace.glossy.is_some();
