@@ -86,7 +86,7 @@ var residual_history: texture_2d<f32>;
 var out_residual: texture_storage_2d<rgba32float, write>;
 // Average of the glossy factor F(w_s) x the mirror demodulation (TaaSettings::current_glossy).
 var glossy_factor_history: texture_2d<f32>;
-var out_glossy_factor: texture_storage_2d<rgba32float, write>;
+var out_glossy_factor: texture_storage_2d<rgba16float, write>;
 // The glossy term of the composite each history texel was last blended with
 // (TaaSettings::moving_glossy): rgb per pixel, row-major.
 var<storage, read> glossy_term_history: array<f32>;
