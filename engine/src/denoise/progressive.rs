@@ -225,7 +225,7 @@ impl SignalTargets {
         let label = |what: &str| format!("progressive/{name} {what}");
         let share = |what: &str| {
             let l = label(what);
-            placement.levels > 0 && !kept.iter().any(|k| l.starts_with(k.as_str()))
+            placement.levels > 0 && !crate::gpu::graph::is_kept(kept, &l)
         };
         let mut t = |label: &str, f| mem.texture(d, label, size, f, rw);
         // 32-bit: a half float stalls a 1 / age mean after about a thousand samples.

@@ -189,7 +189,7 @@ impl Renderer {
             view.history_valid && view.static_view && h.converge_state.as_ref() == Some(&state);
         h.converge_state = Some(state);
         let t = &mut self.targets;
-        let keep_composite = self.kept.iter().any(|k| "composite/hdr".starts_with(k.as_str()));
+        let keep_composite = crate::gpu::graph::is_kept(&self.kept, "composite/hdr");
         if self.stages.converge.allocate(gpu, &mut t.memory, (t.size, t.epoch), keep_composite) {
             t.generation += 1;
         }
@@ -267,7 +267,7 @@ impl Renderer {
         use crate::passes::trace::REFLECTION_LABELS;
         let read = denoiser.is_some_and(|i| self.denoisers[i].denoiser.reads_reflections());
         let shown = settings.view.spec().is_some_and(|v| REFLECTION_LABELS.contains(&v.texture));
-        let kept = self.kept.iter().any(|k| REFLECTION_LABELS.iter().any(|l| l.starts_with(k)));
+        let kept = REFLECTION_LABELS.iter().any(|l| crate::gpu::graph::is_kept(&self.kept, l));
         let shown = shown || kept;
         let t = &mut self.targets;
         if t.trace.set_reflections(gpu, &mut t.memory, t.size, read || shown) {

@@ -303,6 +303,12 @@ impl TransientPool {
     }
 }
 
+/// Whether the frame keeps `label` readable after it: one of `kept` (`Renderer::keep`'s
+/// prefixes, and the texture a view shows) starts it.
+pub fn is_kept(kept: &[String], label: &str) -> bool {
+    kept.iter().any(|k| label.starts_with(k.as_str()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

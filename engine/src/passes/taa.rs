@@ -81,10 +81,8 @@ impl TaaTargets {
         let mut pair = |l: &str, f| {
             PingPong::new(|i| mem.texture(device, &format!("taa/{l} {i}"), size, f, rw))
         };
-        // The glossy factor's average in half floats: on the 22 renders of docs/decisions.md
-        // FLIP against 32-bit at most 0.0011 and cornell_mirror's frame 60 unchanged. The
-        // material and the residual stay 32-bit: in halves their stalled means moved the
-        // living room's Mara frame by FLIP 0.0032 and 0.0036.
+        // The glossy factor's average in half floats (FLIP against 32-bit at most 0.0011); the
+        // material and the residual reach the image directly and stay 32-bit (docs/decisions.md).
         let (history, material, residual, glossy) = (
             pair("history", RGBA32F),
             pair("material", RGBA32F),

@@ -268,7 +268,7 @@ pub(super) fn graph(glossy: bool, kept: &[String]) -> FrameGraph {
     }
     let kept: Vec<String> = g
         .transients()
-        .filter(|t| kept.iter().any(|k| t.starts_with(k.as_str())))
+        .filter(|t| crate::gpu::graph::is_kept(kept, t))
         .map(str::to_string)
         .collect();
     for k in &kept {
