@@ -93,7 +93,7 @@ fn matte_light_at(s: Surface, rd: vec3f, cone_width: f32, rng: ptr<function, u32
     let groups = area_groups();
     let nee_select = 1.0 / f32(max(groups, 1u));
     if groups > 0u {
-        let ls = sample_area_light(s.p, rng);
+        let ls = sample_area_light(s.p, s.ng, rng);
         let wi = to_local(basis, ls.wi);
         if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
             let leg = shadow_leg(origin, s.p, ls.wi, ls.dist, eps);
@@ -102,7 +102,7 @@ fn matte_light_at(s: Surface, rd: vec3f, cone_width: f32, rng: ptr<function, u32
             }
         }
     }
-    return matte + matte_path(basis, origin, s.ng, cone_width, nee_select, rand2(rng), rng);
+    return matte + matte_path(basis, s.p, origin, s.ng, cone_width, nee_select, rand2(rng), rng);
 }
 
 @compute @workgroup_size(8, 8)

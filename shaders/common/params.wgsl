@@ -20,8 +20,6 @@ struct Params {
     env_rot: vec4f,
     // width, height, marginal CDF offset, conditional CDF offset.
     env_size: vec4u,
-    // x: 1 / sum(area x luminance) over emissive triangles.
-    emit: vec4f,
     // Thin lens: x aperture radius (0: a pinhole), y focus distance.
     lens: vec4f,
     // x: samples per pixel this dispatch traces (the reference tracer), from sample_index on.

@@ -8,17 +8,18 @@ fn light_groups() -> u32 {
     return params.num_lights + select(0u, 1u, HAS_EMITTERS) + select(0u, 1u, HAS_ENV);
 }
 
-// Sample one light group uniformly, then a point on it. li already includes 1/select-probability.
-fn sample_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
-    let n = light_groups();
+// Sample one light group uniformly, then a point on it (emitters by the light tree's importance
+// to p and the geometric normal n). li already includes 1/select-probability.
+fn sample_light(p: vec3f, n: vec3f, rng: ptr<function, u32>) -> LightSample {
+    let groups = light_groups();
     let u = rand(rng);
-    let k = min(u32(u * f32(n)), n - 1u);
-    let fn_ = f32(n);
+    let k = min(u32(u * f32(groups)), groups - 1u);
+    let fn_ = f32(groups);
     var s: LightSample;
     if k < params.num_lights {
         s = sample_punctual(k, p);
     } else if HAS_EMITTERS && k == params.num_lights {
-        s = sample_emitter(p, vec3f(rand(rng), rand(rng), rand(rng)));
+        s = sample_emitter(p, n, vec3f(rand(rng), rand(rng), rand(rng)));
     } else {
         s = sample_env(rand2(rng));
     }
@@ -82,7 +83,7 @@ fn next_event(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, bet
     if light_groups() == 0u || (!matte_present && b.delta) {
         return vec3f(0.0);
     }
-    let ls = sample_light(s.p, rng);
+    let ls = sample_light(s.p, s.ng, rng);
     let wi_l = to_local(basis, ls.wi);
     let through = b.transmission > 0.0 && wi_l.z < 0.0 && dot(ls.wi, s.ng) < 0.0;
     if max3(ls.li) > 0.0 && ((wi_l.z > 0.0 && dot(ls.wi, s.ng) > 0.0) || through) {
@@ -109,7 +110,7 @@ fn next_event(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, bet
 // without the cache.
 fn light_sample_ray(s: Surface, b: Bsdf, wo: vec3f, basis: mat3x3f, origin: vec3f, rng: ptr<function, u32>) -> ShadowRay {
     let eps = params.cam_pos.w;
-    let ls = sample_light(s.p, rng);
+    let ls = sample_light(s.p, s.ng, rng);
     let wi = to_local(basis, ls.wi);
     let through = b.transmission > 0.0 && wi.z < 0.0 && dot(ls.wi, s.ng) < 0.0;
     let start = select(origin, offset_ray(s.p, -s.ng, eps), through);
@@ -140,8 +141,11 @@ struct PathStart {
     prev_pdf: f32,
     prev_delta: bool,
     // Probability with which the vertex that chose rd picked the light group its own next-event
-    // estimate sampled (the MIS weight of an emitter hit by rd needs it).
+    // estimate sampled, and the point and geometric normal that estimate chose its emitter for
+    // (the MIS weight of an emitter hit by rd needs them).
     nee_select: f32,
+    nee_p: vec3f,
+    nee_n: vec3f,
     // The ray cone (common/scene.wgsl, cone_lod): its width at ro and its spread angle.
     cone: vec2f,
 }
@@ -154,7 +158,7 @@ fn pixel_spread() -> f32 {
 
 // A camera ray: nothing to weigh against.
 fn camera_path(ro: vec3f, rd: vec3f) -> PathStart {
-    return PathStart(ro, rd, vec3f(1.0), 1, 0.0, true, 1.0, vec2f(0.0, pixel_spread()));
+    return PathStart(ro, rd, vec3f(1.0), 1, 0.0, true, 1.0, ro, vec3f(0.0), vec2f(0.0, pixel_spread()));
 }
 
 // What a path contributes and where its first segment ended (INF for a miss).
@@ -181,6 +185,9 @@ struct PathState {
     prev_pdf: f32,
     prev_delta: bool,
     prev_select: f32,
+    // Where the last vertex's light sample chose its emitter (PathStart::nee_p, nee_n).
+    prev_p: vec3f,
+    prev_n: vec3f,
     radiance: vec3f,
     first_t: f32,
     first_reflectance: vec3f,
@@ -200,7 +207,7 @@ struct PathState {
 const NEVER_CACHED: i32 = 0x7fffffff;
 
 fn path_begin(start: PathStart) -> PathState {
-    return PathState(start.ro, start.rd, start.beta, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false, start.cone, 1.0, NEVER_CACHED);
+    return PathState(start.ro, start.rd, start.beta, start.segments, start.prev_pdf, start.prev_delta, start.nee_select, start.nee_p, start.nee_n, vec3f(0.0), -1.0, vec3f(1.0), -start.rd, false, start.cone, 1.0, NEVER_CACHED);
 }
 
 fn path_result(st: PathState) -> PathResult {
@@ -276,7 +283,8 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
         if !prev_delta {
             let cos_l = abs(dot(s.ng, rd));
             let d2 = dot(s.p - ro, s.p - ro);
-            let light_pdf = prev_select * emitter_pdf_area(m.emission) * d2 / max(cos_l, 1e-12);
+            let area_pdf = emitter_pdf_area(hit.tri, (*st).prev_p, (*st).prev_n);
+            let light_pdf = prev_select * area_pdf * d2 / max(cos_l, 1e-12);
             w = power_heuristic(prev_pdf, light_pdf);
         }
         (*st).radiance += beta * emission * w;
@@ -327,6 +335,8 @@ fn path_step(st: ptr<function, PathState>, rng: ptr<function, u32>) {
     (*st).prev_pdf = bs.pdf;
     (*st).prev_delta = bs.delta;
     (*st).prev_select = select_p;
+    (*st).prev_p = s.p;
+    (*st).prev_n = s.ng;
     (*st).ro = select(origin, origin_through, through);
     (*st).rd = normalize(wi);
     (*st).cone = vec2f(cone_width, cone_spread_after((*st).cone.y, bs.pdf));

@@ -7,52 +7,54 @@ fn area_groups() -> u32 {
     return select(0u, 1u, HAS_EMITTERS) + select(0u, 1u, HAS_ENV);
 }
 
-// One sample of the non-delta lights (emitters or environment, chosen uniformly).
-fn sample_area_light(p: vec3f, rng: ptr<function, u32>) -> LightSample {
+// One sample of the non-delta lights (emitters or environment, chosen uniformly) for the surface
+// at p with geometric normal n.
+fn sample_area_light(p: vec3f, n: vec3f, rng: ptr<function, u32>) -> LightSample {
     let u = rand(rng);
     if HAS_EMITTERS && (!HAS_ENV || u < 0.5) {
-        return sample_area_light_at(p, u, vec3f(rand(rng), rand(rng), rand(rng)));
+        return sample_area_light_at(p, n, u, vec3f(rand(rng), rand(rng), rand(rng)));
     }
-    return sample_area_light_at(p, u, vec3f(rand2(rng), 0.0));
+    return sample_area_light_at(p, n, u, vec3f(rand2(rng), 0.0));
 }
 
 // The same, its point on the emitter (or direction of the environment) from the screen's
 // strata (common/rng.wgsl), the choice between emitters and environment from rng.
-fn sample_area_light_strata(p: vec3f, st: Strata, rng: ptr<function, u32>) -> LightSample {
+fn sample_area_light_strata(p: vec3f, n: vec3f, st: Strata, rng: ptr<function, u32>) -> LightSample {
     let u = rand(rng);
     if HAS_EMITTERS && (!HAS_ENV || u < 0.5) {
-        return sample_area_light_at(p, u, strata3(st));
+        return sample_area_light_at(p, n, u, strata3(st));
     }
-    return sample_area_light_at(p, u, vec3f(strata2(st), 0.0));
+    return sample_area_light_at(p, n, u, vec3f(strata2(st), 0.0));
 }
 
 // u_group chooses emitters (below 0.5) or environment; u places the sample (emitters use all
 // three numbers: triangle, then its two barycentrics; the environment u.xy).
-fn sample_area_light_at(p: vec3f, u_group: f32, u: vec3f) -> LightSample {
-    let n = area_groups();
+fn sample_area_light_at(p: vec3f, n: vec3f, u_group: f32, u: vec3f) -> LightSample {
+    let groups = f32(area_groups());
     var s: LightSample;
     if HAS_EMITTERS && (!HAS_ENV || u_group < 0.5) {
-        s = sample_emitter(p, u);
+        s = sample_emitter(p, n, u);
     } else {
         s = sample_env(u.xy);
     }
-    s.li *= f32(n);
-    s.pdf /= f32(n);
+    s.li *= groups;
+    s.pdf /= groups;
     return s;
 }
 
 // One cosine-sampled matte path (Mara et al. 2017, eq. (6)) from `origin` on a surface with
 // shading frame `basis` and geometric normal ng; 0 where the direction falls below the
 // geometric surface. Cosine sampling cancels eq. (7)'s cos / pi: the throughput starts at 1.
-// u_dir places the first direction; the path's later vertices draw from rng.
-fn matte_path(basis: mat3x3f, origin: vec3f, ng: vec3f, cone_width: f32, nee_select: f32, u_dir: vec2f, rng: ptr<function, u32>) -> vec3f {
+// u_dir places the first direction; the path's later vertices draw from rng. p: the surface
+// point the caller's light sample was chosen for.
+fn matte_path(basis: mat3x3f, p: vec3f, origin: vec3f, ng: vec3f, cone_width: f32, nee_select: f32, u_dir: vec2f, rng: ptr<function, u32>) -> vec3f {
     let wl = cosine_hemisphere(u_dir);
     let wi = basis * wl;
     if dot(wi, ng) <= 0.0 {
         return vec3f(0.0);
     }
     let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), wl.z * INV_PI));
-    var st = path_begin(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, cone));
+    var st = path_begin(PathStart(origin, normalize(wi), vec3f(1.0), 2, wl.z * INV_PI, false, nee_select, p, ng, cone));
     // Where the frame keeps a radiance cache, the path may end at any of its vertices with the
     // vertex's cell's light (cache/path_end.wgsl): the matte light integrates over the vertices,
     // which hides the cells' blocks. The glossy path never does: a mirror would show them.

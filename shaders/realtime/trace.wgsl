@@ -154,9 +154,9 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
         if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
             var ls: LightSample;
             if strata {
-                ls = sample_area_light_strata(s.p, st_light, rng);
+                ls = sample_area_light_strata(s.p, s.ng, st_light, rng);
             } else {
-                ls = sample_area_light(s.p, rng);
+                ls = sample_area_light(s.p, s.ng, rng);
             }
             let wi = to_local(basis, ls.wi);
             if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
@@ -181,7 +181,7 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
             } else {
                 u_dir = rand2(rng);
             }
-            matte += matte_path(basis, origin, s.ng, cone_width, nee_select, u_dir, rng);
+            matte += matte_path(basis, s.p, origin, s.ng, cone_width, nee_select, u_dir, rng);
         } else if !strata {
             // Keep the random sequence of the glossy path independent of the material.
             rand2(rng);
@@ -193,7 +193,7 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
             if bsdf.delta {
                 // A mirror: F(h) = F(w_s) exactly, so the demodulated weight is 1.
                 wl = vec3f(-wo.xy, wo.z);
-                start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select, vec2f(cone_width, pixel_spread()));
+                start = PathStart(origin, mirror, vec3f(1.0), 2, 0.0, true, nee_select, s.p, s.ng, vec2f(cone_width, pixel_spread()));
             } else {
                 wl = reflect(-wo, sample_vndf(bsdf.alpha, wo, rand2(rng)));
                 let g = glossy_eval(bsdf, wo, wl);
@@ -202,7 +202,7 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
                     weight = g.f_cos / (g.pdf * f_s);
                 }
                 let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), g.pdf));
-                start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select, cone);
+                start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select, s.p, s.ng, cone);
             }
             if wl.z > 0.0 && dot(start.rd, s.ng) > 0.0 && max3(start.beta) > 0.0 {
                 let r = trace_path(start, rng);

@@ -1,7 +1,7 @@
 use crate::cli::load_scene;
 use anyhow::{Context, Result};
 use clap::Args;
-use hush_engine::accel::BvhKind;
+use hush_engine::accel::{BvhKind, light_tree};
 use hush_engine::gpu::{Gpu, PreparedScene};
 use hush_engine::passes::{Raycaster, ReferenceTracer, TraceView};
 use serde::Serialize;
@@ -99,6 +99,10 @@ struct BenchResult {
     height: u32,
     spp: u32,
     layouts: Vec<LayoutResult>,
+    /// Emissive triangles, and the light tree's nodes and depth over them.
+    emitters: usize,
+    light_tree_nodes: usize,
+    light_tree_depth: usize,
     /// From the oracle's render_info.json beside the scene, when there is one.
     mitsuba_samples_per_second: Option<f64>,
     /// Mitsuba 3 timed in this run (`--mitsuba`), same size and spp.
@@ -179,10 +183,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
     };
     let mut layouts = vec![];
     let mut adapter = String::new();
-    let mut triangles = 0;
+    let (mut triangles, mut lights) = (0, (0, 0, 0));
     for kind in kinds {
         let prepared = PreparedScene::with_instancing(&scene, kind, instancing(&a.instancing)?)?;
         triangles = prepared.triangle_count();
+        let tree = &prepared.emitters;
+        lights = (prepared.emitter_slots.len(), tree.len(), light_tree::depth(tree));
         let gpu = Gpu::headless(&prepared.requirements(a.width as u64 * a.height as u64, 32))?;
         adapter = gpu.info.name.clone();
         let gscene = prepared.upload(&gpu);
@@ -236,6 +242,9 @@ pub fn run(a: BenchArgs) -> Result<()> {
         height: a.height,
         spp: a.spp,
         layouts,
+        emitters: lights.0,
+        light_tree_nodes: lights.1,
+        light_tree_depth: lights.2,
         mitsuba_samples_per_second: mitsuba_rate(&a.scene),
         mitsuba_measured: if a.mitsuba {
             Some(time_mitsuba(&a.scene, a.width, a.height, a.spp)?)
@@ -257,6 +266,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
                 l.rays_per_second / 1e6,
                 l.samples_per_second / 1e6,
                 l.gpu_bytes as f64 / 1048576.0
+            );
+        }
+        if res.emitters > 0 {
+            println!(
+                "  light tree over {} emissive triangles: {} nodes, depth {}",
+                res.emitters, res.light_tree_nodes, res.light_tree_depth
             );
         }
         if let Some(m) = res.mitsuba_samples_per_second {

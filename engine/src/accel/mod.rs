@@ -9,6 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use obvhs::{BvhBuildParams, triangle::Triangle};
 use std::time::{Duration, Instant};
 
+pub mod light_tree;
 mod refit;
 pub use refit::{REFIT_LIMIT, RefitTree, build_refittable, refit};
 

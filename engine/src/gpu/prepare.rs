@@ -187,10 +187,11 @@ pub struct PreparedScene {
     /// thin-walled, 0) and (absorption per metre rgb, 0) ([`pack_glass`]).
     pub glass: Vec<Vec4>,
     pub lights: Vec<GpuLight>,
-    /// (cumulative probability bits, triangle slot).
-    pub emitters: Vec<[u32; 2]>,
-    /// 1 / sum(area x luminance(emission)).
-    pub emit_inv_total: f32,
+    /// The light tree over the emissive triangles ([`crate::accel::light_tree`]), as
+    /// shaders/common/emitters.wgsl reads it.
+    pub emitters: Vec<crate::accel::light_tree::LightNode>,
+    /// The emissive triangles' slots, the fixed part's first.
+    pub emitter_slots: Vec<u32>,
     pub env_data: Vec<f32>,
     pub env_radiance: Vec3,
     /// width, height, marginal offset, conditional offset.
@@ -401,7 +402,7 @@ impl PreparedScene {
             glass,
             lights,
             emitters: vec![],
-            emit_inv_total: 0.0,
+            emitter_slots: vec![],
             env_data: env.data,
             env_radiance: env.radiance,
             env_size: env.size,

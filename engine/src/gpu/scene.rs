@@ -437,7 +437,11 @@ impl GpuScene {
         ]);
         m.extend(self.material_modules());
         m.push(if f.punctual_lights { "common/lights.wgsl" } else { "common/lights_none.wgsl" });
-        m.push(if f.emitters { "common/emitters.wgsl" } else { "common/emitters_none.wgsl" });
+        if f.emitters {
+            m.extend(["common/light_tree.wgsl", "common/emitters.wgsl"]);
+        } else {
+            m.push("common/emitters_none.wgsl");
+        }
         m.push(match f.env {
             EnvKind::None => "common/env_none.wgsl",
             EnvKind::Constant => "common/env_constant.wgsl",

@@ -28,7 +28,6 @@ pub struct TraceParams {
     pub env_radiance: [f32; 4],
     pub env_rot: [f32; 4],
     pub env_size: [u32; 4],
-    pub emit: [f32; 4],
     /// Thin lens: aperture radius and focus distance in scene units (0: a pinhole), unused, unused.
     pub lens: [f32; 4],
     /// x: samples per pixel this dispatch traces (the reference tracer), from sample_index on;
@@ -256,7 +255,6 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
     let open = view.shutter_camera.map_or((pos, right, up, fwd), |c| camera_frame(p, &c, aspect));
     let moving = view.shutter_camera.is_some_and(|c| c != view.camera) || p.shutter_moves();
     let rot = p.env_rotation_y_degrees.to_radians();
-    let f = &p.features;
     let cam = &view.camera;
     let e = p.ray_epsilon();
     TraceParams {
@@ -267,7 +265,7 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
         max_depth: view.max_depth,
         rr_depth: RR_DEPTH,
         num_lights: p.lights.len() as u32,
-        num_emitters: p.emitters.len() as u32,
+        num_emitters: p.emitter_slots.len() as u32,
         cam_pos: pos.extend(e).to_array(),
         cam_right: right.extend(0.0).to_array(),
         cam_up: up.extend(0.0).to_array(),
@@ -275,7 +273,6 @@ pub(crate) fn make_params(p: &PreparedScene, view: &TraceView) -> TraceParams {
         env_radiance: p.env_radiance.extend(0.0).to_array(),
         env_rot: [rot.cos(), rot.sin(), p.env_pdf_norm, 0.0],
         env_size: p.env_size,
-        emit: [if f.emitters { p.emit_inv_total } else { 0.0 }, 0.0, 0.0, 0.0],
         lens: cam.lens.map_or([0.0; 4], |l| [l.aperture_radius, l.focus_distance, 0.0, 0.0]),
         batch: [1, 0, 0, 0],
         cam_open_pos: open.0.extend(e).to_array(),

@@ -354,6 +354,9 @@ pub(super) fn all_programs() -> Vec<Program> {
                 "common/path_end_none.wgsl",
             ];
             m.extend(set.iter());
+            if set.contains(&"common/emitters.wgsl") {
+                m.push("common/light_tree.wgsl");
+            }
             let prelude = format!(
                 "const HAS_EMITTERS: bool = {};\nconst HAS_ENV: bool = {};\n{stack}",
                 i % 2 == 1,
@@ -568,10 +571,33 @@ fn gpu_structs_match_their_wgsl_mirrors() {
             .collect()
         )
     );
+    use crate::accel::light_tree::LightNode;
+    assert_eq!(
+        wgsl_layout(p, "LightNode"),
+        (
+            size_of::<LightNode>() as u32,
+            [
+                offset_of!(LightNode, centre),
+                offset_of!(LightNode, radius),
+                offset_of!(LightNode, axis),
+                offset_of!(LightNode, cos_o),
+                offset_of!(LightNode, sin_o),
+                offset_of!(LightNode, power),
+                offset_of!(LightNode, child),
+                offset_of!(LightNode, parent),
+                offset_of!(LightNode, area),
+                offset_of!(LightNode, pad),
+                offset_of!(LightNode, pad) + 4,
+                offset_of!(LightNode, pad) + 8
+            ]
+            .map(|o| o as u32)
+            .to_vec()
+        )
+    );
     let (size, offs) = wgsl_layout(p, "Params");
     assert_eq!(size as usize, size_of::<TraceParams>());
     assert_eq!(offs[8] as usize, offset_of!(TraceParams, cam_pos));
-    assert_eq!(offs[15] as usize, offset_of!(TraceParams, emit));
+    assert_eq!(offs[15] as usize, offset_of!(TraceParams, lens));
     let composite = programs.iter().find(|p| p.label == "realtime/composite.wgsl").unwrap();
     let (size, offs) = wgsl_layout(composite, "Frame");
     use crate::frame::FrameParams;

@@ -11,8 +11,9 @@
 //! anything moves.
 
 use super::{Flat, PreparedScene};
+use crate::accel::light_tree::{Emitter, LightTree};
 use crate::accel::{self, Accel, Bvh2GpuNode, BvhKind};
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 use obvhs::triangle::Triangle;
 
 /// What an animated scene's static objects hold of the GPU arrays, from their start: their
@@ -113,7 +114,7 @@ impl PreparedScene {
             let part = self.append_part(&all, 0, 0, 0, protos, false);
             self.accel = part.accel;
             self.append_protos();
-            self.set_emitters(part.emitters);
+            self.set_emitters(part.emitters, 0);
             return;
         }
         let kind = self.accel.kind;
@@ -149,7 +150,7 @@ impl PreparedScene {
         a.median_fallback = part.accel.median_fallback;
         a.depth = sp.depth.max(part.accel.depth);
         let emitters = sp.emitters.iter().copied().chain(part.emitters).collect();
-        self.set_emitters(emitters);
+        self.set_emitters(emitters, sp.emitters.len());
     }
 
     /// The root of the moving objects' tree, which the traversal visits after the static
@@ -336,20 +337,31 @@ impl PreparedScene {
         Part { accel, emitters }
     }
 
-    /// The emitter CDF over (weight, slot) pairs.
-    fn set_emitters(&mut self, list: Vec<(f64, u32)>) {
-        let total: f64 = list.iter().map(|e| e.0).sum();
-        let mut acc = 0.0;
-        self.emitters = list
+    /// The light tree over (area x luminance, slot) pairs, the first `fixed` of the static
+    /// part; each emitter's third vertex's w names its leaf (+ 1, as a float: 0 is no leaf),
+    /// which an emitter hit needs for its MIS weight (shaders/common/emitters.wgsl).
+    fn set_emitters(&mut self, list: Vec<(f64, u32)>, fixed: usize) {
+        let vertices = |at: &[Vec4], slot: u32| {
+            let v = |k: usize| at[3 * slot as usize + k].truncate();
+            [v(0), v(1), v(2)]
+        };
+        let emitters: Vec<Emitter> = list
             .iter()
             .map(|&(w, slot)| {
-                acc += w;
-                [((acc / total) as f32).to_bits(), slot]
+                let v = vertices(&self.tris, slot);
+                let moves = self.tris_open.len() == self.tris.len();
+                let open = moves.then(|| vertices(&self.tris_open, slot));
+                let area = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length() as f64;
+                let luminance = if area > 0.0 { (w / area) as f32 } else { 0.0 };
+                Emitter::triangle(v, open, luminance, slot)
             })
             .collect();
-        if let Some(last) = self.emitters.last_mut() {
-            last[0] = 1.0f32.to_bits();
+        let tree = LightTree::build_split(&emitters, fixed);
+        for (e, &leaf) in emitters.iter().zip(&tree.leaf_of) {
+            let named = if leaf == u32::MAX { 0.0 } else { leaf as f32 + 1.0 };
+            self.tris[3 * e.slot as usize + 2].w = named;
         }
-        self.emit_inv_total = if total > 0.0 { (1.0 / total) as f32 } else { 0.0 };
+        self.emitter_slots = list.iter().map(|e| e.1).collect();
+        self.emitters = tree.nodes;
     }
 }

@@ -65,7 +65,7 @@ impl PreparedScene {
             && self.moving_tree.is_some()
             // Emitters are listed by slot, the static part's first: the last is the moving
             // part's if any is.
-            && self.emitters.last().is_none_or(|e| (e[1] as usize) < sp.slots)
+            && self.emitter_slots.last().is_none_or(|&e| (e as usize) < sp.slots)
     }
 
     /// The moving tree's surface-area cost when built and at its last CPU refit, relative to
