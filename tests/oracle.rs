@@ -32,7 +32,8 @@ struct Case {
     mitsuba_bias_256: f64,
 }
 
-fn parity(c: Case) {
+/// The reference mode against the case's Mitsuba render; returns the measured relMSE.
+fn parity(c: Case) -> f64 {
     let dir = if c.own { mitsuba_scene(c.name) } else { oracle(c.name) };
     let scene = load_gltf(&dir.join(format!("{}.gltf", c.name))).unwrap();
     let reference =
@@ -99,6 +100,7 @@ fn parity(c: Case) {
             allowed[k]
         );
     }
+    m.relmse
 }
 
 #[test]
@@ -184,6 +186,27 @@ fn cornell_glass_matches_mitsuba() {
         ref_spp: 8192,
         mitsuba_bias_256: 0.001,
     });
+}
+
+/// The many-lamp hall (96 small one-sided wall lamps behind pillars, max_depth 4), where the light
+/// tree chooses each light sample. Mitsuba picks its emitters uniformly; an independent 256-spp
+/// Mitsuba render's mean lies 0.12-0.16% from the reference's (its render_info), so 0.2% is the
+/// bias floor. At 80x45 and 256 spp, choosing lamps by area x luminance alone (as Hush did
+/// before the tree) measured relMSE 0.0267, 0.0291 and 0.0299 over three seeds; the tree must
+/// stay under 0.7x the best of those (measured with the tree: 0.01382, noise predicts 0.01383;
+/// FLIP 0.0519; trimmed bias under 0.31%), or the
+/// walk has stopped preferring the lamps that light the point.
+#[test]
+fn many_lights_matches_mitsuba() {
+    let relmse = parity(Case {
+        name: "many_lights",
+        own: false,
+        factor: 4,
+        spp: 256,
+        ref_spp: 8192,
+        mitsuba_bias_256: 0.002,
+    });
+    assert!(relmse < 0.7 * 0.0267, "relMSE {relmse}: no better than a uniform choice of lamp");
 }
 
 #[test]

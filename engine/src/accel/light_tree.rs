@@ -8,7 +8,7 @@
 //! The probability of one emitter, which MIS with BSDF sampling needs where a path hits it,
 //! walks the other way, from its leaf up through the parents.
 //!
-//! shaders/common/emitters.wgsl mirrors [`importance`], [`LightTree::sample`] and
+//! shaders/common/light_tree.wgsl mirrors [`importance`], [`LightTree::sample`] and
 //! [`LightTree::pmf`] on this layout; tests/light_tree.rs checks that both agree. Written here
 //! because no crate builds a light tree into a GPU layout (pbrt-v4's and Cycles' are C++).
 
@@ -24,7 +24,7 @@ const BINS: usize = 12;
 /// Below this depth a node splits by its cost; deeper, at the median (a bound on the GPU walk).
 const COST_DEPTH: usize = 40;
 
-/// One node, as the GPU reads it (`LightNode` in shaders/common/emitters.wgsl), 64 bytes.
+/// One node, as the GPU reads it (`LightNode` in shaders/common/light_tree.wgsl), 64 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct LightNode {
