@@ -42,6 +42,57 @@ fn sample_area_light_at(p: vec3f, n: vec3f, u_group: f32, u: vec3f) -> LightSamp
     return s;
 }
 
+// A matte light sample chosen by resampled importance sampling (Talbot 2005; Bitterli et al.
+// 2020, §3 and Alg. 3, the streaming form): `first` and m - 1 more samples of the area lights
+// are candidates x_i with source pdf p; each weighs w_i = p^(x_i) / p(x_i), p^ the unshadowed
+// matte contribution luminance(L_e) cos θ / π; one is kept with probability w_i / Σw, and
+// f(y) W with W = Σw / (m p^(y)) estimates the matte light without bias wherever p^ > 0 where
+// L_e cos θ > 0 (the tree gives every emitter that faces the point a pmf > 0). `li` is the
+// kept sample's L_e cos θ / π x W before its shadow ray; its `dist` and `wi` place that ray.
+// A candidate the tree found no light for stays one of the m (its weight 0), as eq. (5) needs.
+struct ResampledLight {
+    wi: vec3f,
+    dist: f32,
+    li: vec3f,
+}
+
+fn resample_area_light(p: vec3f, ng: vec3f, ns: vec3f, first: LightSample, m: u32, rng: ptr<function, u32>) -> ResampledLight {
+    var kept = ResampledLight(first.wi, first.dist, vec3f(0.0));
+    var w_kept = 0.0;
+    var w_sum = 0.0;
+    for (var i = 0u; i < m; i++) {
+        var ls = first;
+        if i > 0u {
+            ls = sample_area_light(p, ng, rng);
+        }
+        // li is L_e / p, so w_i = luminance(li) cos θ / π.
+        let cos_s = dot(ls.wi, ns);
+        var w = 0.0;
+        if max3(ls.li) > 0.0 && cos_s > 0.0 && dot(ls.wi, ng) > 0.0 {
+            w = luminance(ls.li) * cos_s * INV_PI;
+        }
+        if !(w > 0.0) || w > 3.0e38 {
+            continue;
+        }
+        w_sum += w;
+        if rand(rng) * w_sum < w {
+            kept = ResampledLight(ls.wi, ls.dist, ls.li * (cos_s * INV_PI));
+            w_kept = w;
+        }
+    }
+    // f(y) W = (L_e cos / π) Σw / (m p^(y)) = (li cos / π) / w_y x Σw / m.
+    if w_kept > 0.0 {
+        kept.li *= w_sum / (f32(m) * w_kept);
+    }
+    return kept;
+}
+
+// A light sample resampled at its vertex has no pdf a BSDF-sampled hit could be weighed
+// against: passed as that vertex's light-group probability (PathStart::nee_select), it makes
+// every light the next segment hits weigh 0 in the power heuristic (the product stays finite,
+// so no 0 x inf), and the resampled sample carries that light alone.
+const NEE_RESAMPLED: f32 = 1.0e18;
+
 // One cosine-sampled matte path (Mara et al. 2017, eq. (6)) from `origin` on a surface with
 // shading frame `basis` and geometric normal ng; 0 where the direction falls below the
 // geometric surface. Cosine sampling cancels eq. (7)'s cos / pi: the throughput starts at 1.

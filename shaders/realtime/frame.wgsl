@@ -57,6 +57,8 @@ struct Frame {
     d1_px: f32,
     // Tests: the matte light entering a denoiser is NaN / +Inf / -Inf on 1 pixel in 7.
     inject_nonfinite: u32,
+    // Light candidates resampled for a matte light sample (realtime/area_light.wgsl); 1: none.
+    light_candidates: u32,
 }
 
 var<uniform> frame: Frame;

@@ -151,6 +151,10 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
         let st_dir = strata_init(px, epoch, strata_seed ^ ((2u * k + 2u) * 0x9e3779b9u));
         let groups = area_groups();
         let nee_select = 1.0 / f32(max(groups, 1u));
+        var matte_select = nee_select;
+        // With more than one light candidate the matte light sample is resampled (its own
+        // shadow ray) and the first candidate serves the glossy light alone.
+        let resampled = has_matte && groups > 0u && frame.light_candidates > 1u;
         if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
             var ls: LightSample;
             if strata {
@@ -159,18 +163,29 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
                 ls = sample_area_light(s.p, s.ng, rng);
             }
             let wi = to_local(basis, ls.wi);
-            if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 {
+            let glossy_nee = has_glossy && !bsdf.delta;
+            if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 && (!resampled || glossy_nee) {
                 let leg = shadow_leg(origin, s.p, ls.wi, ls.dist, eps);
                 if traverse(origin, leg.dir, leg.tmax, true).tri == NO_HIT {
-                    if has_matte {
+                    if has_matte && !resampled {
                         // Eq. (9): the matte light is L_i cos / pi over the pdf; m (1 - F)^2 comes later.
                         matte += ls.li * (wi.z * INV_PI) * power_heuristic(ls.pdf, wi.z * INV_PI);
                     }
-                    if has_glossy {
+                    if glossy_nee {
                         let g = glossy_eval(bsdf, wo, wi);
                         glossy += ls.li * g.f_cos / f_s * power_heuristic(ls.pdf, g.pdf);
                     }
                 }
+            }
+            if resampled {
+                let r = resample_area_light(s.p, s.ng, s.ns, ls, frame.light_candidates, rng);
+                if max3(r.li) > 0.0 {
+                    let leg = shadow_leg(origin, s.p, r.wi, r.dist, eps);
+                    if traverse(origin, leg.dir, leg.tmax, true).tri == NO_HIT {
+                        matte += r.li;
+                    }
+                }
+                matte_select = NEE_RESAMPLED;
             }
         }
 
@@ -181,7 +196,7 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
             } else {
                 u_dir = rand2(rng);
             }
-            matte += matte_path(basis, s.p, origin, s.ng, cone_width, nee_select, u_dir, rng);
+            matte += matte_path(basis, s.p, origin, s.ng, cone_width, matte_select, u_dir, rng);
         } else if !strata {
             // Keep the random sequence of the glossy path independent of the material.
             rand2(rng);

@@ -58,7 +58,8 @@ pub struct FrameParams {
     pub d1_px: f32,
     /// [`crate::settings::FrameSettings::inject_nonfinite`].
     pub inject_nonfinite: u32,
-    pub _pad: u32,
+    /// [`crate::settings::FrameSettings::light_candidates`] (1: no resampling).
+    pub light_candidates: u32,
 }
 
 impl FrameParams {
@@ -121,7 +122,9 @@ impl FrameParams {
             d0_px: r.d0_px.max(0.0),
             d1_px: r.d1_px.max(r.d0_px + 1e-3),
             inject_nonfinite: settings.inject_nonfinite as u32,
-            _pad: 0,
+            light_candidates: settings
+                .light_candidates
+                .clamp(1, crate::settings::MAX_LIGHT_CANDIDATES),
         }
     }
 }

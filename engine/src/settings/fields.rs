@@ -77,6 +77,13 @@ const FRAME_FIELDS: &[Field] = &[
         "Paths per pixel where a move uncovered the surface (a denoiser's history restarts there and counts them as that many frames); 0: off.",
     ),
     f(
+        "light_candidates",
+        "trace",
+        "candidates",
+        Int(1, super::MAX_LIGHT_CANDIDATES as i64),
+        "Light candidates resampled for each matte light sample (RIS, ReSTIR DI's first step); 1: one sample, MIS-weighted as the reference tracer.",
+    ),
+    f(
         "samples_per_pixel",
         "trace",
         "samples",

@@ -233,7 +233,7 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
             d0_px,
             d1_px,
             inject_nonfinite,
-            _pad,
+            light_candidates,
         }),
     );
 }
