@@ -12,6 +12,64 @@ fn emitter_pdf_area(slot: u32, p: vec3f, n: vec3f) -> f32 {
     return light_tree_pmf(leaf, p, n) / emitters[leaf].area;
 }
 
+// A point on emitter triangle `slot` from b2 in [0, 1)^2 (uniform in its area), as seen from p:
+// the direction and distance to it, its radiance towards p (0 from its back: only the
+// counter-clockwise face emits) and the geometric factor cos θ_l / d² that turns its area density
+// into a solid-angle one.
+struct EmitterPoint {
+    wi: vec3f,
+    dist: f32,
+    le: vec3f,
+    g: f32,
+}
+
+fn emitter_point(slot: u32, b2: vec2f, p: vec3f) -> EmitterPoint {
+    // The vertices as texels (at the shutter's close where objects move): one fetch a vertex
+    // instead of the storage buffer's per-word reads.
+    let v0 = tri_texel(slot * 3u).xyz;
+    let e1 = tri_texel(slot * 3u + 1u).xyz - v0;
+    let e2 = tri_texel(slot * 3u + 2u).xyz - v0;
+    let su = sqrt(b2.x);
+    let b = vec2f(1.0 - su, b2.y * su);
+    let q = v0 + b.x * e1 + b.y * e2;
+    let ng = normalize(cross(e1, e2));
+    let v = q - p;
+    let d2 = dot(v, v);
+    let dist = sqrt(d2);
+    let wi = v / dist;
+    let cos_l = -dot(ng, wi);
+    if cos_l <= 0.0 || d2 <= 0.0 {
+        return EmitterPoint(vec3f(0.0, 0.0, 1.0), 0.0, vec3f(0.0), 0.0);
+    }
+    let m = material(tri_material(slot));
+    var le = m.emission;
+    if m.tex.w >= 0 {
+        le *= material_texture(m, 3u, tri_tex_coords(slot, b)).rgb;
+    }
+    return EmitterPoint(wi, dist, le, cos_l / d2);
+}
+
+fn emitter_leaf_slot(leaf: u32) -> u32 {
+    return emitters[leaf].child & ~LIGHT_LEAF;
+}
+
+// An emitter chosen by the tree for p, n with u.x (slot NO_EMITTER where none can light p), and
+// the area density of its point: the tree's pmf over the triangle's area.
+const NO_EMITTER: u32 = 0xffffffffu;
+
+struct EmitterChoice {
+    slot: u32,
+    pdf_area: f32,
+}
+
+fn choose_emitter(p: vec3f, n: vec3f, u: f32) -> EmitterChoice {
+    let c = light_tree_sample(p, n, u);
+    if c.pmf <= 0.0 {
+        return EmitterChoice(NO_EMITTER, 0.0);
+    }
+    return EmitterChoice(emitter_leaf_slot(c.node), c.pmf / emitters[c.node].area);
+}
+
 // One emitter's point for the surface at p with geometric normal n (zero: none): u.x walks the
 // tree, u.yz place the point in the triangle.
 fn sample_emitter(p: vec3f, n: vec3f, u: vec3f) -> LightSample {
@@ -19,34 +77,10 @@ fn sample_emitter(p: vec3f, n: vec3f, u: vec3f) -> LightSample {
     if c.pmf <= 0.0 {
         return no_light();
     }
-    let leaf = emitters[c.node];
-    let slot = leaf.child & ~LIGHT_LEAF;
-    // The vertices as texels (at the shutter's close where objects move): one fetch a vertex
-    // instead of the storage buffer's per-word reads.
-    let v0 = tri_texel(slot * 3u).xyz;
-    let e1 = tri_texel(slot * 3u + 1u).xyz - v0;
-    let e2 = tri_texel(slot * 3u + 2u).xyz - v0;
-    let su = sqrt(u.y);
-    let b = vec2f(1.0 - su, u.z * su);
-    let q = v0 + b.x * e1 + b.y * e2;
-    let ng = normalize(cross(e1, e2));
-    let v = q - p;
-    let d2 = dot(v, v);
-    let dist = sqrt(d2);
-    let wi = v / dist;
-    // One-sided emitters: only the counter-clockwise face emits.
-    let cos_l = -dot(ng, wi);
-    let m = material(tri_material(slot));
-    if cos_l <= 0.0 || d2 <= 0.0 {
+    let e = emitter_point(emitter_leaf_slot(c.node), u.yz, p);
+    let pdf = c.pmf / emitters[c.node].area / e.g;
+    if !(pdf > 0.0) || e.g <= 0.0 {
         return no_light();
     }
-    var le = m.emission;
-    if m.tex.w >= 0 {
-        le *= material_texture(m, 3u, tri_tex_coords(slot, b)).rgb;
-    }
-    let pdf = c.pmf / leaf.area * d2 / cos_l;
-    if pdf <= 0.0 {
-        return no_light();
-    }
-    return LightSample(wi, dist, le / pdf, pdf);
+    return LightSample(e.wi, e.dist, e.le / pdf, pdf);
 }

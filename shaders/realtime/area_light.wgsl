@@ -47,44 +47,73 @@ fn sample_area_light_at(p: vec3f, n: vec3f, u_group: f32, u: vec3f) -> LightSamp
 // are candidates x_i with source pdf p; each weighs w_i = p^(x_i) / p(x_i), p^ the unshadowed
 // matte contribution luminance(L_e) cos θ / π; one is kept with probability w_i / Σw, and
 // f(y) W with W = Σw / (m p^(y)) estimates the matte light without bias wherever p^ > 0 where
-// L_e cos θ > 0 (the tree gives every emitter that faces the point a pmf > 0). `li` is the
-// kept sample's L_e cos θ / π x W before its shadow ray; its `dist` and `wi` place that ray.
-// A candidate the tree found no light for stays one of the m (its weight 0), as eq. (5) needs.
+// L_e cos θ > 0 (the tree gives every emitter that faces the point a pmf > 0). With `glossy`
+// the same candidates are resampled a second time for the glossy light, p^ its demodulated
+// contribution luminance(L_e f_cos / F(w_s)). `li` is the kept sample's contribution x W before
+// its shadow ray; its `dist` and `wi` place that ray. A candidate the tree found no light for
+// stays one of the m (its weight 0), as eq. (5) needs.
 struct ResampledLight {
     wi: vec3f,
     dist: f32,
     li: vec3f,
 }
 
-fn resample_area_light(p: vec3f, ng: vec3f, ns: vec3f, first: LightSample, m: u32, rng: ptr<function, u32>) -> ResampledLight {
-    var kept = ResampledLight(first.wi, first.dist, vec3f(0.0));
-    var w_kept = 0.0;
-    var w_sum = 0.0;
+struct ResampledLights {
+    matte: ResampledLight,
+    glossy: ResampledLight,
+}
+
+// One streaming-RIS reservoir: the kept sample, its weight and the weights' sum.
+struct Ris {
+    kept: ResampledLight,
+    w_kept: f32,
+    w_sum: f32,
+}
+
+fn ris_add(r: ptr<function, Ris>, ls: LightSample, li: vec3f, w: f32, rng: ptr<function, u32>) {
+    if !(w > 0.0) || w > 3.0e38 {
+        return;
+    }
+    (*r).w_sum += w;
+    if rand(rng) * (*r).w_sum < w {
+        (*r).kept = ResampledLight(ls.wi, ls.dist, li);
+        (*r).w_kept = w;
+    }
+}
+
+// f(y) W = f(y) Σw / (m p^(y)), and p^(y) / p(y) = w_y.
+fn ris_result(r: Ris, m: u32) -> ResampledLight {
+    var kept = r.kept;
+    if r.w_kept > 0.0 {
+        kept.li *= r.w_sum / (f32(m) * r.w_kept);
+    } else {
+        kept.li = vec3f(0.0);
+    }
+    return kept;
+}
+
+fn resample_area_light(p: vec3f, ng: vec3f, basis: mat3x3f, b: Bsdf, wo: vec3f, f_s: vec3f, first: LightSample, m: u32, glossy: bool, rng: ptr<function, u32>) -> ResampledLights {
+    let none = ResampledLight(first.wi, first.dist, vec3f(0.0));
+    var rm = Ris(none, 0.0, 0.0);
+    var rg = Ris(none, 0.0, 0.0);
     for (var i = 0u; i < m; i++) {
         var ls = first;
         if i > 0u {
             ls = sample_area_light(p, ng, rng);
         }
-        // li is L_e / p, so w_i = luminance(li) cos θ / π.
-        let cos_s = dot(ls.wi, ns);
-        var w = 0.0;
-        if max3(ls.li) > 0.0 && cos_s > 0.0 && dot(ls.wi, ng) > 0.0 {
-            w = luminance(ls.li) * cos_s * INV_PI;
-        }
-        if !(w > 0.0) || w > 3.0e38 {
+        let wl = to_local(basis, ls.wi);
+        if !(max3(ls.li) > 0.0) || wl.z <= 0.0 || dot(ls.wi, ng) <= 0.0 {
             continue;
         }
-        w_sum += w;
-        if rand(rng) * w_sum < w {
-            kept = ResampledLight(ls.wi, ls.dist, ls.li * (cos_s * INV_PI));
-            w_kept = w;
+        // li is L_e / p, so w_i = luminance(li x the contribution's factor).
+        let matte = ls.li * (wl.z * INV_PI);
+        ris_add(&rm, ls, matte, luminance(matte), rng);
+        if glossy {
+            let g = ls.li * glossy_eval(b, wo, wl).f_cos / f_s;
+            ris_add(&rg, ls, g, luminance(g), rng);
         }
     }
-    // f(y) W = (L_e cos / π) Σw / (m p^(y)) = (li cos / π) / w_y x Σw / m.
-    if w_kept > 0.0 {
-        kept.li *= w_sum / (f32(m) * w_kept);
-    }
-    return kept;
+    return ResampledLights(ris_result(rm, m), ris_result(rg, m));
 }
 
 // A light sample resampled at its vertex has no pdf a BSDF-sampled hit could be weighed

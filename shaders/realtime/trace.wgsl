@@ -99,6 +99,22 @@ fn safe_ratio(a: vec3f, b: vec3f) -> vec3f {
     return select(vec3f(0.0), a / max(b, vec3f(1e-20)), b > vec3f(0.0));
 }
 
+// Resampled light samples on glossy lobes at least this rough (GGX roughness, alpha = 0.04);
+// smoother lobes keep MIS with their glossy path, which finds their highlights better.
+const RESAMPLED_GLOSSY_ROUGHNESS: f32 = 0.2;
+
+// A resampled light sample's light where its shadow ray reaches it.
+fn visible_light(origin: vec3f, p: vec3f, r: ResampledLight, eps: f32) -> vec3f {
+    if !(max3(r.li) > 0.0) {
+        return vec3f(0.0);
+    }
+    let leg = shadow_leg(origin, p, r.wi, r.dist, eps);
+    if traverse(origin, leg.dir, leg.tmax, true).tri == NO_HIT {
+        return r.li;
+    }
+    return vec3f(0.0);
+}
+
 // One factored sample at the hit of camera ray direction rd, its area-light sample and paths
 // averaged over `path_count` independent ones. With `screen_strata` on, pixel px's light sample
 // and first matte direction come from the screen's strata, seeded by strata_seed.
@@ -152,10 +168,16 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
         let groups = area_groups();
         let nee_select = 1.0 / f32(max(groups, 1u));
         var matte_select = nee_select;
+        var glossy_select = nee_select;
         // With more than one light candidate the matte light sample is resampled (its own
-        // shadow ray) and the first candidate serves the glossy light alone.
-        let resampled = has_matte && groups > 0u && frame.light_candidates > 1u;
-        if groups > 0u && (has_matte || (has_glossy && !bsdf.delta)) {
+        // shadow ray), and so is the glossy one on a lobe rough enough for light samples to
+        // find its highlights (RESAMPLED_GLOSSY_ROUGHNESS); a smoother lobe's glossy light
+        // keeps the first candidate and its MIS with the glossy path.
+        let resampled = groups > 0u && frame.light_candidates > 1u;
+        let glossy_nee = has_glossy && !bsdf.delta;
+        let glossy_resampled = resampled && glossy_nee && ms.roughness >= RESAMPLED_GLOSSY_ROUGHNESS;
+        let reused = resampled && has_matte && HAS_RESERVOIRS && k == 0u;
+        if groups > 0u && (has_matte || glossy_nee) {
             var ls: LightSample;
             if strata {
                 ls = sample_area_light_strata(s.p, s.ng, st_light, rng);
@@ -163,29 +185,37 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
                 ls = sample_area_light(s.p, s.ng, rng);
             }
             let wi = to_local(basis, ls.wi);
-            let glossy_nee = has_glossy && !bsdf.delta;
-            if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 && (!resampled || glossy_nee) {
+            let first_matte = has_matte && !resampled;
+            let first_glossy = glossy_nee && !glossy_resampled;
+            if max3(ls.li) > 0.0 && wi.z > 0.0 && dot(ls.wi, s.ng) > 0.0 && (first_matte || first_glossy) {
                 let leg = shadow_leg(origin, s.p, ls.wi, ls.dist, eps);
                 if traverse(origin, leg.dir, leg.tmax, true).tri == NO_HIT {
-                    if has_matte && !resampled {
+                    if first_matte {
                         // Eq. (9): the matte light is L_i cos / pi over the pdf; m (1 - F)^2 comes later.
                         matte += ls.li * (wi.z * INV_PI) * power_heuristic(ls.pdf, wi.z * INV_PI);
                     }
-                    if glossy_nee {
+                    if first_glossy {
                         let g = glossy_eval(bsdf, wo, wi);
                         glossy += ls.li * g.f_cos / f_s * power_heuristic(ls.pdf, g.pdf);
                     }
                 }
             }
-            if resampled {
-                let r = resample_area_light(s.p, s.ng, s.ns, ls, frame.light_candidates, rng);
-                if max3(r.li) > 0.0 {
-                    let leg = shadow_leg(origin, s.p, r.wi, r.dist, eps);
-                    if traverse(origin, leg.dir, leg.tmax, true).tri == NO_HIT {
-                        matte += r.li;
-                    }
-                }
+            if reused {
+                // The first path's matte sample reuses the last frame's (realtime/reservoir.wgsl).
+                matte += reservoir_direct(px, s.p, s.ns, s.ng, origin, eps, frame.light_candidates, rng);
                 matte_select = NEE_RESAMPLED;
+            }
+            let matte_here = resampled && has_matte && !reused;
+            if matte_here || glossy_resampled {
+                let r = resample_area_light(s.p, s.ng, basis, bsdf, wo, f_s, ls, frame.light_candidates, glossy_resampled, rng);
+                if matte_here {
+                    matte += visible_light(origin, s.p, r.matte, eps);
+                    matte_select = NEE_RESAMPLED;
+                }
+                if glossy_resampled {
+                    glossy += visible_light(origin, s.p, r.glossy, eps);
+                    glossy_select = NEE_RESAMPLED;
+                }
             }
         }
 
@@ -217,7 +247,7 @@ fn shade(rd: vec3f, hit: Hit, path_count: u32, px: vec2u, strata_seed: u32, rng:
                     weight = g.f_cos / (g.pdf * f_s);
                 }
                 let cone = vec2f(cone_width, cone_spread_after(pixel_spread(), g.pdf));
-                start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, nee_select, s.p, s.ng, cone);
+                start = PathStart(origin, normalize(basis * wl), weight, 2, g.pdf, false, glossy_select, s.p, s.ng, cone);
             }
             if wl.z > 0.0 && dot(start.rd, s.ng) > 0.0 && max3(start.beta) > 0.0 {
                 let r = trace_path(start, rng);
@@ -272,6 +302,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     var rng = rng_init(px.y * frame.size.x + px.x, frame.index, params.seed);
+    reservoir_clear(px);
     // Sample 0 of the pixel: the raster's ray, or the traced primaries' first lens ray.
     let ray = primary_ray(px, 0u);
     let ro = ray.ro;

@@ -262,7 +262,8 @@ impl Renderer {
 
     /// The trace writes the glossy path's reflection data where the active denoiser reads it,
     /// the view shows it or [`Renderer::keep`] names it, and drops it otherwise (28 bytes a
-    /// pixel in a glossy scene).
+    /// pixel in a glossy scene); and keeps the matte light's reservoirs while the settings reuse
+    /// light samples (64 bytes a pixel).
     fn reflections(&mut self, gpu: &Gpu, settings: &FrameSettings, denoiser: Option<usize>) {
         use crate::passes::trace::REFLECTION_LABELS;
         let read = denoiser.is_some_and(|i| self.denoisers[i].denoiser.reads_reflections());
@@ -271,6 +272,10 @@ impl Renderer {
         let shown = shown || kept;
         let t = &mut self.targets;
         if t.trace.set_reflections(gpu, &mut t.memory, t.size, read || shown) {
+            t.generation += 1;
+        }
+        let reuse = settings.light_candidates > 1 && settings.light_reuse;
+        if t.trace.set_reservoirs(gpu, &mut t.memory, t.size, reuse) {
             t.generation += 1;
         }
     }

@@ -96,6 +96,7 @@ pub fn sample_modules(scene: &GpuScene, reflections: bool) -> Vec<&'static str> 
     // Its samples trace frame.paths: the uncovered pixels' extra paths are the guide's.
     m.extend([
         "realtime/uncovered_none.wgsl",
+        "realtime/reservoir_none.wgsl",
         "realtime/trace.wgsl",
         "supersample/common.wgsl",
         "supersample/samples.wgsl",

@@ -26,7 +26,16 @@ pub struct TraceTargets {
     pub matte: (wgpu::Texture, wgpu::TextureView),
     pub direct: (wgpu::Texture, wgpu::TextureView),
     pub glossy: Option<GlossyTargets>,
+    /// The matte light sample's reservoirs (shaders/realtime/reservoir.wgsl): two 32-byte slots
+    /// a pixel, this frame's and the last frame's, made only while the frame reuses light
+    /// samples ([`TraceTargets::set_reservoirs`]).
+    pub reservoirs: Option<wgpu::Buffer>,
 }
+
+/// The label of [`TraceTargets::reservoirs`].
+pub const RESERVOIRS_LABEL: &str = "trace/reservoirs";
+/// Bytes a pixel of [`TraceTargets::reservoirs`]: two `Reservoir`s of 32.
+pub const RESERVOIR_BYTES: u64 = 64;
 
 pub struct GlossyTargets {
     pub light: (wgpu::Texture, wgpu::TextureView),
@@ -64,7 +73,30 @@ impl TraceTargets {
                 light: mem.texture(d, "trace/glossy", size, MATTE_FORMAT, usage()),
                 reflections: None,
             }),
+            reservoirs: None,
         }
+    }
+
+    /// Make (`on`) or drop the reservoirs; true if it changed. A new buffer is zeros: no
+    /// reservoir (M = 0) for the first frame to reuse.
+    pub fn set_reservoirs(
+        &mut self,
+        gpu: &Gpu,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        on: bool,
+    ) -> bool {
+        if self.reservoirs.is_some() == on {
+            return false;
+        }
+        self.reservoirs = on.then(|| {
+            let bytes = size.0 as u64 * size.1 as u64 * RESERVOIR_BYTES;
+            mem.buffer(&gpu.device, RESERVOIRS_LABEL, bytes, wgpu::BufferUsages::STORAGE)
+        });
+        if !on {
+            mem.forget_labels(&[RESERVOIRS_LABEL.to_string()]);
+        }
+        true
     }
 
     /// Make (`on`) or drop the reflection data; true if it changed. Only Mara's and SVGF's
@@ -122,6 +154,8 @@ struct TraceProgram {
     previous_depth: bool,
     /// It writes the glossy path's reflection data ([`Reflections`]).
     reflections: bool,
+    /// It reuses the matte light samples' reservoirs ([`TraceTargets::reservoirs`]).
+    reservoirs: bool,
 }
 
 impl TraceProgram {
@@ -131,6 +165,7 @@ impl TraceProgram {
             cache: inputs.cache.is_some(),
             previous_depth: inputs.previous_depth.is_some(),
             reflections: inputs.t.has_reflections(),
+            reservoirs: inputs.t.reservoirs.is_some(),
         }
     }
 }
@@ -164,6 +199,11 @@ fn program(
     } else {
         modules.push("realtime/uncovered_none.wgsl");
     }
+    modules.push(if inputs.t.reservoirs.is_some() {
+        "realtime/reservoir.wgsl"
+    } else {
+        "realtime/reservoir_none.wgsl"
+    });
     modules.push("realtime/trace.wgsl");
     crate::shader::Reloadable::new(
         gpu,
@@ -208,7 +248,8 @@ fn bindings<'a>(s: SceneInputs<'a>, g: &'a GBufferTargets, t: &'a TraceTargets) 
         .texture("tr_mean_specular", g.view(Channel::Specular))
         .texture("tr_mean_emission", g.view(Channel::Emission))
         .texture("out_matte", &t.matte.1)
-        .texture("out_direct", &t.direct.1);
+        .texture("out_direct", &t.direct.1)
+        .buffer_opt("reservoirs", t.reservoirs.as_ref());
     if let Some(gl) = &t.glossy {
         b = b.texture("out_glossy", &gl.light.1);
         if let Some(r) = &gl.reflections {

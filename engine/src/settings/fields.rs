@@ -84,6 +84,13 @@ const FRAME_FIELDS: &[Field] = &[
         "Light candidates resampled for each matte light sample (RIS, ReSTIR DI's first step); 1: one sample, MIS-weighted as the reference tracer.",
     ),
     f(
+        "light_reuse",
+        "trace",
+        "",
+        Bool,
+        "With more than one light candidate: merge the reservoir the last frame kept at the surface point (ReSTIR DI's temporal reuse).",
+    ),
+    f(
         "samples_per_pixel",
         "trace",
         "samples",

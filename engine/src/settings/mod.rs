@@ -77,15 +77,25 @@ pub struct FrameSettings {
     /// Light candidates per matte light sample of the real-time frame (resampled importance
     /// sampling, Talbot 2005; the first step of ReSTIR DI, Bitterli et al. 2020 §3): M samples
     /// of the light tree (or the environment), one kept with probability proportional to its
-    /// unshadowed matte contribution, one shadow ray for it. The glossy light keeps the first
-    /// candidate and its MIS with the glossy path; with M > 1 the matte path's first segment
-    /// adds no light it hits (the resampled sample stands for it). 1: one sample, MIS-weighted
-    /// against the matte path as the reference tracer does. Costs M - 1 tree walks and one
-    /// shadow ray a traced pixel. Without reuse across pixels and frames it does not pay: the
-    /// many-lamp hall at 320x180, raw frame 30 against Mitsuba, FLIP 0.2549 / 0.2451 / 0.2421 /
-    /// 0.2391 at M = 1 / 4 / 8 / 16, the trace 87.2 ms at M = 1 and 142.9 ms at 8 (lavapipe),
-    /// so the default is 1.
+    /// unshadowed matte contribution, one shadow ray for it; on glossy lobes of roughness 0.2
+    /// or more the same candidates are resampled again by their glossy contribution, with a
+    /// shadow ray of their own (smoother lobes keep the first candidate and its MIS with the
+    /// glossy path). A path whose first vertex's sample was resampled adds no light its first
+    /// segment hits (the resampled sample stands for it). 1: one sample, MIS-weighted against
+    /// the paths as the reference tracer does. Costs M - 1 tree walks and up to two shadow rays
+    /// a traced pixel. The many-lamp hall at 320x180 (lavapipe), frame 30 against Mitsuba, at
+    /// M = 1 / 4 / 8: SVGF FLIP 0.0586 / 0.0565 / 0.0547, raw 0.2549 / 0.2388 / 0.2330; the
+    /// whole frame 98.8 / 124.1 / 158.6 ms: less than its cost, so the default is 1.
     pub light_candidates: u32,
+    /// With light_candidates > 1: the matte light sample of the first path also merges the
+    /// reservoir the last frame kept where the surface point was (ReSTIR DI's temporal reuse,
+    /// Bitterli et al. 2020 §4), so each pixel's sample stands for up to 21 frames' candidates.
+    /// Costs one reservoir read and write a pixel and 64 bytes a pixel. The many-lamp hall's
+    /// direct light alone (max_depth 2, raw frame 30, 320x180, M = 8) scores FLIP 0.122 with it
+    /// and 0.161 without; the whole raw frame 0.2251 against 0.2330, but SVGF's frame 30 0.0638
+    /// against 0.0547: SVGF's temporal filter takes reused, correlated samples for independent
+    /// ones. A still view's accumulated mean moves 0.16-0.18% (the biased merge).
+    pub light_reuse: bool,
     /// Samples per pixel k of the real-time frame (Voorhuis §5, guide rays): the raster's sample
     /// (the guide) and k - 1 traced at random positions in the pixel, each mixed into its most
     /// similar guide among the four nearest pixels before denoising (eq. 7), the pixel then the
@@ -212,6 +222,7 @@ impl FrameSettings {
             paths_per_pixel: 1,
             uncovered_paths: 8,
             light_candidates: DEFAULT_LIGHT_CANDIDATES,
+            light_reuse: true,
             texture_lod: true,
             screen_strata: true,
             resample_history_frames: 4.0,

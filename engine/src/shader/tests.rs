@@ -392,16 +392,22 @@ pub(super) fn all_programs() -> Vec<Program> {
                 "realtime/area_light.wgsl",
                 glossy,
             ]);
-            // With the cache, the trace of a denoised frame: the previous depth's uncovered test.
+            // With the cache, the trace of a denoised frame: the previous depth's uncovered test,
+            // and the light samples' reservoirs.
             let mut cached_trace = crate::passes::cache::with_path_ends(m.clone());
             cached_trace.extend([
                 "realtime/seen.wgsl",
                 "realtime/uncovered.wgsl",
+                "realtime/reservoir.wgsl",
                 "realtime/trace.wgsl",
             ]);
             let name = format!("realtime trace with the cache {bvh} {i}");
             v.push(compose(&name, &prelude, &cached_trace).unwrap());
-            m.extend(["realtime/uncovered_none.wgsl", "realtime/trace.wgsl"]);
+            m.extend([
+                "realtime/uncovered_none.wgsl",
+                "realtime/reservoir_none.wgsl",
+                "realtime/trace.wgsl",
+            ]);
             v.push(compose(&format!("realtime trace {bvh} {i}"), &prelude, &m).unwrap());
             cache.extend([
                 "realtime/frame.wgsl",
