@@ -78,8 +78,11 @@ fn sample_emitter(p: vec3f, n: vec3f, u: vec3f) -> LightSample {
         return no_light();
     }
     let e = emitter_point(emitter_leaf_slot(c.node), u.yz, p);
+    if e.g <= 0.0 {
+        return no_light();
+    }
     let pdf = c.pmf / emitters[c.node].area / e.g;
-    if !(pdf > 0.0) || e.g <= 0.0 {
+    if !(pdf > 0.0) {
         return no_light();
     }
     return LightSample(e.wi, e.dist, e.le / pdf, pdf);

@@ -84,6 +84,7 @@ impl Renderer {
             t.ensure_previous(gpu);
         }
         self.reflections(gpu, settings, denoiser);
+        self.reservoirs(gpu, settings);
         let (samples, period) = self.sampling(gpu, settings, denoiser)?;
         let (traced, primary_samples, prefilter) = self.primaries(gpu, input, settings, samples)?;
         let cache = settings.cache.enabled && denoiser.is_some();
@@ -262,8 +263,7 @@ impl Renderer {
 
     /// The trace writes the glossy path's reflection data where the active denoiser reads it,
     /// the view shows it or [`Renderer::keep`] names it, and drops it otherwise (28 bytes a
-    /// pixel in a glossy scene); and keeps the matte light's reservoirs while the settings reuse
-    /// light samples (64 bytes a pixel).
+    /// pixel in a glossy scene).
     fn reflections(&mut self, gpu: &Gpu, settings: &FrameSettings, denoiser: Option<usize>) {
         use crate::passes::trace::REFLECTION_LABELS;
         let read = denoiser.is_some_and(|i| self.denoisers[i].denoiser.reads_reflections());
@@ -274,7 +274,13 @@ impl Renderer {
         if t.trace.set_reflections(gpu, &mut t.memory, t.size, read || shown) {
             t.generation += 1;
         }
+    }
+
+    /// The trace keeps the matte light's reservoirs while the settings reuse light samples (64
+    /// bytes a pixel), and drops them otherwise.
+    fn reservoirs(&mut self, gpu: &Gpu, settings: &FrameSettings) {
         let reuse = settings.light_candidates > 1 && settings.light_reuse;
+        let t = &mut self.targets;
         if t.trace.set_reservoirs(gpu, &mut t.memory, t.size, reuse) {
             t.generation += 1;
         }

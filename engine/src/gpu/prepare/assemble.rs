@@ -28,14 +28,14 @@ pub(crate) struct StaticPart {
     pub nodes: usize,
     pub node_bytes: usize,
     pub depth: usize,
-    /// (area x luminance, slot) of its emissive triangles.
-    emitters: Vec<(f64, u32)>,
+    /// (luminance of the emission, slot) of its emissive triangles.
+    emitters: Vec<(f32, u32)>,
 }
 
 /// One part's tree and emitters, its indices already global.
 pub(super) struct Part {
     pub(super) accel: Accel,
-    emitters: Vec<(f64, u32)>,
+    emitters: Vec<(f32, u32)>,
 }
 
 /// Bytes of one node in `kind`'s GPU layout.
@@ -321,14 +321,14 @@ impl PreparedScene {
             if self.features.vertex_extras {
                 self.extras.extend_from_slice(extras[i]);
             }
-            // Emissive triangles by area x luminance (one-sided power up to a constant pi).
+            // Emissive triangles and the luminance of their emission (the light tree weighs them
+            // by area x luminance, one-sided power up to a constant pi).
             let lum = self
                 .materials
                 .get(mats[i] as usize)
                 .map_or(0.0, |m| crate::quality::luminance(Vec3::from_slice(&m.emission)));
             if lum > 0.0 {
-                let area = 0.5 * (t.v1 - t.v0).cross(t.v2 - t.v0).length() as f64;
-                emitters.push((area * lum as f64, (slot_base + local) as u32));
+                emitters.push((lum, (slot_base + local) as u32));
             }
         }
         for o in accel.order.iter_mut() {
@@ -337,23 +337,20 @@ impl PreparedScene {
         Part { accel, emitters }
     }
 
-    /// The light tree over (area x luminance, slot) pairs, the first `fixed` of the static
+    /// The light tree over (luminance, slot) pairs, the first `fixed` of the static
     /// part; each emitter's third vertex's w names its leaf (+ 1, as a float: 0 is no leaf),
     /// which an emitter hit needs for its MIS weight (shaders/common/emitters.wgsl).
-    fn set_emitters(&mut self, list: Vec<(f64, u32)>, fixed: usize) {
+    fn set_emitters(&mut self, list: Vec<(f32, u32)>, fixed: usize) {
         let vertices = |at: &[Vec4], slot: u32| {
             let v = |k: usize| at[3 * slot as usize + k].truncate();
             [v(0), v(1), v(2)]
         };
         let emitters: Vec<Emitter> = list
             .iter()
-            .map(|&(w, slot)| {
-                let v = vertices(&self.tris, slot);
+            .map(|&(luminance, slot)| {
                 let moves = self.tris_open.len() == self.tris.len();
                 let open = moves.then(|| vertices(&self.tris_open, slot));
-                let area = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length() as f64;
-                let luminance = if area > 0.0 { (w / area) as f32 } else { 0.0 };
-                Emitter::triangle(v, open, luminance, slot)
+                Emitter::triangle(vertices(&self.tris, slot), open, luminance, slot)
             })
             .collect();
         let tree = LightTree::build_split(&emitters, fixed);
