@@ -9,7 +9,7 @@ fn emitter_pdf_area(slot: u32, p: vec3f, n: vec3f) -> f32 {
         return 0.0;
     }
     let leaf = named - 1u;
-    return light_tree_pmf(leaf, p, n) / emitters[leaf].area;
+    return light_tree_pmf(leaf, p, n) / light_leaf_area(leaf);
 }
 
 // A point on emitter triangle `slot` from b2 in [0, 1)^2 (uniform in its area), as seen from p:
@@ -50,7 +50,7 @@ fn emitter_point(slot: u32, b2: vec2f, p: vec3f) -> EmitterPoint {
 }
 
 fn emitter_leaf_slot(leaf: u32) -> u32 {
-    return emitters[leaf].child & ~LIGHT_LEAF;
+    return light_child(leaf) & ~LIGHT_LEAF;
 }
 
 // An emitter chosen by the tree for p, n with u.x (slot NO_EMITTER where none can light p), and
@@ -67,7 +67,7 @@ fn choose_emitter(p: vec3f, n: vec3f, u: f32) -> EmitterChoice {
     if c.pmf <= 0.0 {
         return EmitterChoice(NO_EMITTER, 0.0);
     }
-    return EmitterChoice(emitter_leaf_slot(c.node), c.pmf / emitters[c.node].area);
+    return EmitterChoice(emitter_leaf_slot(c.node), c.pmf / light_leaf_area(c.node));
 }
 
 // One emitter's point for the surface at p with geometric normal n (zero: none): u.x walks the
@@ -81,7 +81,7 @@ fn sample_emitter(p: vec3f, n: vec3f, u: vec3f) -> LightSample {
     if e.g <= 0.0 {
         return no_light();
     }
-    let pdf = c.pmf / emitters[c.node].area / e.g;
+    let pdf = c.pmf / light_leaf_area(c.node) / e.g;
     if !(pdf > 0.0) {
         return no_light();
     }

@@ -2,12 +2,16 @@
 //! program (its own bindings and entry point) composed with the embedded modules it exercises.
 
 use hush_engine::gpu::Gpu;
+use hush_engine::gpu::scene::Texels;
 use wgpu::util::DeviceExt;
 
-/// A buffer the test program reads: a uniform or a read-only storage buffer.
+/// What the test program reads: a uniform, a read-only storage buffer, or 16-byte records as
+/// texel rows of an `Rgba32Uint` texture (`hush_engine::gpu::scene::Texels`, as the scene's
+/// tables are kept).
 pub enum Input<'a> {
     Uniform(&'a [u8]),
     Storage(&'a [u8]),
+    Texels(&'a [u8]),
 }
 
 /// Compose `program` (the test's WGSL: bindings and `main`) after `modules`, bind `inputs` to
@@ -32,27 +36,40 @@ pub fn run_compute(
         compilation_options: Default::default(),
         cache: None,
     });
-    let mut buffers: Vec<wgpu::Buffer> = inputs
-        .iter()
-        .map(|input| {
-            let (contents, usage) = match input {
-                Input::Uniform(b) => (*b, wgpu::BufferUsages::UNIFORM),
-                Input::Storage(b) => (*b, wgpu::BufferUsages::STORAGE),
-            };
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage })
-        })
-        .collect();
-    buffers.push(d.create_buffer(&wgpu::BufferDescriptor {
+    let mut memory = hush_engine::gpu::GpuMemory::default();
+    let mut buffers = vec![];
+    let mut texels = vec![];
+    for input in inputs {
+        let (contents, usage) = match input {
+            Input::Uniform(b) => (*b, wgpu::BufferUsages::UNIFORM),
+            Input::Storage(b) => (*b, wgpu::BufferUsages::STORAGE),
+            Input::Texels(b) => {
+                let format = wgpu::TextureFormat::Rgba32Uint;
+                texels.push((
+                    buffers.len() + texels.len(),
+                    Texels::new(gpu, &mut memory, "test texels", b, format),
+                ));
+                continue;
+            }
+        };
+        let init = wgpu::util::BufferInitDescriptor { label: None, contents, usage };
+        buffers.push((buffers.len() + texels.len(), d.create_buffer_init(&init)));
+    }
+    let out = d.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: out_bytes,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
-    }));
-    let entries: Vec<wgpu::BindGroupEntry> = buffers
+    });
+    buffers.push((inputs.len(), out));
+    let mut entries: Vec<wgpu::BindGroupEntry> = buffers
         .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .map(|(i, b)| wgpu::BindGroupEntry { binding: *i as u32, resource: b.as_entire_binding() })
         .collect();
+    entries.extend(texels.iter().map(|(i, t)| wgpu::BindGroupEntry {
+        binding: *i as u32,
+        resource: wgpu::BindingResource::TextureView(&t.view),
+    }));
     let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
         layout: &pipeline.get_bind_group_layout(0),
@@ -66,6 +83,6 @@ pub fn run_compute(
         pass.dispatch_workgroups(groups.0, groups.1, 1);
     }
     gpu.queue.submit([enc.finish()]);
-    let out = buffers.last().unwrap();
+    let out = &buffers.last().unwrap().1;
     hush_engine::gpu::readback_buffer(&gpu.device, &gpu.queue, out, out_bytes).unwrap()
 }

@@ -24,7 +24,8 @@ const BINS: usize = 12;
 /// Below this depth a node splits by its cost; deeper, at the median (a bound on the GPU walk).
 const COST_DEPTH: usize = 40;
 
-/// One node, as the GPU reads it (`LightNode` in shaders/common/light_tree.wgsl), 64 bytes.
+/// One node, 64 bytes: four texels of the scene's `emitter_texels` (shaders/common/light_tree.wgsl
+/// `light_node` reads the first three, a leaf's area the fourth).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct LightNode {

@@ -36,7 +36,8 @@ pub struct GpuScene {
     /// [`PreparedScene::glass`], where some material transmits.
     pub glass: Option<Texels>,
     pub lights: Option<wgpu::Buffer>,
-    pub emitters: Option<wgpu::Buffer>,
+    /// The light tree's nodes (four texels each: shaders/common/light_tree.wgsl).
+    pub emitters: Option<Texels>,
     pub env: Option<wgpu::Buffer>,
     /// The scene's textures as words in texel rows (`tex_words` in shaders/common/textures.wgsl).
     pub textures: Option<Texels>,
@@ -112,11 +113,8 @@ impl PreparedScene {
             (self.env_data.len() * 4) as u64,
             output_bytes,
         ];
-        let count = 2
-            + f.punctual_lights as u32
-            + f.emitters as u32
-            + (f.env == EnvKind::Map) as u32
-            + f.normal_maps as u32;
+        let count =
+            2 + f.punctual_lights as u32 + (f.env == EnvKind::Map) as u32 + f.normal_maps as u32;
         let d = GpuRequirements::default();
         GpuRequirements {
             max_storage_buffer_binding_size: sizes
@@ -140,6 +138,7 @@ impl PreparedScene {
                 self.tlas.len(),
                 self.tlas_order.len() * 4,
                 self.draw_list.len() * 4,
+                std::mem::size_of_val(self.emitters.as_slice()),
             ]
             .into_iter()
             .map(texel_row_count)
@@ -221,12 +220,11 @@ impl PreparedScene {
         let extras = table(f.vertex_extras, "scene/vertex extras", b(&self.extras), Rgba32Uint);
         let tex_uses = table(f.texture_uses, "scene/texture uses", b(&self.tex_uses), Rgba32Float);
         let glass = table(f.transmission, "scene/glass", b(&self.glass), Rgba32Float);
+        let emitters = table(f.emitters, "scene/emitters", b(&self.emitters), Rgba32Uint);
         let copy = s | wgpu::BufferUsages::COPY_DST;
         // Lights and environment are rewritten when the user moves the sun.
         let lights =
             f.punctual_lights.then(|| mem.buffer_init(d, "scene/lights", b(&self.lights), copy));
-        let emitters =
-            f.emitters.then(|| mem.buffer_init(d, "scene/emitters", b(&self.emitters), s));
         let env = (f.env == EnvKind::Map)
             .then(|| mem.buffer_init(d, "scene/environment", b(&self.env_data), copy));
         let textures = f.textures.then(|| {
@@ -325,6 +323,9 @@ impl GpuScene {
             if let Some(t) = self.extras.as_mut() {
                 replaced |= t.write_from(gpu, mem, b(&p.extras), slots * 48);
             }
+            if let Some(t) = self.emitters.as_mut() {
+                replaced |= t.write(gpu, mem, b(&p.emitters));
+            }
         }
         let mut put = |buf: &mut wgpu::Buffer, label: &str, data: &[u8], from: usize| {
             if data.is_empty() {
@@ -354,9 +355,6 @@ impl GpuScene {
             if let Some(t) = self.tangents.as_mut() {
                 put(t, "scene/tangents", b(&p.tangents), slots * 48);
             }
-            if let Some(e) = self.emitters.as_mut() {
-                put(e, "scene/emitters", b(&p.emitters), 0);
-            }
         }
         if let Some(o) = self.objects.as_mut() {
             put(o, "scene/object motion", b(&p.prev_from_current), 0);
@@ -385,7 +383,7 @@ impl GpuScene {
             .texture_opt("tex_use_texels", self.tex_uses.as_ref().map(|t| &t.view))
             .texture_opt("glass_texels", self.glass.as_ref().map(|t| &t.view))
             .buffer_opt("lights", self.lights.as_ref())
-            .buffer_opt("emitters", self.emitters.as_ref())
+            .texture_opt("emitter_texels", self.emitters.as_ref().map(|t| &t.view))
             .buffer_opt("env_data", self.env.as_ref())
             .texture_opt("tex_words", self.textures.as_ref().map(|t| &t.view))
             .buffer_opt("tangents", self.tangents.as_ref())

@@ -11,7 +11,8 @@ pub fn texel_row_count(bytes: usize) -> u32 {
 }
 
 /// An array of 16-byte records as a 2D texture, [`TEXEL_ROW`] texels to a row, read with
-/// textureLoad (the BVH nodes, vertices, shading records, materials and texture words).
+/// textureLoad (the BVH nodes, vertices, shading records, materials, texture words and the light
+/// tree's nodes).
 /// Lavapipe reads a storage buffer at per-lane addresses one lane and one word at a time with a
 /// bounds check each, and a texel with one 16-byte load per lane: with the BVH nodes and the
 /// vertices the intersection tests read in texels, the reference tracer made 0.66 M samples/s

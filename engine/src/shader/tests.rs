@@ -577,11 +577,13 @@ fn gpu_structs_match_their_wgsl_mirrors() {
             .collect()
         )
     );
+    // The walk reads a node's first three texels into WGSL's `LightNode` word by word, in the
+    // order of its members (light_tree.wgsl `light_node`), and a leaf's area from texel 3.
     use crate::accel::light_tree::LightNode;
     assert_eq!(
         wgsl_layout(p, "LightNode"),
         (
-            size_of::<LightNode>() as u32,
+            48,
             [
                 offset_of!(LightNode, centre),
                 offset_of!(LightNode, radius),
@@ -591,15 +593,12 @@ fn gpu_structs_match_their_wgsl_mirrors() {
                 offset_of!(LightNode, power),
                 offset_of!(LightNode, child),
                 offset_of!(LightNode, parent),
-                offset_of!(LightNode, area),
-                offset_of!(LightNode, pad),
-                offset_of!(LightNode, pad) + 4,
-                offset_of!(LightNode, pad) + 8
             ]
             .map(|o| o as u32)
             .to_vec()
         )
     );
+    assert_eq!((offset_of!(LightNode, area), size_of::<LightNode>()), (48, 64));
     let (size, offs) = wgsl_layout(p, "Params");
     assert_eq!(size as usize, size_of::<TraceParams>());
     assert_eq!(offs[8] as usize, offset_of!(TraceParams, cam_pos));
