@@ -520,7 +520,10 @@ fn gpu_posing_matches_the_cpu_and_its_refit_boxes_hold_every_triangle() {
         assert!(got.iter().all(|v| v.is_finite()), "t = {t}: a non-finite vertex");
         let mut cpu = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
         cpu.animate(&scene, t);
-        let (g, c) = (by_input(&got, &got), by_input(&cpu.tris, &cpu.tris));
+        let (g, c) = (
+            hush_tests::triangles_by_input(&got, &got),
+            hush_tests::triangles_by_input(&cpu.tris, &cpu.tris),
+        );
         assert_eq!(g.len(), c.len());
         for ((gi, gv, _), (ci, cv, _)) in g.iter().zip(&c) {
             assert_eq!(gi, ci);
@@ -591,7 +594,10 @@ fn gpu_posing_blurs_from_the_pose_at_the_shutters_open() {
     let open = r.read_triangles_at_open(&gpu).unwrap().unwrap();
     let mut cpu = PreparedScene::new(&scene, hush_engine::accel::BvhKind::DEFAULT).unwrap();
     cpu.expose(&scene, close_t, Some(open_t));
-    let (g, c) = (by_input(&close, &open), by_input(&cpu.tris, &cpu.tris_open));
+    let (g, c) = (
+        hush_tests::triangles_by_input(&close, &open),
+        hush_tests::triangles_by_input(&cpu.tris, &cpu.tris_open),
+    );
     assert_eq!(g.len(), c.len());
     let (mut worst, mut swept) = (0f32, 0f32);
     for ((gi, gc, go), (ci, cc, co)) in g.iter().zip(&c) {
@@ -675,20 +681,6 @@ fn overflowing_joints_never_reach_the_gpu_trace() {
         let img = r.read_hdr(&gpu).unwrap();
         assert!(img.data.iter().all(|p| p.is_finite()), "t = {t}: a non-finite pixel");
     }
-}
-
-/// Each slot's input triangle index (the second vertex's w) and its three vertices in `tris`
-/// and in `ends` (the same slots at another time), sorted by input index: GPU and CPU slots
-/// compared whatever order their trees put them in.
-fn by_input(tris: &[glam::Vec4], ends: &[glam::Vec4]) -> Vec<(u32, [Vec3; 3], [Vec3; 3])> {
-    let p = |v: &[glam::Vec4]| [v[0], v[1], v[2]].map(|p| p.truncate());
-    let mut m: Vec<_> = tris
-        .chunks_exact(3)
-        .zip(ends.chunks_exact(3))
-        .map(|(v, o)| (v[1].w.to_bits(), p(v), p(o)))
-        .collect();
-    m.sort_by_key(|e| e.0);
-    m
 }
 
 /// Triangle vertices (of `tris`, three vec4 a slot) outside a box on their path from the CWBVH

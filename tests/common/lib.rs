@@ -321,3 +321,20 @@ impl Xorshift {
         glam::Vec3::new(s * phi.cos(), s * phi.sin(), z)
     }
 }
+
+/// Each slot's input triangle index (the second vertex's w) and its three vertices in `tris`
+/// and in `ends` (the same slots at another time), sorted by input index: GPU and CPU slots
+/// compared whatever order their trees put them in.
+pub fn triangles_by_input(
+    tris: &[glam::Vec4],
+    ends: &[glam::Vec4],
+) -> Vec<(u32, [glam::Vec3; 3], [glam::Vec3; 3])> {
+    let p = |v: &[glam::Vec4]| [v[0], v[1], v[2]].map(|p| p.truncate());
+    let mut m: Vec<_> = tris
+        .chunks_exact(3)
+        .zip(ends.chunks_exact(3))
+        .map(|(v, o)| (v[1].w.to_bits(), p(v), p(o)))
+        .collect();
+    m.sort_by_key(|e| e.0);
+    m
+}
