@@ -135,7 +135,13 @@ impl PreparedScene {
         // TAA reads the most: the G-buffer (7), the trace's outputs (2, +4 glossy), its four
         // histories and the denoiser's light it follows (2, +3 glossy): 22 in a glossy scene
         // (WebGPU's default is 16; desktop Vulkan, Metal and D3D12 adapters offer far more).
-        r.max_sampled_textures_per_shader_stage = if self.features.glossy { 22 } else { 15 };
+        // The trace reads the scene's tables beside the G-buffer (9), its own inputs (5), the
+        // glossy inputs (4) and the radiance cache's prior (1): a scene of many tables needs
+        // more than TAA.
+        let taa = if self.features.glossy { 22 } else { 15 };
+        let trace = self.sampled_texture_count() + 19;
+        r.max_sampled_textures_per_shader_stage =
+            r.max_sampled_textures_per_shader_stage.max(taa).max(trace);
         r
     }
 }

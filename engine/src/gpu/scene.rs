@@ -117,6 +117,11 @@ impl PreparedScene {
             2 + f.punctual_lights as u32 + (f.env == EnvKind::Map) as u32 + f.normal_maps as u32;
         let d = GpuRequirements::default();
         GpuRequirements {
+            // A shading program may bind every one of the scene's texel tables (the reference
+            // tracer binds no texture of its own).
+            max_sampled_textures_per_shader_stage: self
+                .sampled_texture_count()
+                .max(d.max_sampled_textures_per_shader_stage),
             max_storage_buffer_binding_size: sizes
                 .into_iter()
                 .max()
@@ -147,6 +152,21 @@ impl PreparedScene {
             .max(d.max_texture_dimension_2d),
             ..d
         }
+    }
+
+    /// Texel tables the scene's shading modules declare (`shaders/common`, every sampled
+    /// texture a program that shades may bind): the BVH, vertices, shading records and
+    /// materials, and those only some scenes have.
+    pub fn sampled_texture_count(&self) -> u32 {
+        let f = &self.features;
+        4 + f.animated as u32
+            + 2 * f.deforming as u32
+            + f.vertex_extras as u32
+            + f.texture_uses as u32
+            + f.transmission as u32
+            + f.textures as u32
+            + 4 * f.instances as u32
+            + f.emitters as u32
     }
 
     pub fn upload(&self, gpu: &Gpu) -> GpuScene {
