@@ -12,17 +12,8 @@ fn emitter_pdf_area(slot: u32, p: vec3f, n: vec3f) -> f32 {
     return light_tree_pmf(leaf, p, n) / light_leaf_area(leaf);
 }
 
-// A point on emitter triangle `slot` from b2 in [0, 1)^2 (uniform in its area), as seen from p:
-// the direction and distance to it, its radiance towards p (0 from its back: only the
-// counter-clockwise face emits) and the geometric factor cos θ_l / d² that turns its area density
-// into a solid-angle one.
-struct EmitterPoint {
-    wi: vec3f,
-    dist: f32,
-    le: vec3f,
-    g: f32,
-}
-
+// A point on emitter triangle `slot` from b2 in [0, 1)^2 (uniform in its area), as seen from p
+// (common/path.wgsl `EmitterPoint`; 0 from its back: only the counter-clockwise face emits).
 fn emitter_point(slot: u32, b2: vec2f, p: vec3f) -> EmitterPoint {
     // The vertices as texels (at the shutter's close where objects move): one fetch a vertex
     // instead of the storage buffer's per-word reads.
@@ -55,13 +46,6 @@ fn emitter_leaf_slot(leaf: u32) -> u32 {
 
 // An emitter chosen by the tree for p, n with u.x (slot NO_EMITTER where none can light p), and
 // the area density of its point: the tree's pmf over the triangle's area.
-const NO_EMITTER: u32 = 0xffffffffu;
-
-struct EmitterChoice {
-    slot: u32,
-    pdf_area: f32,
-}
-
 fn choose_emitter(p: vec3f, n: vec3f, u: f32) -> EmitterChoice {
     let c = light_tree_sample(p, n, u);
     if c.pmf <= 0.0 {

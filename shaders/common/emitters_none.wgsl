@@ -7,22 +7,8 @@ fn sample_emitter(p: vec3f, n: vec3f, u: vec3f) -> LightSample {
     return no_light();
 }
 
-struct EmitterPoint {
-    wi: vec3f,
-    dist: f32,
-    le: vec3f,
-    g: f32,
-}
-
 fn emitter_point(slot: u32, b2: vec2f, p: vec3f) -> EmitterPoint {
     return EmitterPoint(vec3f(0.0, 0.0, 1.0), 0.0, vec3f(0.0), 0.0);
-}
-
-const NO_EMITTER: u32 = 0xffffffffu;
-
-struct EmitterChoice {
-    slot: u32,
-    pdf_area: f32,
 }
 
 fn choose_emitter(p: vec3f, n: vec3f, u: f32) -> EmitterChoice {

@@ -8,6 +8,24 @@ fn light_groups() -> u32 {
     return params.num_lights + select(0u, 1u, HAS_EMITTERS) + select(0u, 1u, HAS_ENV);
 }
 
+// What common/emitters.wgsl (or emitters_none.wgsl) gives of an emissive triangle's point seen
+// from p: the direction and distance to it, its radiance towards p and the geometric factor
+// cos θ_l / d² that turns its area density into a solid-angle one.
+struct EmitterPoint {
+    wi: vec3f,
+    dist: f32,
+    le: vec3f,
+    g: f32,
+}
+
+// An emitter the light tree chose (slot NO_EMITTER: none) and the area density of its point.
+const NO_EMITTER: u32 = 0xffffffffu;
+
+struct EmitterChoice {
+    slot: u32,
+    pdf_area: f32,
+}
+
 // Sample one light group uniformly, then a point on it (emitters by the light tree's importance
 // to p and the geometric normal n). li already includes 1/select-probability.
 fn sample_light(p: vec3f, n: vec3f, rng: ptr<function, u32>) -> LightSample {

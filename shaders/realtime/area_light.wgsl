@@ -70,15 +70,25 @@ struct Ris {
     w_sum: f32,
 }
 
-fn ris_add(r: ptr<function, Ris>, ls: LightSample, li: vec3f, w: f32, rng: ptr<function, u32>) {
+// Streaming RIS's step (Alg. 3): a candidate of weight w joins the sum and replaces the kept
+// one with probability w / Σw. A weight that is not finite and positive is no candidate (no
+// random number drawn).
+fn ris_accept(w_sum: ptr<function, f32>, w: f32, rng: ptr<function, u32>) -> bool {
     if !(w > 0.0) || w > 3.0e38 {
-        return;
+        return false;
     }
-    (*r).w_sum += w;
-    if rand(rng) * (*r).w_sum < w {
+    *w_sum += w;
+    return rand(rng) * *w_sum < w;
+}
+
+fn ris_add(r: ptr<function, Ris>, ls: LightSample, li: vec3f, w: f32, rng: ptr<function, u32>) {
+    // A pointer argument names a whole variable (WGSL without unrestricted pointer parameters).
+    var w_sum = (*r).w_sum;
+    if ris_accept(&w_sum, w, rng) {
         (*r).kept = ResampledLight(ls.wi, ls.dist, li);
         (*r).w_kept = w;
     }
+    (*r).w_sum = w_sum;
 }
 
 // f(y) W = f(y) Σw / (m p^(y)), and p^(y) / p(y) = w_y.

@@ -95,11 +95,15 @@ fn direct_candidate(p: vec3f, ng: vec3f, rng: ptr<function, u32>) -> DirectCandi
     return DirectCandidate(d, env_pdf(d.wi) / groups);
 }
 
+// Pixel px's reservoir in the slot of frames of `parity`: this frame writes the slot of
+// frame.index + 1, reads the other.
+fn reservoir_index(px: vec2u, parity: u32) -> u32 {
+    return (parity & 1u) * frame.size.x * frame.size.y + px.y * frame.size.x + px.x;
+}
+
 // A pixel this frame does not resample (background, glass, a back face) leaves no reservoir.
 fn reservoir_clear(px: vec2u) {
-    let pixels = frame.size.x * frame.size.y;
-    let out = ((frame.index + 1u) & 1u) * pixels + px.y * frame.size.x + px.x;
-    reservoirs[out].m = 0.0;
+    reservoirs[reservoir_index(px, frame.index + 1u)].m = 0.0;
 }
 
 // The pixel's resampled matte light (L_e cos θ / π G W, its shadow ray traced), its reservoir
@@ -111,36 +115,26 @@ fn reservoir_direct(px: vec2u, p: vec3f, ns: vec3f, ng: vec3f, origin: vec3f, ep
     for (var i = 0u; i < m; i++) {
         let c = direct_candidate(p, ng, rng);
         let t = direct_target(c.d, ns, ng);
-        let w = t / c.pdf;
-        if !(c.pdf > 0.0) || !(w > 0.0) || w > 3.0e38 {
-            continue;
-        }
-        w_sum += w;
-        if rand(rng) * w_sum < w {
+        if ris_accept(&w_sum, t / c.pdf, rng) {
             y = c.d;
             t_y = t;
         }
     }
     var m_total = f32(m);
-    let pixels = frame.size.x * frame.size.y;
     let clip = frame.prev_view_proj * vec4f(p, 1.0);
     if frame.period == 1u && clip.w > 0.0 {
         let q = vec2i(floor(to_pixels(clip)));
         if all(q >= vec2i(0)) && all(q < vec2i(frame.size)) {
-            let prev = reservoirs[(frame.index & 1u) * pixels + u32(q.y) * frame.size.x + u32(q.x)];
+            let prev = reservoirs[reservoir_index(vec2u(q), frame.index)];
             let near = length(prev.p - p) <= RESERVOIR_MAX_MOVE * length(p - frame.cam_pos.xyz);
             let facing = dot(oct_decode(unpack2x16snorm(prev.n)), ns) >= RESERVOIR_MIN_COS;
             if prev.m > 0.0 && near && facing {
                 let mp = min(prev.m, RESERVOIR_HISTORY_CAP * f32(m));
                 let d = direct_sample_at(prev.id, prev.u, p);
                 let t = direct_target(d, ns, ng);
-                let w = t * prev.w * mp;
-                if w > 0.0 && w < 3.0e38 {
-                    w_sum += w;
-                    if rand(rng) * w_sum < w {
-                        y = d;
-                        t_y = t;
-                    }
+                if ris_accept(&w_sum, t * prev.w * mp, rng) {
+                    y = d;
+                    t_y = t;
                 }
                 m_total += mp;
             }
@@ -161,7 +155,6 @@ fn reservoir_direct(px: vec2u, p: vec3f, ns: vec3f, ng: vec3f, origin: vec3f, ep
     } else {
         big_w = 0.0;
     }
-    let out = ((frame.index + 1u) & 1u) * pixels + px.y * frame.size.x + px.x;
-    reservoirs[out] = Reservoir(p, pack2x16snorm(oct_encode(ns)), y.id, y.u, big_w, m_total);
+    reservoirs[reservoir_index(px, frame.index + 1u)] = Reservoir(p, pack2x16snorm(oct_encode(ns)), y.id, y.u, big_w, m_total);
     return li;
 }
