@@ -315,6 +315,8 @@ impl Running {
         self.govern(dt, &input);
         let size = self.frame_size();
         self.renderer.resize(&self.gpu, size)?;
+        // Below the window's size the upscaler reconstructs it (taa.upscale).
+        self.renderer.show_at(Some((self.config.width, self.config.height)))?;
 
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f)

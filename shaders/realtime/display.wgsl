@@ -15,7 +15,9 @@ struct DisplayOptions {
     // The view's channel and its map's parameter.
     channel: u32,
     param: f32,
-    _pad: vec2u,
+    // Size of the image `hdr` holds: the upscaler's (engine/src/passes/upscale.rs) where it ran,
+    // else the render size (frame.size), which the accumulation and the debug views have.
+    image_size: vec2u,
 }
 
 var<uniform> display: DisplayOptions;
@@ -112,9 +114,13 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let i = px.y * frame.size.x + px.x;
     var c: vec3f;
     if display.map == 0u {
-        var l = hdr[i].rgb;
+        var l: vec3f;
         if frame.accumulated > 0u {
             l = accumulation[i].rgb / f32(frame.accumulated);
+        } else {
+            let size = max(display.image_size, vec2u(1u));
+            let q_image = min(vec2u(pos.xy * vec2f(size) / vec2f(max(display.target_size, vec2u(1u)))), size - 1u);
+            l = hdr[q_image.y * size.x + q_image.x].rgb;
         }
         c = aces(max(l * frame.exposure, vec3f(0.0)));
     } else {

@@ -45,6 +45,10 @@ pub struct BenchArgs {
     /// other passes then run at the two sizes in turn).
     #[arg(long)]
     pub rescale: bool,
+    /// Real-time mode: trace at this resolution scale per side and show at WIDTHxHEIGHT through
+    /// the temporal upscaler (`taa.upscale`).
+    #[arg(long)]
+    pub scale: Option<f32>,
     /// Image size of the tracer benchmark.
     #[arg(long, default_value_t = 128)]
     pub width: u32,

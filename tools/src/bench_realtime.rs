@@ -42,6 +42,10 @@ struct RealtimeResult {
     bytes_per_pixel: f64,
     persistent_bytes_per_pixel: f64,
     transient_bytes_per_pixel: f64,
+    /// The upscaler's shown-size targets (0 where it does not run).
+    upscale_bytes: u64,
+    /// Every per-pixel target of the frame, the scene's tables and the upscaler's, in bytes.
+    total_bytes: u64,
     allocations: Vec<(String, u64)>,
 }
 
@@ -58,12 +62,18 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         crate::cli::check_output(p, &["puffin"], "--profile")?;
     }
     let scene = load_scene(&a.scene, &a.load)?;
-    let size = (a.width, a.height);
+    let shown = (a.width, a.height);
+    let size = match a.scale {
+        None => shown,
+        Some(s) if (0.1..=1.0).contains(&s) => crate::realtime::scaled(shown, s),
+        Some(s) => bail!("--scale {s}: use 0.1 to 1"),
+    };
     let instancing = crate::bench::instancing(&a.instancing)?;
     let (gpu, mut r) = Renderer::headless_with(scene, bvh_kind(&a.bvh)?, instancing, size)?;
     if a.cpu_posing {
         r.set_gpu_posing(&gpu, false)?;
     }
+    r.show_at(Some(shown))?;
     if !gpu.timestamps {
         bail!(
             "adapter {} has no timestamp queries; per-pass GPU times are not available",
@@ -73,7 +83,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("bench display target"),
-        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        size: wgpu::Extent3d { width: shown.0, height: shown.1, depth_or_array_layers: 1 },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
@@ -82,7 +92,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         view_formats: &[],
     });
     let view = tex.create_view(&Default::default());
-    let target = DisplayTarget { view: &view, format, size };
+    let target = DisplayTarget { view: &view, format, size: shown };
     let settings = match &a.preset {
         Some(p) => FrameSettings {
             max_depth: crate::cli::path_length(None, Some(p), r.scene.max_depth)?,
@@ -172,6 +182,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         bytes_per_pixel: r.bytes_per_pixel(),
         persistent_bytes_per_pixel: r.bytes_per_pixel() - r.transient_bytes_per_pixel(),
         transient_bytes_per_pixel: r.transient_bytes_per_pixel(),
+        upscale_bytes: r.upscale_bytes(),
+        total_bytes: r.allocations().iter().map(|(_, b)| b).sum(),
         allocations: r.allocations(),
     };
     if a.json {
@@ -195,6 +207,15 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             "  memory     {:.0} bytes/pixel persistent + {:.0} transient peak = {:.0} in all",
             res.persistent_bytes_per_pixel, res.transient_bytes_per_pixel, res.bytes_per_pixel
         );
+        if res.upscale_bytes > 0 {
+            println!(
+                "  upscaler   {:.0} bytes per shown pixel ({}x{} shown); frame and scene {:.1} MB in all",
+                res.upscale_bytes as f64 / (shown.0 as f64 * shown.1 as f64),
+                shown.0,
+                shown.1,
+                res.total_bytes as f64 / 1e6
+            );
+        }
     }
     Ok(())
 }

@@ -98,7 +98,15 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let path = a.camera_path.as_deref().map(CameraPath::load).transpose()?;
     let camera = a.camera.as_deref().map(parse_camera).transpose()?;
     let scene = load_scene(&a.scene, &a.load)?;
-    let size = image_size(&scene, a.width, a.height);
+    let shown = image_size(&scene, a.width, a.height);
+    let size = match a.scale {
+        None => shown,
+        Some(s) if (0.1..=1.0).contains(&s) => scaled(shown, s),
+        Some(s) => bail!("--scale {s}: use 0.1 to 1"),
+    };
+    if a.scale.is_some() && a.target_ms.is_some() {
+        bail!("--scale pins the resolution scale that --target-ms lets the governor choose");
+    }
     let camera = camera.unwrap_or_else(|| scene.camera_or_default());
     if let Some(v) = &view
         && v.spec().is_some_and(|s| s.needs_glossy())
@@ -139,6 +147,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if a.cpu_posing {
         r.set_gpu_posing(&gpu, false)?;
     }
+    r.show_at(Some(shown))?;
     if let Some(dir) = &a.out_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
@@ -189,16 +198,20 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let secs = start.elapsed().as_secs_f64();
     match (&a.out, view) {
         (Some(out), Some(view)) => {
-            let shown = r.display_image(&gpu, &FrameSettings { view, ..settings })?;
-            shown.save(out).with_context(|| format!("writing {}", out.display()))?;
+            let image = r.display_image(&gpu, &FrameSettings { view, ..settings })?;
+            image.save(out).with_context(|| format!("writing {}", out.display()))?;
         }
         (Some(out), None) => r.read_hdr(&gpu)?.save(out)?,
         _ => {}
     }
+    let traced = match size == shown {
+        true => String::new(),
+        false => format!(" (traced at {}x{})", size.0, size.1),
+    };
     eprintln!(
-        "{name}: {}x{} real-time, {frames} frames{} in {secs:.2} s on {}",
-        size.0,
-        size.1,
+        "{name}: {}x{}{traced} real-time, {frames} frames{} in {secs:.2} s on {}",
+        shown.0,
+        shown.1,
         if a.accumulate { " accumulated" } else { "" },
         gpu.info.name
     );
@@ -230,14 +243,12 @@ pub fn governed_frame(
     last_camera: &mut Option<hush_engine::scene::Camera>,
 ) -> Result<GovernedFrame> {
     let c = g.choice();
-    let size = (
-        (full.0 as f32 * c.scale).round().max(1.0) as u32,
-        (full.1 as f32 * c.scale).round().max(1.0) as u32,
-    );
+    let size = scaled(full, c.scale);
     let mut s = FrameSettings { sample_fraction: c.fraction, ..settings.clone() };
     hush_engine::settings::cap_filter_levels(&mut s, c.levels);
     let start = std::time::Instant::now();
     r.resize(gpu, size)?;
+    r.show_at(Some(full))?;
     r.render(gpu, input, &s, None)?;
     let passes = r.pass_times(gpu)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -301,4 +312,10 @@ fn governed(
         std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(rows)
+}
+
+/// `full` at resolution scale `scale` per side (at least one pixel).
+pub fn scaled(full: (u32, u32), scale: f32) -> (u32, u32) {
+    let side = |v: u32| (v as f32 * scale).round().max(1.0) as u32;
+    (side(full.0), side(full.1))
 }

@@ -70,6 +70,11 @@ pub struct RenderArgs {
     /// Real-time mode with --target-ms: the smallest resolution scale per side (default 0.25).
     #[arg(long)]
     pub min_scale: Option<f32>,
+    /// Real-time mode: trace at this resolution scale per side (0.1 to 1) and show the frame at
+    /// --width x --height, reconstructed by the temporal upscaler (`taa.upscale`; off, or with
+    /// --denoiser none, the image is stretched). The images written are at the shown size.
+    #[arg(long)]
+    pub scale: Option<f32>,
     /// Frames per second of the animation clock when no camera path gives times (default 60);
     /// the frame interval the shutter is a fraction of.
     #[arg(long)]
@@ -156,6 +161,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ("--accumulate", a.accumulate),
         ("--target-ms", a.target_ms.is_some()),
         ("--min-scale", a.min_scale.is_some()),
+        ("--scale", a.scale.is_some()),
         ("--view", a.view.is_some()),
         ("--out-dir", a.out_dir.is_some()),
     ];

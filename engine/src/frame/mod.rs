@@ -26,6 +26,7 @@ use crate::passes::primaries::Primaries;
 use crate::passes::supersample::Supersample;
 use crate::passes::taa::TaaStage;
 use crate::passes::trace::{SceneInputs, TraceInputs, TracePass};
+use crate::passes::upscale::UpscaleStage;
 use crate::scene::{Camera, Scene};
 use anyhow::{Context, Result, bail};
 use glam::{Vec2, Vec3};
@@ -119,6 +120,8 @@ pub struct Renderer {
     rescale_from: Option<Targets>,
     /// What the last resampling carried across a change of size.
     last_rescale: crate::passes::rescale::Rescaled,
+    /// The size the frame is shown at ([`Renderer::show_at`]).
+    shown_size: Option<(u32, u32)>,
 }
 
 impl PreparedScene {
@@ -213,6 +216,7 @@ impl Renderer {
             .context("creating the composite pass")?;
         let taa = TaaStage::new(gpu, &mut uniforms.memory, prepared.features.motion());
         let converge = ConvergeStage::new(gpu, &mut uniforms.memory);
+        let upscale = UpscaleStage::new(gpu, &mut uniforms.memory, prepared.features.motion());
         let stages = Stages {
             gbuffer,
             trace,
@@ -220,6 +224,7 @@ impl Renderer {
             display: None,
             taa,
             converge,
+            upscale,
             supersample: Supersample::new(),
             primaries: Primaries::default(),
             prefilter: Prefilter::default(),
@@ -241,6 +246,7 @@ impl Renderer {
             posing: None,
             rescale_from: None,
             last_rescale: Default::default(),
+            shown_size: None,
         };
         r.set_gpu_posing(gpu, true)?;
         log::info!("{}", r.report());
@@ -304,11 +310,35 @@ impl Renderer {
         self.targets.size
     }
 
+    /// Show the frame at `size` (None: at the render size). Where that is larger than the render
+    /// size and a denoiser runs, the temporal upscaler (passes/upscale.rs,
+    /// `TaaSettings::upscale`) reconstructs it from the jittered frames in TAA's place; else
+    /// the display stretches the render size's image.
+    pub fn show_at(&mut self, size: Option<(u32, u32)>) -> Result<()> {
+        if let Some(s) = size {
+            check_size(s)?;
+        }
+        self.shown_size = size;
+        Ok(())
+    }
+
+    /// The size of the image the last frame showed: the upscaler's where it ran, else the
+    /// render size.
+    pub fn shown_image_size(&self) -> (u32, u32) {
+        self.stages.upscale.output().map_or(self.targets.size, |(_, s)| s)
+    }
+
+    /// Bytes of the upscaler's shown-size targets (0 while it does not run).
+    pub fn upscale_bytes(&self) -> u64 {
+        self.stages.upscale.memory.total_bytes()
+    }
+
     /// Every buffer and texture of the frame and the scene, (label, bytes).
     pub fn allocations(&self) -> Vec<(String, u64)> {
         let mut v = self.gpu_scene.memory.allocations.clone();
         v.extend(self.targets.memory.allocations.iter().cloned());
         v.extend(self.uniforms.memory.allocations.iter().cloned());
+        v.extend(self.stages.upscale.memory.allocations.iter().cloned());
         if let Some(c) = self.stages.cache.cells() {
             v.extend(c.memory.allocations.iter().cloned());
         }

@@ -7,6 +7,7 @@ use crate::gpu::{BindKey, Gpu, Parity};
 use crate::passes::converge::ConvergeParams;
 use crate::passes::io::ChainView;
 use crate::passes::reference::{TraceView, make_params};
+use crate::passes::upscale::UpscaleParams;
 use crate::settings::{
     FrameSettings, MAX_PATHS_PER_PIXEL, MAX_PRIMARY_SAMPLES, MAX_SAMPLES_PER_PIXEL,
 };
@@ -43,6 +44,10 @@ pub(super) struct FramePlan<'s> {
     pub parity: Parity,
     /// The still-view mean's parameters where it runs (passes/converge.rs).
     pub converge: Option<ConvergeParams>,
+    /// The upscaler's parameters where it runs in TAA's place (passes/upscale.rs).
+    pub upscale: Option<UpscaleParams>,
+    /// TAA runs after frames the upscaler ran instead: its history restarts.
+    pub taa_restarts: bool,
 }
 
 impl Renderer {
@@ -96,13 +101,14 @@ impl Renderer {
             // The gather's test of what the last frame saw.
             self.targets.ensure_previous(gpu);
         }
+        let upscaled = self.upscaled_size(settings, denoiser);
         let cam = self.camera_setup(&input.camera);
         let h = &self.history;
-        // The raster's position in the pixel: Halton for TAA, uniformly random for the
-        // accumulate mode's box filter, the centre otherwise.
+        // The raster's position in the pixel: Halton for TAA and the upscaler, uniformly random
+        // for the accumulate mode's box filter, the centre otherwise.
         let jitter = if settings.accumulate {
             super::random_jitter(h.frame_index, settings.seed)
-        } else if denoiser.is_some() && settings.taa.enabled {
+        } else if denoiser.is_some() && (settings.taa.enabled || upscaled.is_some()) {
             halton_jitter(h.frame_index)
         } else {
             Vec2::splat(0.5)
@@ -119,6 +125,9 @@ impl Renderer {
             static_view: !moved && h.prev_view_proj == Some(cam.view_proj),
         };
         let converge = self.converge_plan(gpu, input, settings, (denoiser, samples), &view);
+        let upscale = self.upscale_plan(gpu, settings, (denoiser, upscaled), converge.as_ref());
+        let taa_restarts = upscale.is_none() && self.history.upscaled_last.is_some();
+        self.history.upscaled_last = upscaled;
         let denoised = denoiser.is_some();
         // Extra paths where a move uncovered a surface only where a history is there to restart
         // (on a cut, a first frame or a change of denoiser every pixel would take them) and
@@ -154,7 +163,45 @@ impl Renderer {
             frame_index: self.history.frame_index,
             parity: Parity::of_frame(self.history.frame_index),
             converge,
+            upscale,
+            taa_restarts,
         })
+    }
+
+    /// The size the upscaler shows this frame at, where it runs: a denoiser runs, the setting
+    /// is on and the frame is shown larger than it renders (never smaller on either axis).
+    fn upscaled_size(
+        &self,
+        settings: &FrameSettings,
+        denoiser: Option<usize>,
+    ) -> Option<(u32, u32)> {
+        let render = self.targets.size;
+        self.shown_size.filter(|s| {
+            denoiser.is_some()
+                && settings.taa.upscale
+                && *s != render
+                && s.0 >= render.0
+                && s.1 >= render.1
+        })
+    }
+
+    /// The upscaler's parameters where it shows at `shown`; its targets are made or dropped
+    /// here. Its history continues where it ran last frame at the same shown size and
+    /// denoiser, its raw samples' mean where the still-view mean (`converge`) continues.
+    fn upscale_plan(
+        &mut self,
+        gpu: &Gpu,
+        settings: &FrameSettings,
+        (denoiser, shown): (Option<usize>, Option<(u32, u32)>),
+        converge: Option<&ConvergeParams>,
+    ) -> Option<UpscaleParams> {
+        let render = self.targets.size;
+        if self.stages.upscale.allocate(gpu, shown) {
+            self.targets.generation += 1;
+        }
+        let h = &self.history;
+        let continues = shown.is_some() && h.upscaled_last == shown && h.denoised_last == denoiser;
+        shown.map(|s| UpscaleParams::new(&settings.taa, (render, s), continues, converge))
     }
 
     /// The still-view mean's parameters where it runs this frame: a denoiser ran (TAA's image is

@@ -8,13 +8,14 @@ use anyhow::{Context, Result};
 use glam::Vec3;
 
 impl Renderer {
-    /// The display's image of the last frame (tone-mapped or the chosen debug view) as 8-bit sRGB.
+    /// The display's image of the last frame (tone-mapped or the chosen debug view) as 8-bit
+    /// sRGB, at the size it was shown at.
     pub fn display_image(
         &mut self,
         gpu: &Gpu,
         settings: &FrameSettings,
     ) -> Result<image::RgbaImage> {
-        let (w, h) = self.targets.size;
+        let (w, h) = self.shown_image_size();
         let format = wgpu::TextureFormat::Rgba8Unorm;
         let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("display image"),
@@ -72,14 +73,15 @@ impl Renderer {
         self.history.accumulated
     }
 
-    /// The last frame's linear HDR image (after composite), or in accumulate mode the mean.
+    /// The last frame's linear HDR image (after composite, TAA or the upscaler, at the size it
+    /// was shown at), or in accumulate mode the mean.
     pub fn read_hdr(&self, gpu: &Gpu) -> Result<Image> {
-        let (w, h) = self.targets.size;
+        let (w, h) = self.shown_image_size();
         let n = w as u64 * h as u64 * 16;
-        let shown =
-            super::record::after_taa(&self.stages.taa, &self.stages.converge, &self.targets.hdr)
-                .filter(|_| self.history.denoised_last.is_some())
-                .unwrap_or(&self.targets.hdr);
+        let s = &self.stages;
+        let shown = super::record::after_taa(&s.taa, &s.converge, &s.upscale, &self.targets.hdr)
+            .filter(|_| self.history.denoised_last.is_some())
+            .unwrap_or(&self.targets.hdr);
         let (buf, scale) = match (&self.targets.accumulation, self.history.accumulated) {
             (Some(a), k) if k > 0 => (a, 1.0 / k as f32),
             _ => (shown, 1.0),

@@ -31,6 +31,7 @@ pub(super) struct Stages {
     pub display: Option<DisplayPass>,
     pub taa: TaaStage,
     pub converge: ConvergeStage,
+    pub upscale: crate::passes::upscale::UpscaleStage,
     pub supersample: Supersample,
     pub primaries: Primaries,
     pub prefilter: Prefilter,
@@ -54,6 +55,8 @@ pub(super) struct FrameHistory {
     /// What the still-view mean was taken with: the camera, the shutter's camera and the
     /// settings (None: it restarts).
     pub converge_state: Option<ConvergeState>,
+    /// The size the upscaler showed last frame (None: it did not run).
+    pub upscaled_last: Option<(u32, u32)>,
 }
 
 pub(super) type ConvergeState = (crate::scene::Camera, Option<crate::scene::Camera>, FrameSettings);
@@ -108,6 +111,7 @@ impl Renderer {
         s.record_resolve(&mut rec, plan, &io, t)?;
         s.record_taa(&mut rec, plan, &io, denoiser.as_ref())?;
         s.record_converge(&mut rec, plan, &io)?;
+        s.record_upscale(&mut rec, plan, &io)?;
         s.record_display(&mut rec, plan, (&io, u, t), target)?;
         if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
             p.record_copy(rec.enc, &t.gbuffer, t.size);
@@ -159,11 +163,13 @@ impl Renderer {
             let (t, u) = (&self.targets, &self.uniforms);
             let io = t.io(&u.frame, &self.gpu_scene);
             let denoised = self.history.denoised_last;
-            let after_taa = after_taa(&self.stages.taa, &self.stages.converge, &t.hdr);
+            let bind_key = self.bind_key(denoised);
+            let s = &mut self.stages;
+            let after_taa = after_taa(&s.taa, &s.converge, &s.upscale, &t.hdr);
             let fb = u.shown(t, &io, after_taa.filter(|_| denoised.is_some()));
             let (view, view_key) = t.view_texture(settings);
-            let key = BindKey { view: view_key, ..self.bind_key(denoised) };
-            if let Some(d) = self.stages.display.as_mut() {
+            let key = BindKey { view: view_key, ..bind_key };
+            if let Some(d) = s.display.as_mut() {
                 d.record(&mut Recorder::new(gpu, &mut enc, None), key, &fb, view, target.view)?;
             }
             gpu.queue.submit([enc.finish()]);
@@ -195,20 +201,24 @@ impl Renderer {
         };
         let (map, channel, param) = spec.map_or((0, 0, 0.0), |s| s.map.encode(t.size.0));
         let srgb = !target.format.is_srgb() as u32;
+        // The image's size: the upscaler's where it runs this frame (or ran, for a redisplay).
+        let image = self.history.upscaled_last.unwrap_or(t.size);
         let options: [u32; 8] =
-            [srgb, map, target.size.0, target.size.1, channel, param.to_bits(), 0, 0];
+            [srgb, map, target.size.0, target.size.1, channel, param.to_bits(), image.0, image.1];
         gpu.queue.write_buffer(&u.display, 0, bytemuck::cast_slice(&options));
         Ok(())
     }
 }
 
-/// The image after TAA (and the still-view mean where it ran), once TAA ran.
+/// The image after TAA (and the still-view mean where it ran), once TAA ran; the upscaler's
+/// where it ran in TAA's place.
 pub(super) fn after_taa<'a>(
     taa: &'a TaaStage,
     converge: &'a ConvergeStage,
+    upscale: &'a crate::passes::upscale::UpscaleStage,
     hdr: &'a wgpu::Buffer,
 ) -> Option<&'a wgpu::Buffer> {
-    converge.output(hdr).or(taa.output())
+    upscale.output().map(|(b, _)| b).or(converge.output(hdr)).or(taa.output())
 }
 
 /// What the stages read: the scene, the trace's inputs, and the frame's I/O with the
@@ -378,9 +388,13 @@ impl Stages {
         io: &FrameIo,
         denoiser: Option<&Outputs>,
     ) -> Result<()> {
-        let Some(d) = denoiser else { return Ok(()) };
+        let Some(d) = denoiser.filter(|_| plan.upscale.is_none()) else { return Ok(()) };
         let s = plan.settings;
         let mut tp = TaaParams::new(&s.taa);
+        // Its history was not written while the upscaler ran in its place.
+        if plan.taa_restarts {
+            tp.enabled = 0;
+        }
         // A frame that traces one pixel in N (N > 1) shows light that gains a sample per pixel
         // only every N frames, so a still pixel's frames are not alike: TAA's long still-view
         // mean (taa.still_frames) would keep the young, hole-filled frames in the image for
@@ -404,15 +418,26 @@ impl Stages {
         plan: &FramePlan,
         io: &FrameIo,
     ) -> Result<()> {
-        let (Some(params), Some(taa)) = (plan.converge, self.taa.output()) else {
+        let (Some(params), Some(taa), None) = (plan.converge, self.taa.output(), plan.upscale)
+        else {
             self.converge.skip();
             return Ok(());
         };
         self.converge.record(rec, plan.output_key, io, taa, &params, plan.parity)
     }
 
-    /// The image after TAA when a denoiser ran, else the composite's, tone-mapped (or the
-    /// debug view) into `target`.
+    /// Below the size shown, the upscaler in TAA's place (passes/upscale.rs).
+    fn record_upscale(&mut self, rec: &mut Recorder, plan: &FramePlan, io: &FrameIo) -> Result<()> {
+        let Some(params) = plan.upscale.as_ref() else {
+            self.upscale.skip();
+            return Ok(());
+        };
+        let _pass = crate::profile::scope(crate::passes::upscale::LABEL);
+        self.upscale.record(rec, plan.output_key, io, params, plan.parity)
+    }
+
+    /// The image after TAA (or the upscaler) when a denoiser ran, else the composite's,
+    /// tone-mapped (or the debug view) into `target`.
     fn record_display(
         &mut self,
         rec: &mut Recorder,
@@ -422,7 +447,7 @@ impl Stages {
     ) -> Result<()> {
         let (Some(target), Some(d)) = (target, self.display.as_mut()) else { return Ok(()) };
         let _pass = crate::profile::scope(composite::DISPLAY);
-        let after_taa = after_taa(&self.taa, &self.converge, &t.hdr);
+        let after_taa = after_taa(&self.taa, &self.converge, &self.upscale, &t.hdr);
         let shown = u.shown(t, io, after_taa.filter(|_| plan.denoiser.is_some()));
         let (view, view_key) = t.view_texture(plan.settings);
         d.record(rec, BindKey { view: view_key, ..plan.output_key }, &shown, view, target.view)

@@ -20,3 +20,4 @@ pub mod schedule;
 pub mod supersample;
 pub mod taa;
 pub mod trace;
+pub mod upscale;

@@ -291,6 +291,7 @@ fn modules(
         Some(MatteState::Moments) => "taa/matte_moments.wgsl",
         None => "taa/matte_none.wgsl",
     });
+    m.push("taa/history_test.wgsl");
     m.push("taa/taa.wgsl");
     m
 }

@@ -66,6 +66,23 @@ described! {
         /// too uncertain before), default 16.
         converge_min_samples: f32 = 16.0,
             ("taa.converge_min_samples", "taa", "samples", Float(2.0, 1024.0, 1.0));
+        /// Where the frame is traced below the size it is shown at (the governor's scale, `render
+        /// --scale`), the temporal upscaler takes TAA's place (passes/upscale.rs): each shown pixel
+        /// accumulates the jittered samples that land near it, and a still view converges to the
+        /// shown resolution's detail instead of stretching the render pixels. Off: the image is
+        /// stretched. 48 bytes per shown pixel while it runs.
+        upscale: bool = true,
+            ("taa.upscale", "taa", "", Bool);
+        /// The upscaler's kernel: a Gaussian of this standard deviation in shown pixels, default
+        /// 0.4. Narrower is sharper and needs more frames to fill every pixel: SVGF's frame 60
+        /// at scale 0.5 (160x90 level, 160x160 cornell_mirror) FLIP 0.1036 / 0.1015 at 0.3,
+        /// 0.1030 at 0.4, 0.1050 / 0.1055 at 0.5.
+        upscale_sigma: f32 = 0.4,
+            ("taa.upscale_sigma", "taa", "px", Float(0.2, 2.0, 0.05));
+        /// While anything moves, the upscaler's history keeps at most this many frames' worth of
+        /// samples, default 10 (TAA's `alpha` 0.1): more is smoother and lags more.
+        upscale_moving_frames: f32 = 10.0,
+            ("taa.upscale_moving_frames", "taa", "frames", Float(1.0, 64.0, 1.0));
     }
     hidden {
     }

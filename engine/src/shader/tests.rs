@@ -114,6 +114,14 @@ pub(super) fn all_programs() -> Vec<Program> {
             v.push(compose(m[m.len() - 1], "", &m).unwrap());
         }
     }
+    for motion in MOTIONS {
+        for glossy in [false, true] {
+            for accumulate in [true, false] {
+                let m = crate::passes::upscale::modules(motion, glossy, accumulate);
+                v.push(compose(m[m.len() - 1], "", &m).unwrap());
+            }
+        }
+    }
     for (format, main) in [
         ("rgba32float", "realtime/rescale_float.wgsl"),
         ("r32float", "realtime/rescale_float.wgsl"),
@@ -162,6 +170,7 @@ pub(super) fn all_programs() -> Vec<Program> {
                 "taa/glossy.wgsl",
                 "taa/glossy_term.wgsl",
                 "taa/matte.wgsl",
+                "taa/history_test.wgsl",
                 "taa/taa.wgsl",
             ],
             &[
@@ -169,6 +178,7 @@ pub(super) fn all_programs() -> Vec<Program> {
                 "taa/glossy_none.wgsl",
                 "taa/glossy_term.wgsl",
                 "taa/matte_none.wgsl",
+                "taa/history_test.wgsl",
                 "taa/taa.wgsl",
             ],
             &[
@@ -176,6 +186,7 @@ pub(super) fn all_programs() -> Vec<Program> {
                 "taa/glossy_none.wgsl",
                 "taa/glossy_term.wgsl",
                 "taa/matte_moments.wgsl",
+                "taa/history_test.wgsl",
                 "taa/taa.wgsl",
             ],
         ] {

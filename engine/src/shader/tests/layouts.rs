@@ -193,6 +193,25 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
             pad,
         }),
     );
+    use crate::passes::upscale::UpscaleParams;
+    for label in ["taa/upscale.wgsl", "taa/upscale_shown.wgsl"] {
+        same(
+            &v,
+            label,
+            "UpscaleParams",
+            layout!(UpscaleParams {
+                out_size,
+                sigma,
+                moving_weight,
+                fill_weight,
+                continues,
+                raw_continues,
+                bias_sigmas,
+                min_samples,
+                _pad,
+            }),
+        );
+    }
     same(
         &v,
         "taa/converge.wgsl",

@@ -1,0 +1,125 @@
+// The upscaler's accumulation (taa/upscale_common.wgsl says what it keeps and why).
+
+var up_history: texture_2d<f32>;
+var out_up_history: texture_storage_2d<rgba32float, write>;
+// The raw samples' kernel-weighted mean (rgb) and weight (a); their weighted mean squared
+// length (r) and sum of squared weights (g), for the mean's variance.
+var raw_history: texture_2d<f32>;
+var raw_m2_history: texture_2d<f32>;
+var out_raw: texture_storage_2d<rgba32float, write>;
+var out_raw_m2: texture_storage_2d<rg32float, write>;
+
+// Bilinear read of the history at shown-pixel coordinates `at` (texel centres at +0.5).
+fn history_bilinear(at: vec2f) -> vec4f {
+    let b = bilinear_taps(at);
+    let hi = vec2i(up.out_size) - 1;
+    var sum = vec4f(0.0);
+    for (var k = 0; k < 4; k++) {
+        sum += b.w[k] * textureLoad(up_history, clamp(bilinear_tap(b, k), vec2i(0), hi), 0);
+    }
+    return sum;
+}
+
+fn finite4(v: vec4f) -> bool {
+    return all(v == v) && all(abs(v) <= vec4f(3.0e38));
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    let o = gid.xy;
+    if any(o >= up.out_size) {
+        return;
+    }
+    let centre = centre_sample(o);
+    let inv_2s2 = 1.0 / (2.0 * up.sigma * up.sigma);
+    // The raw mean is kept only in a still view; in a moving one the nearest depth picks the
+    // motion (a still view's motion is zero everywhere).
+    let static_view = frame.static_view != 0u;
+    let raw_on = up.bias_sigmas > 0.0 && static_view;
+    var sum_w = 0.0;
+    var sum_c = vec3f(0.0);
+    var raw_w = 0.0;
+    var raw_w2 = 0.0;
+    var raw_c = vec3f(0.0);
+    var raw_c2 = 0.0;
+    var lo = vec3f(3.0e38);
+    var hi = vec3f(-3.0e38);
+    var nearest = clamp(centre, vec2i(0), vec2i(frame.size) - 1);
+    var nearest_z = 3.0e38;
+    for (var k = 0; k < 9; k++) {
+        let i = centre + neighbour_3x3(k);
+        if !in_bounds(i) {
+            continue;
+        }
+        let c = sample_at(i);
+        let d = sample_offset(o, i);
+        let w = exp(-dot(d, d) * inv_2s2);
+        sum_w += w;
+        sum_c += w * c;
+        // The kernel cut at 1% of its peak (3 sigma): remodulating a sample costs more than all
+        // the rest of its use here.
+        if raw_on && w >= 0.01 && traced_this_frame(vec2u(i)) {
+            let x = half_safe(remodulated(vec2u(i)));
+            raw_w += w;
+            raw_w2 += w * w;
+            raw_c += w * x;
+            raw_c2 += w * dot(x, x);
+        }
+        let y = to_ycocg(c);
+        lo = min(lo, y);
+        hi = max(hi, y);
+        let z = select(depth_at(i), -1.0, static_view);
+        if z >= 0.0 && z < nearest_z {
+            nearest = i;
+            nearest_z = z;
+        }
+    }
+    let mv = textureLoad(gb_motion, nearest, 0).xy;
+    let still = dot(mv, mv) < 1e-4;
+    let settled = still && frame.static_view != 0u;
+    var hist = vec4f(0.0);
+    let prev = vec2f(o) + 0.5 + mv / to_render();
+    let on_screen = all(prev >= vec2f(0.0)) && all(prev < vec2f(up.out_size));
+    if up.continues != 0u && on_screen {
+        // The previous depth buffer is the render size's; without one the clamp alone decides.
+        var shown = true;
+        if frame.history_valid != 0u {
+            let taps = history_taps(nearest, vec2f(nearest) + 0.5 + mv, still);
+            shown = any(taps.w != vec4f(0.0));
+        }
+        if shown {
+            hist = select(history_bilinear(prev), textureLoad(up_history, vec2i(o), 0), still);
+        }
+        if !finite4(hist) || hist.a <= 0.0 {
+            hist = vec4f(0.0);
+        }
+    }
+    if !settled && hist.a > 0.0 {
+        hist = vec4f(from_ycocg(clamp(to_ycocg(hist.rgb), lo, hi)), min(hist.a, up.moving_weight));
+    }
+    let weight = hist.a + sum_w;
+    var mean = spatial_estimate(o);
+    if weight > 1e-20 {
+        mean = (hist.rgb * hist.a + sum_c) / weight;
+    }
+    textureStore(out_up_history, vec2i(o), vec4f(mean, weight));
+
+    // The raw mean continues only while the view stands still (its own texel, unclamped).
+    var raw = vec4f(0.0);
+    var raw_m2 = vec4f(0.0);
+    if up.raw_continues != 0u && settled {
+        raw = textureLoad(raw_history, vec2i(o), 0);
+        raw_m2 = textureLoad(raw_m2_history, vec2i(o), 0);
+        if !finite4(raw) || !finite4(raw_m2) || raw.a <= 0.0 {
+            raw = vec4f(0.0);
+            raw_m2 = vec4f(0.0);
+        }
+    }
+    let raw_weight = raw.a + raw_w;
+    if raw_weight > 1e-20 {
+        raw = vec4f((raw.rgb * raw.a + raw_c) / raw_weight, raw_weight);
+        raw_m2 = vec4f((raw_m2.r * (raw_weight - raw_w) + raw_c2) / raw_weight, raw_m2.g + raw_w2, 0.0, 0.0);
+    }
+    textureStore(out_raw, vec2i(o), raw);
+    textureStore(out_raw_m2, vec2i(o), raw_m2);
+}

@@ -1,0 +1,89 @@
+// The temporal upscaler (engine/src/passes/upscale.rs): where the frame is traced below the size
+// it is shown at, each shown pixel accumulates the composite's jittered samples that land near
+// it, in place of TAA. The raster samples render pixel i at i + frame.jitter (Halton(2, 3)), so
+// over frames the samples of a render pixel sweep the shown pixels it covers.
+//
+// Each shown pixel o keeps a weighted mean of the samples it received (rgb) and their weight
+// (a). A sample at distance d (in shown pixels) from o's centre weighs exp(-d^2 / 2 sigma^2):
+// with sigma about half a shown pixel the mean converges to the image at the shown resolution,
+// not the render resolution's (a bilinear stretch keeps the render pixel's box forever). The
+// history is reprojected through the motion of the render pixel nearest the camera among the
+// nine around o (motion dilated from the nearest depth, so an edge moves with its foreground),
+// tested against the previous depth buffer as TAA tests its own (taa/history_test.wgsl) and,
+// while anything moves, clamped to the YCoCg box of the nine samples around o (Karis 2014) and
+// capped at `moving_weight`: about `TaaSettings::upscale_moving_frames` frames of samples. In a
+// still view the weight grows without bound, and the mean is the plain kernel-weighted mean of
+// every sample since the view settled.
+//
+// Beside it, in a still view, the upscaler keeps the same kernel-weighted mean of the raw
+// samples (the trace's light remodulated, as the still-view mean after TAA keeps it at the
+// render size: passes/converge.rs), and the image shown moves towards that mean where the
+// denoised one is off by more than the mean's noise (taa/upscale_shown.wgsl).
+//
+// What is shown also takes a small weight (`fill_weight`, a quarter of a frame's samples) of
+// the nine samples filtered with a Gaussian of half a render pixel: where the history has no
+// weight (a first frame, a surface just uncovered) that spatial estimate is the image, and it
+// fades as samples arrive.
+
+struct UpscaleParams {
+    // The size shown (the history's and the output's); frame.size is the render size.
+    out_size: vec2u,
+    // The accumulation kernel's standard deviation, in shown pixels.
+    sigma: f32,
+    // The most weight a history keeps while anything moves.
+    moving_weight: f32,
+    // Weight of the spatial estimate in the image shown.
+    fill_weight: f32,
+    // 1 when the history continues last frame's (same shown size, upscaled last frame).
+    continues: u32,
+    // 1 when the raw samples' mean continues (the still-view mean's condition, passes/converge.rs).
+    raw_continues: u32,
+    // TaaSettings::converge_sigmas and converge_min_samples (0 sigmas: no raw mean).
+    bias_sigmas: f32,
+    min_samples: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+var<uniform> up: UpscaleParams;
+var<storage, read> hdr: array<vec4f>;
+
+fn sample_at(i: vec2i) -> vec3f {
+    return half_safe(hdr[u32(i.y) * frame.size.x + u32(i.x)].rgb);
+}
+
+// Render pixels per shown pixel (at most 1 on each axis).
+fn to_render() -> vec2f {
+    return vec2f(frame.size) / vec2f(up.out_size);
+}
+
+// The render pixel whose sample lies nearest shown pixel o's centre; the nine around it hold
+// every sample within a render pixel of it.
+fn centre_sample(o: vec2u) -> vec2i {
+    return vec2i(floor((vec2f(o) + 0.5) * to_render() - frame.jitter + 0.5));
+}
+
+// Offset, in shown pixels, from o's centre to the sample of render pixel i.
+fn sample_offset(o: vec2u, i: vec2i) -> vec2f {
+    return (vec2f(i) + frame.jitter) / to_render() - (vec2f(o) + 0.5);
+}
+
+// The nine samples around o filtered with a Gaussian of half a render pixel: the image where
+// the history has no weight yet.
+fn spatial_estimate(o: vec2u) -> vec3f {
+    let centre = centre_sample(o);
+    var sum_w = 0.0;
+    var sum_c = vec3f(0.0);
+    for (var k = 0; k < 9; k++) {
+        let i = centre + neighbour_3x3(k);
+        if !in_bounds(i) {
+            continue;
+        }
+        let dr = sample_offset(o, i) * to_render();
+        let w = exp(-2.0 * dot(dr, dr));
+        sum_w += w;
+        sum_c += w * sample_at(i);
+    }
+    return sum_c / max(sum_w, 1e-20);
+}
