@@ -3,6 +3,11 @@
 // it, in place of TAA. The raster samples render pixel i at i + frame.jitter (Halton(2, 3)), so
 // over frames the samples of a render pixel sweep the shown pixels it covers.
 //
+// The light is accumulated demodulated: each sample divided by its render pixel's material
+// (`demodulation`), the mean multiplied by the materials of a raster at the shown size averaged
+// over its own jitter, so that textures keep the shown size's detail whatever the scale (the
+// raster is the cheap part of the frame).
+//
 // Each shown pixel o keeps a weighted mean of the samples it received (rgb) and their weight
 // (a). A sample at distance d (in shown pixels) from o's centre weighs exp(-d^2 / 2 sigma^2):
 // with sigma about half a shown pixel the mean converges to the image at the shown resolution,
@@ -41,16 +46,33 @@ struct UpscaleParams {
     // TaaSettings::converge_sigmas and converge_min_samples (0 sigmas: no raw mean).
     bias_sigmas: f32,
     min_samples: f32,
+    // TaaSettings::upscale_moving_frames: the materials' mean's length while anything moves.
+    moving_frames: f32,
     pad0: u32,
     pad1: u32,
-    pad2: u32,
 }
 
 var<uniform> up: UpscaleParams;
 var<storage, read> hdr: array<vec4f>;
 
-fn sample_at(i: vec2i) -> vec3f {
-    return half_safe(hdr[u32(i.y) * frame.size.x + u32(i.x)].rgb);
+// What the light is divided by at the render size and multiplied by at the shown size, so that
+// the materials' detail comes from the shown size's raster: the diffuse albedo plus the
+// specular reflectance at normal incidence (1 off any surface). Emission is taken out before
+// and put back after, from the shown size's raster, so that a lamp's edge is the shown size's.
+fn demodulation(hit: bool, base: vec4f, f0: vec3f) -> vec3f {
+    if !hit {
+        return vec3f(1.0);
+    }
+    return max(base.rgb * (1.0 - base.a) + f0, vec3f(0.02));
+}
+
+// The composite's sample of render pixel i less its emission, divided by its material's
+// demodulation.
+fn light_at(i: vec2i) -> vec3f {
+    let c = half_safe(hdr[u32(i.y) * frame.size.x + u32(i.x)].rgb);
+    let hit = textureLoad(gb_object, i, 0).y != NO_SURFACE;
+    let a = demodulation(hit, textureLoad(gb_base_color, i, 0), textureLoad(gb_specular, i, 0).rgb);
+    return (c - textureLoad(gb_emission, i, 0).rgb) / a;
 }
 
 // Render pixels per shown pixel (at most 1 on each axis).
@@ -69,7 +91,7 @@ fn sample_offset(o: vec2u, i: vec2i) -> vec2f {
     return (vec2f(i) + frame.jitter) / to_render() - (vec2f(o) + 0.5);
 }
 
-// The nine samples around o filtered with a Gaussian of half a render pixel: the image where
+// The nine samples' light around o filtered with a Gaussian of half a render pixel: the image where
 // the history has no weight yet.
 fn spatial_estimate(o: vec2u) -> vec3f {
     let centre = centre_sample(o);
@@ -83,7 +105,7 @@ fn spatial_estimate(o: vec2u) -> vec3f {
         let dr = sample_offset(o, i) * to_render();
         let w = exp(-2.0 * dot(dr, dr));
         sum_w += w;
-        sum_c += w * sample_at(i);
+        sum_c += w * light_at(i);
     }
     return sum_c / max(sum_w, 1e-20);
 }

@@ -142,6 +142,9 @@ impl Renderer {
             denoised,
             (primary_samples, uncovered_paths, prev_jitter),
         );
+        if let Some(shown) = upscaled {
+            self.upload_shown(gpu, input, settings, shown, jitter);
+        }
         self.history.denoised_last = denoiser;
         if let Some(target) = target {
             self.prepare_display(gpu, target, settings)?;
@@ -166,6 +169,26 @@ impl Renderer {
             upscale,
             taa_restarts,
         })
+    }
+
+    /// The frame's uniform at the shown size, for the upscaler's raster of the materials: the
+    /// same camera, sampled at `jitter` within each shown pixel.
+    fn upload_shown(
+        &self,
+        gpu: &Gpu,
+        input: &FrameInput,
+        settings: &FrameSettings,
+        shown: (u32, u32),
+        jitter: Vec2,
+    ) {
+        let cam = super::CameraSetup::new(&input.camera, self.prepared.origin, shown, self.near());
+        let jittered = cam.jittered(jitter, shown);
+        let prev = self.history.prev_view_proj.unwrap_or(cam.view_proj);
+        let index = self.history.frame_index;
+        let eps = self.prepared.ray_epsilon();
+        let fp =
+            FrameParams::new(&cam, jittered, prev, jitter, shown, index, settings, 0, eps, 0.0);
+        self.stages.upscale.write_frame(gpu, &fp);
     }
 
     /// The size the upscaler shows this frame at, where it runs: a denoiser runs, the setting

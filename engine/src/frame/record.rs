@@ -111,7 +111,7 @@ impl Renderer {
         s.record_resolve(&mut rec, plan, &io, t)?;
         s.record_taa(&mut rec, plan, &io, denoiser.as_ref())?;
         s.record_converge(&mut rec, plan, &io)?;
-        s.record_upscale(&mut rec, plan, &io)?;
+        s.record_upscale(&mut rec, plan, &io, gpu_scene)?;
         s.record_display(&mut rec, plan, (&io, u, t), target)?;
         if let (true, Some(p)) = (denoiser.is_some(), &t.previous) {
             p.record_copy(rec.enc, &t.gbuffer, t.size);
@@ -427,13 +427,19 @@ impl Stages {
     }
 
     /// Below the size shown, the upscaler in TAA's place (passes/upscale.rs).
-    fn record_upscale(&mut self, rec: &mut Recorder, plan: &FramePlan, io: &FrameIo) -> Result<()> {
+    fn record_upscale(
+        &mut self,
+        rec: &mut Recorder,
+        plan: &FramePlan,
+        io: &FrameIo,
+        scene: &crate::gpu::GpuScene,
+    ) -> Result<()> {
         let Some(params) = plan.upscale.as_ref() else {
             self.upscale.skip();
             return Ok(());
         };
         let _pass = crate::profile::scope(crate::passes::upscale::LABEL);
-        self.upscale.record(rec, plan.output_key, io, params, plan.parity)
+        self.upscale.record(rec, (plan.output_key, scene), io, params, plan.parity)
     }
 
     /// The image after TAA (or the upscaler) when a denoiser ran, else the composite's,

@@ -57,11 +57,22 @@ pub struct GBufferTargets {
 
 impl GBufferTargets {
     pub fn new(gpu: &Gpu, mem: &mut GpuMemory, size: (u32, u32)) -> GBufferTargets {
+        Self::labelled(gpu, mem, size, "")
+    }
+
+    /// As [`GBufferTargets::new`], each label after `prefix` (a second G-buffer's).
+    pub fn labelled(
+        gpu: &Gpu,
+        mem: &mut GpuMemory,
+        size: (u32, u32),
+        prefix: &str,
+    ) -> GBufferTargets {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
-        let depth = mem.texture(&gpu.device, "gbuffer/depth", size, DEPTH_FORMAT, usage);
-        let color = COLOR_FORMATS.map(|(l, f)| mem.texture(&gpu.device, l, size, f, usage));
+        let mut t = |l: &str, f| mem.texture(&gpu.device, &format!("{prefix}{l}"), size, f, usage);
+        let depth = t("gbuffer/depth", DEPTH_FORMAT);
+        let color = COLOR_FORMATS.map(|(l, f)| t(l, f));
         GBufferTargets { depth, color }
     }
 

@@ -6,13 +6,16 @@
 //!
 //! Its history lives at the shown size and outlives a change of render scale (the governor's),
 //! which the render-size histories cross only by resampling (passes/rescale.rs). Per shown
-//! pixel: 112 bytes (pairs of the samples' mean and weight, 32, of the raw samples' for the
-//! still view, 32 and 16, and the image shown, 16), held only while it runs. Its settings are `TaaSettings::upscale`, `upscale_sigma` and
+//! pixel: 196 bytes (pairs of the light's mean and weight, 32, of the raw samples' for the
+//! still view, 32 and 16, of the materials' and the emission's means, 8 each, the image shown,
+//! 16, and the raster's G-buffer at the shown size, 36), held only while it runs. Its settings are `TaaSettings::upscale`, `upscale_sigma` and
 //! `upscale_moving_frames`.
 
 use super::chain::ChainStage;
+use super::gbuffer::{Channel, GBufferPass, GBufferTargets};
 use super::io::FrameIo;
-use crate::gpu::{Gpu, GpuMemory, Parity, PingPong, Recorder, Tex};
+use crate::frame::FrameParams;
+use crate::gpu::{Gpu, GpuMemory, GpuScene, Parity, PingPong, Recorder, Tex};
 use crate::settings::TaaSettings;
 use anyhow::{Context, Result};
 use bytemuck::{Pod, Zeroable};
@@ -20,6 +23,8 @@ use bytemuck::{Pod, Zeroable};
 pub const LABEL: &str = "upscale";
 /// Its second pass: the image shown.
 pub const SHOWN: &str = "upscale/shown";
+/// The raster at the shown size before them.
+pub const RASTER: &str = "upscale/gbuffer";
 /// Labels of what it allocates start with this.
 pub const PREFIX: &str = "upscale/";
 
@@ -35,7 +40,8 @@ pub struct UpscaleParams {
     pub raw_continues: u32,
     pub bias_sigmas: f32,
     pub min_samples: f32,
-    pub _pad: [u32; 3],
+    pub moving_frames: f32,
+    pub _pad: [u32; 2],
 }
 
 impl UpscaleParams {
@@ -50,24 +56,32 @@ impl UpscaleParams {
         raw: Option<&super::converge::ConvergeParams>,
     ) -> Self {
         let sigma = s.upscale_sigma.clamp(0.2, 2.0);
+        let moving_frames = s.upscale_moving_frames.clamp(1.0, 1024.0);
         let density = (render.0 as f32 / shown.0 as f32) * (render.1 as f32 / shown.1 as f32);
         let per_frame = std::f32::consts::TAU * sigma * sigma * density;
         UpscaleParams {
             out_size: [shown.0, shown.1],
             sigma,
-            moving_weight: s.upscale_moving_frames.clamp(1.0, 1024.0) * per_frame,
+            moving_weight: moving_frames * per_frame,
             fill_weight: 0.25 * per_frame,
             continues: continues as u32,
             raw_continues: raw.is_some_and(|c| c.continues != 0) as u32,
             bias_sigmas: raw.map_or(0.0, |c| c.bias_sigmas),
             min_samples: raw.map_or(2.0, |c| c.min_samples),
-            _pad: [0; 3],
+            moving_frames,
+            _pad: [0; 2],
         }
     }
 }
 
 struct UpscaleTargets {
     size: (u32, u32),
+    /// The raster's G-buffer at the shown size: the materials the light is modulated by.
+    gbuffer: GBufferTargets,
+    /// The shown raster's demodulation albedo averaged over its jitter (rgb) and its count (a),
+    /// and its emission's average.
+    albedo: PingPong<Tex>,
+    emission: PingPong<Tex>,
     /// Kernel-weighted mean of the samples (rgb) and their weight (a).
     history: PingPong<Tex>,
     /// The same of the raw samples, and their mean squared length (r) and sum of squared
@@ -80,6 +94,9 @@ struct UpscaleTargets {
 
 pub struct UpscaleStage {
     params: wgpu::Buffer,
+    /// The frame's uniform at the shown size, for its raster.
+    frame: wgpu::Buffer,
+    raster: Option<GBufferPass>,
     /// What its shown-size targets cost (apart from the render-size targets: they outlive them).
     pub memory: GpuMemory,
     targets: Option<UpscaleTargets>,
@@ -96,15 +113,26 @@ impl UpscaleStage {
         let u = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let bytes = size_of::<UpscaleParams>() as u64;
         let params = memory.buffer(&gpu.device, "upscale/params", bytes, u);
+        let bytes = size_of::<FrameParams>() as u64;
+        let frame = memory.buffer(&gpu.device, "upscale/frame", bytes, u);
         let memory = GpuMemory::default();
-        UpscaleStage { params, memory, targets: None, programs: None, motion, ran: false }
+        let (targets, programs, raster) = (None, None, None);
+        UpscaleStage { params, frame, raster, memory, targets, programs, motion, ran: false }
+    }
+
+    /// Write the frame's uniform at the shown size (its raster's camera and jitter).
+    pub fn write_frame(&self, gpu: &Gpu, frame: &FrameParams) {
+        gpu.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(frame));
     }
 
     pub fn pipelines(&mut self) -> impl Iterator<Item = &mut dyn crate::shader::Reload> {
+        let raster =
+            self.raster.iter_mut().map(|r| &mut r.pipeline as &mut dyn crate::shader::Reload);
         self.programs
             .iter_mut()
             .flatten()
             .map(|s| &mut s.pipeline as &mut dyn crate::shader::Reload)
+            .chain(raster)
     }
 
     /// Make the targets for showing at `size` (None: drop them); true if anything changed.
@@ -124,10 +152,13 @@ impl UpscaleStage {
             let history = pair("history", wgpu::TextureFormat::Rgba32Float);
             let raw = pair("raw", wgpu::TextureFormat::Rgba32Float);
             let raw_m2 = pair("raw m2", wgpu::TextureFormat::Rg32Float);
+            let albedo = pair("albedo", wgpu::TextureFormat::Rgba16Float);
+            let emission = pair("emission", wgpu::TextureFormat::Rgba16Float);
+            let gbuffer = GBufferTargets::labelled(gpu, mem, size, PREFIX);
             let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
             let bytes = size.0 as u64 * size.1 as u64 * 16;
             let image = mem.buffer(d, "upscale/image", bytes, usage);
-            UpscaleTargets { size, history, raw, raw_m2, image }
+            UpscaleTargets { size, gbuffer, albedo, emission, history, raw, raw_m2, image }
         });
         true
     }
@@ -142,11 +173,12 @@ impl UpscaleStage {
         self.ran = false;
     }
 
-    /// Record the upscale of `io.hdr` (the composite's image) with `params`.
+    /// Record the raster at the shown size and the upscale of `io.hdr` (the composite's image)
+    /// with `params`.
     pub fn record(
         &mut self,
         rec: &mut Recorder,
-        key: crate::gpu::BindKey,
+        (key, scene): (crate::gpu::BindKey, &GpuScene),
         io: &FrameIo,
         params: &UpscaleParams,
         parity: Parity,
@@ -155,6 +187,14 @@ impl UpscaleStage {
         let gpu = rec.gpu;
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let t = self.targets.as_ref().context("the upscaler records before its targets exist")?;
+        let frame = &self.frame;
+        let raster = super::chain::made(&mut self.raster, || GBufferPass::new(gpu, scene, frame))
+            .context("creating the upscaler's raster")?;
+        {
+            let _pass = crate::profile::scope(RASTER);
+            raster.record(rec, scene, frame, &t.gbuffer)?;
+        }
+        let g = |c| t.gbuffer.view(c);
         let up = &self.params;
         let accumulate = |p: Parity| {
             io.bindings()
@@ -166,6 +206,14 @@ impl UpscaleStage {
                 .texture("out_raw", &t.raw.output(p).1)
                 .texture("raw_m2_history", &t.raw_m2.history(p).1)
                 .texture("out_raw_m2", &t.raw_m2.output(p).1)
+                .texture("albedo_history", &t.albedo.history(p).1)
+                .texture("out_albedo", &t.albedo.output(p).1)
+                .texture("emission_history", &t.emission.history(p).1)
+                .texture("out_emission", &t.emission.output(p).1)
+                .texture("shown_base_color", g(Channel::BaseColor))
+                .texture("shown_specular", g(Channel::Specular))
+                .texture("shown_ids", g(Channel::Ids))
+                .texture("shown_emission", g(Channel::Emission))
         };
         let shown = |p: Parity| {
             io.bindings()
@@ -174,6 +222,8 @@ impl UpscaleStage {
                 .texture("up_mean", &t.history.output(p).1)
                 .texture("raw", &t.raw.output(p).1)
                 .texture("raw_m2", &t.raw_m2.output(p).1)
+                .texture("albedo", &t.albedo.output(p).1)
+                .texture("emission", &t.emission.output(p).1)
                 .buffer("upscaled", &t.image)
         };
         let (motion, glossy) = (self.motion, io.trace.glossy.is_some());

@@ -208,6 +208,7 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
                 raw_continues,
                 bias_sigmas,
                 min_samples,
+                moving_frames,
                 _pad,
             }),
         );
