@@ -1,8 +1,8 @@
 //! The temporal upscaler (hush_engine::passes::upscale, shaders/taa/upscale*.wgsl): a frame
 //! traced at half the size it is shown at converges towards the shown size's image, closer than
 //! the stretch of the same frames; the image comes back at the shown size, finite while the
-//! camera moves; and the frame goes back to TAA at the render size with the upscaler's memory
-//! released.
+//! camera moves; TAA's memory is released while the upscaler runs and the upscaler's once the
+//! frame goes back to TAA at the render size.
 
 use glam::DVec3;
 use hush_engine::accel::BvhKind;
@@ -64,6 +64,11 @@ fn a_still_view_upscaled_is_closer_to_the_shown_size_than_the_stretch() {
         let img = if upscale {
             assert_eq!((img.width, img.height), SHOWN, "the upscaled image is at the shown size");
             assert!(r.upscale_bytes() > 0);
+            // TAA and the still-view mean hold no textures while the upscaler runs instead.
+            let labels: Vec<String> = r.allocations().into_iter().map(|(l, _)| l).collect();
+            for held in ["taa/history 0", "converge/mean 0"] {
+                assert!(!labels.iter().any(|l| l == held), "{held} while upscaling");
+            }
             img
         } else {
             assert_eq!((img.width, img.height), RENDER);

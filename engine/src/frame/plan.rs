@@ -80,9 +80,18 @@ impl Renderer {
             let h = &mut self.history;
             *h = super::FrameHistory { frame_index: h.frame_index, ..Default::default() };
         }
+        let upscaled = self.upscaled_size(settings, denoiser);
         if denoiser.is_some() {
             let t = &mut self.targets;
-            if self.stages.taa.allocate(gpu, &mut t.memory, t.size, t.epoch) {
+            // The upscaler runs in TAA's place and keeps its own still-view mean.
+            let changed = match upscaled {
+                None => self.stages.taa.allocate(gpu, &mut t.memory, t.size, t.epoch),
+                Some(_) => {
+                    let taa = self.stages.taa.release(&mut t.memory, t.epoch);
+                    self.stages.converge.release(&mut t.memory, t.epoch) || taa
+                }
+            };
+            if changed {
                 t.generation += 1;
             }
             // TAA's test of what a move uncovered reads the previous depth.
@@ -101,7 +110,6 @@ impl Renderer {
             // The gather's test of what the last frame saw.
             self.targets.ensure_previous(gpu);
         }
-        let upscaled = self.upscaled_size(settings, denoiser);
         let cam = self.camera_setup(&input.camera);
         let h = &self.history;
         // The raster's position in the pixel: Halton for TAA and the upscaler, uniformly random
@@ -124,7 +132,13 @@ impl Renderer {
                 && h.prev_jittered.is_some(),
             static_view: !moved && h.prev_view_proj == Some(cam.view_proj),
         };
-        let converge = self.converge_plan(gpu, input, settings, (denoiser, samples), &view);
+        let converge = self.converge_plan(
+            gpu,
+            input,
+            settings,
+            (denoiser, samples, upscaled.is_none()),
+            &view,
+        );
         let upscale = self.upscale_plan(gpu, settings, (denoiser, upscaled), converge.as_ref());
         let taa_restarts = upscale.is_none() && self.history.upscaled_last.is_some();
         self.history.upscaled_last = upscaled;
@@ -227,7 +241,8 @@ impl Renderer {
         shown.map(|s| UpscaleParams::new(&settings.taa, (render, s), continues, converge))
     }
 
-    /// The still-view mean's parameters where it runs this frame: a denoiser ran (TAA's image is
+    /// The still-view mean's parameters where it runs this frame (its textures made where
+    /// `allocate`): a denoiser ran (TAA's image is
     /// there to move), the stage is on, and every pixel is one sample (k > 1 mixes samples into
     /// guides the mean cannot remodulate). It continues last frame's mean while the view stands
     /// still with the same camera, settings and size; anything else restarts it, but for the
@@ -237,7 +252,7 @@ impl Renderer {
         gpu: &Gpu,
         input: &FrameInput,
         settings: &FrameSettings,
-        (denoiser, samples): (Option<usize>, u32),
+        (denoiser, samples, allocate): (Option<usize>, u32, bool),
         view: &ChainView,
     ) -> Option<ConvergeParams> {
         let taa = &settings.taa;
@@ -261,7 +276,10 @@ impl Renderer {
         h.converge_state = Some(state);
         let t = &mut self.targets;
         let keep_composite = crate::gpu::graph::is_kept(&self.kept, "composite/hdr");
-        if self.stages.converge.allocate(gpu, &mut t.memory, (t.size, t.epoch), keep_composite) {
+        // Where the upscaler runs it keeps the mean itself and only the parameters are asked for.
+        if allocate
+            && self.stages.converge.allocate(gpu, &mut t.memory, (t.size, t.epoch), keep_composite)
+        {
             t.generation += 1;
         }
         Some(ConvergeParams {

@@ -129,6 +129,17 @@ impl ConvergeStage {
         Some(t.shown.as_ref().unwrap_or(hdr))
     }
 
+    /// Drop the textures (the upscaler keeps its own still-view mean); `memory` forgets them
+    /// where they are the frame targets' of `epoch`. True if there were any.
+    pub fn release(&mut self, memory: &mut GpuMemory, epoch: u64) -> bool {
+        self.ran = false;
+        let Some((e, _)) = self.targets.take() else { return false };
+        if e == epoch {
+            memory.forget("converge/");
+        }
+        true
+    }
+
     /// Note that this frame does not run the stage (TAA's image is shown).
     pub fn skip(&mut self) {
         self.ran = false;

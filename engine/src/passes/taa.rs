@@ -176,6 +176,16 @@ impl TaaStage {
         super::chain::made_for_epoch(&mut self.targets, epoch, make)
     }
 
+    /// Drop the textures (the upscaler runs in TAA's place); `memory` forgets them where they
+    /// are the frame targets' of `epoch`. True if there were any.
+    pub fn release(&mut self, memory: &mut GpuMemory, epoch: u64) -> bool {
+        let Some((e, _)) = self.targets.take() else { return false };
+        if e == epoch {
+            memory.forget("taa/");
+        }
+        true
+    }
+
     /// The image after TAA (once it ran).
     pub fn output(&self) -> Option<&wgpu::Buffer> {
         self.targets.as_ref().map(|(_, t)| &t.final_image)
