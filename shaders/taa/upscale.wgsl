@@ -1,5 +1,6 @@
 // The upscaler's accumulation (taa/upscale_common.wgsl says what it keeps and why).
 
+var up_raw_samples: texture_2d<f32>;
 var up_history: texture_2d<f32>;
 var out_up_history: texture_storage_2d<rgba32float, write>;
 // The raw samples' kernel-weighted mean (rgb) and weight (a); their weighted mean squared
@@ -72,15 +73,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if !in_bounds(i) {
             continue;
         }
-        let c = light_at(i);
+        let sample = textureLoad(up_samples, i, 0);
+        let c = sample.rgb;
         let d = sample_offset(o, i);
         let w = exp(-dot(d, d) * inv_2s2);
         sum_w += w;
         sum_c += w * c;
         // The kernel cut at 1% of its peak (3 sigma): remodulating a sample costs more than all
         // the rest of its use here.
-        if raw_on && w >= 0.01 && traced_this_frame(vec2u(i)) {
-            let x = half_safe(remodulated(vec2u(i)));
+        let raw_sample = select(vec4f(0.0), textureLoad(up_raw_samples, i, 0), raw_on && w >= 0.01);
+        if raw_sample.a > 0.0 {
+            let x = raw_sample.rgb;
             raw_w += w;
             raw_w2 += w * w;
             raw_c += w * x;
@@ -89,7 +92,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let y = to_ycocg(c);
         lo = min(lo, y);
         hi = max(hi, y);
-        let z = select(depth_at(i), -1.0, static_view);
+        let z = select(sample.a, -1.0, static_view);
         if z >= 0.0 && z < nearest_z {
             nearest = i;
             nearest_z = z;
@@ -128,9 +131,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         hist = vec4f(from_ycocg(clamp(to_ycocg(hist.rgb), lo, hi)), min(hist.a, up.moving_weight));
     }
     let weight = hist.a + sum_w;
-    var mean = spatial_estimate(o);
+    var mean: vec3f;
     if weight > 1e-20 {
         mean = (hist.rgb * hist.a + sum_c) / weight;
+    } else {
+        mean = spatial_estimate(o);
     }
     textureStore(out_up_history, vec2i(o), vec4f(mean, weight));
     // The materials' mean over the shown raster's jitter: a plain mean in a still view, at

@@ -29,6 +29,9 @@
 // the nine samples filtered with a Gaussian of half a render pixel: where the history has no
 // weight (a first frame, a surface just uncovered) that spatial estimate is the image, and it
 // fades as samples arrive.
+//
+// taa/upscale_samples.wgsl first writes each render pixel's demodulated light and raw sample
+// once (a shown pixel reads nine of them: sixteen shown pixels a render pixel at scale 0.25).
 
 struct UpscaleParams {
     // The size shown (the history's and the output's); frame.size is the render size.
@@ -53,7 +56,6 @@ struct UpscaleParams {
 }
 
 var<uniform> up: UpscaleParams;
-var<storage, read> hdr: array<vec4f>;
 
 // What the light is divided by at the render size and multiplied by at the shown size, so that
 // the materials' detail comes from the shown size's raster: the diffuse albedo plus the
@@ -64,48 +66,4 @@ fn demodulation(hit: bool, base: vec4f, f0: vec3f) -> vec3f {
         return vec3f(1.0);
     }
     return max(base.rgb * (1.0 - base.a) + f0, vec3f(0.02));
-}
-
-// The composite's sample of render pixel i less its emission, divided by its material's
-// demodulation.
-fn light_at(i: vec2i) -> vec3f {
-    let c = half_safe(hdr[u32(i.y) * frame.size.x + u32(i.x)].rgb);
-    let hit = textureLoad(gb_object, i, 0).y != NO_SURFACE;
-    let a = demodulation(hit, textureLoad(gb_base_color, i, 0), textureLoad(gb_specular, i, 0).rgb);
-    return (c - textureLoad(gb_emission, i, 0).rgb) / a;
-}
-
-// Render pixels per shown pixel (at most 1 on each axis).
-fn to_render() -> vec2f {
-    return vec2f(frame.size) / vec2f(up.out_size);
-}
-
-// The render pixel whose sample lies nearest shown pixel o's centre; the nine around it hold
-// every sample within a render pixel of it.
-fn centre_sample(o: vec2u) -> vec2i {
-    return vec2i(floor((vec2f(o) + 0.5) * to_render() - frame.jitter + 0.5));
-}
-
-// Offset, in shown pixels, from o's centre to the sample of render pixel i.
-fn sample_offset(o: vec2u, i: vec2i) -> vec2f {
-    return (vec2f(i) + frame.jitter) / to_render() - (vec2f(o) + 0.5);
-}
-
-// The nine samples' light around o filtered with a Gaussian of half a render pixel: the image where
-// the history has no weight yet.
-fn spatial_estimate(o: vec2u) -> vec3f {
-    let centre = centre_sample(o);
-    var sum_w = 0.0;
-    var sum_c = vec3f(0.0);
-    for (var k = 0; k < 9; k++) {
-        let i = centre + neighbour_3x3(k);
-        if !in_bounds(i) {
-            continue;
-        }
-        let dr = sample_offset(o, i) * to_render();
-        let w = exp(-2.0 * dot(dr, dr));
-        sum_w += w;
-        sum_c += w * light_at(i);
-    }
-    return sum_c / max(sum_w, 1e-20);
 }

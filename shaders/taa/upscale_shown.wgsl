@@ -18,7 +18,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let p = vec2i(o);
     let m = textureLoad(up_mean, p, 0);
-    let light = (m.rgb * m.a + up.fill_weight * spatial_estimate(o)) / (m.a + up.fill_weight);
+    // The spatial estimate only where it still shows (by 1 / 1000 or more).
+    var light = m.rgb;
+    if up.fill_weight > 1e-3 * m.a {
+        light = (m.rgb * m.a + up.fill_weight * spatial_estimate(o)) / (m.a + up.fill_weight);
+    }
     var result = light * textureLoad(albedo, p, 0).rgb + textureLoad(emission, p, 0).rgb;
     let own = textureLoad(raw, p, 0);
     let own_m2 = textureLoad(raw_m2, p, 0);

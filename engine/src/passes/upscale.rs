@@ -23,6 +23,9 @@ use bytemuck::{Pod, Zeroable};
 pub const LABEL: &str = "upscale";
 /// Its second pass: the image shown.
 pub const SHOWN: &str = "upscale/shown";
+/// Its first pass, at the render size, and what it writes.
+pub const SAMPLES: &str = "upscale/samples";
+const RAW_SAMPLES: &str = "upscale/raw samples";
 /// The raster at the shown size before them.
 pub const RASTER: &str = "upscale/gbuffer";
 /// Labels of what it allocates start with this.
@@ -102,7 +105,9 @@ pub struct UpscaleStage {
     targets: Option<UpscaleTargets>,
     /// The accumulation and the image shown, made on first use (they depend on whether the
     /// scene has glossy light).
-    programs: Option<[ChainStage; 2]>,
+    programs: Option<[ChainStage; 3]>,
+    /// Each render pixel's demodulated light (and depth) and raw sample, at the render size.
+    samples: Option<((u32, u32), Tex, Tex)>,
     motion: crate::gpu::Motion,
     /// Whether the last frame recorded ran it (its image is then the one shown).
     ran: bool,
@@ -117,7 +122,18 @@ impl UpscaleStage {
         let frame = memory.buffer(&gpu.device, "upscale/frame", bytes, u);
         let memory = GpuMemory::default();
         let (targets, programs, raster) = (None, None, None);
-        UpscaleStage { params, frame, raster, memory, targets, programs, motion, ran: false }
+        let samples = None;
+        UpscaleStage {
+            params,
+            frame,
+            raster,
+            memory,
+            targets,
+            programs,
+            samples,
+            motion,
+            ran: false,
+        }
     }
 
     /// Write the frame's uniform at the shown size (its raster's camera and jitter).
@@ -141,6 +157,7 @@ impl UpscaleStage {
             return false;
         }
         self.memory.forget(PREFIX);
+        self.samples = None;
         self.targets = size.map(|size| {
             let (d, mem) = (&gpu.device, &mut self.memory);
             let rw = wgpu::TextureUsages::STORAGE_BINDING
@@ -194,12 +211,30 @@ impl UpscaleStage {
             let _pass = crate::profile::scope(RASTER);
             raster.record(rec, scene, frame, &t.gbuffer)?;
         }
+        if self.samples.as_ref().is_none_or(|s| s.0 != io.size) {
+            for l in [SAMPLES, RAW_SAMPLES] {
+                self.memory.forget(l);
+            }
+            let rw = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING;
+            let f = wgpu::TextureFormat::Rgba32Float;
+            let mut make = |l| self.memory.texture(&gpu.device, l, io.size, f, rw);
+            self.samples = Some((io.size, make(SAMPLES), make(RAW_SAMPLES)));
+        }
+        let (_, samples, raw_samples) = self.samples.as_ref().context("no samples")?;
         let g = |c| t.gbuffer.view(c);
         let up = &self.params;
-        let accumulate = |p: Parity| {
+        let write_samples = |_: Parity| {
             io.bindings()
                 .buffer("up", up)
                 .buffer("hdr", io.hdr)
+                .texture("out_samples", &samples.1)
+                .texture("out_raw_samples", &raw_samples.1)
+        };
+        let accumulate = |p: Parity| {
+            io.bindings()
+                .buffer("up", up)
+                .texture("up_samples", &samples.1)
+                .texture("up_raw_samples", &raw_samples.1)
                 .texture("up_history", &t.history.history(p).1)
                 .texture("out_up_history", &t.history.output(p).1)
                 .texture("raw_history", &t.raw.history(p).1)
@@ -218,7 +253,7 @@ impl UpscaleStage {
         let shown = |p: Parity| {
             io.bindings()
                 .buffer("up", up)
-                .buffer("hdr", io.hdr)
+                .texture("up_samples", &samples.1)
                 .texture("up_mean", &t.history.output(p).1)
                 .texture("raw", &t.raw.output(p).1)
                 .texture("raw_m2", &t.raw_m2.output(p).1)
@@ -227,13 +262,15 @@ impl UpscaleStage {
                 .buffer("upscaled", &t.image)
         };
         let (motion, glossy) = (self.motion, io.trace.glossy.is_some());
-        let [a, b] = super::chain::made(&mut self.programs, || {
-            let offered = accumulate(Parity::default());
-            let a = ChainStage::new(gpu, LABEL, &modules(motion, glossy, true), "main", &offered)?;
-            let offered = shown(Parity::default());
-            let b = ChainStage::new(gpu, SHOWN, &modules(motion, glossy, false), "main", &offered)?;
-            Ok([a, b])
+        let [s, a, b] = super::chain::made(&mut self.programs, || {
+            let m = |pass| modules(motion, glossy, pass);
+            let p = Parity::default();
+            let s = ChainStage::new(gpu, SAMPLES, &m(Pass::Samples), "main", &write_samples(p))?;
+            let a = ChainStage::new(gpu, LABEL, &m(Pass::Accumulate), "main", &accumulate(p))?;
+            let b = ChainStage::new(gpu, SHOWN, &m(Pass::Shown), "main", &shown(p))?;
+            Ok([s, a, b])
         })?;
+        s.record(rec, key, parity, io.size, write_samples)?;
         a.record(rec, key, parity, t.size, accumulate)?;
         b.record(rec, key, parity, t.size, shown)?;
         self.ran = true;
@@ -241,19 +278,34 @@ impl UpscaleStage {
     }
 }
 
-/// The modules of the accumulation (`accumulate`) or of the image shown, for the scene's kind
-/// of motion, with its glossy light or without.
-pub fn modules(motion: crate::gpu::Motion, glossy: bool, accumulate: bool) -> Vec<&'static str> {
+/// The modules of one of its passes, for the scene's kind of motion, with the scene's glossy
+/// light or without.
+pub fn modules(motion: crate::gpu::Motion, glossy: bool, pass: Pass) -> Vec<&'static str> {
     let mut m = vec!["common/bilinear.wgsl", "realtime/reproject.wgsl", "taa/upscale_common.wgsl"];
-    if accumulate {
-        m.extend([
-            super::composite::REMODULATE,
+    match pass {
+        Pass::Samples => m.extend([super::composite::REMODULATE, "taa/upscale_samples.wgsl"]),
+        Pass::Accumulate => m.extend([
+            "taa/upscale_gather.wgsl",
             motion.module(),
             "taa/history_test.wgsl",
             "taa/upscale.wgsl",
-        ]);
-    } else {
-        m.push("taa/upscale_shown.wgsl");
+        ]),
+        Pass::Shown => m.extend(["taa/upscale_gather.wgsl", "taa/upscale_shown.wgsl"]),
     }
     super::composite::modules(glossy, &m)
+}
+
+/// The upscaler's three passes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// Each render pixel's demodulated light and raw sample, once.
+    Samples,
+    /// The shown pixels' means.
+    Accumulate,
+    /// The image shown.
+    Shown,
+}
+
+impl Pass {
+    pub const ALL: [Pass; 3] = [Pass::Samples, Pass::Accumulate, Pass::Shown];
 }

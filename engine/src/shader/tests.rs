@@ -116,8 +116,8 @@ pub(super) fn all_programs() -> Vec<Program> {
     }
     for motion in MOTIONS {
         for glossy in [false, true] {
-            for accumulate in [true, false] {
-                let m = crate::passes::upscale::modules(motion, glossy, accumulate);
+            for pass in crate::passes::upscale::Pass::ALL {
+                let m = crate::passes::upscale::modules(motion, glossy, pass);
                 v.push(compose(m[m.len() - 1], "", &m).unwrap());
             }
         }

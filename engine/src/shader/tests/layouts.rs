@@ -194,7 +194,7 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
         }),
     );
     use crate::passes::upscale::UpscaleParams;
-    for label in ["taa/upscale.wgsl", "taa/upscale_shown.wgsl"] {
+    for label in ["taa/upscale_samples.wgsl", "taa/upscale.wgsl", "taa/upscale_shown.wgsl"] {
         same(
             &v,
             label,
