@@ -93,6 +93,12 @@ fn panel_for(gpu: &Gpu, r: &Renderer, message: String) -> ui::Panel {
         settings: hush_engine::settings::FrameSettings {
             max_depth: r.scene.max_depth.max(2),
             denoiser: default_denoiser(gpu),
+            // A software rasterizer draws the upscaler's raster at the window's size as slowly
+            // as sixteen of the frame's at scale 0.25.
+            taa: hush_engine::settings::TaaSettings {
+                upscale_materials: gpu.info.device_type != wgpu::DeviceType::Cpu,
+                ..Default::default()
+            },
             ..Default::default()
         },
         resolution_scale: 1.0,

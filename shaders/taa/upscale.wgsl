@@ -22,6 +22,9 @@ var shown_ids: texture_2d<u32>;
 var shown_emission: texture_2d<f32>;
 
 fn shown_albedo(o: vec2i) -> vec3f {
+    if up.materials == 0u {
+        return vec3f(1.0);
+    }
     let hit = textureLoad(shown_ids, o, 0).y != NO_SURFACE;
     return demodulation(hit, textureLoad(shown_base_color, o, 0), textureLoad(shown_specular, o, 0).rgb);
 }
@@ -146,7 +149,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let a_now = shown_albedo(vec2i(o));
     textureStore(out_albedo, vec2i(o), vec4f(albedo.rgb + (a_now - albedo.rgb) / (n + 1.0), n + 1.0));
-    let e_now = half_safe(textureLoad(shown_emission, vec2i(o), 0).rgb);
+    var e_now = vec3f(0.0);
+    if up.materials != 0u {
+        e_now = half_safe(textureLoad(shown_emission, vec2i(o), 0).rgb);
+    }
     textureStore(out_emission, vec2i(o), vec4f(emission + (e_now - emission) / (n + 1.0), 0.0));
 
     // The raw mean continues only while the view stands still (its own texel, unclamped).

@@ -51,8 +51,9 @@ struct UpscaleParams {
     min_samples: f32,
     // TaaSettings::upscale_moving_frames: the materials' mean's length while anything moves.
     moving_frames: f32,
+    // 1: the materials come from the shown size's raster (TaaSettings::upscale_materials).
+    materials: u32,
     pad0: u32,
-    pad1: u32,
 }
 
 var<uniform> up: UpscaleParams;

@@ -11,6 +11,9 @@ var out_raw_samples: texture_storage_2d<rgba32float, write>;
 // demodulation.
 fn light_at(i: vec2i) -> vec3f {
     let c = half_safe(hdr[u32(i.y) * frame.size.x + u32(i.x)].rgb);
+    if up.materials == 0u {
+        return c;
+    }
     let hit = textureLoad(gb_object, i, 0).y != NO_SURFACE;
     let a = demodulation(hit, textureLoad(gb_base_color, i, 0), textureLoad(gb_specular, i, 0).rgb);
     return (c - textureLoad(gb_emission, i, 0).rgb) / a;

@@ -44,7 +44,8 @@ pub struct UpscaleParams {
     pub bias_sigmas: f32,
     pub min_samples: f32,
     pub moving_frames: f32,
-    pub _pad: [u32; 2],
+    pub materials: u32,
+    pub _pad: u32,
 }
 
 impl UpscaleParams {
@@ -72,7 +73,8 @@ impl UpscaleParams {
             bias_sigmas: raw.map_or(0.0, |c| c.bias_sigmas),
             min_samples: raw.map_or(2.0, |c| c.min_samples),
             moving_frames,
-            _pad: [0; 2],
+            materials: s.upscale_materials as u32,
+            _pad: 0,
         }
     }
 }
@@ -207,7 +209,7 @@ impl UpscaleStage {
         let frame = &self.frame;
         let raster = super::chain::made(&mut self.raster, || GBufferPass::new(gpu, scene, frame))
             .context("creating the upscaler's raster")?;
-        {
+        if params.materials != 0 {
             let _pass = crate::profile::scope(RASTER);
             raster.record(rec, scene, frame, &t.gbuffer)?;
         }

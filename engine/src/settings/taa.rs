@@ -73,6 +73,13 @@ described! {
         /// stretched. 48 bytes per shown pixel while it runs.
         upscale: bool = true,
             ("taa.upscale", "taa", "", Bool);
+        /// The upscaler takes the materials (albedo and emission) from a raster at the shown
+        /// size, so that textures keep its detail at any scale (level SVGF frame 60 at scale
+        /// 0.25, FLIP 0.1400 against 0.1777 without). The raster costs its pixels: on a GPU
+        /// little, on a software rasterizer as much as sixteen render-size rasters at scale 0.25
+        /// (the viewer turns it off there).
+        upscale_materials: bool = true,
+            ("taa.upscale_materials", "taa", "", Bool);
         /// The upscaler's kernel: a Gaussian of this standard deviation in shown pixels, default
         /// 0.4. Narrower is sharper and needs more frames to fill every pixel: SVGF's frame 60
         /// at scale 0.5 (160x90 level, 160x160 cornell_mirror) FLIP 0.1036 / 0.1015 at 0.3,

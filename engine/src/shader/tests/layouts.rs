@@ -209,6 +209,7 @@ fn every_uniform_matches_its_wgsl_mirror_member_by_member() {
                 bias_sigmas,
                 min_samples,
                 moving_frames,
+                materials,
                 _pad,
             }),
         );
