@@ -255,10 +255,10 @@ fn the_default_level_renders_without_nan() {
         // Emission may be off screen, and SVGF's spike cut waits for 4 frames' samples, its
         // spread for the regression's 16 (tests/svgf_spikes.rs reads both); every other view
         // shows something from the level's camera (the radiance cache's after a jump:
-        // tests/radiance_cache.rs).
+        // tests/radiance_cache.rs; the upscaler's where it runs: tests/upscale.rs).
         let own = hush_engine::settings::FRAME_VIEWS
             .iter()
-            .filter(|v| !v.needs_traced_primaries() && !v.needs_cache())
+            .filter(|v| !v.needs_traced_primaries() && !v.needs_cache() && !v.needs_upscaler())
             .chain(entry.info.views);
         let views: Vec<View> =
             std::iter::once(View::FINAL).chain(own.map(|v| View::named(v.name))).collect();

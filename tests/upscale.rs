@@ -2,7 +2,8 @@
 //! traced at half the size it is shown at converges towards the shown size's image, closer than
 //! the stretch of the same frames; the image comes back at the shown size, finite while the
 //! camera moves; TAA's memory is released while the upscaler runs and the upscaler's once the
-//! frame goes back to TAA at the render size.
+//! frame goes back to TAA at the render size; its views show its inputs and its history's
+//! length.
 
 use glam::DVec3;
 use hush_engine::accel::BvhKind;
@@ -10,7 +11,7 @@ use hush_engine::frame::{FrameInput, Renderer};
 use hush_engine::gpu::Gpu;
 use hush_engine::quality::{Image, flip_ldr};
 use hush_engine::scene::Camera;
-use hush_engine::settings::{Denoiser, FrameSettings, TaaSettings};
+use hush_engine::settings::{Denoiser, FrameSettings, TaaSettings, View};
 
 const SHOWN: (u32, u32) = (96, 54);
 const RENDER: (u32, u32) = (48, 27);
@@ -125,4 +126,64 @@ fn a_moving_view_follows_and_the_frame_returns_to_taa() {
     let f = flip_ldr(&back, &truth);
     eprintln!("back at the shown size: FLIP against the frame that never upscaled {f:.4}");
     assert!(f < 0.15, "{f}");
+}
+
+/// Mean of the display's grey (the red channel, decoded from sRGB) over the image.
+fn mean_grey(img: &image::RgbaImage) -> f64 {
+    let decode = |v: u8| {
+        let c = v as f64 / 255.0;
+        if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    };
+    img.pixels().map(|p| decode(p.0[0])).sum::<f64>() / (img.width() * img.height()) as f64
+}
+
+/// The upscaler's views show its inputs and history at the shown size, and the history's
+/// length in frames: one frame's samples are 1/32 of white, sixteen still frames' half (the
+/// view reads one of the two parities: 15 or 16 frames), and while the camera moves the mean
+/// stays under the cap, `upscale_moving_frames` (10), plus the frame's own: 11/32 (0.34).
+/// Every view is
+/// black where the upscaler does not run.
+#[test]
+fn the_upscalers_views_show_its_inputs_and_history_length() {
+    let scene = hush_engine::scene::default_level();
+    let s = FrameSettings { denoiser: Denoiser::SVGF, ..Default::default() };
+    let (gpu, mut r) = Renderer::headless(scene, BvhKind::DEFAULT, RENDER).unwrap();
+    r.show_at(Some(SHOWN)).unwrap();
+    let view = |r: &mut Renderer, name: &str| {
+        let v = FrameSettings { view: View::named(name), ..s.clone() };
+        r.display_image(&gpu, &v).unwrap()
+    };
+    r.render(&gpu, &input(0.0), &s, None).unwrap();
+    let one = mean_grey(&view(&mut r, "upscale/history frames"));
+    for _ in 1..16 {
+        r.render(&gpu, &input(0.0), &s, None).unwrap();
+    }
+    let sixteen = mean_grey(&view(&mut r, "upscale/history frames"));
+    eprintln!("history frames / 32: after 1 frame {one:.3}, after 16 {sixteen:.3}");
+    assert!(one < 0.1, "{one}");
+    assert!((0.38..0.62).contains(&sixteen), "{sixteen}");
+    let names: Vec<&str> = hush_engine::settings::FRAME_VIEWS
+        .iter()
+        .filter(|v| v.needs_upscaler())
+        .map(|v| v.name)
+        .collect();
+    assert!(names.len() >= 6, "{names:?}");
+    for name in &names {
+        let img = view(&mut r, name);
+        assert_eq!(img.dimensions(), SHOWN, "{name} at the shown size");
+        assert!(img.pixels().any(|p| p.0[..3] != [0, 0, 0]), "{name} is black while upscaling");
+    }
+    for k in 1..8 {
+        r.render(&gpu, &input(0.05 * k as f64), &s, None).unwrap();
+    }
+    let moving = mean_grey(&view(&mut r, "upscale/history frames"));
+    eprintln!("history frames / 32 while moving: {moving:.3}");
+    assert!(moving < 0.36, "{moving}");
+
+    r.resize(&gpu, SHOWN).unwrap();
+    r.render(&gpu, &input(0.4), &s, None).unwrap();
+    for name in &names {
+        let img = view(&mut r, name);
+        assert!(img.pixels().all(|p| p.0[..3] == [0, 0, 0]), "{name} shows without the upscaler");
+    }
 }

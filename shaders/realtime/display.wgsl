@@ -124,7 +124,14 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         }
         c = aces(max(l * frame.exposure, vec3f(0.0)));
     } else {
-        let d = debug_view(vec2i(px));
+        // The view's texel: its texture's own size (the render size's, or the upscaler's shown
+        // size; the unused binding is one texel). Depth is read from the G-buffer's binding.
+        var dims = max(textureDimensions(view_float), textureDimensions(view_uint));
+        if display.map == 6u {
+            dims = frame.size;
+        }
+        let v = min(vec2u(pos.xy * vec2f(dims) / vec2f(max(display.target_size, vec2u(1u)))), dims - 1u);
+        let d = debug_view(vec2i(v));
         c = select(clamp(d.rgb, vec3f(0.0), vec3f(1.0)), aces(max(d.rgb * frame.exposure, vec3f(0.0))), d.a > 0.5);
     }
     if display.encode_srgb != 0u {

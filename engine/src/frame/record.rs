@@ -18,6 +18,7 @@ use crate::passes::supersample::Supersample;
 use crate::passes::taa::TaaParams;
 use crate::passes::taa::TaaStage;
 use crate::passes::trace::{self, SceneInputs, TraceInputs, TracePass};
+use crate::passes::upscale::UpscaleParams;
 use crate::settings::FrameSettings;
 use anyhow::{Context, Result};
 use glam::{Mat4, Vec2};
@@ -167,7 +168,7 @@ impl Renderer {
             let s = &mut self.stages;
             let after_taa = after_taa(&s.taa, &s.converge, &s.upscale, &t.hdr);
             let fb = u.shown(t, &io, after_taa.filter(|_| denoised.is_some()));
-            let (view, view_key) = t.view_texture(settings);
+            let (view, view_key) = t.view_texture(settings, &s.upscale.memory);
             let key = BindKey { view: view_key, ..bind_key };
             if let Some(d) = s.display.as_mut() {
                 d.record(&mut Recorder::new(gpu, &mut enc, None), key, &fb, view, target.view)?;
@@ -199,10 +200,12 @@ impl Renderer {
                     .with_context(|| format!("no view {:?}", settings.view.name()))?,
             ),
         };
-        let (map, channel, param) = spec.map_or((0, 0, 0.0), |s| s.map.encode(t.size.0));
-        let srgb = !target.format.is_srgb() as u32;
         // The image's size: the upscaler's where it runs this frame (or ran, for a redisplay).
         let image = self.history.upscaled_last.unwrap_or(t.size);
+        let frame_weight = UpscaleParams::frame_weight(&settings.taa, (t.size, image));
+        let (map, channel, param) =
+            spec.map_or((0, 0, 0.0), |s| s.map.encode(t.size.0, frame_weight));
+        let srgb = !target.format.is_srgb() as u32;
         let options: [u32; 8] =
             [srgb, map, target.size.0, target.size.1, channel, param.to_bits(), image.0, image.1];
         gpu.queue.write_buffer(&u.display, 0, bytemuck::cast_slice(&options));
@@ -455,7 +458,7 @@ impl Stages {
         let _pass = crate::profile::scope(composite::DISPLAY);
         let after_taa = after_taa(&self.taa, &self.converge, &self.upscale, &t.hdr);
         let shown = u.shown(t, io, after_taa.filter(|_| plan.denoiser.is_some()));
-        let (view, view_key) = t.view_texture(plan.settings);
+        let (view, view_key) = t.view_texture(plan.settings, &self.upscale.memory);
         d.record(rec, BindKey { view: view_key, ..plan.output_key }, &shown, view, target.view)
     }
 }

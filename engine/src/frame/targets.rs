@@ -142,15 +142,21 @@ impl Targets {
         }
     }
 
-    /// The texture `settings.view` shows, if this frame has it (a denoiser's view is black
-    /// until the denoiser has run), and its index in the view list + 1 (0: none), which the
-    /// display's bind groups are keyed on.
-    pub fn view_texture(&self, settings: &FrameSettings) -> (Option<&wgpu::Texture>, usize) {
+    /// The texture `settings.view` shows, among this frame's and `upscaler`'s (the upscaler's
+    /// shown-size targets), if it has it (a denoiser's view is black until the denoiser has
+    /// run), and its index in the view list + 1 (0: none), which the display's bind groups are
+    /// keyed on.
+    pub fn view_texture<'a>(
+        &'a self,
+        settings: &FrameSettings,
+        upscaler: &'a GpuMemory,
+    ) -> (Option<&'a wgpu::Texture>, usize) {
         let views = crate::settings::all_views();
         let Some(i) = views.iter().position(|v| v.name == settings.view.name()) else {
             return (None, 0);
         };
-        match self.memory.find_texture(views[i].texture) {
+        let label = views[i].texture;
+        match self.memory.find_texture(label).or_else(|| upscaler.find_texture(label)) {
             Some(tex) => (Some(tex), i + 1),
             None => (None, 0),
         }

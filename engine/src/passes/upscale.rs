@@ -61,8 +61,7 @@ impl UpscaleParams {
     ) -> Self {
         let sigma = s.upscale_sigma.clamp(0.2, 2.0);
         let moving_frames = s.upscale_moving_frames.clamp(1.0, 1024.0);
-        let density = (render.0 as f32 / shown.0 as f32) * (render.1 as f32 / shown.1 as f32);
-        let per_frame = std::f32::consts::TAU * sigma * sigma * density;
+        let per_frame = Self::frame_weight(s, (render, shown));
         UpscaleParams {
             out_size: [shown.0, shown.1],
             sigma,
@@ -76,6 +75,16 @@ impl UpscaleParams {
             materials: s.upscale_materials as u32,
             _pad: 0,
         }
+    }
+
+    /// The kernel weight one frame's samples bring a shown pixel on average, rendering at
+    /// `render` to show at `shown`: 2 pi sigma^2 times the samples per shown pixel. The
+    /// history's weight over it is its length in frames (the `upscale/history frames` view).
+    pub fn frame_weight(s: &TaaSettings, (render, shown): ((u32, u32), (u32, u32))) -> f32 {
+        let sigma = s.upscale_sigma.clamp(0.2, 2.0);
+        let density =
+            (render.0 as f32 / shown.0.max(1) as f32) * (render.1 as f32 / shown.1.max(1) as f32);
+        std::f32::consts::TAU * sigma * sigma * density
     }
 }
 

@@ -13,6 +13,10 @@ pub enum ViewMap {
     Grey { channel: u32, divisor: f32 },
     /// One channel over this fraction of the frame's width (at least 1), as grey.
     GreyPerWidth { channel: u32, fraction: f32 },
+    /// One channel as frames' worth of samples, white at `frames`: the upscaler's history
+    /// weight over the kernel weight one frame brings a shown pixel (`UpscaleParams::frame_weight`,
+    /// which depends on the scale).
+    UpscaleFrames { channel: u32, frames: f32 },
     /// Two channels from `channel` as pixels of motion: hue = direction, brightness = length
     /// (1 px = 0.25).
     Motion { channel: u32 },
@@ -34,14 +38,19 @@ pub enum ViewMap {
 }
 
 impl ViewMap {
-    /// (map, channel, parameter) as the display's uniform carries them.
-    pub fn encode(self, width: u32) -> (u32, u32, f32) {
+    /// (map, channel, parameter) as the display's uniform carries them, for a frame `width`
+    /// render pixels wide whose upscaler (if it runs) brings a shown pixel `frame_weight` of
+    /// kernel weight a frame.
+    pub fn encode(self, width: u32, frame_weight: f32) -> (u32, u32, f32) {
         match self {
             ViewMap::Light => (1, 0, 0.0),
             ViewMap::Color => (2, 0, 0.0),
             ViewMap::Grey { channel, divisor } => (3, channel, divisor),
             ViewMap::GreyPerWidth { channel, fraction } => {
                 (3, channel, (width as f32 * fraction).max(1.0))
+            }
+            ViewMap::UpscaleFrames { channel, frames } => {
+                (3, channel, (frame_weight * frames).max(1e-6))
             }
             ViewMap::Motion { channel } => (4, channel, 0.0),
             ViewMap::Normal => (5, 0, 0.0),
@@ -74,6 +83,12 @@ impl ViewSpec {
     /// move uncovered pixels it holds light for.
     pub fn needs_cache(&self) -> bool {
         self.texture.starts_with("cache/")
+    }
+
+    /// Views of the temporal upscaler's textures (`upscale/...`): black unless it runs (the
+    /// frame shown above the size it is traced at, with a denoiser).
+    pub fn needs_upscaler(&self) -> bool {
+        self.texture.starts_with(crate::passes::upscale::PREFIX)
     }
 
     /// Views of buffers that exist only in scenes with a specular lobe: the glossy chain's
@@ -122,4 +137,18 @@ pub const FRAME_VIEWS: &[ViewSpec] = &[
     // frames' worth of samples it stands for (white: 4, the default `cache.prior_frames`).
     v("cache/prior", "cache/prior", ViewMap::Light),
     v("cache/prior frames", "cache/prior", ViewMap::Grey { channel: 3, divisor: 4.0 }),
+    // The temporal upscaler's, where it runs (passes/upscale.rs). Its inputs: each render
+    // pixel's light divided by its material, and the shown size's raster's materials averaged
+    // over its jitter. Its history: the kernel-weighted mean of the samples, and its weight in
+    // frames' worth of samples (white: 32; while anything moves it is capped at
+    // `taa.upscale_moving_frames`, 10 by default); the still view's mean of the raw samples.
+    v("upscale/samples", "upscale/samples", ViewMap::Light),
+    v("upscale/materials", "upscale/albedo 0", ViewMap::Color),
+    v("upscale/shown base_color", "upscale/gbuffer/base_color", ViewMap::Color),
+    v("upscale/history", "upscale/history 0", ViewMap::Light),
+    v("upscale/history frames", "upscale/history 0", UPSCALE_FRAMES),
+    v("upscale/still-view mean", "upscale/raw 0", ViewMap::Light),
+    v("upscale/still-view frames", "upscale/raw 0", UPSCALE_FRAMES),
 ];
+
+const UPSCALE_FRAMES: ViewMap = ViewMap::UpscaleFrames { channel: 3, frames: 32.0 };
